@@ -1,0 +1,126 @@
+#pragma once
+/// The validated design model (DESIGN.md "Design file"): stations, their target ellipse and
+/// their lower/upper five-bar mechanisms. Lengths in mm, angles in radians inside the library.
+/// A Design is built once by load_design() (or by hand followed by validate()) and then only read.
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fivebar/error.hpp"
+
+namespace fivebar {
+
+using Vec2 = Eigen::Vector2d;
+
+/// A validation failure: `key` is the path of the offending value relative to the structure that
+/// validated it (e.g. "links[2]"); the loader prefixes the file, line and full key path.
+class ValidationError : public InputError {
+ public:
+  ValidationError(std::string key, const std::string& message)
+      : InputError(key + ": " + message), key_(std::move(key)), rule_(message) {}
+  const std::string& key() const noexcept { return key_; }
+  const std::string& rule() const noexcept { return rule_; }
+
+ private:
+  std::string key_;
+  std::string rule_;
+};
+
+/// Working mode (IK branch): for each leg i the sign of cross(A_i - O_i, P - A_i), +1 or -1.
+/// Both elbows outward is "-+" for a lower mechanism and "+-" for an upper one.
+struct WorkingMode {
+  std::int8_t sign1 = -1;
+  std::int8_t sign2 = +1;
+  friend bool operator==(const WorkingMode&, const WorkingMode&) = default;
+};
+
+/// Parses "+-" style strings; std::nullopt when malformed.
+std::optional<WorkingMode> parse_working_mode(std::string_view text);
+std::string to_string(WorkingMode mode);
+/// The four working modes in the fixed order "++", "+-", "-+", "--".
+std::array<WorkingMode, 4> all_working_modes();
+
+/// Assembly mode (FK branch): sign of cross(A2 - A1, P - A1); Any = not restricted.
+enum class AssemblyMode : std::int8_t { Minus = -1, Any = 0, Plus = 1 };
+std::optional<AssemblyMode> parse_assembly_mode(std::string_view text);
+std::string to_string(AssemblyMode mode);
+
+/// Counter-clockwise arc of admissible motor angles from lo to hi (radians).
+struct JointRange {
+  double lo = 0.0;
+  double hi = 0.0;
+  /// Width of the arc in (0, 2*pi].
+  double span() const;
+  /// True when angle (any representative) lies on the arc, within tol radians.
+  bool contains(double angle, double tol = 0.0) const;
+};
+
+/// One five-bar linkage. O1, O2 base joints; L = {L1, L2, L3, L4} (mm); A_i = O_i + L_i e(theta_i);
+/// distal links L3 (from A1) and L4 (from A2) meet at the tactor P.
+struct Mechanism {
+  std::string name;  ///< "lower" or "upper"
+  Vec2 O1{0.0, 0.0};
+  Vec2 O2{0.0, 0.0};
+  std::array<double, 4> L{0.0, 0.0, 0.0, 0.0};
+  WorkingMode working_mode{};
+  AssemblyMode assembly_mode = AssemblyMode::Any;
+  std::optional<std::array<JointRange, 2>> joint_limits;  ///< radians
+  double min_lci = 0.0;                                    ///< usability threshold in [0, 1]
+
+  /// Largest length of the linkage (links and base distance), mm: the scale of every tolerance.
+  double length_scale() const;
+  /// Throws ValidationError naming the key ("links[2]", "bases[1]", ...) on a broken rule.
+  void validate() const;
+};
+
+/// Filled target ellipse of the fingertip: centre (mm), full axis lengths (mm), rotation (rad).
+struct Ellipse {
+  Vec2 center{0.0, 0.0};
+  Vec2 axes{0.0, 0.0};  ///< full lengths along its own x and y axes
+  double angle = 0.0;   ///< radians, counter-clockwise from +x
+  void validate() const;
+  /// Point on the boundary at parameter t (radians).
+  Vec2 boundary_point(double t) const;
+};
+
+/// One finger station: a target ellipse and up to two mechanisms sharing it.
+struct Station {
+  std::string name;  ///< "index", "thumb", ...
+  Ellipse target;
+  std::optional<Mechanism> lower;
+  std::optional<Mechanism> upper;
+  void validate() const;
+  /// The mechanisms present, lower first.
+  std::vector<const Mechanism*> mechanisms() const;
+  const Mechanism* mechanism(std::string_view which) const;
+};
+
+/// A whole design (and scene).
+struct Design {
+  std::string name;                   ///< used for outputs/<name>/: a safe file name
+  std::filesystem::path source;       ///< file it was loaded from (may be empty)
+  std::vector<Station> stations;      ///< in file order
+  std::optional<std::vector<std::string>> products;  ///< absent: every product the data allows
+
+  void validate() const;
+  const Station* station(std::string_view name) const;
+};
+
+/// Product names a scene may list, in build order.
+const std::vector<std::string>& known_products();
+
+/// Loads and validates a design file. Throws InputError whose message names the file, line, key,
+/// value and the rule broken ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2] = -3:
+/// must be > 0 mm").
+Design load_design(const std::filesystem::path& path);
+/// Same, from text (for tests and stdin); `origin` names the source in messages.
+Design load_design_from_string(const std::string& text, const std::string& origin);
+
+}  // namespace fivebar

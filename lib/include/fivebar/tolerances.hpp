@@ -1,0 +1,32 @@
+#pragma once
+/// Named numerical tolerances. Every tolerance is relative: multiply by a length scale
+/// (Mechanism::length_scale(), mm) or compare a dimensionless quantity (a sine, a ratio).
+/// No algorithm file holds a bare epsilon.
+
+#include <limits>
+
+namespace fivebar::tol {
+
+/// Machine epsilon of double.
+inline constexpr double kEps = std::numeric_limits<double>::epsilon();
+
+/// h^2 = (r1 - a)(r1 + a) of a circle-circle intersection is computed with an absolute error of
+/// a few eps * r1^2. Below -kReachRel * r1^2 the circles do not meet (unreachable); between that
+/// and 0 they are tangent within rounding and h is clamped to 0.
+inline constexpr double kReachRel = 16.0 * kEps;
+
+/// |sin| of a joint angle (type I: between a proximal and its distal link; type II: between the
+/// two distal links) below which the configuration is reported singular. At |sin| = s the branch
+/// position is known to about eps/s of the length scale, and the branch sign itself is
+/// undecidable once s approaches sqrt(eps) ~ 1.5e-8; 1e-7 leaves a factor ~7 of guard.
+inline constexpr double kSingularSin = 1e-7;
+
+/// Loop closure: an IK branch is accepted when FK of its angles puts each distal link end within
+/// kClosureRel * length_scale of its nominal length. Regular poses close to a few eps; near a
+/// singularity the angles are only known to ~eps/s, so the bound follows the conditioning.
+inline constexpr double kClosureRel = 256.0 * kEps;
+
+/// Two base joints closer than this (relative to the length scale) count as coincident.
+inline constexpr double kCoincidentRel = 4.0 * kEps;
+
+}  // namespace fivebar::tol
