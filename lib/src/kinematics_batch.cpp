@@ -1,0 +1,1 @@
+// Batch kinematics: being written.
