@@ -74,6 +74,7 @@ double lci(const Eigen::Matrix2d& J);
 struct CircleIntersection {
   Status status = Status::unreachable;  ///< ok, unreachable, or singular_type1 for tangency
   Vec2 point{0.0, 0.0};
+  Vec2 offset{0.0, 0.0};  ///< point - c1, computed without the cancellation of that subtraction
   double h = 0.0;  ///< distance of the point from the centre line
   double d = 0.0;  ///< centre distance
 };

@@ -1,0 +1,38 @@
+#pragma once
+// Small helpers shared by the scalar and batch kinematics (private).
+
+#include <algorithm>
+#include <cmath>
+
+#include "fivebar/kinematics.hpp"
+#include "fivebar/tolerances.hpp"
+
+namespace fivebar::detail {
+
+inline double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
+inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+/// Tolerance on h^2 = (r1 - a)(r1 + a): its rounding error is a few eps * r1 * max(r1, |a|).
+inline double reach_tolerance(double r1, double a) {
+  return tol::kReachRel * r1 * std::max(r1, std::fabs(a));
+}
+
+/// 1/cond of [[m00, m01], [m10, m11]] from the Frobenius norm and determinant:
+/// sigma_max^2 = (f + sqrt((f - 2g)(f + 2g)))/2, sigma_min = g / sigma_max, g = |det|.
+inline double lci2(double m00, double m01, double m10, double m11) {
+  const double f = m00 * m00 + m01 * m01 + m10 * m10 + m11 * m11;
+  const double g = std::fabs(m00 * m11 - m01 * m10);
+  const double disc = std::max(0.0, (f - 2.0 * g) * (f + 2.0 * g));
+  const double denom = f + std::sqrt(disc);
+  return denom > 0.0 ? std::min(1.0, 2.0 * g / denom) : 0.0;
+}
+
+/// Worst status first: unreachable > singular_type1 > singular_type2 > ok. Written as selects on
+/// integers (no short-circuit) so that loops calling it stay vectorisable.
+inline Status classify(bool reachable, double type1_sin_min, double type2_sin) {
+  const int t2 = type2_sin < tol::kSingularSin ? int(Status::singular_type2) : int(Status::ok);
+  const int t1 = type1_sin_min < tol::kSingularSin ? int(Status::singular_type1) : t2;
+  return static_cast<Status>(reachable ? t1 : int(Status::unreachable));
+}
+
+}  // namespace fivebar::detail
