@@ -45,9 +45,8 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
   }
   // Same expressions, in the same order, as the batch kernels (kinematics_batch.cpp).
   const double inv_d = 1.0 / d;
-  const double a = 0.5 * (d + (r1 - r2) * (r1 + r2) * inv_d);
-  const double h2 = (r1 - a) * (r1 + a);
-  if (h2 < -detail::reach_tolerance(r1, a)) return out;
+  double a, h2;
+  if (!detail::chord(detail::CirclePair::make(r1, r2), d, inv_d, a, h2)) return out;
   const double h = std::sqrt(std::max(0.0, h2));
   const double ux = dv.x() * inv_d, uy = dv.y() * inv_d;
   const double s = side >= 0 ? 1.0 : -1.0;

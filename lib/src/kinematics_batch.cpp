@@ -5,7 +5,7 @@
 //
 // IK here is not re-verified by a forward pass: the elbows are the exact circle intersection and
 // the angles are atan2 of the elbow offsets, so loop closure holds by construction up to the
-// atan2 error (<= 2 ulp); test_kinematics verifies batch IK by FK on every regime.
+// atan2 error (< 3 ulp); test_kinematics verifies batch IK by FK on every regime.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -21,8 +21,13 @@ namespace {
 using detail::cross;
 
 struct LegConst {
-  double ox, oy, l_prox, l_dist, dd;  // dd = (l_prox - l_dist)(l_prox + l_dist)
+  double ox, oy;
+  detail::CirclePair circles;  // (O, L_i) and (P, L_{i+2})
 };
+
+LegConst leg(const Vec2& O, double l_prox, double l_dist) {
+  return {O.x(), O.y(), detail::CirclePair::make(l_prox, l_dist)};
+}
 
 /// Elbow offset A - O for a leg at tactor (px, py), side s = -sigma; returns reachability.
 inline bool elbow_offset(const LegConst& g, double px, double py, double s, double& ex, double& ey) {
@@ -31,9 +36,8 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double s, doub
   const bool coincident = !(d2 > 0.0);
   const double d = std::sqrt(coincident ? 1.0 : d2);
   const double inv_d = 1.0 / d;
-  const double a = 0.5 * (d + g.dd * inv_d);
-  const double h2 = (g.l_prox - a) * (g.l_prox + a);
-  const bool reach = !coincident & (h2 >= -detail::reach_tolerance(g.l_prox, a));
+  double a, h2;
+  const bool reach = !coincident & detail::chord(g.circles, d, inv_d, a, h2);
   const double h = std::sqrt(std::max(0.0, h2));
   const double ux = dx * inv_d, uy = dy * inv_d;
   ex = reach ? a * ux - s * h * uy : 0.0;
@@ -50,7 +54,7 @@ void fk_kernel(const Mechanism& m, std::span<const double> theta1, std::span<con
   const std::size_t n = theta1.size();
   const double o1x = m.O1.x(), o1y = m.O1.y(), o2x = m.O2.x(), o2y = m.O2.y();
   const double L1 = m.L[0], L2 = m.L[1], L3 = m.L[2], L4 = m.L[3];
-  const double dd = (L3 - L4) * (L3 + L4);  // scalar: (r1 - r2) * (r1 + r2)
+  const detail::CirclePair distal = detail::CirclePair::make(L3, L4);
   const double inv13 = 1.0 / (L1 * L3), inv24 = 1.0 / (L2 * L4), inv34 = 1.0 / (L3 * L4);
   const double fixed_side = m.assembly_mode == AssemblyMode::Minus ? -1.0 : 1.0;
   const double w1 = m.working_mode.sign1, w2 = m.working_mode.sign2;
@@ -65,18 +69,21 @@ void fk_kernel(const Mechanism& m, std::span<const double> theta1, std::span<con
     const bool coincident = !(d2 > 0.0);
     const double d = std::sqrt(coincident ? 1.0 : d2);
     const double inv_d = 1.0 / d;
-    const double a = 0.5 * (d + dd * inv_d);
-    const double h2 = (L3 - a) * (L3 + a);
-    const bool reach = !coincident & (h2 >= -detail::reach_tolerance(L3, a));
+    double a, h2;
+    const bool reach = !coincident & detail::chord(distal, d, inv_d, a, h2);
     const double h = std::sqrt(std::max(0.0, h2));
     const double ux = dx * inv_d, uy = dy * inv_d;
     double side = fixed_side;
     if constexpr (kAny) {
       // "+" candidate: P - A1 and P - A2, and whether its working mode is the design's.
       const double f1x_p = a * ux - h * uy, f1y_p = a * uy + h * ux;
-      const double m1 = cross(e1x, e1y, f1x_p, f1y_p) * w1;
-      const double m2 = cross(e2x, e2y, f1x_p - dx, f1y_p - dy) * w2;
-      side = std::min(m1, m2) > 0.0 ? 1.0 : -1.0;
+      const double f1x_m = a * ux + h * uy, f1y_m = a * uy - h * ux;  // "-" candidate
+      const double p1 = cross(e1x, e1y, f1x_p, f1y_p) * w1;
+      const double p2 = cross(e2x, e2y, f1x_p - dx, f1y_p - dy) * w2;
+      const double m1 = cross(e1x, e1y, f1x_m, f1y_m) * w1;
+      const double m2 = cross(e2x, e2y, f1x_m - dx, f1y_m - dy) * w2;
+      // As the scalar fk(): "+" if it is in the working mode, else "-" if that is, else "+".
+      side = (std::min(p1, p2) > 0.0) | !(std::min(m1, m2) > 0.0) ? 1.0 : -1.0;
     }
     const double ox = a * ux - side * h * uy, oy = a * uy + side * h * ux;  // P - A1
     const double pxk = a1x + ox, pyk = a1y + oy;
@@ -117,8 +124,8 @@ void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const do
               std::span<double> theta1, std::span<double> theta2, std::span<Status> status) {
   const std::size_t n = px.size();
   assert(py.size() == n && theta1.size() == n && theta2.size() == n && status.size() == n);
-  const LegConst g1{m.O1.x(), m.O1.y(), m.L[0], m.L[2], (m.L[0] - m.L[2]) * (m.L[0] + m.L[2])};
-  const LegConst g2{m.O2.x(), m.O2.y(), m.L[1], m.L[3], (m.L[1] - m.L[3]) * (m.L[1] + m.L[3])};
+  const LegConst g1 = leg(m.O1, m.L[0], m.L[2]);
+  const LegConst g2 = leg(m.O2, m.L[1], m.L[3]);
   const double s1 = -m.working_mode.sign1, s2 = -m.working_mode.sign2;
   const double inv13 = 1.0 / (m.L[0] * m.L[2]), inv24 = 1.0 / (m.L[1] * m.L[3]),
                inv34 = 1.0 / (m.L[2] * m.L[3]);
@@ -142,8 +149,8 @@ void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const d
                std::span<double> lci, std::span<Status> status) {
   const std::size_t n = px.size();
   assert(py.size() == n && lci.size() == n && status.size() == n);
-  const LegConst g1{m.O1.x(), m.O1.y(), m.L[0], m.L[2], (m.L[0] - m.L[2]) * (m.L[0] + m.L[2])};
-  const LegConst g2{m.O2.x(), m.O2.y(), m.L[1], m.L[3], (m.L[1] - m.L[3]) * (m.L[1] + m.L[3])};
+  const LegConst g1 = leg(m.O1, m.L[0], m.L[2]);
+  const LegConst g2 = leg(m.O2, m.L[1], m.L[3]);
   const double s1 = -m.working_mode.sign1, s2 = -m.working_mode.sign2;
   const double inv13 = 1.0 / (m.L[0] * m.L[2]), inv24 = 1.0 / (m.L[1] * m.L[3]),
                inv34 = 1.0 / (m.L[2] * m.L[3]);

@@ -17,6 +17,29 @@ inline double reach_tolerance(double r1, double a) {
   return tol::kReachRel * r1 * std::max(r1, std::fabs(a));
 }
 
+/// Circle pair (c1, r1), (c2, r2) prepared for the intersection: the foot of the intersection
+/// chord is measured from the centre of the SMALLER circle, so that h^2 = (r - a)(r + a) keeps
+/// the digits of the small radius when the other is much larger (link ratios up to 1e4).
+struct CirclePair {
+  double rs;   ///< smaller radius
+  double dd;   ///< (rs - rb)(rs + rb) <= 0
+  double w0;   ///< 0 when the small circle is c1, else 1
+  double sgn;  ///< +1 when the small circle is c1, else -1
+  static CirclePair make(double r1, double r2) {
+    return r1 <= r2 ? CirclePair{r1, (r1 - r2) * (r1 + r2), 0.0, 1.0}
+                    : CirclePair{r2, (r2 - r1) * (r2 + r1), 1.0, -1.0};
+  }
+};
+
+/// Foot distance `a` from c1 along u = (c2 - c1)/d, and h^2; `reach` false when the circles miss
+/// each other by more than rounding. Shared verbatim by the scalar and batch paths.
+inline bool chord(const CirclePair& c, double d, double inv_d, double& a, double& h2) {
+  const double as = 0.5 * (d + c.dd * inv_d);  // from the small circle's centre
+  h2 = (c.rs - as) * (c.rs + as);
+  a = c.w0 * d + c.sgn * as;
+  return h2 >= -reach_tolerance(c.rs, as);
+}
+
 /// 1/cond of [[m00, m01], [m10, m11]] from the Frobenius norm and determinant:
 /// sigma_max^2 = (f + sqrt((f - 2g)(f + 2g)))/2, sigma_min = g / sigma_max, g = |det|.
 inline double lci2(double m00, double m01, double m10, double m11) {

@@ -82,7 +82,7 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
 
 // --- Batch (structure of arrays) --------------------------------------------------------------
 // All spans of one call have the same length n. Written branch-free over fast vectorisable
-// sin/cos/atan2 (fivebar/detail/fastmath.hpp, <= 2 ulp); statuses as in the scalar functions,
+// sin/cos/atan2 (fivebar/detail/fastmath.hpp, < 3 ulp); statuses as in the scalar functions,
 // without the Jacobian-based quantities.
 
 /// FK of n joint-angle pairs in the mechanism's assembly mode.
