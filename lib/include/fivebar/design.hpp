@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "fivebar/error.hpp"
@@ -21,12 +22,19 @@ using Vec2 = Eigen::Vector2d;
 
 /// A validation failure: `key` is the path of the offending value relative to the structure that
 /// validated it (e.g. "links[2]"); the loader prefixes the file, line and full key path.
+/// `rule` either starts with the value ("= -3 mm: must be > 0", what() = "links[2] = -3 mm: must
+/// be > 0") or is a bare rule ("must contain at least one of lower, upper", joined with ": ").
 class ValidationError : public InputError {
  public:
   ValidationError(std::string key, const std::string& message)
-      : InputError(key + ": " + message), key_(std::move(key)), rule_(message) {}
+      : InputError(compose(key, message)), key_(std::move(key)), rule_(message) {}
   const std::string& key() const noexcept { return key_; }
   const std::string& rule() const noexcept { return rule_; }
+  /// "key = value: rule" or "key: rule", as what() reads.
+  static std::string compose(const std::string& key, const std::string& rule) {
+    if (rule.starts_with("= ")) return key + " " + rule;
+    return key + ": " + rule;
+  }
 
  private:
   std::string key_;
@@ -113,12 +121,16 @@ struct Design {
   const Station* station(std::string_view name) const;
 };
 
+/// True when `name` can serve as a design or station name and hence as one path component under
+/// outputs/: 1 to 64 characters from [A-Za-z0-9_.-], the first not '.' or '-'.
+bool is_safe_name(std::string_view name);
+
 /// Product names a scene may list, in build order.
 const std::vector<std::string>& known_products();
 
-/// Loads and validates a design file. Throws InputError whose message names the file, line, key,
-/// value and the rule broken ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2] = -3:
-/// must be > 0 mm").
+/// Loads and validates a design file. Throws InputError whose message names the file, line, full
+/// key path, value and the rule broken ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2]
+/// = -3 mm: must be > 0"); problems of the whole file omit the line ("x.yaml: no such design file").
 Design load_design(const std::filesystem::path& path);
 /// Same, from text (for tests and stdin); `origin` names the source in messages.
 Design load_design_from_string(const std::string& text, const std::string& origin);

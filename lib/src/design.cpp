@@ -1,0 +1,384 @@
+// The design model: mode strings, joint ranges, and the one validate() of each design struct.
+// Validation messages name the key relative to the validated struct, the value (in file units:
+// mm and degrees) and the limit; Station and Design prefix the keys of what they contain.
+
+#include "fivebar/design.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "design_keys.hpp"
+#include "fivebar/tolerances.hpp"
+
+namespace fivebar {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+/// Largest admissible length or |coordinate|, mm. Far beyond any device, it keeps squared lengths
+/// (1e24) and sums of them far from overflow, so every later formula stays finite.
+constexpr double kMaxLengthMm = 1e12;
+
+/// Two joint-limit angles are the same (mod 2 pi) when their ccw difference is within this many
+/// ulps of the largest magnitude involved: degree -> radian conversion rounds each one by ~1 ulp,
+/// so lo = 10 deg, hi = 370 deg must still count as equal.
+constexpr double kAngleEqualUlps = 16.0;
+
+constexpr std::size_t kMaxNameLength = 64;
+
+constexpr const char* kSafeNameRule =
+    "must be a safe file name: 1 to 64 characters from A-Z a-z 0-9 _ . -, "
+    "not starting with '.' or '-'";
+
+/// Shortest text that reads back as the same double ("-3", "12.5", "1e+13", "nan").
+std::string format_number(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+/// Radians shown in degrees, rounded so that a value typed in degrees reads back as typed.
+std::string format_degrees(double radians) {
+  if (!std::isfinite(radians)) return format_number(radians);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", radians * kDegPerRad);
+  return buffer;
+}
+
+/// Angle reduced to [0, 2 pi).
+double wrap_two_pi(double angle) {
+  double r = std::fmod(angle, kTwoPi);
+  if (r < 0.0) r += kTwoPi;
+  if (r >= kTwoPi) r = 0.0;  // r was a tiny negative number
+  return r;
+}
+
+void check_length(const std::string& key, double value_mm) {
+  if (!std::isfinite(value_mm)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be finite");
+  if (!(value_mm > 0.0)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be > 0");
+  if (value_mm > kMaxLengthMm) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be <= 1e12");
+}
+
+void check_coordinate(const std::string& key, double value_mm) {
+  if (!std::isfinite(value_mm)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be finite");
+  if (std::abs(value_mm) > kMaxLengthMm) {
+    throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be within [-1e12, 1e12]");
+  }
+}
+
+void check_point(const std::string& key, const Vec2& p_mm) {
+  check_coordinate(detail::key_index(key, 0), p_mm.x());
+  check_coordinate(detail::key_index(key, 1), p_mm.y());
+}
+
+/// Runs a nested validate() and re-throws its error with the key prefixed by `prefix`.
+template <class F>
+void validate_nested(const std::string& prefix, F&& validate) {
+  try {
+    validate();
+  } catch (const ValidationError& e) {
+    throw ValidationError(detail::key_join(prefix, e.key()), e.rule());
+  }
+}
+
+bool is_plain_word(std::string_view name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-';
+  });
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Key paths
+
+namespace detail {
+
+std::string key_child(std::string_view parent, std::string_view name) {
+  std::string key(parent);
+  if (is_plain_word(name)) {
+    if (!key.empty()) key += '.';
+    key += name;
+    return key;
+  }
+  key += "[\"";
+  for (char c : name) {
+    if (c == '"' || c == '\\') key += '\\';
+    key += c;
+  }
+  key += "\"]";
+  return key;
+}
+
+std::string key_index(std::string_view parent, std::size_t i) {
+  return std::string(parent) + "[" + std::to_string(i) + "]";
+}
+
+std::string key_join(std::string_view parent, std::string_view relative) {
+  if (parent.empty()) return std::string(relative);
+  if (relative.empty()) return std::string(parent);
+  if (relative.front() == '[') return std::string(parent) + std::string(relative);
+  return std::string(parent) + "." + std::string(relative);
+}
+
+std::string key_parent(std::string_view key) {
+  // Scan forward: components are `name`, `.name`, `[digits]` and `["text"]` (with \" escapes).
+  std::size_t last_start = 0;
+  std::size_t i = 0;
+  while (i < key.size()) {
+    last_start = i;
+    if (key[i] == '[') {
+      if (i + 1 < key.size() && key[i + 1] == '"') {
+        i += 2;
+        while (i < key.size() && key[i] != '"') i += (key[i] == '\\') ? 2 : 1;
+        i += 2;  // closing quote and bracket
+      } else {
+        while (i < key.size() && key[i] != ']') ++i;
+        ++i;
+      }
+    } else {
+      if (key[i] == '.') ++i;
+      while (i < key.size() && key[i] != '.' && key[i] != '[') ++i;
+    }
+  }
+  return std::string(key.substr(0, std::min(last_start, key.size())));
+}
+
+std::string quoted(std::string_view text) {
+  std::string out = "'";
+  for (char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\x%02x", static_cast<unsigned>(u));
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  out += "'";
+  return out;
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------------------------------------
+// Modes
+
+std::optional<WorkingMode> parse_working_mode(std::string_view text) {
+  if (text.size() != 2) return std::nullopt;
+  auto sign = [](char c) -> std::optional<std::int8_t> {
+    if (c == '+') return std::int8_t{+1};
+    if (c == '-') return std::int8_t{-1};
+    return std::nullopt;
+  };
+  const auto s1 = sign(text[0]);
+  const auto s2 = sign(text[1]);
+  if (!s1 || !s2) return std::nullopt;
+  return WorkingMode{*s1, *s2};
+}
+
+std::string to_string(WorkingMode mode) {
+  std::string text;
+  text += mode.sign1 > 0 ? '+' : '-';
+  text += mode.sign2 > 0 ? '+' : '-';
+  return text;
+}
+
+std::array<WorkingMode, 4> all_working_modes() {
+  return {WorkingMode{+1, +1}, WorkingMode{+1, -1}, WorkingMode{-1, +1}, WorkingMode{-1, -1}};
+}
+
+std::optional<AssemblyMode> parse_assembly_mode(std::string_view text) {
+  if (text == "+") return AssemblyMode::Plus;
+  if (text == "-") return AssemblyMode::Minus;
+  if (text == "any") return AssemblyMode::Any;
+  return std::nullopt;
+}
+
+std::string to_string(AssemblyMode mode) {
+  switch (mode) {
+    case AssemblyMode::Plus: return "+";
+    case AssemblyMode::Minus: return "-";
+    case AssemblyMode::Any: break;
+  }
+  return "any";
+}
+
+// ---------------------------------------------------------------------------------------------
+// JointRange
+
+double JointRange::span() const {
+  const double d = wrap_two_pi(hi - lo);
+  return d > 0.0 ? d : kTwoPi;
+}
+
+bool JointRange::contains(double angle, double tol) const {
+  const double offset = wrap_two_pi(angle - lo);  // ccw from lo, in [0, 2 pi)
+  return offset <= span() + tol || offset >= kTwoPi - tol;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Mechanism
+
+double Mechanism::length_scale() const {
+  return std::max({L[0], L[1], L[2], L[3], (O2 - O1).norm()});
+}
+
+void Mechanism::validate() const {
+  // Coincident base joints are allowed: degenerate, but valid (extreme-case tests use them).
+  check_point("bases[0]", O1);
+  check_point("bases[1]", O2);
+  for (std::size_t i = 0; i < L.size(); ++i) check_length(detail::key_index("links", i), L[i]);
+
+  auto valid_sign = [](std::int8_t s) { return s == 1 || s == -1; };
+  if (!valid_sign(working_mode.sign1) || !valid_sign(working_mode.sign2)) {
+    throw ValidationError("working_mode", "= (" + std::to_string(working_mode.sign1) + ", " +
+                                              std::to_string(working_mode.sign2) +
+                                              "): both signs must be +1 or -1");
+  }
+  if (assembly_mode != AssemblyMode::Plus && assembly_mode != AssemblyMode::Minus &&
+      assembly_mode != AssemblyMode::Any) {
+    throw ValidationError("assembly_mode", "= " + std::to_string(static_cast<int>(assembly_mode)) +
+                                               ": must be \"+\", \"-\" or \"any\"");
+  }
+
+  if (joint_limits) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      const JointRange& range = (*joint_limits)[i];
+      const std::string key = detail::key_index("joint_limits", i);
+      for (std::size_t j = 0; j < 2; ++j) {
+        const double angle = j == 0 ? range.lo : range.hi;
+        if (!std::isfinite(angle)) {
+          throw ValidationError(detail::key_index(key, j), "= " + format_number(angle) + " deg: must be finite");
+        }
+      }
+      const double d = wrap_two_pi(range.hi - range.lo);
+      const double tol = kAngleEqualUlps * tol::kEps * std::max({kTwoPi, std::abs(range.lo), std::abs(range.hi)});
+      if (d <= tol || d >= kTwoPi - tol) {
+        throw ValidationError(key, "= [" + format_degrees(range.lo) + ", " + format_degrees(range.hi) +
+                                       "] deg: lo and hi must differ (mod 360)");
+      }
+    }
+  }
+
+  if (!(min_lci >= 0.0 && min_lci <= 1.0)) {  // also rejects NaN
+    throw ValidationError("min_lci", "= " + format_number(min_lci) + ": must be in [0, 1]");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Ellipse
+
+void Ellipse::validate() const {
+  check_point("center", center);
+  check_length("axes[0]", axes.x());
+  check_length("axes[1]", axes.y());
+  if (!std::isfinite(angle)) throw ValidationError("angle", "= " + format_number(angle) + " deg: must be finite");
+}
+
+Vec2 Ellipse::boundary_point(double t) const {
+  const Vec2 p_ellipse(0.5 * axes.x() * std::cos(t), 0.5 * axes.y() * std::sin(t));
+  const double c = std::cos(angle);
+  const double s = std::sin(angle);
+  return center + Vec2(c * p_ellipse.x() - s * p_ellipse.y(), s * p_ellipse.x() + c * p_ellipse.y());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Station
+
+void Station::validate() const {
+  validate_nested("target", [&] { target.validate(); });
+  if (!lower && !upper) throw ValidationError("mechanisms", "must contain at least one of lower, upper");
+  if (lower) validate_nested("mechanisms.lower", [&] { lower->validate(); });
+  if (upper) validate_nested("mechanisms.upper", [&] { upper->validate(); });
+}
+
+std::vector<const Mechanism*> Station::mechanisms() const {
+  std::vector<const Mechanism*> present;
+  if (lower) present.push_back(&*lower);
+  if (upper) present.push_back(&*upper);
+  return present;
+}
+
+const Mechanism* Station::mechanism(std::string_view which) const {
+  if (which == "lower") return lower ? &*lower : nullptr;
+  if (which == "upper") return upper ? &*upper : nullptr;
+  return nullptr;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Design
+
+bool is_safe_name(std::string_view name) {
+  if (name.empty() || name.size() > kMaxNameLength) return false;
+  if (name.front() == '.' || name.front() == '-') return false;  // also excludes "." and ".."
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '.' || c == '-';
+  });
+}
+
+const std::vector<std::string>& known_products() {
+  // In build order; each capability appends its product here.
+  static const std::vector<std::string> products{
+      "kinematics",
+  };
+  return products;
+}
+
+void Design::validate() const {
+  if (!is_safe_name(name)) throw ValidationError("name", "= " + detail::quoted(name) + ": " + kSafeNameRule);
+
+  if (stations.empty()) throw ValidationError("stations", "must contain at least one station");
+  for (std::size_t i = 0; i < stations.size(); ++i) {
+    const Station& station = stations[i];
+    const std::string key = detail::key_child("stations", station.name);
+    if (!is_safe_name(station.name)) {
+      throw ValidationError(key, "station name " + detail::quoted(station.name) + " " + kSafeNameRule);
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (stations[j].name == station.name) {
+        throw ValidationError(key, "station name " + detail::quoted(station.name) + " is used twice (stations " +
+                                       std::to_string(j) + " and " + std::to_string(i) + ")");
+      }
+    }
+    validate_nested(key, [&] { station.validate(); });
+  }
+
+  if (products) {
+    const auto& known = known_products();
+    for (std::size_t i = 0; i < products->size(); ++i) {
+      const std::string& product = (*products)[i];
+      const std::string key = detail::key_index("products", i);
+      if (std::find(known.begin(), known.end(), product) == known.end()) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        throw ValidationError(key, "= " + detail::quoted(product) + ": unknown product (known: " + list + ")");
+      }
+      for (std::size_t j = 0; j < i; ++j) {
+        if ((*products)[j] == product) {
+          throw ValidationError(key, "= " + detail::quoted(product) + ": listed twice (also products[" +
+                                         std::to_string(j) + "])");
+        }
+      }
+    }
+  }
+}
+
+const Station* Design::station(std::string_view wanted) const {
+  for (const Station& s : stations) {
+    if (s.name == wanted) return &s;
+  }
+  return nullptr;
+}
+
+}  // namespace fivebar

@@ -1,0 +1,467 @@
+// YAML design loader (DESIGN.md "Design file"). yaml-cpp stays in this file.
+//
+// The loader checks the shape of the file (known keys, no duplicates, types, list lengths,
+// required values, finite numbers) and converts units (degrees -> radians); the value rules live
+// in the one validate() of each struct (design.cpp). Every error becomes an InputError
+// "FILE:LINE: KEY = VALUE: RULE" (or "FILE:LINE: KEY: RULE") with the full key path; for errors
+// thrown by validate() the line comes from a key-path -> line map filled while parsing.
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <initializer_list>
+#include <map>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "design_keys.hpp"
+#include "fivebar/design.hpp"
+
+namespace fivebar {
+
+namespace {
+
+using detail::key_child;
+using detail::key_index;
+
+constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+
+/// Top-level sections that later versions fill in (DESIGN.md); rejected clearly until then.
+constexpr std::string_view kReservedSections[] = {"geometry", "print", "controller", "sweep", "patterns"};
+
+constexpr std::size_t kMaxShownValue = 60;
+
+const std::string kYamlFloatTag = "tag:yaml.org,2002:float";
+const std::string kYamlIntTag = "tag:yaml.org,2002:int";
+
+std::string lower_case(std::string_view text) {
+  std::string out(text);
+  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return out;
+}
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// Compact one-line rendering of a node for messages: scalars as written, [a, b], {k: v}.
+void render(const YAML::Node& node, std::string& out) {
+  if (out.size() > kMaxShownValue) return;
+  switch (node.Type()) {
+    case YAML::NodeType::Null: out += "null"; break;
+    case YAML::NodeType::Scalar:
+      if (node.Tag() == "!") {
+        out += '"' + node.Scalar() + '"';
+      } else {
+        out += node.Scalar();
+      }
+      break;
+    case YAML::NodeType::Sequence: {
+      out += '[';
+      bool first = true;
+      for (const auto& element : node) {
+        if (!first) out += ", ";
+        first = false;
+        render(element, out);
+      }
+      out += ']';
+      break;
+    }
+    case YAML::NodeType::Map: {
+      out += '{';
+      bool first = true;
+      for (const auto& pair : node) {
+        if (!first) out += ", ";
+        first = false;
+        render(pair.first, out);
+        out += ": ";
+        render(pair.second, out);
+      }
+      out += '}';
+      break;
+    }
+    case YAML::NodeType::Undefined: out += "(undefined)"; break;
+  }
+}
+
+std::string render(const YAML::Node& node) {
+  std::string out;
+  render(node, out);
+  std::string shown = detail::quoted(out);
+  shown = shown.substr(1, shown.size() - 2);  // control characters escaped, no quotes
+  if (shown.size() > kMaxShownValue) shown = shown.substr(0, kMaxShownValue) + "...";
+  return shown;
+}
+
+class Loader {
+ public:
+  explicit Loader(std::string origin) : origin_(std::move(origin)) {}
+
+  Design load(const std::string& text);
+
+ private:
+  /// One `key: value` pair of a YAML map, with its full key path and the line of its key.
+  struct Entry {
+    std::string name;
+    std::string path;
+    YAML::Node value;
+    int line = 0;
+  };
+  using Entries = std::vector<Entry>;
+
+  [[noreturn]] void fail(int line, const std::string& key, const std::string& rule) const {
+    std::string message = origin_ + ":" + std::to_string(line) + ": ";
+    message += key.empty() ? rule : ValidationError::compose(key, rule);
+    throw InputError(message);
+  }
+  [[noreturn]] void fail_value(const YAML::Node& node, int line, const std::string& key,
+                               const std::string& rule) const {
+    fail(line, key, "= " + render(node) + ": " + rule);
+  }
+
+  /// 1-based line of a node; `fallback` for nodes without a position (e.g. an empty value).
+  static int line_of(const YAML::Node& node, int fallback) {
+    const YAML::Mark mark = node.Mark();
+    if (mark.is_null() || node.IsNull()) return fallback;
+    return mark.line + 1;
+  }
+
+  void note(const std::string& key, int line) { lines_.emplace(key, line); }
+
+  /// Line of a key path, or of its nearest recorded parent.
+  int line_for(std::string key) const {
+    while (true) {
+      const auto it = lines_.find(key);
+      if (it != lines_.end()) return it->second;
+      if (key.empty()) return 1;
+      key = detail::key_parent(key);
+    }
+  }
+
+  Entries entries(const YAML::Node& map, const std::string& path, int line,
+                  std::initializer_list<std::string_view> allowed, const std::string& expected,
+                  bool any_key = false);
+  const Entry* find(const Entries& all, std::string_view name) const;
+  const Entry& require(const Entries& all, std::string_view name, const std::string& path, int line) const;
+
+  double number(const YAML::Node& node, const std::string& path, int line, std::string_view unit) const;
+  std::string string(const YAML::Node& node, const std::string& path, int line, const std::string& expected) const;
+  /// A list of exactly n elements; records the line of each element.
+  std::vector<YAML::Node> list(const YAML::Node& node, const std::string& path, int line, std::size_t n,
+                               const std::string& expected);
+  Vec2 point(const YAML::Node& node, const std::string& path, int line, const std::string& expected);
+
+  Ellipse target(const Entry& entry);
+  Mechanism mechanism(const Entry& entry);
+  Station station(const Entry& entry);
+
+  std::string origin_;
+  std::map<std::string, int> lines_;
+};
+
+Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, int line,
+                                std::initializer_list<std::string_view> allowed, const std::string& expected,
+                                bool any_key) {
+  if (!map.IsMap()) {
+    if (path.empty()) fail(line, "", "a design file must hold a map " + expected + ", not " + render(map));
+    fail_value(map, line, path, "must be a map " + expected);
+  }
+  Entries all;
+  std::map<std::string, int> first_line;
+  for (const auto& pair : map) {
+    const int key_line = line_of(pair.first, line);
+    if (!pair.first.IsScalar()) {
+      fail(key_line, path, "key " + render(pair.first) + " is not a name: keys must be plain strings");
+    }
+    const std::string name = pair.first.Scalar();
+    const std::string key = key_child(path, name);
+    if (const auto it = first_line.find(name); it != first_line.end()) {
+      fail(key_line, key, "duplicate key (first given at line " + std::to_string(it->second) + ")");
+    }
+    if (!any_key && std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
+      if (path.empty() && std::find(std::begin(kReservedSections), std::end(kReservedSections), name) !=
+                              std::end(kReservedSections)) {
+        fail(key_line, key, "key '" + name + "' is not supported by this version of fivebar");
+      }
+      std::string rule = "unknown key";
+      std::string_view closest;
+      std::size_t best = 3;  // suggest only near misses: up to 2 edits
+      for (std::string_view candidate : allowed) {
+        const std::size_t d = edit_distance(name, candidate);
+        if (d < best) best = d, closest = candidate;
+      }
+      if (!closest.empty()) rule += "; did you mean '" + std::string(closest) + "'?";
+      rule += " (allowed here: ";
+      bool first = true;
+      for (std::string_view candidate : allowed) {
+        rule += (first ? "" : ", ") + std::string(candidate);
+        first = false;
+      }
+      fail(key_line, key, rule + ")");
+    }
+    first_line.emplace(name, key_line);
+    note(key, key_line);
+    all.push_back(Entry{name, key, pair.second, key_line});
+  }
+  return all;
+}
+
+const Loader::Entry* Loader::find(const Entries& all, std::string_view name) const {
+  for (const Entry& e : all) {
+    if (e.name == name) return &e;
+  }
+  return nullptr;
+}
+
+const Loader::Entry& Loader::require(const Entries& all, std::string_view name, const std::string& path,
+                                     int line) const {
+  const Entry* e = find(all, name);
+  if (e == nullptr) fail(line, key_child(path, name), "required key is missing");
+  return *e;
+}
+
+double Loader::number(const YAML::Node& node, const std::string& path, int line, std::string_view unit) const {
+  const std::string expected = unit.empty() ? "must be a number" : "must be a number (" + std::string(unit) + ")";
+  if (!node.IsScalar()) fail_value(node, line, path, expected);
+  const std::string& tag = node.Tag();
+  if (tag == "!") fail_value(node, line, path, expected + ", not a quoted string");
+  if (tag != "?" && tag != kYamlFloatTag && tag != kYamlIntTag) fail_value(node, line, path, expected);
+
+  const std::string& text = node.Scalar();
+  bool boolean = false;
+  if (YAML::convert<bool>::decode(node, boolean)) fail_value(node, line, path, expected + ", not a boolean");
+  const std::string lower = lower_case(text);
+  if (lower == ".inf" || lower == "+.inf" || lower == "-.inf" || lower == ".nan") {
+    fail_value(node, line, path, "must be a finite number");
+  }
+
+  std::string_view digits = text;
+  if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
+  double value = 0.0;
+  const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
+  if (end != digits.data() + digits.size() || digits.empty()) fail_value(node, line, path, expected);
+  if (ec == std::errc::result_out_of_range) {
+    value = std::strtod(std::string(digits).c_str(), nullptr);  // overflow -> inf, underflow -> ~0
+  } else if (ec != std::errc{}) {
+    fail_value(node, line, path, expected);
+  }
+  if (!std::isfinite(value)) fail_value(node, line, path, "must be a finite number");
+  return value;
+}
+
+std::string Loader::string(const YAML::Node& node, const std::string& path, int line,
+                           const std::string& expected) const {
+  if (!node.IsScalar()) fail_value(node, line, path, expected);
+  return node.Scalar();
+}
+
+std::vector<YAML::Node> Loader::list(const YAML::Node& node, const std::string& path, int line, std::size_t n,
+                                     const std::string& expected) {
+  if (!node.IsSequence()) fail_value(node, line, path, "must be " + expected);
+  if (node.size() != n) {
+    fail_value(node, line, path, "must be " + expected + ", not " + std::to_string(node.size()) + " element" +
+                                     (node.size() == 1 ? "" : "s"));
+  }
+  std::vector<YAML::Node> elements;
+  for (std::size_t i = 0; i < n; ++i) {
+    elements.push_back(node[i]);
+    note(key_index(path, i), line_of(node[i], line));
+  }
+  return elements;
+}
+
+Vec2 Loader::point(const YAML::Node& node, const std::string& path, int line, const std::string& expected) {
+  const auto xy = list(node, path, line, 2, expected);
+  return Vec2(number(xy[0], key_index(path, 0), line_of(xy[0], line), "mm"),
+              number(xy[1], key_index(path, 1), line_of(xy[1], line), "mm"));
+}
+
+Ellipse Loader::target(const Entry& entry) {
+  const Entries all = entries(entry.value, entry.path, entry.line, {"center", "axes", "angle"},
+                              "{center: [x, y], axes: [a, b], angle: deg}");
+  Ellipse ellipse;
+  const Entry& center = require(all, "center", entry.path, entry.line);
+  ellipse.center = point(center.value, center.path, center.line, "a list of 2 numbers [x, y] (mm)");
+  const Entry& axes = require(all, "axes", entry.path, entry.line);
+  ellipse.axes = point(axes.value, axes.path, axes.line, "a list of 2 full axis lengths [a, b] (mm)");
+  if (const Entry* angle = find(all, "angle")) {
+    ellipse.angle = kRadPerDeg * number(angle->value, angle->path, angle->line, "deg");
+  }
+  return ellipse;
+}
+
+Mechanism Loader::mechanism(const Entry& entry) {
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"bases", "links", "working_mode", "assembly_mode", "joint_limits", "min_lci"},
+                              "(bases, links, working_mode, ...)");
+  Mechanism m;
+  m.name = entry.name;
+
+  const Entry& bases = require(all, "bases", entry.path, entry.line);
+  const std::string bases_expected = "a list of 2 base joints [[x1, y1], [x2, y2]] (mm)";
+  const auto base_nodes = list(bases.value, bases.path, bases.line, 2, bases_expected);
+  m.O1 = point(base_nodes[0], key_index(bases.path, 0), line_of(base_nodes[0], bases.line),
+               "a point [x, y] (mm)");
+  m.O2 = point(base_nodes[1], key_index(bases.path, 1), line_of(base_nodes[1], bases.line),
+               "a point [x, y] (mm)");
+
+  const Entry& links = require(all, "links", entry.path, entry.line);
+  const auto link_nodes = list(links.value, links.path, links.line, 4, "a list of 4 lengths [L1, L2, L3, L4] (mm)");
+  for (std::size_t i = 0; i < 4; ++i) {
+    m.L[i] = number(link_nodes[i], key_index(links.path, i), line_of(link_nodes[i], links.line), "mm");
+  }
+
+  const std::string working_expected = "must be one of \"++\", \"+-\", \"-+\", \"--\"";
+  const Entry& working = require(all, "working_mode", entry.path, entry.line);
+  const auto working_mode = parse_working_mode(string(working.value, working.path, working.line, working_expected));
+  if (!working_mode) fail_value(working.value, working.line, working.path, working_expected);
+  m.working_mode = *working_mode;
+
+  if (const Entry* assembly = find(all, "assembly_mode")) {
+    const std::string expected = "must be one of \"+\", \"-\", \"any\"";
+    const auto mode = parse_assembly_mode(string(assembly->value, assembly->path, assembly->line, expected));
+    if (!mode) fail_value(assembly->value, assembly->line, assembly->path, expected);
+    m.assembly_mode = *mode;
+  }
+
+  if (const Entry* limits = find(all, "joint_limits")) {
+    const std::string expected = "a list of 2 ranges [[lo1, hi1], [lo2, hi2]] (deg)";
+    const auto range_nodes = list(limits->value, limits->path, limits->line, 2, expected);
+    std::array<JointRange, 2> ranges;
+    for (std::size_t i = 0; i < 2; ++i) {
+      const std::string path = key_index(limits->path, i);
+      const int line = line_of(range_nodes[i], limits->line);
+      const auto ends = list(range_nodes[i], path, line, 2, "a range [lo, hi] (deg, counter-clockwise from lo)");
+      ranges[i].lo = kRadPerDeg * number(ends[0], key_index(path, 0), line_of(ends[0], line), "deg");
+      ranges[i].hi = kRadPerDeg * number(ends[1], key_index(path, 1), line_of(ends[1], line), "deg");
+    }
+    m.joint_limits = ranges;
+  }
+
+  if (const Entry* lci = find(all, "min_lci")) m.min_lci = number(lci->value, lci->path, lci->line, "");
+  return m;
+}
+
+Station Loader::station(const Entry& entry) {
+  const Entries all = entries(entry.value, entry.path, entry.line, {"target", "mechanisms"}, "(target, mechanisms)");
+  Station s;
+  s.name = entry.name;
+  s.target = target(require(all, "target", entry.path, entry.line));
+  // An absent or empty `mechanisms` is left to Station::validate(), which names the rule.
+  if (const Entry* mechanisms = find(all, "mechanisms")) {
+    for (const Entry& m : entries(mechanisms->value, mechanisms->path, mechanisms->line, {"lower", "upper"},
+                                  "with keys lower and/or upper")) {
+      (m.name == "lower" ? s.lower : s.upper) = mechanism(m);
+    }
+  }
+  return s;
+}
+
+Design Loader::load(const std::string& text) {
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(text);
+  } catch (const YAML::Exception& e) {
+    const int line = e.mark.is_null() ? 1 : e.mark.line + 1;
+    std::string rule = "YAML syntax error: " + e.msg + " (column " + std::to_string(e.mark.column + 1) + ")";
+    // `assembly_mode: -` reads as the start of a list: the usual cause of this message.
+    if (e.msg.find("block entry") != std::string::npos) rule += "; quote mode strings, as in \"-\"";
+    fail(line, "", rule);
+  }
+  if (documents.empty() || (documents.size() == 1 && documents[0].IsNull())) {
+    throw InputError(origin_ + ": empty design file: expected a map with at least 'name' and 'stations'");
+  }
+  if (documents.size() > 1) {
+    fail(line_of(documents[1], 1), "", "a design file holds one YAML document, this one has " +
+                                           std::to_string(documents.size()));
+  }
+  const YAML::Node& root = documents[0];
+  const int root_line = line_of(root, 1);
+  note("", root_line);
+
+  Design design;
+  try {
+    const Entries all = entries(root, "", root_line, {"name", "stations", "products"},
+                                "at the top level (name, stations, products)");
+    const Entry& name = require(all, "name", "", root_line);
+    design.name = string(name.value, name.path, name.line, "must be a name (letters, digits, _ . -)");
+
+    const Entry& stations = require(all, "stations", "", root_line);
+    for (const Entry& s : entries(stations.value, stations.path, stations.line, {},
+                                  "of station names to stations", /*any_key=*/true)) {
+      design.stations.push_back(station(s));
+    }
+
+    if (const Entry* products = find(all, "products")) {
+      if (!products->value.IsSequence()) fail_value(products->value, products->line, products->path, "must be a list of product names");
+      std::vector<std::string> names;
+      for (std::size_t i = 0; i < products->value.size(); ++i) {
+        const YAML::Node element = products->value[i];
+        const std::string path = key_index(products->path, i);
+        const int line = line_of(element, products->line);
+        note(path, line);
+        names.push_back(string(element, path, line, "must be a product name"));
+      }
+      design.products = std::move(names);
+    }
+  } catch (const YAML::Exception& e) {  // not expected: the walk above checks every type first
+    fail(e.mark.is_null() ? root_line : e.mark.line + 1, "", "YAML error: " + e.msg);
+  }
+
+  try {
+    design.validate();
+  } catch (const ValidationError& e) {
+    fail(line_for(e.key()), e.key(), e.rule());
+  }
+  return design;
+}
+
+}  // namespace
+
+Design load_design_from_string(const std::string& text, const std::string& origin) {
+  return Loader(origin).load(text);
+}
+
+Design load_design(const std::filesystem::path& path) {
+  const std::string origin = path.string();
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw InputError(origin + ": no such design file");
+  if (std::filesystem::is_directory(status)) throw InputError(origin + ": is a directory, not a design file");
+
+  errno = 0;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    const int error = errno;
+    throw InputError(origin + ": cannot read the design file" + (error != 0 ? std::string(": ") + std::strerror(error) : ""));
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(origin + ": cannot read the design file");
+
+  Design design = load_design_from_string(text.str(), origin);
+  design.source = path;
+  return design;
+}
+
+}  // namespace fivebar

@@ -1,0 +1,519 @@
+// Tests of the design model (lib/src/design.cpp) and the YAML loader (lib/src/yaml/design_loader.cpp):
+// the shipped designs against the paper's Table 1, every validate() rule, the malformed-file corpus
+// in test/data/malformed/, mode strings and joint ranges.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fivebar/design.hpp"
+
+namespace fivebar {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+using ::testing::ThrowsMessage;
+
+constexpr double kPi = std::numbers::pi;
+double deg(double degrees) { return degrees * kPi / 180.0; }
+
+const fs::path kSourceDir = FIVEBAR_SOURCE_DIR;
+
+// ---------------------------------------------------------------------------------------------
+// Shipped designs against the paper (Table 1 and Section II), numbers typed independently.
+
+void expect_mechanism(const Mechanism* m, const char* name, Vec2 O1, Vec2 O2, std::array<double, 4> L,
+                      const char* working, AssemblyMode assembly) {
+  ASSERT_NE(m, nullptr) << name;
+  SCOPED_TRACE(name);
+  EXPECT_EQ(m->name, name);
+  EXPECT_EQ(m->O1, O1);
+  EXPECT_EQ(m->O2, O2);
+  EXPECT_EQ(m->L, L);
+  EXPECT_EQ(to_string(m->working_mode), working);
+  EXPECT_EQ(m->assembly_mode, assembly);
+  EXPECT_FALSE(m->joint_limits.has_value());
+  EXPECT_EQ(m->min_lci, 0.0);
+}
+
+void expect_index_station(const Station* index) {
+  ASSERT_NE(index, nullptr);
+  EXPECT_EQ(index->target.center, Vec2(6.25, 15.5));
+  EXPECT_EQ(index->target.axes, Vec2(15.0, 12.0));
+  EXPECT_EQ(index->target.angle, 0.0);
+  expect_mechanism(index->mechanism("lower"), "lower", {0.0, 0.0}, {12.5, 0.0}, {9.0, 9.0, 15.0, 15.0}, "-+",
+                   AssemblyMode::Plus);
+  expect_mechanism(index->mechanism("upper"), "upper", {0.0, 31.0}, {12.5, 31.0}, {9.0, 9.0, 15.0, 15.0}, "+-",
+                   AssemblyMode::Minus);
+}
+
+TEST(ShippedDesigns, Iros2022MatchesTable1) {
+  const fs::path path = kSourceDir / "designs/iros2022.yaml";
+  const Design design = load_design(path);
+  EXPECT_EQ(design.name, "iros2022");
+  EXPECT_EQ(design.source, path);
+  ASSERT_EQ(design.stations.size(), 2u);
+  EXPECT_EQ(design.stations[0].name, "index");  // file order
+  EXPECT_EQ(design.stations[1].name, "thumb");
+  expect_index_station(design.station("index"));
+
+  const Station* thumb = design.station("thumb");
+  ASSERT_NE(thumb, nullptr);
+  EXPECT_EQ(thumb->target.center, Vec2(6.25, 17.5));
+  EXPECT_EQ(thumb->target.axes, Vec2(15.0, 14.0));
+  EXPECT_EQ(thumb->target.angle, 0.0);
+  expect_mechanism(thumb->mechanism("lower"), "lower", {0.0, 0.0}, {12.5, 0.0}, {9.0, 9.0, 17.5, 17.5}, "-+",
+                   AssemblyMode::Plus);
+  expect_mechanism(thumb->mechanism("upper"), "upper", {0.0, 35.0}, {12.5, 35.0}, {9.0, 9.0, 17.5, 17.5}, "+-",
+                   AssemblyMode::Minus);
+
+  EXPECT_EQ(design.station("middle"), nullptr);
+  EXPECT_NO_THROW(design.validate());
+}
+
+TEST(ShippedDesigns, TargetsAreCentredBetweenTheFourBaseJoints) {
+  const Design design = load_design(kSourceDir / "designs/iros2022.yaml");
+  for (const Station& s : design.stations) {
+    SCOPED_TRACE(s.name);
+    const Vec2 centroid = (s.lower->O1 + s.lower->O2 + s.upper->O1 + s.upper->O2) / 4.0;
+    EXPECT_EQ(s.target.center, centroid);
+  }
+}
+
+TEST(ShippedDesigns, IndexOnly) {
+  const Design design = load_design(kSourceDir / "designs/iros2022-index.yaml");
+  EXPECT_EQ(design.name, "iros2022-index");
+  ASSERT_EQ(design.stations.size(), 1u);
+  expect_index_station(design.station("index"));
+  EXPECT_EQ(design.station("thumb"), nullptr);
+  EXPECT_FALSE(design.products.has_value());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Malformed corpus: each file states the message substrings (and line) it must produce.
+
+struct MalformedCase {
+  fs::path path;
+  std::vector<std::string> expects;
+  int line = 0;  // 0: not stated
+};
+
+std::vector<fs::path> malformed_files() {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(kSourceDir / "test/data/malformed")) {
+    if (entry.path().extension() == ".yaml") files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+MalformedCase read_case(const fs::path& path) {
+  MalformedCase c{path, {}, 0};
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line) && line.starts_with("# expect")) {
+    if (line.starts_with("# expect-line: ")) {
+      c.line = std::stoi(line.substr(15));
+    } else if (line.starts_with("# expect: ")) {
+      c.expects.push_back(line.substr(10));
+    }
+  }
+  if (fs::file_size(path) == 0) c.expects.push_back("empty design file");  // no room for a comment
+  return c;
+}
+
+class Malformed : public ::testing::TestWithParam<fs::path> {};
+
+TEST_P(Malformed, IsRejectedWithFileLineAndKey) {
+  const MalformedCase c = read_case(GetParam());
+  ASSERT_FALSE(c.expects.empty()) << c.path << " lacks a first line '# expect: ...'";
+  try {
+    load_design(c.path);
+    FAIL() << c.path << " was accepted";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    SCOPED_TRACE(message);
+    EXPECT_THAT(message, StartsWith(c.path.string() + ":"));
+    for (const std::string& expected : c.expects) EXPECT_THAT(message, HasSubstr(expected));
+    if (c.line > 0) {
+      EXPECT_THAT(message, StartsWith(c.path.string() + ":" + std::to_string(c.line) + ": "));
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Corpus, Malformed, ::testing::ValuesIn(malformed_files()),
+                         [](const ::testing::TestParamInfo<fs::path>& info) {
+                           std::string name = info.param.stem().string();
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
+
+TEST(MalformedCorpus, IsLargeEnough) { EXPECT_GE(malformed_files().size(), 30u); }
+
+// ---------------------------------------------------------------------------------------------
+// Loader details not covered by the corpus.
+
+const std::string kMinimal = R"(name: m
+stations:
+  s:
+    target: {center: [0, 1], axes: [2, 3]}
+    mechanisms:
+      upper:
+        bases: [[0, 0], [1, 0]]
+        links: [1, 2, 3, 4]
+        working_mode: "++"
+)";
+
+TEST(Loader, DefaultsAndUnits) {
+  const Design design = load_design_from_string(kMinimal, "<test>");
+  EXPECT_TRUE(design.source.empty());
+  const Station& s = design.stations.at(0);
+  EXPECT_EQ(s.target.angle, 0.0);
+  EXPECT_FALSE(s.lower.has_value());
+  ASSERT_TRUE(s.upper.has_value());
+  EXPECT_EQ(s.upper->assembly_mode, AssemblyMode::Any);
+  EXPECT_EQ(s.upper->min_lci, 0.0);
+  EXPECT_EQ(s.mechanisms().size(), 1u);
+  EXPECT_EQ(s.mechanism("lower"), nullptr);
+}
+
+TEST(Loader, DegreesBecomeRadians) {
+  const Design design = load_design_from_string(R"(name: m
+stations:
+  s:
+    target: {center: [0, 1], axes: [2, 3], angle: 90}
+    mechanisms:
+      lower:
+        bases: [[0, 0], [0, 0]]   # coincident base joints: degenerate but valid
+        links: [1, 2.5, 3e0, +4]  # integers, decimals, exponents and a plus sign
+        working_mode: --
+        assembly_mode: any
+        joint_limits: [[350, 10], [-90, 180]]
+        min_lci: 1
+)",
+                                                "<test>");
+  const Station& s = design.stations.at(0);
+  EXPECT_DOUBLE_EQ(s.target.angle, kPi / 2);
+  const Mechanism& m = *s.lower;
+  EXPECT_EQ(m.L, (std::array<double, 4>{1.0, 2.5, 3.0, 4.0}));
+  EXPECT_EQ(m.working_mode, (WorkingMode{-1, -1}));
+  ASSERT_TRUE(m.joint_limits.has_value());
+  EXPECT_DOUBLE_EQ((*m.joint_limits)[0].lo, deg(350));
+  EXPECT_DOUBLE_EQ((*m.joint_limits)[0].hi, deg(10));
+  EXPECT_DOUBLE_EQ((*m.joint_limits)[1].lo, deg(-90));
+  EXPECT_DOUBLE_EQ((*m.joint_limits)[1].hi, deg(180));
+  EXPECT_EQ(m.min_lci, 1.0);
+}
+
+TEST(Loader, ProductsKeepTheirOrder) {
+  const Design design = load_design_from_string("products: [kinematics]\n" + kMinimal, "<test>");
+  ASSERT_TRUE(design.products.has_value());
+  EXPECT_EQ(*design.products, std::vector<std::string>{"kinematics"});
+}
+
+TEST(Loader, OriginNamesTheSource) {
+  EXPECT_THAT([] { load_design_from_string("name: [", "<stdin>"); },
+              ThrowsMessage<InputError>(StartsWith("<stdin>:1: YAML syntax error")));
+}
+
+TEST(Loader, ValidateErrorsGetTheLineOfTheirKey) {
+  const std::string text = kMinimal + "        min_lci: 2\n";
+  EXPECT_THAT([&] { load_design_from_string(text, "x.yaml"); },
+              ThrowsMessage<InputError>(
+                  HasSubstr("x.yaml:10: stations.s.mechanisms.upper.min_lci = 2: must be in [0, 1]")));
+}
+
+TEST(Loader, MissingFile) {
+  const fs::path path = kSourceDir / "test/data/no-such-design.yaml";
+  EXPECT_THAT([&] { load_design(path); },
+              ThrowsMessage<InputError>(HasSubstr(path.string() + ": no such design file")));
+}
+
+TEST(Loader, DirectoryIsNotADesign) {
+  const fs::path path = kSourceDir / "designs";
+  EXPECT_THAT([&] { load_design(path); }, ThrowsMessage<InputError>(HasSubstr(path.string() + ": is a directory")));
+}
+
+TEST(Loader, UnreadableFile) {
+  const fs::path path = fs::temp_directory_path() / "fivebar-test-design-unreadable.yaml";
+  { std::ofstream(path) << kMinimal; }
+  fs::permissions(path, fs::perms::none);
+  std::ifstream probe(path);
+  if (probe.good()) {  // root reads anything
+    fs::remove(path);
+    GTEST_SKIP() << "running with permissions that read mode-000 files";
+  }
+  EXPECT_THAT([&] { load_design(path); },
+              ThrowsMessage<InputError>(HasSubstr(path.string() + ": cannot read the design file")));
+  fs::remove(path);
+}
+
+// ---------------------------------------------------------------------------------------------
+// validate(): one test per rule, on hand-built values.
+
+Mechanism valid_mechanism() {
+  Mechanism m;
+  m.name = "lower";
+  m.O1 = {0.0, 0.0};
+  m.O2 = {12.5, 0.0};
+  m.L = {9.0, 9.0, 15.0, 15.0};
+  m.working_mode = {-1, +1};
+  m.assembly_mode = AssemblyMode::Plus;
+  return m;
+}
+
+Station valid_station() {
+  Station s;
+  s.name = "index";
+  s.target.center = {6.25, 15.5};
+  s.target.axes = {15.0, 12.0};
+  s.lower = valid_mechanism();
+  return s;
+}
+
+Design valid_design() {
+  Design d;
+  d.name = "d";
+  d.stations = {valid_station()};
+  return d;
+}
+
+template <class T, class Edit>
+void expect_invalid(T value, Edit edit, const std::string& message) {
+  edit(value);
+  EXPECT_THAT([&] { value.validate(); }, ThrowsMessage<InputError>(HasSubstr(message)));
+}
+
+TEST(MechanismValidate, AcceptsThePaperAndCoincidentBases) {
+  EXPECT_NO_THROW(valid_mechanism().validate());
+  Mechanism m = valid_mechanism();
+  m.O2 = m.O1;
+  EXPECT_NO_THROW(m.validate());
+}
+
+TEST(MechanismValidate, Links) {
+  auto m = valid_mechanism();
+  expect_invalid(m, [](Mechanism& x) { x.L[2] = -3; }, "links[2] = -3 mm: must be > 0");
+  expect_invalid(m, [](Mechanism& x) { x.L[0] = 0; }, "links[0] = 0 mm: must be > 0");
+  expect_invalid(m, [](Mechanism& x) { x.L[3] = 1e13; }, "links[3] = 1e+13 mm: must be <= 1e12");
+  expect_invalid(m, [](Mechanism& x) { x.L[1] = std::nan(""); }, "links[1] = nan mm: must be finite");
+  expect_invalid(m, [](Mechanism& x) { x.L[1] = INFINITY; }, "links[1] = inf mm: must be finite");
+  m.L[3] = 1e12;
+  EXPECT_NO_THROW(m.validate());
+}
+
+TEST(MechanismValidate, ThrowsValidationErrorWithRelativeKey) {
+  Mechanism m = valid_mechanism();
+  m.L[2] = -3;
+  EXPECT_THAT([&] { m.validate(); }, ThrowsMessage<InputError>(HasSubstr("links[2]")));
+  try {
+    m.validate();
+    FAIL();
+  } catch (const ValidationError& e) {
+    EXPECT_EQ(e.key(), "links[2]");
+    EXPECT_EQ(e.rule(), "= -3 mm: must be > 0");
+    EXPECT_STREQ(e.what(), "links[2] = -3 mm: must be > 0");
+  }
+}
+
+TEST(MechanismValidate, Bases) {
+  const auto m = valid_mechanism();
+  expect_invalid(m, [](Mechanism& x) { x.O1.y() = std::nan(""); }, "bases[0][1] = nan mm: must be finite");
+  expect_invalid(m, [](Mechanism& x) { x.O2.x() = -INFINITY; }, "bases[1][0] = -inf mm: must be finite");
+  expect_invalid(m, [](Mechanism& x) { x.O2.x() = -2e12; }, "bases[1][0] = -2e+12 mm: must be within");
+}
+
+TEST(MechanismValidate, Modes) {
+  const auto m = valid_mechanism();
+  expect_invalid(m, [](Mechanism& x) { x.working_mode.sign2 = 0; }, "working_mode = (-1, 0): both signs must be");
+  expect_invalid(m, [](Mechanism& x) { x.assembly_mode = static_cast<AssemblyMode>(7); }, "assembly_mode = 7");
+}
+
+TEST(MechanismValidate, JointLimits) {
+  auto m = valid_mechanism();
+  m.joint_limits = std::array<JointRange, 2>{JointRange{deg(350), deg(10)}, JointRange{deg(0), deg(180)}};
+  EXPECT_NO_THROW(m.validate());
+  expect_invalid(m, [](Mechanism& x) { (*x.joint_limits)[1].hi = deg(0); },
+                 "joint_limits[1] = [0, 0] deg: lo and hi must differ (mod 360)");
+  expect_invalid(m, [](Mechanism& x) { (*x.joint_limits)[0] = {deg(-90), deg(270)}; },
+                 "joint_limits[0] = [-90, 270] deg: lo and hi must differ (mod 360)");
+  expect_invalid(m, [](Mechanism& x) { (*x.joint_limits)[0].lo = std::nan(""); },
+                 "joint_limits[0][0] = nan deg: must be finite");
+  expect_invalid(m, [](Mechanism& x) { (*x.joint_limits)[1].hi = INFINITY; },
+                 "joint_limits[1][1] = inf deg: must be finite");
+}
+
+TEST(MechanismValidate, MinLci) {
+  const auto m = valid_mechanism();
+  expect_invalid(m, [](Mechanism& x) { x.min_lci = 1.5; }, "min_lci = 1.5: must be in [0, 1]");
+  expect_invalid(m, [](Mechanism& x) { x.min_lci = -0.25; }, "min_lci = -0.25: must be in [0, 1]");
+  expect_invalid(m, [](Mechanism& x) { x.min_lci = std::nan(""); }, "min_lci = nan: must be in [0, 1]");
+}
+
+TEST(MechanismValidate, LengthScale) {
+  Mechanism m = valid_mechanism();
+  EXPECT_EQ(m.length_scale(), 15.0);
+  m.O2 = {30.0, 40.0};
+  EXPECT_EQ(m.length_scale(), 50.0);
+}
+
+TEST(EllipseValidate, Rules) {
+  const Ellipse e = valid_station().target;
+  EXPECT_NO_THROW(e.validate());
+  expect_invalid(e, [](Ellipse& x) { x.axes.x() = 0; }, "axes[0] = 0 mm: must be > 0");
+  expect_invalid(e, [](Ellipse& x) { x.axes.y() = -1; }, "axes[1] = -1 mm: must be > 0");
+  expect_invalid(e, [](Ellipse& x) { x.center.x() = INFINITY; }, "center[0] = inf mm: must be finite");
+  expect_invalid(e, [](Ellipse& x) { x.angle = std::nan(""); }, "angle = nan deg: must be finite");
+}
+
+TEST(EllipseValidate, BoundaryPoint) {
+  Ellipse e;
+  e.center = {1.0, 2.0};
+  e.axes = {4.0, 2.0};
+  e.angle = kPi / 2;
+  const Vec2 end_of_major = e.boundary_point(0.0);  // major axis (length 4) turned to +y
+  EXPECT_NEAR(end_of_major.x(), 1.0, 1e-15);
+  EXPECT_NEAR(end_of_major.y(), 4.0, 1e-15);
+  const Vec2 end_of_minor = e.boundary_point(kPi / 2);
+  EXPECT_NEAR(end_of_minor.x(), 0.0, 1e-15);
+  EXPECT_NEAR(end_of_minor.y(), 2.0, 1e-15);
+}
+
+TEST(StationValidate, Rules) {
+  const Station s = valid_station();
+  EXPECT_NO_THROW(s.validate());
+  expect_invalid(s, [](Station& x) { x.lower.reset(); }, "mechanisms: must contain at least one of lower, upper");
+  expect_invalid(s, [](Station& x) { x.lower->L[2] = -3; }, "mechanisms.lower.links[2] = -3 mm");
+  expect_invalid(s, [](Station& x) { x.upper = valid_mechanism(); x.upper->min_lci = 2; },
+                 "mechanisms.upper.min_lci = 2");
+  expect_invalid(s, [](Station& x) { x.target.axes.y() = 0; }, "target.axes[1] = 0 mm");
+}
+
+TEST(DesignValidate, Names) {
+  const Design d = valid_design();
+  EXPECT_NO_THROW(d.validate());
+  for (const char* bad : {"", ".", "..", "../../x", "a/b", ".hidden", "-rf", "a b", "x\ny"}) {
+    SCOPED_TRACE(bad);
+    expect_invalid(d, [&](Design& x) { x.name = bad; }, "must be a safe file name");
+  }
+  expect_invalid(d, [](Design& x) { x.name = "../../x"; }, "name = '../../x': must be a safe file name");
+  expect_invalid(d, [](Design& x) { x.name = std::string(65, 'a'); }, "must be a safe file name");
+  Design ok = d;
+  ok.name = std::string(64, 'a');
+  EXPECT_NO_THROW(ok.validate());
+  ok.name = "iros2022-v1.2_b";
+  EXPECT_NO_THROW(ok.validate());
+}
+
+TEST(DesignValidate, Stations) {
+  const Design d = valid_design();
+  expect_invalid(d, [](Design& x) { x.stations.clear(); }, "stations: must contain at least one station");
+  expect_invalid(d, [](Design& x) { x.stations[0].name = "a/b"; }, "stations[\"a/b\"]: station name 'a/b' must be");
+  expect_invalid(d, [](Design& x) { x.stations.push_back(x.stations[0]); },
+                 "stations.index: station name 'index' is used twice");
+  expect_invalid(d, [](Design& x) { x.stations[0].lower->L[2] = -3; },
+                 "stations.index.mechanisms.lower.links[2] = -3 mm: must be > 0");
+}
+
+TEST(DesignValidate, Products) {
+  const Design d = valid_design();
+  expect_invalid(d, [](Design& x) { x.products = std::vector<std::string>{"kinematics", "nope"}; },
+                 "products[1] = 'nope': unknown product");
+  expect_invalid(d, [](Design& x) { x.products = std::vector<std::string>{"kinematics", "kinematics"}; },
+                 "products[1] = 'kinematics': listed twice");
+  Design ok = d;
+  ok.products = known_products();
+  EXPECT_NO_THROW(ok.validate());
+  ok.products = std::vector<std::string>{};
+  EXPECT_NO_THROW(ok.validate());
+}
+
+TEST(DesignValidate, KnownProductsStartWithKinematics) {
+  ASSERT_FALSE(known_products().empty());
+  EXPECT_EQ(known_products().front(), "kinematics");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Modes and joint ranges.
+
+TEST(Modes, WorkingModeRoundTrip) {
+  const std::array<const char*, 4> texts{"++", "+-", "-+", "--"};
+  const auto modes = all_working_modes();
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(to_string(modes[i]), texts[i]);
+    EXPECT_EQ(parse_working_mode(texts[i]), modes[i]);
+  }
+  EXPECT_EQ(parse_working_mode("-+"), (WorkingMode{-1, +1}));
+  EXPECT_EQ(WorkingMode{}, (WorkingMode{-1, +1}));
+  for (const char* bad : {"", "+", "+++", "+x", "x-", " +-", "+ -", "pm"}) {
+    EXPECT_FALSE(parse_working_mode(bad).has_value()) << bad;
+  }
+}
+
+TEST(Modes, AssemblyModeRoundTrip) {
+  for (const AssemblyMode mode : {AssemblyMode::Plus, AssemblyMode::Minus, AssemblyMode::Any}) {
+    EXPECT_EQ(parse_assembly_mode(to_string(mode)), mode);
+  }
+  EXPECT_EQ(to_string(AssemblyMode::Plus), "+");
+  EXPECT_EQ(to_string(AssemblyMode::Minus), "-");
+  EXPECT_EQ(to_string(AssemblyMode::Any), "any");
+  for (const char* bad : {"", "ANY", "+-", "up", "0"}) EXPECT_FALSE(parse_assembly_mode(bad).has_value()) << bad;
+}
+
+TEST(JointRange, WrappedArc) {
+  const JointRange r{deg(350), deg(10)};
+  EXPECT_NEAR(r.span(), deg(20), 1e-14);
+  EXPECT_TRUE(r.contains(0.0));
+  EXPECT_TRUE(r.contains(deg(5)));
+  EXPECT_TRUE(r.contains(deg(355)));
+  EXPECT_TRUE(r.contains(deg(-5)));
+  EXPECT_TRUE(r.contains(deg(365)));  // any representative
+  EXPECT_TRUE(r.contains(deg(-715)));
+  EXPECT_FALSE(r.contains(deg(180)));
+  EXPECT_FALSE(r.contains(deg(11)));
+  EXPECT_FALSE(r.contains(deg(349)));
+  EXPECT_TRUE(r.contains(r.lo));
+  EXPECT_TRUE(r.contains(r.hi));
+}
+
+TEST(JointRange, Tolerance) {
+  const JointRange r{deg(350), deg(10)};
+  EXPECT_FALSE(r.contains(deg(10.5)));
+  EXPECT_TRUE(r.contains(deg(10.5), deg(1)));
+  EXPECT_FALSE(r.contains(deg(349.5)));
+  EXPECT_TRUE(r.contains(deg(349.5), deg(1)));
+}
+
+TEST(JointRange, PlainAndLargeArcs) {
+  const JointRange half{0.0, kPi};
+  EXPECT_NEAR(half.span(), kPi, 1e-15);
+  EXPECT_TRUE(half.contains(kPi / 2));
+  EXPECT_FALSE(half.contains(-kPi / 2));
+  const JointRange most{deg(10), deg(0)};  // ccw from 10 deg round to 0 deg: all but 10 degrees
+  EXPECT_NEAR(most.span(), deg(350), 1e-14);
+  EXPECT_TRUE(most.contains(deg(180)));
+  EXPECT_FALSE(most.contains(deg(5)));
+  const JointRange negative{deg(-90), deg(90)};
+  EXPECT_NEAR(negative.span(), kPi, 1e-15);
+  EXPECT_TRUE(negative.contains(0.0));
+  EXPECT_FALSE(negative.contains(kPi));
+}
+
+TEST(KeyedErrors, ComposeReadsAsAKeyValueRule) {
+  EXPECT_EQ(ValidationError::compose("links[2]", "= -3 mm: must be > 0"), "links[2] = -3 mm: must be > 0");
+  EXPECT_EQ(ValidationError::compose("stations", "must contain at least one station"),
+            "stations: must contain at least one station");
+}
+
+}  // namespace
+}  // namespace fivebar
