@@ -344,6 +344,23 @@ TEST_P(KinematicsRegime, BatchAgreesWithScalar) {
     }
   }
   EXPECT_GT(ok, n / 10);
+  // The lean scalar forms give the full forms' point and angles to the last bit (same arithmetic,
+  // same libm).
+  for (std::size_t k = 0; k < n; ++k) {
+    const Pose p = fk(m, t1[k], t2[k]);
+    const PointResult r = fk_point(m, t1[k], t2[k]);
+    if (p.status == Status::ok && min_sin(p) > 1e-6) {
+      ASSERT_EQ(r.status, Status::ok);
+      EXPECT_EQ(r.P, p.P);
+      const Pose q = ik(m, p.P);
+      const AnglesResult a = ik_angles(m, p.P);
+      if (q.status != Status::ok || min_sin(q) < 1e-6) continue;
+      ASSERT_EQ(a.status, Status::ok);
+      EXPECT_EQ(a.theta1, q.theta1);
+      EXPECT_EQ(a.theta2, q.theta2);
+      EXPECT_LE(a.closure_error_mm, tol::kClosureRel * scale);
+    }
+  }
   // IK batch of the FK points, verified by FK (loop closure), and LCI batch against scalar.
   ik_batch(m, px, py, u1, u2, st2);
   lci_batch(m, px, py, l, st3);

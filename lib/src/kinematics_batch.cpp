@@ -1,11 +1,17 @@
-// Batch (structure-of-arrays) kinematics. The loop bodies are branch-free (selects only) and call
-// only inline arithmetic, sqrt and the fdlibm-style kernels of fastmath.hpp, so GCC vectorises
-// them at -O2/-O3 without -ffast-math (-fno-math-errno suffices for sqrt). The arithmetic is the
-// scalar path's, expression for expression; test_kinematics checks the two agree.
+// Lean kinematics: FK to the tactor point and IK to the joint angles with a status, nothing else.
+// One per-element kernel serves two entry points:
+//   - the batch (structure-of-arrays) loops, over fastmath.hpp's vectorisable sin/cos/atan2:
+//     the bodies are branch-free (selects only), so GCC vectorises them at -O3 without
+//     -ffast-math (-fno-math-errno and -fno-trapping-math suffice);
+//   - fk_point / ik_angles, the scalar forms, over glibc's sin/cos/atan2 (< 1 ulp).
+// The arithmetic is the full scalar path's (kinematics.cpp), expression for expression, through
+// the shared detail::chord(); test_kinematics checks they agree.
 //
-// IK here is not re-verified by a forward pass: the elbows are the exact circle intersection and
-// the angles are atan2 of the elbow offsets, so loop closure holds by construction up to the
-// atan2 error (< 3 ulp); test_kinematics verifies batch IK by FK on every regime.
+// ik_angles verifies the loop closure of the elbow configuration. The batch IK is not re-verified
+// per point:
+// the elbows are the exact circle intersection and the angles are atan2 of the elbow offsets, so
+// closure holds by construction up to the atan2 error (< 3 ulp); test_kinematics verifies batch
+// IK by FK on every regime.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -20,17 +26,87 @@ namespace {
 
 using detail::cross;
 
+struct FastTrig {
+  static void sincos(double x, double& s, double& c) { detail::fast_sincos(x, s, c); }
+  static double atan2(double y, double x) { return detail::fast_atan2(y, x); }
+};
+struct LibmTrig {
+  static void sincos(double x, double& s, double& c) { ::sincos(x, &s, &c); }  // glibc, one reduction
+  static double atan2(double y, double x) { return std::atan2(y, x); }
+};
+
+/// Loop-invariant constants of one mechanism.
+struct FkConst {
+  double o1x, o1y, o2x, o2y, L1, L2, L3, L4;
+  detail::CirclePair distal;
+  double thr13, thr24, thr34, fixed_side, w1, w2;  // thrIJ = kSingularSin * L_I * L_J
+  explicit FkConst(const Mechanism& m)
+      : o1x(m.O1.x()), o1y(m.O1.y()), o2x(m.O2.x()), o2y(m.O2.y()), L1(m.L[0]), L2(m.L[1]),
+        L3(m.L[2]), L4(m.L[3]), distal(detail::CirclePair::make(L3, L4)),
+        thr13(tol::kSingularSin * L1 * L3), thr24(tol::kSingularSin * L2 * L4),
+        thr34(tol::kSingularSin * L3 * L4),
+        fixed_side(m.assembly_mode == AssemblyMode::Minus ? -1.0 : 1.0), w1(m.working_mode.sign1),
+        w2(m.working_mode.sign2) {}
+};
+
+/// FK of one angle pair. kAny selects the branch per point by the working mode (as fk() does);
+/// a template parameter rather than a loop-invariant select, which defeats GCC's vectoriser.
+template <class Trig, bool kAny>
+inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, double& py, Status& status) {
+  double s1, c1, s2, c2;
+  Trig::sincos(theta1, s1, c1);
+  Trig::sincos(theta2, s2, c2);
+  const double e1x = g.L1 * c1, e1y = g.L1 * s1, e2x = g.L2 * c2, e2y = g.L2 * s2;
+  const double a1x = g.o1x + e1x, a1y = g.o1y + e1y, a2x = g.o2x + e2x, a2y = g.o2y + e2y;
+  const double dx = a2x - a1x, dy = a2y - a1y;
+  const double d2 = dx * dx + dy * dy;
+  const bool coincident = !(d2 > 0.0);
+  const double d = std::sqrt(coincident ? 1.0 : d2);
+  const double inv_d = 1.0 / d;
+  double a, h2;
+  const bool reach = !coincident & detail::chord(g.distal, d, inv_d, a, h2);
+  const double h = std::sqrt(std::max(0.0, h2));
+  const double ux = dx * inv_d, uy = dy * inv_d;
+  double side = g.fixed_side;
+  if constexpr (kAny) {
+    const double f1x_p = a * ux - h * uy, f1y_p = a * uy + h * ux;  // P - A1 on "+"
+    const double f1x_m = a * ux + h * uy, f1y_m = a * uy - h * ux;  // P - A1 on "-"
+    const double p1 = cross(e1x, e1y, f1x_p, f1y_p) * g.w1;
+    const double p2 = cross(e2x, e2y, f1x_p - dx, f1y_p - dy) * g.w2;
+    const double m1 = cross(e1x, e1y, f1x_m, f1y_m) * g.w1;
+    const double m2 = cross(e2x, e2y, f1x_m - dx, f1y_m - dy) * g.w2;
+    // As fk(): "+" if it is in the working mode, else "-" if that is, else "+".
+    side = (std::min(p1, p2) > 0.0) | !(std::min(m1, m2) > 0.0) ? 1.0 : -1.0;
+  }
+  const double ox = a * ux - side * h * uy, oy = a * uy + side * h * ux;  // P - A1
+  const double pxk = a1x + ox, pyk = a1y + oy;
+  // |cross(P - A2, ...)| with P - A2 = (P - A1) - (A2 - A1); |cross(P - A1, P - A2)| = d h.
+  const bool sing1 = (std::fabs(cross(e1x, e1y, ox, oy)) < g.thr13) |
+                     (std::fabs(cross(e2x, e2y, ox - dx, oy - dy)) < g.thr24);
+  const bool sing2 = d * h < g.thr34;
+  px = reach ? pxk : 0.0;
+  py = reach ? pyk : 0.0;
+  status = detail::classify(reach, sing1, sing2);
+}
+
 struct LegConst {
   double ox, oy;
   detail::CirclePair circles;  // (O, L_i) and (P, L_{i+2})
+  double s;                    // chord side: -sigma of the working mode
 };
 
-LegConst leg(const Vec2& O, double l_prox, double l_dist) {
-  return {O.x(), O.y(), detail::CirclePair::make(l_prox, l_dist)};
-}
+struct IkConst {
+  LegConst g1, g2;
+  double thr13, thr24, thr34;  // kSingularSin * L_I * L_J
+  explicit IkConst(const Mechanism& m)
+      : g1{m.O1.x(), m.O1.y(), detail::CirclePair::make(m.L[0], m.L[2]), -double(m.working_mode.sign1)},
+        g2{m.O2.x(), m.O2.y(), detail::CirclePair::make(m.L[1], m.L[3]), -double(m.working_mode.sign2)},
+        thr13(tol::kSingularSin * m.L[0] * m.L[2]), thr24(tol::kSingularSin * m.L[1] * m.L[3]),
+        thr34(tol::kSingularSin * m.L[2] * m.L[3]) {}
+};
 
-/// Elbow offset A - O for a leg at tactor (px, py), side s = -sigma; returns reachability.
-inline bool elbow_offset(const LegConst& g, double px, double py, double s, double& ex, double& ey) {
+/// Elbow offset A - O for a leg at tactor (px, py); returns reachability.
+inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, double& ey) {
   const double dx = px - g.ox, dy = py - g.oy;
   const double d2 = dx * dx + dy * dy;
   const bool coincident = !(d2 > 0.0);
@@ -40,79 +116,91 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double s, doub
   const bool reach = !coincident & detail::chord(g.circles, d, inv_d, a, h2);
   const double h = std::sqrt(std::max(0.0, h2));
   const double ux = dx * inv_d, uy = dy * inv_d;
-  ex = reach ? a * ux - s * h * uy : 0.0;
-  ey = reach ? a * uy + s * h * ux : 0.0;
+  ex = reach ? a * ux - g.s * h * uy : 0.0;
+  ey = reach ? a * uy + g.s * h * ux : 0.0;
   return reach;
 }
 
-/// FK kernel; kAny selects the branch per point by the working mode, else `fixed_side` is used.
-/// Templated so that the branch choice is not a loop-invariant select (which defeats GCC's
-/// vectoriser).
-template <bool kAny>
-void fk_kernel(const Mechanism& m, std::span<const double> theta1, std::span<const double> theta2,
-               std::span<double> px, std::span<double> py, std::span<Status> status) {
-  const std::size_t n = theta1.size();
-  const double o1x = m.O1.x(), o1y = m.O1.y(), o2x = m.O2.x(), o2y = m.O2.y();
-  const double L1 = m.L[0], L2 = m.L[1], L3 = m.L[2], L4 = m.L[3];
-  const detail::CirclePair distal = detail::CirclePair::make(L3, L4);
-  const double inv13 = 1.0 / (L1 * L3), inv24 = 1.0 / (L2 * L4), inv34 = 1.0 / (L3 * L4);
-  const double fixed_side = m.assembly_mode == AssemblyMode::Minus ? -1.0 : 1.0;
-  const double w1 = m.working_mode.sign1, w2 = m.working_mode.sign2;
-  for (std::size_t k = 0; k < n; ++k) {
-    double s1, c1, s2, c2;
-    detail::fast_sincos(theta1[k], s1, c1);
-    detail::fast_sincos(theta2[k], s2, c2);
-    const double e1x = L1 * c1, e1y = L1 * s1, e2x = L2 * c2, e2y = L2 * s2;
-    const double a1x = o1x + e1x, a1y = o1y + e1y, a2x = o2x + e2x, a2y = o2y + e2y;
-    const double dx = a2x - a1x, dy = a2y - a1y;
-    const double d2 = dx * dx + dy * dy;
-    const bool coincident = !(d2 > 0.0);
-    const double d = std::sqrt(coincident ? 1.0 : d2);
-    const double inv_d = 1.0 / d;
-    double a, h2;
-    const bool reach = !coincident & detail::chord(distal, d, inv_d, a, h2);
-    const double h = std::sqrt(std::max(0.0, h2));
-    const double ux = dx * inv_d, uy = dy * inv_d;
-    double side = fixed_side;
-    if constexpr (kAny) {
-      // "+" candidate: P - A1 and P - A2, and whether its working mode is the design's.
-      const double f1x_p = a * ux - h * uy, f1y_p = a * uy + h * ux;
-      const double f1x_m = a * ux + h * uy, f1y_m = a * uy - h * ux;  // "-" candidate
-      const double p1 = cross(e1x, e1y, f1x_p, f1y_p) * w1;
-      const double p2 = cross(e2x, e2y, f1x_p - dx, f1y_p - dy) * w2;
-      const double m1 = cross(e1x, e1y, f1x_m, f1y_m) * w1;
-      const double m2 = cross(e2x, e2y, f1x_m - dx, f1y_m - dy) * w2;
-      // As the scalar fk(): "+" if it is in the working mode, else "-" if that is, else "+".
-      side = (std::min(p1, p2) > 0.0) | !(std::min(m1, m2) > 0.0) ? 1.0 : -1.0;
-    }
-    const double ox = a * ux - side * h * uy, oy = a * uy + side * h * ux;  // P - A1
-    const double pxk = a1x + ox, pyk = a1y + oy;
-    const double f1x = pxk - a1x, f1y = pyk - a1y, f2x = pxk - a2x, f2y = pyk - a2y;
-    const double t1 = std::fabs(cross(e1x, e1y, f1x, f1y)) * inv13;
-    const double t2 = std::fabs(cross(e2x, e2y, f2x, f2y)) * inv24;
-    const double tb = d * h * inv34;
-    px[k] = reach ? pxk : 0.0;
-    py[k] = reach ? pyk : 0.0;
-    status[k] = detail::classify(reach, std::min(t1, t2), tb);
-  }
+/// Elbows and their singularity measures at one tactor point.
+struct Elbows {
+  double e1x, e1y, e2x, e2y, f1x, f1y, f2x, f2y;
+  bool reach;
+};
+inline Elbows elbows(const IkConst& g, double px, double py) {
+  Elbows e;
+  const bool r1 = elbow_offset(g.g1, px, py, e.e1x, e.e1y);
+  const bool r2 = elbow_offset(g.g2, px, py, e.e2x, e.e2y);
+  e.f1x = px - (g.g1.ox + e.e1x);
+  e.f1y = py - (g.g1.oy + e.e1y);
+  e.f2x = px - (g.g2.ox + e.e2x);
+  e.f2y = py - (g.g2.oy + e.e2y);
+  e.reach = r1 & r2;
+  return e;
+}
+
+template <class Trig>
+inline void ik_one(const IkConst& g, double px, double py, double& theta1, double& theta2, Status& status) {
+  const Elbows e = elbows(g, px, py);
+  const bool sing1 = (std::fabs(cross(e.e1x, e.e1y, e.f1x, e.f1y)) < g.thr13) |
+                     (std::fabs(cross(e.e2x, e.e2y, e.f2x, e.f2y)) < g.thr24);
+  const bool sing2 = std::fabs(cross(e.f1x, e.f1y, e.f2x, e.f2y)) < g.thr34;
+  theta1 = e.reach ? Trig::atan2(e.e1y, e.e1x) : 0.0;
+  theta2 = e.reach ? Trig::atan2(e.e2y, e.e2x) : 0.0;
+  status = detail::classify(e.reach, sing1, sing2);
 }
 
 }  // namespace
+
+// --- scalar lean forms ---------------------------------------------------------------------------
+
+PointResult fk_point(const Mechanism& m, double theta1, double theta2) {
+  PointResult r;
+  if (!(std::isfinite(theta1) && std::isfinite(theta2))) return r;
+  const FkConst g(m);
+  double px, py;
+  if (m.assembly_mode == AssemblyMode::Any) {
+    fk_one<LibmTrig, true>(g, theta1, theta2, px, py, r.status);
+  } else {
+    fk_one<LibmTrig, false>(g, theta1, theta2, px, py, r.status);
+  }
+  r.P = {px, py};
+  return r;
+}
+
+AnglesResult ik_angles(const Mechanism& m, const Vec2& P) {
+  AnglesResult r;
+  const IkConst g(m);
+  const Elbows e = elbows(g, P.x(), P.y());
+  ik_one<LibmTrig>(g, P.x(), P.y(), r.theta1, r.theta2, r.status);
+  if (r.status == Status::unreachable) return r;
+  // Loop closure of the configuration the angles describe: |A_i - O_i| = L_i, |P - A_i| = L_{i+2}
+  // (first-order length residuals, no square roots). ik() additionally runs the angles forward
+  // through sin/cos; here that would cost as much as the IK itself, and atan2 of the elbow offset
+  // is exact to < 1 ulp.
+  const auto residual = [](double x, double y, double l) { return std::fabs((x * x + y * y) - l * l) / (2.0 * l); };
+  r.closure_error_mm = std::max({residual(e.e1x, e.e1y, m.L[0]), residual(e.e2x, e.e2y, m.L[1]),
+                                 residual(e.f1x, e.f1y, m.L[2]), residual(e.f2x, e.f2y, m.L[3])});
+  if (!(r.closure_error_mm <= tol::kClosureRel * m.length_scale()) && r.status == Status::ok)
+    r.status = Status::singular_type1;  // only a numerically degenerate chord can get here
+  return r;
+}
+
+// --- batch ---------------------------------------------------------------------------------------
 
 void fk_batch(const Mechanism& m, std::span<const double> theta1, std::span<const double> theta2,
               std::span<double> px, std::span<double> py, std::span<Status> status) {
   const std::size_t n = theta1.size();
   assert(theta2.size() == n && px.size() == n && py.size() == n && status.size() == n);
+  const FkConst g(m);
   if (m.assembly_mode == AssemblyMode::Any) {
-    fk_kernel<true>(m, theta1, theta2, px, py, status);
+    for (std::size_t k = 0; k < n; ++k) fk_one<FastTrig, true>(g, theta1[k], theta2[k], px[k], py[k], status[k]);
   } else {
-    fk_kernel<false>(m, theta1, theta2, px, py, status);
+    for (std::size_t k = 0; k < n; ++k) fk_one<FastTrig, false>(g, theta1[k], theta2[k], px[k], py[k], status[k]);
   }
   // Arguments beyond the fast reduction's range (|theta| > 1e6 rad) are rare: redo them exactly.
   for (std::size_t k = 0; k < n; ++k) {
     if (!(std::fabs(theta1[k]) <= detail::kFastTrigMax && std::fabs(theta2[k]) <= detail::kFastTrigMax)) {
-      const bool finite = std::isfinite(theta1[k]) && std::isfinite(theta2[k]);
-      const Pose p = finite ? fk(m, theta1[k], theta2[k]) : Pose{};
+      const PointResult p = fk_point(m, theta1[k], theta2[k]);
       px[k] = p.P.x();
       py[k] = p.P.y();
       status[k] = p.status;
@@ -124,49 +212,23 @@ void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const do
               std::span<double> theta1, std::span<double> theta2, std::span<Status> status) {
   const std::size_t n = px.size();
   assert(py.size() == n && theta1.size() == n && theta2.size() == n && status.size() == n);
-  const LegConst g1 = leg(m.O1, m.L[0], m.L[2]);
-  const LegConst g2 = leg(m.O2, m.L[1], m.L[3]);
-  const double s1 = -m.working_mode.sign1, s2 = -m.working_mode.sign2;
-  const double inv13 = 1.0 / (m.L[0] * m.L[2]), inv24 = 1.0 / (m.L[1] * m.L[3]),
-               inv34 = 1.0 / (m.L[2] * m.L[3]);
-  for (std::size_t k = 0; k < n; ++k) {
-    double e1x, e1y, e2x, e2y;
-    const bool r1 = elbow_offset(g1, px[k], py[k], s1, e1x, e1y);
-    const bool r2 = elbow_offset(g2, px[k], py[k], s2, e2x, e2y);
-    const double f1x = px[k] - (g1.ox + e1x), f1y = py[k] - (g1.oy + e1y);
-    const double f2x = px[k] - (g2.ox + e2x), f2y = py[k] - (g2.oy + e2y);
-    const double t1 = std::fabs(cross(e1x, e1y, f1x, f1y)) * inv13;
-    const double t2 = std::fabs(cross(e2x, e2y, f2x, f2y)) * inv24;
-    const double tb = std::fabs(cross(f1x, f1y, f2x, f2y)) * inv34;
-    const bool reach = r1 & r2;
-    theta1[k] = reach ? detail::fast_atan2(e1y, e1x) : 0.0;
-    theta2[k] = reach ? detail::fast_atan2(e2y, e2x) : 0.0;
-    status[k] = detail::classify(reach, std::min(t1, t2), tb);
-  }
+  const IkConst g(m);
+  for (std::size_t k = 0; k < n; ++k) ik_one<FastTrig>(g, px[k], py[k], theta1[k], theta2[k], status[k]);
 }
 
 void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
                std::span<double> lci, std::span<Status> status) {
   const std::size_t n = px.size();
   assert(py.size() == n && lci.size() == n && status.size() == n);
-  const LegConst g1 = leg(m.O1, m.L[0], m.L[2]);
-  const LegConst g2 = leg(m.O2, m.L[1], m.L[3]);
-  const double s1 = -m.working_mode.sign1, s2 = -m.working_mode.sign2;
-  const double inv13 = 1.0 / (m.L[0] * m.L[2]), inv24 = 1.0 / (m.L[1] * m.L[3]),
-               inv34 = 1.0 / (m.L[2] * m.L[3]);
+  const IkConst g(m);
   for (std::size_t k = 0; k < n; ++k) {
-    double e1x, e1y, e2x, e2y;
-    const bool r1 = elbow_offset(g1, px[k], py[k], s1, e1x, e1y);
-    const bool r2 = elbow_offset(g2, px[k], py[k], s2, e2x, e2y);
-    const double f1x = px[k] - (g1.ox + e1x), f1y = py[k] - (g1.oy + e1y);
-    const double f2x = px[k] - (g2.ox + e2x), f2y = py[k] - (g2.oy + e2y);
-    const double c1 = cross(e1x, e1y, f1x, f1y), c2 = cross(e2x, e2y, f2x, f2y);
-    const double cb = cross(f1x, f1y, f2x, f2y);
-    const bool reach = r1 & r2;
-    const Status st = detail::classify(reach, std::min(std::fabs(c1) * inv13, std::fabs(c2) * inv24),
-                                       std::fabs(cb) * inv34);
+    const Elbows e = elbows(g, px[k], py[k]);
+    const double c1 = cross(e.e1x, e.e1y, e.f1x, e.f1y), c2 = cross(e.e2x, e.e2y, e.f2x, e.f2y);
+    const double cb = cross(e.f1x, e.f1y, e.f2x, e.f2y);
+    const Status st = detail::classify(e.reach, (std::fabs(c1) < g.thr13) | (std::fabs(c2) < g.thr24),
+                                       std::fabs(cb) < g.thr34);
     // M = adj(B) C, cond(M) = cond(J) (see kinematics.cpp).
-    const double v = detail::lci2(f2y * c1, -f1y * c2, -f2x * c1, f1x * c2);
+    const double v = detail::lci2(e.f2y * c1, -e.f1y * c2, -e.f2x * c1, e.f1x * c2);
     lci[k] = st == Status::ok ? v : 0.0;
     status[k] = st;
   }

@@ -52,10 +52,15 @@ inline double lci2(double m00, double m01, double m10, double m11) {
 
 /// Worst status first: unreachable > singular_type1 > singular_type2 > ok. Written as selects on
 /// integers (no short-circuit) so that loops calling it stay vectorisable.
-inline Status classify(bool reachable, double type1_sin_min, double type2_sin) {
-  const int t2 = type2_sin < tol::kSingularSin ? int(Status::singular_type2) : int(Status::ok);
-  const int t1 = type1_sin_min < tol::kSingularSin ? int(Status::singular_type1) : t2;
+inline Status classify(bool reachable, bool type1, bool type2) {
+  const int t2 = type2 ? int(Status::singular_type2) : int(Status::ok);
+  const int t1 = type1 ? int(Status::singular_type1) : t2;
   return static_cast<Status>(reachable ? t1 : int(Status::unreachable));
+}
+
+/// Same, from the |sin| of the worst elbow angle and of the tactor angle.
+inline Status classify(bool reachable, double type1_sin_min, double type2_sin) {
+  return classify(reachable, type1_sin_min < tol::kSingularSin, type2_sin < tol::kSingularSin);
 }
 
 }  // namespace fivebar::detail

@@ -1,1 +1,249 @@
+// FK/IK speed on the paper's index lower mechanism, each beside a floor that does only the work no
+// FK/IK can avoid (FK: sine and cosine of both angles and two square roots; IK: four square roots
+// and two atan2), with the same sin/cos/atan2 as the measured code (glibc for scalar, fastmath.hpp
+// for batch). Items per second = evaluations per second. Compare ratios within one run:
+//   ./build/fivebar_bench --benchmark_filter='fk|ik'
 #include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "fivebar/detail/fastmath.hpp"
+#include "fivebar/kinematics.hpp"
+
+namespace {
+
+using fivebar::Mechanism;
+using fivebar::Status;
+using fivebar::Vec2;
+
+constexpr std::size_t kN = 4096;
+
+Mechanism index_lower() {
+  Mechanism m;
+  m.name = "lower";
+  m.O1 = {0.0, 0.0};
+  m.O2 = {12.5, 0.0};
+  m.L = {9.0, 9.0, 15.0, 15.0};
+  m.working_mode = {-1, +1};
+  m.assembly_mode = fivebar::AssemblyMode::Plus;
+  return m;
+}
+
+/// Points uniformly in the index target ellipse (15 x 12 mm at (6.25, 15.5)) and their angles.
+struct Data {
+  std::vector<double> px, py, t1, t2, ox, oy, o1, o2;
+  std::vector<Status> st;
+  Data() : px(kN), py(kN), t1(kN), t2(kN), ox(kN), oy(kN), o1(kN), o2(kN), st(kN) {
+    const Mechanism m = index_lower();
+    std::mt19937_64 rng(42);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    for (std::size_t k = 0; k < kN;) {
+      const double x = u(rng), y = u(rng);
+      if (x * x + y * y > 1.0) continue;
+      px[k] = 6.25 + 7.5 * x;
+      py[k] = 15.5 + 6.0 * y;
+      const fivebar::Pose p = fivebar::ik(m, {px[k], py[k]});
+      t1[k] = p.theta1;
+      t2[k] = p.theta2;
+      ++k;
+    }
+  }
+};
+const Data& data() {
+  static const Data d;
+  return d;
+}
+
+// --- FK --------------------------------------------------------------------------------------------
+
+void BM_fk_floor_scalar(benchmark::State& state) {
+  const Data& d = data();
+  std::vector<double> ox(kN), oy(kN);
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      const double s1 = std::sin(d.t1[k]), c1 = std::cos(d.t1[k]);
+      const double s2 = std::sin(d.t2[k]), c2 = std::cos(d.t2[k]);
+      const double r1 = std::sqrt(c1 * c2 + 2.0), r2 = std::sqrt(s1 * s2 + 2.0);
+      ox[k] = r1;
+      oy[k] = r2;
+    }
+    benchmark::DoNotOptimize(ox.data());
+    benchmark::DoNotOptimize(oy.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_fk_floor_scalar);
+
+void BM_fk_scalar(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  std::vector<double> ox(kN), oy(kN);
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      const fivebar::PointResult r = fivebar::fk_point(m, d.t1[k], d.t2[k]);
+      ox[k] = r.P.x();
+      oy[k] = r.P.y();
+    }
+    benchmark::DoNotOptimize(ox.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_fk_scalar);
+
+/// The full pose: point, Jacobian, LCI, transmission angles, singularity distances.
+void BM_fk_scalar_full_pose(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  double acc = 0.0;
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) acc += fivebar::fk(m, d.t1[k], d.t2[k]).lci;
+    benchmark::DoNotOptimize(acc);
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_fk_scalar_full_pose);
+
+void BM_fk_floor_batch(benchmark::State& state) {
+  const Data& d = data();
+  std::vector<double> ox(kN), oy(kN);
+  const double* t1 = d.t1.data();
+  const double* t2 = d.t2.data();
+  double* __restrict x = ox.data();
+  double* __restrict y = oy.data();
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      double s1, c1, s2, c2;
+      fivebar::detail::fast_sincos(t1[k], s1, c1);
+      fivebar::detail::fast_sincos(t2[k], s2, c2);
+      x[k] = std::sqrt(c1 * c2 + 2.0);
+      y[k] = std::sqrt(s1 * s2 + 2.0);
+    }
+    benchmark::DoNotOptimize(x);
+    benchmark::DoNotOptimize(y);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_fk_floor_batch);
+
+void BM_fk_batch(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  std::vector<double> ox(kN), oy(kN);
+  std::vector<Status> st(kN);
+  for (auto _ : state) {
+    fivebar::fk_batch(m, d.t1, d.t2, ox, oy, st);
+    benchmark::DoNotOptimize(ox.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_fk_batch);
+
+// --- IK --------------------------------------------------------------------------------------------
+
+void BM_ik_floor_scalar(benchmark::State& state) {
+  const Data& d = data();
+  std::vector<double> o1(kN), o2(kN);
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      const double x = d.px[k], y = d.py[k];
+      const double r1 = std::sqrt(x * x + y * y), r2 = std::sqrt(x * y + 400.0);
+      const double r3 = std::sqrt(r1 + y), r4 = std::sqrt(r2 + x);
+      o1[k] = std::atan2(r1 - x, r3);
+      o2[k] = std::atan2(r2 - y, r4);
+    }
+    benchmark::DoNotOptimize(o1.data());
+    benchmark::DoNotOptimize(o2.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_ik_floor_scalar);
+
+void BM_ik_scalar(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  std::vector<double> o1(kN), o2(kN);
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      const fivebar::AnglesResult r = fivebar::ik_angles(m, {d.px[k], d.py[k]});
+      o1[k] = r.theta1;
+      o2[k] = r.theta2;
+    }
+    benchmark::DoNotOptimize(o1.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_ik_scalar);
+
+void BM_ik_scalar_full_pose(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  double acc = 0.0;
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) acc += fivebar::ik(m, {d.px[k], d.py[k]}).lci;
+    benchmark::DoNotOptimize(acc);
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_ik_scalar_full_pose);
+
+void BM_ik_floor_batch(benchmark::State& state) {
+  const Data& d = data();
+  std::vector<double> o1(kN), o2(kN);
+  const double* px = d.px.data();
+  const double* py = d.py.data();
+  double* __restrict a = o1.data();
+  double* __restrict b = o2.data();
+  for (auto _ : state) {
+    for (std::size_t k = 0; k < kN; ++k) {
+      const double x = px[k], y = py[k];
+      const double r1 = std::sqrt(x * x + y * y), r2 = std::sqrt(x * y + 400.0);
+      const double r3 = std::sqrt(r1 + y), r4 = std::sqrt(r2 + x);
+      a[k] = fivebar::detail::fast_atan2(r1 - x, r3);
+      b[k] = fivebar::detail::fast_atan2(r2 - y, r4);
+    }
+    benchmark::DoNotOptimize(a);
+    benchmark::DoNotOptimize(b);
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_ik_floor_batch);
+
+void BM_ik_batch(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  std::vector<double> o1(kN), o2(kN);
+  std::vector<Status> st(kN);
+  for (auto _ : state) {
+    fivebar::ik_batch(m, d.px, d.py, o1, o2, st);
+    benchmark::DoNotOptimize(o1.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_ik_batch);
+
+/// LCI from elbow positions only (square roots, no trigonometry): the workspace/coverage kernel.
+void BM_lci_batch(benchmark::State& state) {
+  const Data& d = data();
+  const Mechanism m = index_lower();
+  std::vector<double> l(kN);
+  std::vector<Status> st(kN);
+  for (auto _ : state) {
+    fivebar::lci_batch(m, d.px, d.py, l, st);
+    benchmark::DoNotOptimize(l.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
+}
+BENCHMARK(BM_lci_batch);
+
+}  // namespace

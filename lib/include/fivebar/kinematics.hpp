@@ -80,6 +80,25 @@ struct CircleIntersection {
 };
 CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, double r2, int side);
 
+// --- Lean scalar forms -------------------------------------------------------------------------
+// The point or the angles and a status, nothing else: for control loops and per-sample checks.
+
+struct PointResult {
+  Status status = Status::unreachable;
+  Vec2 P{0.0, 0.0};  ///< mm; zero when unreachable
+};
+struct AnglesResult {
+  Status status = Status::unreachable;
+  double theta1 = 0.0;  ///< rad; zero when unreachable
+  double theta2 = 0.0;
+  double closure_error_mm = 0.0;
+};
+/// FK to the tactor point in the mechanism's assembly mode (as fk()).
+PointResult fk_point(const Mechanism& m, double theta1, double theta2);
+/// IK to the joint angles in the mechanism's working mode (as ik()); verifies the loop closure of
+/// the elbow configuration, without ik()'s forward sin/cos pass.
+AnglesResult ik_angles(const Mechanism& m, const Vec2& P);
+
 // --- Batch (structure of arrays) --------------------------------------------------------------
 // All spans of one call have the same length n. Written branch-free over fast vectorisable
 // sin/cos/atan2 (fivebar/detail/fastmath.hpp, < 3 ulp); statuses as in the scalar functions,
