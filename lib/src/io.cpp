@@ -1,0 +1,217 @@
+#include "fivebar/io.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <streambuf>
+
+#include "fivebar/error.hpp"
+
+namespace fivebar {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+[[noreturn]] void throw_io(const fs::path& path, const std::string& what, int err) {
+  throw IoError("cannot write '" + path.string() + "': " + what +
+                (err != 0 ? ": " + errno_text(err) : std::string()));
+}
+
+/// Unbuffered-by-the-kernel output stream buffer over a POSIX descriptor: std::ofstream exposes
+/// no descriptor to fsync.
+class FdStreambuf : public std::streambuf {
+ public:
+  explicit FdStreambuf(int fd) : fd_(fd) { setp(buf_.data(), buf_.data() + buf_.size()); }
+  /// errno of the first failed write, 0 if none.
+  int error() const noexcept { return error_; }
+
+ protected:
+  int_type overflow(int_type ch) override {
+    if (!drain()) return traits_type::eof();
+    if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(ch);
+      pbump(1);
+    }
+    return traits_type::not_eof(ch);
+  }
+  int sync() override { return drain() ? 0 : -1; }
+
+ private:
+  bool drain() {
+    const char* p = pbase();
+    std::size_t left = static_cast<std::size_t>(pptr() - pbase());
+    while (left > 0 && error_ == 0) {
+      const ssize_t n = ::write(fd_, p, left);
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        error_ = errno;
+        break;
+      }
+      p += n;
+      left -= static_cast<std::size_t>(n);
+    }
+    setp(buf_.data(), buf_.data() + buf_.size());
+    return error_ == 0;
+  }
+
+  int fd_;
+  int error_ = 0;
+  std::array<char, 1 << 16> buf_{};
+};
+
+std::uint64_t random_token() {
+  // Seeded once per thread from the system's entropy source, never from the clock.
+  thread_local std::mt19937_64 engine{[] {
+    std::random_device device;
+    return (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  }()};
+  return engine();
+}
+
+}  // namespace
+
+struct AtomicFile::Impl {
+  fs::path target;
+  fs::path temp;
+  int fd = -1;
+  std::unique_ptr<FdStreambuf> buf;
+  std::unique_ptr<std::ostream> os;
+  bool committed = false;
+
+  void close_and_remove() noexcept {
+    os.reset();
+    buf.reset();
+    if (fd >= 0) ::close(fd);
+    fd = -1;
+    if (!temp.empty()) ::unlink(temp.c_str());
+    temp.clear();
+  }
+};
+
+AtomicFile::AtomicFile(fs::path path) : impl_(std::make_unique<Impl>()) {
+  impl_->target = std::move(path);
+  const fs::path name = impl_->target.filename();
+  if (name.empty() || name == "." || name == "..") {
+    throw_io(impl_->target, "not a file name", 0);
+  }
+  const fs::path dir = impl_->target.parent_path();
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    char token[17];
+    std::snprintf(token, sizeof token, "%016llx", static_cast<unsigned long long>(random_token()));
+    const std::string temp_name = "." + name.string() + ".tmp." + std::to_string(::getpid()) + "." + token;
+    const fs::path temp = dir.empty() ? fs::path(temp_name) : dir / temp_name;
+    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd >= 0) {
+      impl_->temp = temp;
+      impl_->fd = fd;
+      impl_->buf = std::make_unique<FdStreambuf>(fd);
+      impl_->os = std::make_unique<std::ostream>(impl_->buf.get());
+      return;
+    }
+    if (errno != EEXIST) throw_io(impl_->target, "cannot create a temporary file", errno);
+  }
+  throw_io(impl_->target, "cannot find a free temporary name", EEXIST);
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+AtomicFile::AtomicFile(AtomicFile&&) noexcept = default;
+AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
+  if (this != &other) {
+    discard();
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
+
+std::ostream& AtomicFile::stream() {
+  if (!impl_ || !impl_->os) throw std::logic_error("AtomicFile::stream() after commit or discard");
+  return *impl_->os;
+}
+
+void AtomicFile::commit() {
+  if (!impl_ || !impl_->os) throw std::logic_error("AtomicFile::commit() after commit or discard");
+  Impl& f = *impl_;
+  f.os->flush();
+  if (!*f.os || f.buf->error() != 0) {
+    const int err = f.buf->error();
+    f.close_and_remove();
+    throw_io(f.target, "write failed", err);
+  }
+  if (::fsync(f.fd) != 0) {
+    const int err = errno;
+    f.close_and_remove();
+    throw_io(f.target, "fsync failed", err);
+  }
+  f.os.reset();
+  f.buf.reset();
+  const int fd = f.fd;
+  f.fd = -1;
+  if (::close(fd) != 0) {
+    const int err = errno;
+    f.close_and_remove();
+    throw_io(f.target, "close failed", err);
+  }
+  if (::rename(f.temp.c_str(), f.target.c_str()) != 0) {
+    const int err = errno;
+    f.close_and_remove();
+    throw_io(f.target, "rename failed", err);
+  }
+  f.temp.clear();
+  f.committed = true;
+  // Make the rename itself durable; best effort (some file systems refuse fsync on directories).
+  const fs::path dir = f.target.parent_path().empty() ? fs::path(".") : f.target.parent_path();
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+void AtomicFile::discard() noexcept {
+  if (impl_) impl_->close_and_remove();
+}
+
+const fs::path& AtomicFile::path() const noexcept { return impl_->target; }
+const fs::path& AtomicFile::temp_path() const noexcept { return impl_->temp; }
+
+void write_file_atomic(const fs::path& path, std::string_view content) {
+  AtomicFile file(path);
+  file.stream().write(content.data(), static_cast<std::streamsize>(content.size()));
+  file.commit();
+}
+
+void make_directories(const fs::path& dir) {
+  if (dir.empty()) return;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw IoError("cannot create directory '" + dir.string() + "': " + ec.message());
+  if (!fs::is_directory(dir, ec)) throw IoError("'" + dir.string() + "' exists and is not a directory");
+}
+
+fs::path resolve_output_dir(const fs::path& root, std::string_view name) {
+  const auto refuse = [&](const std::string& why) {
+    throw InputError("output name '" + std::string(name) + "' " + why + " (output root '" +
+                     root.string() + "')");
+  };
+  if (name.empty()) refuse("is empty");
+  const fs::path rel(name);
+  if (rel.has_root_name() || rel.has_root_directory()) refuse("must be relative");
+
+  fs::path base = root.lexically_normal();
+  if (!base.has_filename() && base != base.root_path()) base = base.parent_path();  // "out/" -> "out"
+  const fs::path result = (base / rel).lexically_normal();
+  const fs::path inside = result.lexically_relative(base);
+  if (inside.empty() || inside == "." || *inside.begin() == "..") refuse("escapes the output root");
+  // A trailing separator ("name/") normalises to a path with an empty last element.
+  if (!result.has_filename()) return result.parent_path();
+  return result;
+}
+
+}  // namespace fivebar

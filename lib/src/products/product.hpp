@@ -1,0 +1,67 @@
+#pragma once
+/// The product registry behind run_scene() (fivebar/scene.hpp). A product is one entry: a name
+/// from known_products(), what it needs first, whether a design has the data for it, and how to
+/// build it. Each capability adds one entry: a `Product <name>_product()` in its own file here,
+/// listed once in registry.cpp.
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fivebar/design.hpp"
+#include "fivebar/io.hpp"
+
+namespace fivebar::products {
+
+/// What a product's build() sees and may use.
+struct Context {
+  const Design& design;
+  std::filesystem::path dir;                       ///< the scene's output directory (exists)
+  const std::map<std::string, nlohmann::json>& results;  ///< results of products built so far
+  std::function<void(std::string_view)> progress;  ///< may be empty
+  std::vector<std::filesystem::path> files;        ///< files written so far, relative to dir
+
+  /// The result of an earlier product (a prerequisite), or nullptr.
+  const nlohmann::json* result_of(std::string_view name) const;
+  /// Writes `relative` under dir atomically (creating sub-directories) and records it.
+  std::filesystem::path write_file(const std::filesystem::path& relative, std::string_view content);
+  /// For streamed files: an AtomicFile at `relative` under dir; after commit(), call record().
+  AtomicFile open_file(const std::filesystem::path& relative);
+  void record(const std::filesystem::path& relative);
+  void say(std::string_view message) const;
+};
+
+/// What build() returns.
+struct Built {
+  nlohmann::json result;  ///< goes to summary.json under results.<name>
+  std::string markdown;   ///< body of the product's section in summary.md (no top heading)
+  bool passed = true;     ///< the product's own check; true when it has none
+  std::string check;      ///< one line describing the check's outcome
+};
+
+struct Product {
+  std::string name;                   ///< as in known_products()
+  std::string title;                  ///< section heading in summary.md
+  std::vector<std::string> prerequisites;  ///< products that must be built first
+  /// Why this design cannot have the product (missing section, no mechanism, tool not
+  /// installed), or std::nullopt when it can.
+  std::function<std::optional<std::string>(const Design&)> unavailable;
+  std::function<Built(Context&)> build;
+};
+
+/// All implemented products; run_scene() follows known_products() for the order.
+const std::vector<Product>& registry();
+/// The entry named `name`, or nullptr when this build does not implement it.
+const Product* find_product(std::string_view name);
+
+// --- Entries (one file each) -----------------------------------------------------------------
+/// Link data, modes and the pose at the target centre and axis ends of every mechanism.
+Product kinematics_product();
+
+}  // namespace fivebar::products
