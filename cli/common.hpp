@@ -1,0 +1,127 @@
+#pragma once
+// Shared pieces of the `fivebar` subcommands: exit codes, DESIGN/--station/--mechanism handling,
+// argument parsing with messages that name the option, CSV batch input and output formatting.
+// No maths here: every number comes from lib/.
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <istream>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fivebar/design.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/kinematics.hpp"
+
+namespace fivebar::cli {
+
+/// DESIGN.md "Exit codes".
+enum Exit : int {
+  kOk = 0,           ///< success
+  kCheckFailed = 1,  ///< a check failed / no solution
+  kBadInput = 2,     ///< usage error or bad design file
+  kInternal = 3,     ///< internal error (or the output could not be written)
+};
+
+/// Ends a subcommand's callback with `code` (CLI11's idiom: a RuntimeError carries the code).
+void finish(int code);
+
+// --- Design and mechanism selection -----------------------------------------------------------
+
+/// DESIGN plus the --station / --mechanism choice, bound by add_target_options().
+struct Target {
+  std::string design;
+  std::string station;
+  std::string mechanism;
+};
+void add_design_argument(CLI::App& sub, std::string& design);
+void add_target_options(CLI::App& sub, Target& target);
+
+/// Loads DESIGN; InputError (exit 2) with the loader's file:line:key message on failure.
+Design load(const std::string& path);
+
+struct Selection {
+  const Station* station = nullptr;
+  const Mechanism* mechanism = nullptr;
+  /// "index/lower"
+  std::string label() const;
+};
+/// Resolves --station / --mechanism: an empty choice means "the only one present"; otherwise, or
+/// for a name that is not there, InputError listing the choices.
+Selection select(const Design& design, const Target& target);
+
+// --- Values -----------------------------------------------------------------------------------
+
+/// "A,B" -> two finite numbers; InputError naming `option` and the expected form otherwise.
+std::array<double, 2> parse_pair(std::string_view text, std::string_view option, std::string_view form);
+/// A finite number; std::nullopt when `text` is not exactly one.
+std::optional<double> parse_number(std::string_view text);
+
+// --- Output -----------------------------------------------------------------------------------
+
+/// The one JSON document of a --json run, on stdout.
+void print_json(const nlohmann::json& doc);
+/// Fixed-point text ("-0.0000" shows as "0.0000").
+std::string fixed(double value, int digits = 4);
+/// Shortest text that reads back to the same double (CSV output).
+std::string exact(double value);
+/// Key/value table of one pose for human readers (angles in degrees, lengths in mm).
+void print_pose(std::ostream& out, const Mechanism& m, const Pose& pose);
+/// Compact description of the joint-limit verdict: "within", "OUTSIDE", "none set".
+std::string limits_text(const Mechanism& m, const Pose& pose);
+
+// --- Batch CSV --------------------------------------------------------------------------------
+
+/// Reads a CSV with a header line, streaming: only the current row is held. Columns are found by
+/// name (extra columns are ignored, so a previous command's output can be fed back). Blank lines
+/// and lines starting with '#' are skipped; '-' reads stdin. Errors are InputError "FILE:LINE: ...".
+class CsvReader {
+ public:
+  CsvReader(const std::string& path, std::vector<std::string> columns);
+  ~CsvReader();
+  /// The next row's values of the requested columns, in the requested order; false at the end.
+  bool next(std::vector<double>& values);
+  /// "FILE:LINE" of the row last returned.
+  std::string where() const;
+
+ private:
+  bool next_line(std::string& line);
+  std::string name_;
+  std::unique_ptr<std::istream> file_;
+  std::istream* in_ = nullptr;
+  std::size_t line_no_ = 0;
+  std::vector<std::string> columns_;
+  std::vector<std::size_t> index_;
+  std::size_t width_ = 0;
+};
+
+/// Where batch rows go: stdout, or an atomically written file (--output).
+class BatchSink {
+ public:
+  explicit BatchSink(const std::string& output_path);
+  std::ostream& out();
+  /// Commits the file (no-op for stdout). Without it the file is discarded.
+  void commit();
+
+ private:
+  std::optional<AtomicFile> file_;
+};
+
+/// Header and one row of batch output: x_mm,y_mm,theta1_deg,theta2_deg,status,lci,mode,assembly,
+/// within_joint_limits. For an unreachable row the known inputs are echoed and the rest left empty.
+extern const char* const kBatchHeader;
+void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Vec2>& point_mm,
+                     const std::optional<std::array<double, 2>>& theta_deg);
+
+// --- Subcommands (one file each) ----------------------------------------------------------------
+void setup_fk(CLI::App& app);
+void setup_ik(CLI::App& app);
+void setup_run(CLI::App& app);
+
+}  // namespace fivebar::cli

@@ -1,0 +1,177 @@
+// fivebar ik: tactor point (mm) -> motor angles (deg) in the design's working mode, or all four.
+
+#include <iostream>
+#include <memory>
+
+#include "common.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/json.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct IkOptions {
+  Target target;
+  std::string point;       ///< "X,Y" in mm
+  std::string point_file;  ///< batch CSV, '-' = stdin
+  std::string output;      ///< batch output file; empty = stdout
+  std::string mode;        ///< "+-" etc.; empty = the design's working mode
+  bool all = false;
+  bool json = false;
+};
+
+/// A configuration the device can take: it exists and respects the joint limits.
+bool usable(const Pose& pose) { return pose.status != Status::unreachable && pose.within_joint_limits; }
+
+WorkingMode mode_of(const IkOptions& opt, const Mechanism& m) {
+  if (opt.mode.empty()) return m.working_mode;
+  const auto mode = parse_working_mode(opt.mode);
+  if (!mode) throw InputError("--mode '" + opt.mode + "': expected two signs such as -+ (leg 1, leg 2)");
+  return *mode;
+}
+
+nlohmann::json context_json(const Design& design, const Selection& sel, const Vec2& p) {
+  return {{"command", "ik"},
+          {"design", design.name},
+          {"station", sel.station->name},
+          {"mechanism", sel.mechanism->name},
+          {"target_mm", {p.x(), p.y()}}};
+}
+
+int run_batch(const IkOptions& opt, const Mechanism& m, WorkingMode mode) {
+  CsvReader reader(opt.point_file, {"x_mm", "y_mm"});
+  BatchSink sink(opt.output);
+  std::ostream& out = sink.out();
+  out << kBatchHeader << "\n";
+  std::vector<double> row;
+  std::size_t rows = 0, unsolved = 0;
+  while (reader.next(row)) {
+    const Vec2 p(row[0], row[1]);
+    const Pose pose = ik(m, p, mode);
+    write_batch_row(out, pose, p, std::nullopt);
+    ++rows;
+    if (!usable(pose)) ++unsolved;
+  }
+  sink.commit();
+  if (unsolved > 0) {
+    std::cerr << "fivebar ik: " << unsolved << " of " << rows
+              << " rows have no usable solution (unreachable or outside the joint limits)\n";
+    return kCheckFailed;
+  }
+  return kOk;
+}
+
+void print_all(const Selection& sel, const Vec2& p, const std::array<Pose, 4>& poses) {
+  const Mechanism& m = *sel.mechanism;
+  std::cout << sel.label() << "  ik at P = (" << fixed(p.x()) << ", " << fixed(p.y())
+            << ") mm, all four working modes (* = the design's)\n\n";
+  std::printf("  %-6s %-15s %12s %12s %8s %10s %9s %8s\n", "mode", "status", "theta1(deg)", "theta2(deg)", "LCI",
+              "typeI(mm)", "typeIIsin", "limits");
+  std::cout << std::flush;
+  const auto modes = all_working_modes();
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Pose& pose = poses[k];
+    const std::string name = to_string(modes[k]) + (modes[k] == m.working_mode ? " *" : "");
+    if (pose.status == Status::unreachable) {
+      std::printf("  %-6s %-15s %12s %12s %8s %10s %9s %8s\n", name.c_str(), "unreachable", "-", "-", "-", "-", "-",
+                  "-");
+    } else {
+      std::printf("  %-6s %-15s %12s %12s %8s %10s %9s %8s\n", name.c_str(),
+                  std::string(to_string(pose.status)).c_str(), fixed(angle_deg(pose.theta1)).c_str(),
+                  fixed(angle_deg(pose.theta2)).c_str(), fixed(pose.lci).c_str(),
+                  fixed(pose.type1_distance_mm).c_str(), fixed(pose.type2_sin).c_str(),
+                  limits_text(m, pose).c_str());
+    }
+  }
+  std::fflush(stdout);
+}
+
+int run_ik(const IkOptions& opt) {
+  if (opt.point.empty() == opt.point_file.empty()) {
+    throw InputError("ik needs exactly one of --point X,Y or --point-file FILE");
+  }
+  if (!opt.output.empty() && opt.point_file.empty()) throw InputError("--output is for batch runs (--point-file)");
+  const Design design = load(opt.target.design);
+  const Selection sel = select(design, opt.target);
+  const Mechanism& m = *sel.mechanism;
+  const WorkingMode mode = mode_of(opt, m);
+  if (!opt.point_file.empty()) return run_batch(opt, m, mode);
+
+  const auto xy = parse_pair(opt.point, "--point", "X,Y in mm");
+  const Vec2 p(xy[0], xy[1]);
+
+  if (opt.all) {
+    const auto poses = ik_all(m, p);
+    bool any = false;
+    for (const Pose& pose : poses) any = any || usable(pose);
+    if (opt.json) {
+      nlohmann::json doc = context_json(design, sel, p);
+      doc["design_working_mode"] = to_string(m.working_mode);
+      doc["branches"] = nlohmann::json::array();
+      const auto modes = all_working_modes();
+      for (std::size_t k = 0; k < 4; ++k) {
+        nlohmann::json b = to_json(poses[k]);
+        b["working_mode"] = to_string(modes[k]);
+        doc["branches"].push_back(b);
+      }
+      print_json(doc);
+    } else {
+      print_all(sel, p, poses);
+    }
+    if (!any) std::cerr << "fivebar ik: no working mode reaches this point within the joint limits\n";
+    return any ? kOk : kCheckFailed;
+  }
+
+  const Pose pose = ik(m, p, mode);
+  if (opt.json) {
+    nlohmann::json doc = context_json(design, sel, p);
+    doc["working_mode"] = to_string(mode);
+    doc.update(to_json(pose));
+    print_json(doc);
+  } else {
+    std::cout << sel.label() << "  ik at P = (" << fixed(p.x()) << ", " << fixed(p.y()) << ") mm, working mode "
+              << to_string(mode) << "\n";
+    print_pose(std::cout, m, pose);
+  }
+  if (pose.status == Status::unreachable) {
+    std::cerr << "fivebar ik: point unreachable: it lies outside the annulus of at least one leg\n";
+    return kCheckFailed;
+  }
+  if (!pose.within_joint_limits) {
+    std::cerr << "fivebar ik: the solution lies outside the joint limits\n";
+    return kCheckFailed;
+  }
+  return kOk;
+}
+
+}  // namespace
+
+void setup_ik(CLI::App& app) {
+  auto opt = std::make_shared<IkOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "ik", "Inverse kinematics: tactor point X,Y (mm) -> motor angles (deg) in the design's working mode");
+  add_target_options(*sub, opt->target);
+  auto* point = sub->add_option("-p,--point", opt->point, "Tactor point X,Y in mm, station frame (e.g. --point 6.25,15.5)")
+                    ->type_name("X,Y");
+  auto* file = sub->add_option("--point-file", opt->point_file,
+                               "Batch: CSV with header columns x_mm,y_mm ('-' = stdin); "
+                               "writes one CSV row per input row")
+                   ->type_name("FILE");
+  sub->add_option("-o,--output", opt->output, "Batch: write the CSV to this file (atomically) instead of stdout")->type_name("FILE");
+  auto* mode = sub->add_option("--mode", opt->mode,
+                               "Working mode: signs of cross(A_i-O_i, P-A_i) for legs 1 and 2, e.g. -+ "
+                               "(elbows out, lower) or +- (upper); default: the design's")
+                   ->type_name("SIGNS");
+  auto* all = sub->add_flag("-a,--all", opt->all, "All four working modes ++, +-, -+, --");
+  auto* json = sub->add_flag("--json", opt->json, "Print one JSON document (mm, deg) on stdout and nothing else");
+  point->excludes(file);
+  all->excludes(mode);
+  file->excludes(all)->excludes(json);
+  sub->footer(
+      "Exit status: 0 a solution within the joint limits, 1 none (unreachable or outside the limits), 2 bad input, "
+      "3 internal error.");
+  sub->callback([opt]() { finish(run_ik(*opt)); });
+}
+
+}  // namespace fivebar::cli

@@ -1,0 +1,83 @@
+// fivebar: command-line entry point. Subcommands live in one file each (setup_<cmd> / run_<cmd>);
+// this file maps every outcome to the exit codes of DESIGN.md.
+
+#include <algorithm>
+#include <cctype>
+#include <iostream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "common.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/version.hpp"
+
+namespace {
+
+/// CLI11 reads "-+" or "-.5,2" after an option as an option of its own. Values of the options
+/// below often start with '-' (modes, branches, negative numbers), so "--mode -+" is rewritten
+/// to "--mode=-+" before parsing.
+std::vector<std::string> join_dash_values(int argc, char** argv) {
+  static const std::set<std::string> takes_value{"-t", "--theta", "-p", "--point", "--mode", "-b", "--branch"};
+  std::vector<std::string> args(argv + 1, argv + argc);
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (takes_value.count(a) > 0 && i + 1 < args.size()) {
+      const std::string& v = args[i + 1];
+      const bool dash_value = !v.empty() && v[0] == '-' && (v.size() == 1 || !std::isalpha(static_cast<unsigned char>(v[1])));
+      if (dash_value) {
+        // Short forms take "-bVALUE"; long forms "--opt=VALUE".
+        out.push_back(a.size() == 2 ? a + v : a + "=" + v);
+        ++i;
+        continue;
+      }
+    }
+    out.push_back(a);
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace fivebar::cli;
+  CLI::App app{
+      "fivebar " + std::string(fivebar::version()) +
+          ": design five-bar-linkage cutaneous haptic devices (IROS 2022).\n"
+          "Lengths in mm and angles in degrees on the command line, in files and in JSON.",
+      "fivebar"};
+  app.set_version_flag("--version", "fivebar " + std::string(fivebar::version()));
+  app.require_subcommand(1);
+  app.footer(
+      "Run 'fivebar <subcommand> --help' for its options.\n"
+      "Exit status: 0 success, 1 a check failed or no solution, 2 bad input (usage or design file), "
+      "3 internal error.");
+  setup_fk(app);
+  setup_ik(app);
+  setup_run(app);
+
+  try {
+    std::vector<std::string> args = join_dash_values(argc, argv);
+    std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
+    app.parse(args);
+    return kOk;
+  } catch (const CLI::RuntimeError& e) {  // a subcommand's own exit code (see finish())
+    return e.get_exit_code();
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    (void)app.exit(e);  // prints the message and a --help hint on stderr
+    return kBadInput;
+  } catch (const fivebar::InputError& e) {
+    std::cerr << "fivebar: error: " << e.what() << "\n";
+    return kBadInput;
+  } catch (const fivebar::IoError& e) {
+    std::cerr << "fivebar: error: " << e.what() << "\n";
+    return kInternal;
+  } catch (const std::exception& e) {
+    std::cerr << "fivebar: internal error: " << e.what() << "\n";
+    return kInternal;
+  }
+}

@@ -1,0 +1,94 @@
+// fivebar run: build the products a scene asks for into <out>/<name>/ (DESIGN.md "Scenes").
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "common.hpp"
+#include "fivebar/scene.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct RunOptions {
+  std::string design;
+  std::string out = "outputs";
+  std::vector<std::string> products;
+  bool json = false;
+  bool quiet = false;
+};
+
+void print_report(const SceneReport& report) {
+  std::cout << "scene " << report.design_name << " -> " << report.out_dir.generic_string() << "\n\n";
+  for (const auto& p : report.products) {
+    std::string state;
+    std::string note;
+    if (p.state == ProductOutcome::State::built) {
+      state = p.passed ? "built, passed" : "built, FAILED";
+      if (p.prerequisite && !p.requested) state += " (prerequisite)";
+      note = p.check;
+    } else {
+      state = p.requested ? "NOT BUILT" : "left out";
+      note = p.reason;
+    }
+    std::printf("  %-12s %-16s %s\n", p.name.c_str(), state.c_str(), note.c_str());
+  }
+  std::fflush(stdout);
+  std::cout << "\nsummary: " << report.summary_md.generic_string() << "\n"
+            << "         " << report.summary_json.generic_string() << "\n";
+  const auto missing = report.missing();
+  if (!missing.empty()) {
+    std::cerr << "fivebar run: requested but not built:";
+    for (const auto& m : missing) std::cerr << " " << m;
+    std::cerr << " (see the summary for why)\n";
+  }
+}
+
+int run_run(const RunOptions& opt) {
+  const Design design = load(opt.design);
+  SceneOptions options;
+  options.out_root = opt.out;
+  if (!opt.products.empty()) options.products = opt.products;
+  if (!opt.quiet) {
+    options.progress = [](std::string_view message) { std::cerr << "fivebar: " << message << "\n"; };
+  }
+  const SceneReport report = run_scene(design, options);
+  if (opt.json) {
+    nlohmann::json doc = report.to_json();
+    doc["summary_md"] = report.summary_md.generic_string();
+    doc["summary_json"] = report.summary_json.generic_string();
+    print_json(doc);
+  } else {
+    print_report(report);
+  }
+  return report.ok() ? kOk : kCheckFailed;
+}
+
+}  // namespace
+
+void setup_run(CLI::App& app) {
+  auto opt = std::make_shared<RunOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "run", "Build the products a scene lists (default: all it has data for) into OUT/<name>/ with summary.md/.json");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("-o,--out", opt->out, "Output root; the scene writes OUT/<design name>/")
+      ->capture_default_str()
+      ->type_name("DIR");
+  sub->add_option("-P,--products", opt->products,
+                  "Comma-separated products to build instead of the scene's list (known: " + [] {
+                    std::string names;
+                    for (const auto& n : known_products()) names += (names.empty() ? "" : ", ") + n;
+                    return names;
+                  }() + ")")
+      ->delimiter(',')
+      ->type_name("LIST");
+  sub->add_flag("--json", opt->json, "Print the summary as one JSON document on stdout and nothing else");
+  sub->add_flag("-q,--quiet", opt->quiet, "No progress lines on stderr");
+  sub->footer(
+      "Exit status: 0 every built product passed, 1 a check failed or a requested product could not be built, "
+      "2 bad input, 3 internal error or output not writable.");
+  sub->callback([opt]() { finish(run_run(*opt)); });
+}
+
+}  // namespace fivebar::cli
