@@ -1,0 +1,70 @@
+# shellcheck shell=bash
+# Set-up shared by ./run.sh and ./test.sh (DESIGN.md "Two commands"); source it, then call
+# fivebar_setup [TARGET...]. It installs the Debian packages that are missing (apt-get, via sudo
+# when not root), configures a Release build in build/ (Ninja when available) and builds.
+
+FIVEBAR_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+
+# Every package a capability of fivebar needs, so one set-up serves all of them.
+FIVEBAR_PACKAGES=(
+  build-essential cmake git pkg-config ccache
+  libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev
+  libvtk9-dev libcairo2-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  openscad
+)
+
+fivebar_log() { printf '[fivebar] %s\n' "$*" >&2; }
+
+# Installs the packages of FIVEBAR_PACKAGES that dpkg does not report as installed.
+fivebar_install_packages() {
+  if ! command -v dpkg-query >/dev/null 2>&1; then
+    fivebar_log "dpkg-query not found: not a Debian system, skipping package installation"
+    return 0
+  fi
+  local missing=() pkg
+  for pkg in "${FIVEBAR_PACKAGES[@]}"; do
+    if [[ "$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)" != "install ok installed" ]]; then
+      missing+=("$pkg")
+    fi
+  done
+  if ((${#missing[@]} == 0)); then
+    fivebar_log "all ${#FIVEBAR_PACKAGES[@]} Debian packages present"
+    return 0
+  fi
+  local as_root=()
+  if [[ "$(id -u)" -ne 0 ]]; then
+    if ! command -v sudo >/dev/null 2>&1; then
+      fivebar_log "missing packages: ${missing[*]}"
+      fivebar_log "run as root or install sudo, then try again"
+      return 1
+    fi
+    as_root=(sudo)
+  fi
+  fivebar_log "installing: ${missing[*]}"
+  "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+  "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
+}
+
+# Configures build/ (Release) once and builds the given targets (default: everything).
+fivebar_build() {
+  local generator=()
+  # The generator of an existing build/ is kept; a fresh one uses Ninja when it is installed.
+  if [[ ! -f "$FIVEBAR_ROOT/build/CMakeCache.txt" ]] && command -v ninja >/dev/null 2>&1; then
+    generator=(-G Ninja)
+  fi
+  fivebar_log "configuring build/ (Release)"
+  cmake -S "$FIVEBAR_ROOT" -B "$FIVEBAR_ROOT/build" -DCMAKE_BUILD_TYPE=Release "${generator[@]}"
+  local targets=()
+  local t
+  for t in "$@"; do targets+=(--target "$t"); done
+  fivebar_log "building with $(nproc) jobs"
+  cmake --build "$FIVEBAR_ROOT/build" -j"$(nproc)" "${targets[@]}"
+}
+
+# Packages, configure, build.
+fivebar_setup() {
+  fivebar_install_packages
+  fivebar_build "$@"
+}

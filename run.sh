@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Quick start 1/2: install what is missing, build (Release) and run the paper's scene,
+#   fivebar run designs/iros2022.yaml [ARGS...]   -> outputs/iros2022/summary.md
+# Extra arguments go to `fivebar run` (e.g. ./run.sh --out /tmp/x --products kinematics).
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")"
+source .ci/setup.sh
+fivebar_setup fivebar_cli
+exec build/fivebar run designs/iros2022.yaml "$@"
