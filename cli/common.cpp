@@ -136,7 +136,7 @@ std::array<double, 2> parse_pair(std::string_view text, std::string_view option,
 
 // --- Output -----------------------------------------------------------------------------------
 
-void print_json(const nlohmann::json& doc) { std::cout << doc.dump(2) << "\n"; }
+void print_json(const Json& doc) { std::cout << doc.dump(2) << "\n"; }
 
 std::string fixed(double value, int digits) {
   char buf[64];

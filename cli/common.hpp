@@ -17,6 +17,7 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 
 namespace fivebar::cli {
@@ -66,7 +67,7 @@ std::optional<double> parse_number(std::string_view text);
 // --- Output -----------------------------------------------------------------------------------
 
 /// The one JSON document of a --json run, on stdout.
-void print_json(const nlohmann::json& doc);
+void print_json(const Json& doc);
 /// Fixed-point text ("-0.0000" shows as "0.0000").
 std::string fixed(double value, int digits = 4);
 /// Shortest text that reads back to the same double (CSV output).

@@ -31,7 +31,7 @@ AssemblyMode branch_of(const FkOptions& opt, const Mechanism& m) {
   return *mode;
 }
 
-nlohmann::json context_json(const Design& design, const Selection& sel, const std::array<double, 2>& theta_deg) {
+Json context_json(const Design& design, const Selection& sel, const std::array<double, 2>& theta_deg) {
   return {{"command", "fk"},
           {"design", design.name},
           {"station", sel.station->name},
@@ -79,11 +79,11 @@ int run_fk(const FkOptions& opt) {
     const auto poses = fk_all(m, t1, t2);
     const bool any = poses[0].status != Status::unreachable || poses[1].status != Status::unreachable;
     if (opt.json) {
-      nlohmann::json doc = context_json(design, sel, theta_deg);
-      doc["branches"] = nlohmann::json::array();
+      Json doc = context_json(design, sel, theta_deg);
+      doc["branches"] = Json::array();
       const char* names[2] = {"+", "-"};
       for (int k = 0; k < 2; ++k) {
-        nlohmann::json p = to_json(poses[static_cast<std::size_t>(k)]);
+        Json p = to_json(poses[static_cast<std::size_t>(k)]);
         p["branch"] = names[k];
         doc["branches"].push_back(p);
       }
@@ -101,7 +101,7 @@ int run_fk(const FkOptions& opt) {
 
   const Pose pose = fk(m, t1, t2, branch);
   if (opt.json) {
-    nlohmann::json doc = context_json(design, sel, theta_deg);
+    Json doc = context_json(design, sel, theta_deg);
     doc["branch"] = to_string(branch);
     doc.update(to_json(pose));
     print_json(doc);

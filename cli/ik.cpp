@@ -31,7 +31,7 @@ WorkingMode mode_of(const IkOptions& opt, const Mechanism& m) {
   return *mode;
 }
 
-nlohmann::json context_json(const Design& design, const Selection& sel, const Vec2& p) {
+Json context_json(const Design& design, const Selection& sel, const Vec2& p) {
   return {{"command", "ik"},
           {"design", design.name},
           {"station", sel.station->name},
@@ -106,12 +106,12 @@ int run_ik(const IkOptions& opt) {
     bool any = false;
     for (const Pose& pose : poses) any = any || usable(pose);
     if (opt.json) {
-      nlohmann::json doc = context_json(design, sel, p);
+      Json doc = context_json(design, sel, p);
       doc["design_working_mode"] = to_string(m.working_mode);
-      doc["branches"] = nlohmann::json::array();
+      doc["branches"] = Json::array();
       const auto modes = all_working_modes();
       for (std::size_t k = 0; k < 4; ++k) {
-        nlohmann::json b = to_json(poses[k]);
+        Json b = to_json(poses[k]);
         b["working_mode"] = to_string(modes[k]);
         doc["branches"].push_back(b);
       }
@@ -125,7 +125,7 @@ int run_ik(const IkOptions& opt) {
 
   const Pose pose = ik(m, p, mode);
   if (opt.json) {
-    nlohmann::json doc = context_json(design, sel, p);
+    Json doc = context_json(design, sel, p);
     doc["working_mode"] = to_string(mode);
     doc.update(to_json(pose));
     print_json(doc);

@@ -55,7 +55,7 @@ int run_run(const RunOptions& opt) {
   }
   const SceneReport report = run_scene(design, options);
   if (opt.json) {
-    nlohmann::json doc = report.to_json();
+    Json doc = report.to_json();
     doc["summary_md"] = report.summary_md.generic_string();
     doc["summary_json"] = report.summary_json.generic_string();
     print_json(doc);

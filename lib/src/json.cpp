@@ -4,7 +4,7 @@
 #include <numbers>
 
 namespace fivebar {
-using nlohmann::json;
+using json = Json;
 
 namespace {
 

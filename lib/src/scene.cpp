@@ -12,7 +12,7 @@
 #include "products/product.hpp"
 
 namespace fivebar {
-using nlohmann::json;
+using json = Json;
 
 namespace {
 

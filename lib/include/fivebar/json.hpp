@@ -13,6 +13,10 @@
 
 namespace fivebar {
 
+/// The JSON type of fivebar's output: keys keep their insertion order, so documents read in a
+/// sensible order (status first) rather than alphabetically.
+using Json = nlohmann::ordered_json;
+
 /// Radians to degrees, normalised to (-180, 180]; -0 becomes 0.
 double angle_deg(double angle_rad);
 
@@ -29,17 +33,17 @@ std::string mode_string(const WorkingMode& mode);
 ///   type1_distance_mm}, closure_error_mm, within_joint_limits.
 /// For an unreachable pose every geometric field (point, angles, elbows, modes, Jacobian,
 /// transmission, singularity, closure, joint limits) is null: there is no configuration to describe.
-nlohmann::json to_json(const Pose& pose);
+Json to_json(const Pose& pose);
 /// Mechanism data: name, bases_mm, links_mm [L1..L4], working_mode, assembly_mode ("+", "-",
 /// "any"), joint_limits_deg ([[lo, hi], [lo, hi]] with lo in (-180, 180] and hi = lo + span, or
 /// null), min_lci, length_scale_mm.
-nlohmann::json to_json(const Mechanism& mechanism);
+Json to_json(const Mechanism& mechanism);
 /// Target ellipse: center_mm, axes_mm (full lengths), angle_deg.
-nlohmann::json to_json(const Ellipse& ellipse);
+Json to_json(const Ellipse& ellipse);
 
-/// nlohmann's ADL hooks, so that `nlohmann::json j = pose;` works.
-void to_json(nlohmann::json& j, const Pose& pose);
-void to_json(nlohmann::json& j, const Mechanism& mechanism);
-void to_json(nlohmann::json& j, const Ellipse& ellipse);
+/// nlohmann's ADL hooks, so that `Json j = pose;` works.
+void to_json(Json& j, const Pose& pose);
+void to_json(Json& j, const Mechanism& mechanism);
+void to_json(Json& j, const Ellipse& ellipse);
 
 }  // namespace fivebar

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/json.hpp"
 
 namespace fivebar {
 
@@ -38,7 +39,7 @@ struct ProductOutcome {
   std::string reason;        ///< why it was left out (empty when built)
   bool passed = true;        ///< the product's own check (coverage, collision, ...); true if none
   std::string check;         ///< one line on the check's outcome, may be empty
-  nlohmann::json result;     ///< the product's results (units at the edges)
+  Json result;     ///< the product's results (units at the edges)
   std::string title;         ///< heading of its section in summary.md
   std::string markdown;      ///< body of its section in summary.md
   std::vector<std::filesystem::path> files;  ///< files it wrote, relative to the scene directory
@@ -60,7 +61,7 @@ struct SceneReport {
   /// Names of requested products that could not be built.
   std::vector<std::string> missing() const;
   /// The summary.json document.
-  nlohmann::json to_json() const;
+  Json to_json() const;
   /// The summary.md text.
   std::string to_markdown() const;
 };

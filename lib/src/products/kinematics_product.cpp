@@ -14,7 +14,7 @@
 #include "products/product.hpp"
 
 namespace fivebar::products {
-using nlohmann::json;
+using json = Json;
 
 namespace {
 

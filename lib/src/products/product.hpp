@@ -16,6 +16,7 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/json.hpp"
 
 namespace fivebar::products {
 
@@ -23,12 +24,12 @@ namespace fivebar::products {
 struct Context {
   const Design& design;
   std::filesystem::path dir;                       ///< the scene's output directory (exists)
-  const std::map<std::string, nlohmann::json>& results;  ///< results of products built so far
+  const std::map<std::string, Json>& results;  ///< results of products built so far
   std::function<void(std::string_view)> progress;  ///< may be empty
   std::vector<std::filesystem::path> files;        ///< files written so far, relative to dir
 
   /// The result of an earlier product (a prerequisite), or nullptr.
-  const nlohmann::json* result_of(std::string_view name) const;
+  const Json* result_of(std::string_view name) const;
   /// Writes `relative` under dir atomically (creating sub-directories) and records it.
   std::filesystem::path write_file(const std::filesystem::path& relative, std::string_view content);
   /// For streamed files: an AtomicFile at `relative` under dir; after commit(), call record().
@@ -39,7 +40,7 @@ struct Context {
 
 /// What build() returns.
 struct Built {
-  nlohmann::json result;  ///< goes to summary.json under results.<name>
+  Json result;  ///< goes to summary.json under results.<name>
   std::string markdown;   ///< body of the product's section in summary.md (no top heading)
   bool passed = true;     ///< the product's own check; true when it has none
   std::string check;      ///< one line describing the check's outcome

@@ -18,7 +18,7 @@ const Product* find_product(std::string_view name) {
   return nullptr;
 }
 
-const nlohmann::json* Context::result_of(std::string_view name) const {
+const Json* Context::result_of(std::string_view name) const {
   const auto it = results.find(std::string(name));
   return it == results.end() ? nullptr : &it->second;
 }
