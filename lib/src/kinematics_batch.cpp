@@ -234,4 +234,29 @@ void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const d
   }
 }
 
+void conditioning_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
+                        std::span<double> lci, std::span<double> force, std::span<std::int8_t> assembly,
+                        std::span<Status> status) {
+  const std::size_t n = px.size();
+  assert(py.size() == n && lci.size() == n && force.size() == n && assembly.size() == n && status.size() == n);
+  const IkConst g(m);
+  for (std::size_t k = 0; k < n; ++k) {
+    const Elbows e = elbows(g, px[k], py[k]);
+    const double c1 = cross(e.e1x, e.e1y, e.f1x, e.f1y), c2 = cross(e.e2x, e.e2y, e.f2x, e.f2y);
+    const double cb = cross(e.f1x, e.f1y, e.f2x, e.f2y);
+    const bool sing2 = std::fabs(cb) < g.thr34;
+    const Status st = detail::classify(e.reach, (std::fabs(c1) < g.thr13) | (std::fabs(c2) < g.thr24), sing2);
+    const double m00 = e.f2y * c1, m01 = -e.f1y * c2, m10 = -e.f2x * c1, m11 = e.f1x * c2;
+    const double fro2 = m00 * m00 + m01 * m01 + m10 * m10 + m11 * m11;
+    const double det = std::fabs(m00 * m11 - m01 * m10);
+    const double root = fro2 + std::sqrt(std::max(0.0, (fro2 - 2.0 * det) * (fro2 + 2.0 * det)));
+    const bool ok = st == Status::ok;
+    lci[k] = ok & (root > 0.0) ? std::min(1.0, 2.0 * det / root) : 0.0;
+    const double smax = std::sqrt(0.5 * root);
+    force[k] = ok & (smax > 0.0) ? std::fabs(cb) / smax : 0.0;
+    assembly[k] = std::int8_t(e.reach & !sing2 ? (cb > 0.0 ? 1 : -1) : 0);
+    status[k] = st;
+  }
+}
+
 }  // namespace fivebar

@@ -115,4 +115,11 @@ void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const do
 void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
                std::span<double> lci, std::span<Status> status);
 
+/// LCI, force capability (1/sigma_max(J)) and the realised assembly sign (sign of
+/// cross(P - A1, P - A2), 0 on type II) at n tactor points in the working mode; zeros where not ok.
+/// Elbow positions only: square roots, no trigonometry.
+void conditioning_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
+                        std::span<double> lci, std::span<double> force, std::span<std::int8_t> assembly,
+                        std::span<Status> status);
+
 }  // namespace fivebar
