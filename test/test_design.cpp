@@ -517,3 +517,50 @@ TEST(KeyedErrors, ComposeReadsAsAKeyValueRule) {
 
 }  // namespace
 }  // namespace fivebar
+
+namespace fivebar {
+namespace {
+
+TEST(Loader, GeometryAndPrintSectionsWithDefaults) {
+  const std::string stations = R"(stations:
+  s:
+    target: {center: [6.25, 15.5], axes: [15, 12]}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 15, 15], working_mode: "-+"}
+)";
+  // A bare section takes every default; a scalar width applies to all four links.
+  const Design bare = load_design_from_string("name: g\ngeometry:\nprint:\n" + stations, "<test>");
+  ASSERT_TRUE(bare.geometry && bare.print);
+  EXPECT_EQ(bare.geometry->link_width, (std::array<double, 4>{4.0, 4.0, 4.0, 4.0}));
+  EXPECT_EQ(bare.print->pin_clearance, 0.15);
+  const Design set = load_design_from_string(
+      "name: g\ngeometry: {link_width: 3.5, layers: [0, 1, 2, 3], pin_diameter: 1.5}\n"
+      "print: {fn: 64, material: Grey V4, pin_clearance: 0.2}\n" + stations,
+      "<test>");
+  EXPECT_EQ(set.geometry->link_width, (std::array<double, 4>{3.5, 3.5, 3.5, 3.5}));
+  EXPECT_EQ(set.geometry->layers, (std::array<int, 4>{0, 1, 2, 3}));
+  EXPECT_EQ(set.geometry->pin_diameter, 1.5);
+  EXPECT_EQ(set.print->fn, 64);
+  EXPECT_EQ(set.print->material, "Grey V4");
+  EXPECT_EQ(set.print->pin_clearance, 0.2);
+  const Design none = load_design_from_string("name: g\n" + stations, "<test>");
+  EXPECT_FALSE(none.geometry.has_value());
+  EXPECT_FALSE(none.print.has_value());
+}
+
+TEST(GeometryValidate, Rules) {
+  Geometry g;
+  EXPECT_NO_THROW(g.validate());
+  g.link_width[3] = 0.0;
+  EXPECT_THAT([&] { g.validate(); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("link_width[3]")));
+  g = Geometry{};
+  g.motor_shaft_flat = 2.0;
+  EXPECT_THAT([&] { g.validate(); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("motor_shaft_flat")));
+  PrintSettings p;
+  EXPECT_NO_THROW(p.validate());
+  p.pin_clearance = -0.1;
+  EXPECT_THAT([&] { p.validate(); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("pin_clearance")));
+}
+
+}  // namespace
+}  // namespace fivebar

@@ -4,6 +4,8 @@
 
 #include "fivebar/design.hpp"
 
+#include <sstream>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -316,6 +318,63 @@ const Mechanism* Station::mechanism(std::string_view which) const {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Geometry and print settings
+
+namespace {
+void require_length(const std::string& key, double v, double lo_exclusive, double hi) {
+  if (!(v > lo_exclusive) || !(v <= hi)) {
+    std::ostringstream s;
+    s << "= " << v << " mm: must be > " << lo_exclusive << " and <= " << hi << " mm";
+    throw ValidationError(key, s.str());
+  }
+}
+}  // namespace
+
+void Geometry::validate() const {
+  for (std::size_t i = 0; i < 4; ++i) require_length(detail::key_index("link_width", i), link_width[i], 0.0, 1e3);
+  require_length("link_thickness", link_thickness, 0.0, 1e3);
+  require_length("pin_diameter", pin_diameter, 0.0, 1e3);
+  require_length("boss_diameter", boss_diameter, 0.0, 1e3);
+  if (!(boss_diameter > pin_diameter)) {
+    std::ostringstream s;
+    s << "= " << boss_diameter << " mm: must be larger than pin_diameter (" << pin_diameter << " mm)";
+    throw ValidationError("boss_diameter", s.str());
+  }
+  require_length("tactor_diameter", tactor_diameter, 0.0, 1e3);
+  require_length("tactor_height", tactor_height, 0.0, 1e3);
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (layers[i] < 0 || layers[i] > 7) {
+      throw ValidationError(detail::key_index("layers", i), "= " + std::to_string(layers[i]) + ": must be 0 ... 7");
+    }
+  }
+  if (!(layer_gap >= 0.0) || !(layer_gap <= 100.0)) {
+    throw ValidationError("layer_gap", "= " + std::to_string(layer_gap) + " mm: must be >= 0 and <= 100 mm");
+  }
+  require_length("motor_shaft_diameter", motor_shaft_diameter, 0.0, 1e3);
+  if (!(motor_shaft_flat >= 0.0) || !(motor_shaft_flat < 0.5 * motor_shaft_diameter)) {
+    std::ostringstream s;
+    s << "= " << motor_shaft_flat << " mm: must be >= 0 and less than the shaft radius ("
+      << 0.5 * motor_shaft_diameter << " mm)";
+    throw ValidationError("motor_shaft_flat", s.str());
+  }
+  if (!(min_clearance >= 0.0) || !(min_clearance <= 100.0)) {
+    throw ValidationError("min_clearance", "= " + std::to_string(min_clearance) + " mm: must be >= 0 and <= 100 mm");
+  }
+}
+
+void PrintSettings::validate() const {
+  if (!(pin_clearance >= 0.0) || !(pin_clearance <= 1.0)) {
+    std::ostringstream s;
+    s << "= " << pin_clearance << " mm: must be >= 0 and <= 1 mm (resin guides: 0.1 - 0.25)";
+    throw ValidationError("pin_clearance", s.str());
+  }
+  require_length("min_wall", min_wall, 0.0, 100.0);
+  if (fn < 8 || fn > 1024) throw ValidationError("fn", "= " + std::to_string(fn) + ": must be 8 ... 1024");
+  require_length("layer_height", layer_height, 0.0, 1.0);
+  if (material.empty() || material.size() > 200) throw ValidationError("material", "must be 1 ... 200 characters");
+}
+
+// ---------------------------------------------------------------------------------------------
 // Design
 
 bool is_safe_name(std::string_view name) {
@@ -352,6 +411,37 @@ void Design::validate() const {
       }
     }
     validate_nested(key, [&] { station.validate(); });
+  }
+
+  if (geometry) {
+    validate_nested("geometry", [&] { geometry->validate(); });
+    // Every link must hold its two pin bosses apart: shorter links cannot be printed.
+    for (const Station& station : stations) {
+      for (const Mechanism* m : station.mechanisms()) {
+        for (std::size_t i = 0; i < 4; ++i) {
+          if (m->L[i] < geometry->boss_diameter) {
+            std::ostringstream s;
+            s << "= " << m->L[i] << " mm: shorter than geometry.boss_diameter (" << geometry->boss_diameter
+              << " mm): the pin bosses at its ends would overlap";
+            throw ValidationError(detail::key_index(detail::key_join(detail::key_child("stations", station.name),
+                                                                     "mechanisms." + m->name + ".links"),
+                                                    i),
+                                  s.str());
+          }
+        }
+      }
+    }
+  }
+  if (print) {
+    validate_nested("print", [&] { print->validate(); });
+    const Geometry g = geometry.value_or(Geometry{});
+    const double wall = 0.5 * (g.boss_diameter - g.pin_diameter) - print->pin_clearance;
+    if (wall < print->min_wall) {
+      std::ostringstream s;
+      s << "= " << print->min_wall << " mm: the wall around each pin hole is only " << wall
+        << " mm ((boss_diameter - pin_diameter)/2 - pin_clearance); raise geometry.boss_diameter";
+      throw ValidationError("print.min_wall", s.str());
+    }
   }
 
   if (products) {

@@ -110,12 +110,42 @@ struct Station {
   const Mechanism* mechanism(std::string_view which) const;
 };
 
+/// Physical link geometry (`geometry:`), for collision checking and printed parts. Defaults
+/// follow the paper's resin-printed device in spirit (mm).
+struct Geometry {
+  std::array<double, 4> link_width{4.0, 4.0, 4.0, 4.0};  ///< L1..L4: outline is a capsule this wide
+  double link_thickness = 2.5;         ///< of every link plate
+  double pin_diameter = 2.0;           ///< nominal pin at every joint (O_i, A_i, P)
+  double boss_diameter = 5.0;          ///< rounded link end around each pin
+  double tactor_diameter = 4.0;        ///< contact disk at P
+  double tactor_height = 6.0;          ///< above the top link plane
+  std::array<int, 4> layers{0, 0, 1, 1};  ///< plane of L1..L4, 0 nearest the base plate
+  double layer_gap = 0.4;              ///< between planes (washers)
+  double motor_shaft_diameter = 3.0;   ///< D-shaft of the motors
+  double motor_shaft_flat = 0.5;       ///< depth of the shaft's flat
+  double min_clearance = 0.3;          ///< a smaller gap between links counts as a collision
+  /// Throws ValidationError naming the key ("link_width[2]", "pin_diameter").
+  void validate() const;
+};
+
+/// Resin printing (`print:`): clearances and minimums of the printer and material.
+struct PrintSettings {
+  double pin_clearance = 0.15;  ///< radial, mm (Tough 2000 guides: 0.1 - 0.25)
+  double min_wall = 0.8;        ///< the printer's minimum wall, mm
+  int fn = 96;                  ///< OpenSCAD $fn for printed circles
+  double layer_height = 0.05;   ///< mm
+  std::string material = "Formlabs Tough 2000";
+  void validate() const;
+};
+
 /// A whole design (and scene).
 struct Design {
   std::string name;                   ///< used for outputs/<name>/: a safe file name
   std::filesystem::path source;       ///< file it was loaded from (may be empty)
   std::vector<Station> stations;      ///< in file order
   std::optional<std::vector<std::string>> products;  ///< absent: every product the data allows
+  std::optional<Geometry> geometry;       ///< `geometry:`; absent: collision and parts left out
+  std::optional<PrintSettings> print;     ///< `print:`; parts use defaults when absent
 
   void validate() const;
   const Station* station(std::string_view name) const;

@@ -36,7 +36,7 @@ using detail::key_index;
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 /// Top-level sections that later versions fill in (DESIGN.md); rejected clearly until then.
-constexpr std::string_view kReservedSections[] = {"geometry", "print", "controller", "sweep", "patterns"};
+constexpr std::string_view kReservedSections[] = {"controller", "sweep", "patterns"};
 
 constexpr std::size_t kMaxShownValue = 60;
 
@@ -172,6 +172,10 @@ class Loader {
   Vec2 point(const YAML::Node& node, const std::string& path, int line, const std::string& expected);
 
   Ellipse target(const Entry& entry);
+  Geometry geometry(const Entry& entry);
+  PrintSettings print(const Entry& entry);
+  /// An optional number: `fallback` when the key is absent.
+  double optional_number(const Entries& all, std::string_view name, double fallback, std::string_view unit) const;
   Mechanism mechanism(const Entry& entry);
   Station station(const Entry& entry);
 
@@ -310,6 +314,70 @@ Ellipse Loader::target(const Entry& entry) {
   return ellipse;
 }
 
+double Loader::optional_number(const Entries& all, std::string_view name, double fallback,
+                               std::string_view unit) const {
+  const Entry* e = find(all, name);
+  return e ? number(e->value, e->path, e->line, unit) : fallback;
+}
+
+Geometry Loader::geometry(const Entry& entry) {
+  Geometry g;
+  if (entry.value.IsNull()) return g;  // `geometry:` alone: every default
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"link_width", "link_thickness", "pin_diameter", "boss_diameter", "tactor_diameter",
+                               "tactor_height", "layers", "layer_gap", "motor_shaft_diameter", "motor_shaft_flat",
+                               "min_clearance"},
+                              "of link geometry (link_width, link_thickness, ...)");
+  if (const Entry* w = find(all, "link_width")) {
+    if (w->value.IsScalar()) {
+      g.link_width.fill(number(w->value, w->path, w->line, "mm"));
+    } else {
+      const auto items = list(w->value, w->path, w->line, 4, "a width (mm) or a list of 4 widths [L1, L2, L3, L4]");
+      for (std::size_t i = 0; i < 4; ++i) {
+        g.link_width[i] = number(items[i], key_index(w->path, i), line_of(items[i], w->line), "mm");
+      }
+    }
+  }
+  g.link_thickness = optional_number(all, "link_thickness", g.link_thickness, "mm");
+  g.pin_diameter = optional_number(all, "pin_diameter", g.pin_diameter, "mm");
+  g.boss_diameter = optional_number(all, "boss_diameter", g.boss_diameter, "mm");
+  g.tactor_diameter = optional_number(all, "tactor_diameter", g.tactor_diameter, "mm");
+  g.tactor_height = optional_number(all, "tactor_height", g.tactor_height, "mm");
+  if (const Entry* l = find(all, "layers")) {
+    const auto items = list(l->value, l->path, l->line, 4, "a list of 4 plane indices [L1, L2, L3, L4]");
+    for (std::size_t i = 0; i < 4; ++i) {
+      const std::string path = key_index(l->path, i);
+      const int line = line_of(items[i], l->line);
+      const double v = number(items[i], path, line, "");
+      if (v != std::floor(v) || std::fabs(v) > 1e6) fail_value(items[i], line, path, "must be a whole number");
+      g.layers[i] = int(v);
+    }
+  }
+  g.layer_gap = optional_number(all, "layer_gap", g.layer_gap, "mm");
+  g.motor_shaft_diameter = optional_number(all, "motor_shaft_diameter", g.motor_shaft_diameter, "mm");
+  g.motor_shaft_flat = optional_number(all, "motor_shaft_flat", g.motor_shaft_flat, "mm");
+  g.min_clearance = optional_number(all, "min_clearance", g.min_clearance, "mm");
+  return g;
+}
+
+PrintSettings Loader::print(const Entry& entry) {
+  PrintSettings p;
+  if (entry.value.IsNull()) return p;
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"pin_clearance", "min_wall", "fn", "layer_height", "material"},
+                              "of print settings (pin_clearance, min_wall, fn, layer_height, material)");
+  p.pin_clearance = optional_number(all, "pin_clearance", p.pin_clearance, "mm");
+  p.min_wall = optional_number(all, "min_wall", p.min_wall, "mm");
+  if (const Entry* fn = find(all, "fn")) {
+    const double v = number(fn->value, fn->path, fn->line, "");
+    if (v != std::floor(v) || std::fabs(v) > 1e6) fail_value(fn->value, fn->line, fn->path, "must be a whole number");
+    p.fn = int(v);
+  }
+  p.layer_height = optional_number(all, "layer_height", p.layer_height, "mm");
+  if (const Entry* m = find(all, "material")) p.material = string(m->value, m->path, m->line, "must be a material name");
+  return p;
+}
+
 Mechanism Loader::mechanism(const Entry& entry) {
   const Entries all = entries(entry.value, entry.path, entry.line,
                               {"bases", "links", "working_mode", "assembly_mode", "joint_limits", "min_lci"},
@@ -401,8 +469,8 @@ Design Loader::load(const std::string& text) {
 
   Design design;
   try {
-    const Entries all = entries(root, "", root_line, {"name", "stations", "products"},
-                                "at the top level (name, stations, products)");
+    const Entries all = entries(root, "", root_line, {"name", "stations", "products", "geometry", "print"},
+                                "at the top level (name, stations, products, geometry, print)");
     const Entry& name = require(all, "name", "", root_line);
     design.name = string(name.value, name.path, name.line, "must be a name (letters, digits, _ . -)");
 
@@ -411,6 +479,9 @@ Design Loader::load(const std::string& text) {
                                   "of station names to stations", /*any_key=*/true)) {
       design.stations.push_back(station(s));
     }
+
+    if (const Entry* g = find(all, "geometry")) design.geometry = geometry(*g);
+    if (const Entry* p = find(all, "print")) design.print = print(*p);
 
     if (const Entry* products = find(all, "products")) {
       if (!products->value.IsSequence()) fail_value(products->value, products->line, products->path, "must be a list of product names");
