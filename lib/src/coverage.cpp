@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "fivebar/kinematics.hpp"
@@ -20,7 +21,6 @@ constexpr double kPi = std::numbers::pi;
 /// Margins closer to zero than this (times the length scale) are re-decided exactly.
 constexpr double kMarginRel = 1e-9;
 /// Boundary samples for the general (joint-limited) path.
-constexpr int kBoundarySamples = 256;
 /// Polygon sizes of the exact fallback and of the covered-fraction measure.
 constexpr int kExactPolygon = 1024;
 constexpr int kFractionPolygon = 512;
@@ -48,6 +48,21 @@ std::vector<Vec2> ellipse_polygon(const Ellipse& e, int n, double scale) {
   return out;
 }
 
+/// Unit-circle samples (cos, sin) of k * 2 pi / n by rotation (error ~ k eps, ample for sampling).
+void unit_circle(int n, std::vector<double>& c, std::vector<double>& s) {
+  c.resize(n);
+  s.resize(n);
+  const double cd = std::cos(2 * kPi / n), sd = std::sin(2 * kPi / n);
+  double x = 1.0, y = 0.0;
+  for (int k = 0; k < n; ++k) {
+    c[k] = x;
+    s[k] = y;
+    const double xn = x * cd - y * sd;
+    y = x * sd + y * cd;
+    x = xn;
+  }
+}
+
 double polygon_area(const std::vector<Vec2>& p) {
   double a = 0.0;
   for (std::size_t k = 0; k < p.size(); ++k) {
@@ -58,11 +73,6 @@ double polygon_area(const std::vector<Vec2>& p) {
   return 0.5 * std::fabs(a);
 }
 
-bool inside_filled(const Ellipse& e, const Vec2& p) {
-  const Frame f(e);
-  const Vec2 q = f.to_local(p);
-  return (q.x() / f.a) * (q.x() / f.a) + (q.y() / f.b) * (q.y() / f.b) <= 1.0;
-}
 
 }  // namespace
 
@@ -81,8 +91,13 @@ EllipseExtremes ellipse_distance_extremes(const Ellipse& e, const Vec2& p) {
   };
   auto dg = [&](double t) { return (b * b - a * a) * std::cos(2 * t) + a * x * std::cos(t) + b * y * std::sin(t); };
   constexpr int N = 48;
+  thread_local std::vector<double> uc, us;
+  if (uc.size() != N) unit_circle(N, uc, us);
   double fs[N];
-  for (int k = 0; k < N; ++k) fs[k] = f(2 * kPi * k / N);
+  for (int k = 0; k < N; ++k) {
+    const double dx = a * uc[k] - x, dy = b * us[k] - y;
+    fs[k] = dx * dx + dy * dy;
+  }
   double best_min = std::numeric_limits<double>::infinity(), best_max = -1.0, t_min = 0.0, t_max = 0.0;
   for (int k = 0; k < N; ++k) {
     const double fp = fs[(k + N - 1) % N], fc = fs[k], fn = fs[(k + 1) % N];
@@ -158,86 +173,165 @@ double annuli_margin(const Mechanism& m, const Ellipse& target, Vec2* worst_poin
 
 namespace {
 
-/// General path: distance from the ellipse boundary to the region boundary, minimised over the
-/// ellipse parameter (samples, then golden-section refinement of every local minimum).
-double boundary_gap(const Region& region, const Ellipse& e, Vec2* where, bool* crosses) {
-  const Frame fr(e);
-  std::vector<double> d(kBoundarySamples);
-  *crosses = false;
-  for (int k = 0; k < kBoundarySamples; ++k) {
-    const Vec2 q = fr.at(1.0, 2 * kPi * k / kBoundarySamples);
-    d[k] = region.boundary_distance(q);
-    if (!region.contains(q)) *crosses = true;
+/// One leg's reachable set in double precision, analytic (no CGAL): the annulus, or the
+/// curvilinear rectangle of its joint range (workspace.hpp). The mechanism's region is the
+/// intersection of its legs' sets, and the distance from the ellipse to the complement of an
+/// intersection is the smaller of the distances to the complements: legs are fitted one by one.
+struct LegSet {
+  Vec2 O;
+  double lp = 0, ld = 0, r_out = 0, r_in = 0;
+  int sigma = 1;
+  const JointRange* limits = nullptr;
+  std::vector<CurvePiece> pieces;  // the boundary (limited legs only)
+
+  bool contains(const Vec2& p) const {
+    const double d = (p - O).norm();
+    if (d > r_out || d < r_in) return false;
+    if (!limits) return true;
+    const CircleIntersection x = intersect_circles(O, lp, p, ld, -sigma);
+    if (x.status == Status::unreachable) return false;
+    return limits->contains(std::atan2(x.offset.y(), x.offset.x()));
   }
-  double best = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < kBoundarySamples; ++k) {
-    const double dp = d[(k + kBoundarySamples - 1) % kBoundarySamples], dn = d[(k + 1) % kBoundarySamples];
-    if (!(d[k] <= dp && d[k] <= dn)) continue;
-    double lo = 2 * kPi * (k - 1) / kBoundarySamples, hi = 2 * kPi * (k + 1) / kBoundarySamples;
-    const double r = 0.5 * (std::sqrt(5.0) - 1.0);
-    double x1 = hi - r * (hi - lo), x2 = lo + r * (hi - lo);
-    double f1 = region.boundary_distance(fr.at(1.0, x1)), f2 = region.boundary_distance(fr.at(1.0, x2));
-    for (int it = 0; it < 60 && hi - lo > 1e-13; ++it) {
-      if (f1 < f2) {
-        hi = x2;
-        x2 = x1;
-        f2 = f1;
-        x1 = hi - r * (hi - lo);
-        f1 = region.boundary_distance(fr.at(1.0, x1));
-      } else {
-        lo = x1;
-        x1 = x2;
-        f1 = f2;
-        x2 = lo + r * (hi - lo);
-        f2 = region.boundary_distance(fr.at(1.0, x2));
+  double boundary_distance(const Vec2& p) const {
+    double best = std::numeric_limits<double>::infinity();
+    for (const CurvePiece& c : pieces) best = std::min(best, (c.closest_point(p) - p).norm());
+    return best;
+  }
+};
+
+CurvePiece arc(const Vec2& center, double radius, const Vec2& from, const Vec2& to, bool ccw) {
+  CurvePiece c;
+  c.is_arc = true;
+  c.center = center;
+  c.radius = radius;
+  c.source = from;
+  c.target = to;
+  c.ccw = ccw;
+  return c;
+}
+
+LegSet make_leg(const Vec2& O, double lp, double ld, int sigma, const JointRange* limits) {
+  LegSet leg;
+  leg.O = O;
+  leg.lp = lp;
+  leg.ld = ld;
+  leg.sigma = sigma;
+  leg.r_out = lp + ld;
+  leg.r_in = std::fabs(lp - ld);
+  if (limits == nullptr || limits->span() >= 2 * kPi) return leg;
+  leg.limits = limits;
+  const double lo = limits->lo, hi = limits->lo + limits->span();
+  const Vec2 e_lo(std::cos(lo), std::sin(lo)), e_hi(std::cos(hi), std::sin(hi));
+  const Vec2 a_lo = O + lp * e_lo, a_hi = O + lp * e_hi;
+  const Vec2 s_lo = O + leg.r_out * e_lo, s_hi = O + leg.r_out * e_hi;
+  const Vec2 f_lo = O + (lp - ld) * e_lo, f_hi = O + (lp - ld) * e_hi;
+  leg.pieces.push_back(arc(O, leg.r_out, s_lo, s_hi, true));       // stretched
+  leg.pieces.push_back(arc(a_hi, ld, s_hi, f_hi, sigma > 0));      // theta = hi
+  if (leg.r_in > 0) leg.pieces.push_back(arc(O, leg.r_in, f_hi, f_lo, false));  // folded
+  leg.pieces.push_back(arc(a_lo, ld, f_lo, s_lo, sigma < 0));      // theta = lo
+  return leg;
+}
+
+struct LegFit {
+  bool inside = false;
+  double margin = 0.0;
+  Vec2 worst{0.0, 0.0};
+};
+
+/// Closed form against an annulus: distance from the filled ellipse to the complement of the
+/// disk |P - O| <= r_out and to the hole |P - O| < r_in.
+LegFit fit_annulus(const LegSet& leg, const Ellipse& e) {
+  LegFit f;
+  const EllipseExtremes ex = ellipse_distance_extremes(e, leg.O);
+  f.margin = leg.r_out - ex.max_distance;
+  f.worst = ex.farthest;
+  if (leg.r_in > 0.0) {
+    const double near = ex.p_inside ? 0.0 : ex.min_distance;
+    if (near - leg.r_in < f.margin) {
+      f.margin = near - leg.r_in;
+      f.worst = ex.p_inside ? leg.O : ex.nearest;
+    }
+  }
+  f.inside = f.margin > 0.0;
+  return f;
+}
+
+/// Joint-limited leg: samples of the ellipse boundary, membership of each, distance to the four
+/// boundary arcs; every local minimum of that distance refined by golden section.
+LegFit fit_limited(const LegSet& leg, const Ellipse& e) {
+  constexpr int N = 128;
+  const Frame fr(e);
+  thread_local std::vector<double> uc, us;
+  if (uc.size() != N) unit_circle(N, uc, us);
+  auto point = [&](double c, double s) { return fr.to_world({fr.a * c, fr.b * s}); };
+  double d[N];
+  bool all_in = leg.contains(e.center);
+  double deepest = 0.0;
+  Vec2 deepest_at = e.center;
+  for (int k = 0; k < N; ++k) {
+    const Vec2 q = point(uc[k], us[k]);
+    d[k] = leg.boundary_distance(q);
+    if (!leg.contains(q)) {
+      all_in = false;
+      if (d[k] > deepest) {
+        deepest = d[k];
+        deepest_at = q;
       }
     }
-    const double t = f1 < f2 ? x1 : x2;
+  }
+  LegFit f;
+  if (!all_in) {
+    f.margin = -deepest;
+    f.worst = deepest_at;
+    return f;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < N; ++k) {
+    if (!(d[k] <= d[(k + N - 1) % N] && d[k] <= d[(k + 1) % N])) continue;
+    auto dist = [&](double t) { return leg.boundary_distance(fr.at(1.0, t)); };
+    double lo = 2 * kPi * (k - 1) / N, hi = 2 * kPi * (k + 1) / N;
+    const double r = 0.5 * (std::sqrt(5.0) - 1.0);
+    double x1 = hi - r * (hi - lo), x2 = lo + r * (hi - lo);
+    double f1 = dist(x1), f2 = dist(x2);
+    for (int it = 0; it < 48; ++it) {
+      if (f1 < f2) {
+        hi = x2, x2 = x1, f2 = f1, x1 = hi - r * (hi - lo), f1 = dist(x1);
+      } else {
+        lo = x1, x1 = x2, f1 = f2, x2 = lo + r * (hi - lo), f2 = dist(x2);
+      }
+    }
     const double v = std::min({f1, f2, d[k]});
     if (v < best) {
       best = v;
-      *where = v == d[k] ? fr.at(1.0, 2 * kPi * k / kBoundarySamples) : fr.at(1.0, t);
+      f.worst = v == d[k] ? point(uc[k], us[k]) : fr.at(1.0, f1 < f2 ? x1 : x2);
     }
   }
-  return best;
-}
-
-/// Deepest point of the filled ellipse outside the region (for negative margins).
-double deepest_outside(const Region& region, const Ellipse& e, Vec2* where) {
-  const Frame fr(e);
-  double worst = 0.0;
-  for (int ring = 0; ring <= 16; ++ring) {
-    const double r = ring / 16.0;
-    const int n = ring == 0 ? 1 : 128;
-    for (int k = 0; k < n; ++k) {
-      const Vec2 q = fr.at(r, 2 * kPi * k / n);
-      if (region.contains(q)) continue;
-      const double dist = region.boundary_distance(q);
-      if (dist > worst) {
-        worst = dist;
-        *where = q;
-      }
-    }
-  }
-  return worst;
+  f.margin = best;
+  f.inside = best > 0.0;
+  return f;
 }
 
 void conditioning_over(const Mechanism& m, const Ellipse& e, const CoverageOptions& options, CoverageResult& out) {
   const Frame fr(e);
-  std::vector<double> px, py;
-  px.push_back(e.center.x());
-  py.push_back(e.center.y());
+  thread_local std::vector<double> uc, us, px, py, lci, force;
+  thread_local std::vector<std::int8_t> assembly;
+  thread_local std::vector<Status> status;
+  if (int(uc.size()) != options.angles) unit_circle(options.angles, uc, us);
+  px.assign(1, e.center.x());
+  py.assign(1, e.center.y());
   for (int ring = 1; ring <= options.rings; ++ring) {
+    const double r = double(ring) / options.rings;
     for (int k = 0; k < options.angles; ++k) {
-      const Vec2 q = fr.at(double(ring) / options.rings, 2 * kPi * k / options.angles);
+      const Vec2 q = fr.to_world({r * fr.a * uc[k], r * fr.b * us[k]});
       px.push_back(q.x());
       py.push_back(q.y());
     }
   }
   const std::size_t n = px.size();
-  std::vector<double> lci(n), force(n);
-  std::vector<std::int8_t> assembly(n);
-  std::vector<Status> status(n);
+  lci.resize(n);
+  force.resize(n);
+  assembly.resize(n);
+  status.resize(n);
   conditioning_batch(m, px, py, lci, force, assembly, status);
   out.min_lci = std::numeric_limits<double>::infinity();
   out.min_force_capability = std::numeric_limits<double>::infinity();
@@ -252,60 +346,85 @@ void conditioning_over(const Mechanism& m, const Ellipse& e, const CoverageOptio
     if (m.assembly_mode != AssemblyMode::Any && assembly[k] != std::int8_t(m.assembly_mode)) out.assembly_ok = false;
   }
   out.min_lci_point = {px[best], py[best]};
-  // Refine the minimum LCI by a compass search inside the ellipse (the field is smooth there).
+  // Refine the minimum LCI by a compass search inside the ellipse (the field is smooth there):
+  // four candidates a step, evaluated together.
   if (out.min_lci > 0.0) {
     Vec2 p = out.min_lci_point;
     double step = std::max(fr.a, fr.b) / std::max(2, options.rings);
-    for (int it = 0; it < 40 && step > 1e-9 * std::max(fr.a, fr.b); ++it) {
-      bool moved = false;
-      for (const Vec2& dir : {Vec2(1, 0), Vec2(-1, 0), Vec2(0, 1), Vec2(0, -1)}) {
-        const Vec2 cand = p + step * dir;
-        if (!inside_filled(e, cand)) continue;
-        const Pose pose = ik(m, cand);
-        if (pose.status == Status::ok && pose.lci < out.min_lci) {
-          out.min_lci = pose.lci;
-          p = cand;
-          moved = true;
+    const Vec2 dirs[4] = {Vec2(1, 0), Vec2(-1, 0), Vec2(0, 1), Vec2(0, -1)};
+    double cx[4], cy[4], cl[4], cf[4];
+    std::int8_t ca[4];
+    Status cs[4];
+    // LCI is smooth: a location to 1e-6 of the ellipse size gives its minimum to ~1e-12.
+    for (int it = 0; it < 60 && step > 1e-6 * std::max(fr.a, fr.b); ++it) {
+      for (int k = 0; k < 4; ++k) {
+        cx[k] = p.x() + step * dirs[k].x();
+        cy[k] = p.y() + step * dirs[k].y();
+      }
+      conditioning_batch(m, cx, cy, cl, cf, ca, cs);
+      int pick = -1;
+      for (int k = 0; k < 4; ++k) {
+        const Vec2 q = fr.to_local({cx[k], cy[k]});
+        const bool in = (q.x() / fr.a) * (q.x() / fr.a) + (q.y() / fr.b) * (q.y() / fr.b) <= 1.0;
+        if (cs[k] == Status::ok && cl[k] < out.min_lci && in) {
+          out.min_lci = cl[k];
+          pick = k;
         }
       }
-      if (!moved) step *= 0.5;
+      if (pick >= 0) {
+        p = {cx[pick], cy[pick]};
+      } else {
+        step *= 0.5;
+      }
     }
     out.min_lci_point = p;
   }
   out.lci_ok = out.min_lci >= m.min_lci;
 }
 
-}  // namespace
-
-CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse& target,
-                        const CoverageOptions& options) {
-  CoverageResult out;
-  const double tol = kMarginRel * m.length_scale();
-  bool crosses = false;
-  if (!m.joint_limits) {
-    out.margin_mm = annuli_margin(m, target, &out.worst_point);
-    out.inside = out.margin_mm > 0.0;
-    out.method = "closed form: ellipse against both annuli (robust point-ellipse extremes)";
-  } else {
-    Vec2 where = target.center;
-    const double gap = boundary_gap(region, target, &where, &crosses);
-    bool loop_inside = false;
-    for (const BoundaryLoop& loop : region.loops())
-      if (!loop.pieces.empty() && inside_filled(target, loop.pieces[0].source)) loop_inside = true;
-    out.inside = !crosses && !loop_inside && region.contains(target.center) && gap > 0.0;
-    if (out.inside) {
-      out.margin_mm = gap;
-      out.worst_point = where;
-    } else {
-      out.margin_mm = -deepest_outside(region, target, &out.worst_point);
-      if (out.margin_mm == 0.0) out.worst_point = where;
+/// Containment and margin of the ellipse in the mechanism's region (legs one by one).
+LegFit fit_mechanism(const Mechanism& m, const Ellipse& e, std::string* method) {
+  const JointRange* l1 = m.joint_limits ? &(*m.joint_limits)[0] : nullptr;
+  const JointRange* l2 = m.joint_limits ? &(*m.joint_limits)[1] : nullptr;
+  const LegSet legs[2] = {make_leg(m.O1, m.L[0], m.L[2], m.working_mode.sign1, l1),
+                          make_leg(m.O2, m.L[1], m.L[3], m.working_mode.sign2, l2)};
+  LegFit out;
+  out.margin = std::numeric_limits<double>::infinity();
+  out.inside = true;
+  bool limited = false;
+  for (const LegSet& leg : legs) {
+    limited = limited || leg.limits != nullptr;
+    const LegFit f = leg.limits ? fit_limited(leg, e) : fit_annulus(leg, e);
+    out.inside = out.inside && f.inside;
+    if (f.margin < out.margin) {
+      out.margin = f.margin;
+      out.worst = f.worst;
     }
-    out.method = "distance from the ellipse to every boundary arc (sampled + golden-section refined)";
   }
+  *method = limited ? "distance from the ellipse to each leg's boundary arcs (closed form for annuli; sampled + "
+                      "golden-section refined for joint-limit arcs)"
+                    : "closed form: ellipse against both annuli (robust point-ellipse extremes)";
+  return out;
+}
+
+CoverageResult coverage_impl(const Mechanism& m, const Region* given, const Ellipse& target,
+                             const CoverageOptions& options) {
+  CoverageResult out;
+  std::optional<Region> built;
+  auto region = [&]() -> const Region& {
+    if (given) return *given;
+    if (!built) built = reachable_region(m);
+    return *built;
+  };
+  const LegFit fit = fit_mechanism(m, target, &out.method);
+  out.margin_mm = fit.margin;
+  out.worst_point = fit.worst;
+  out.inside = fit.inside;
+  const double tol = kMarginRel * m.length_scale();
   if (std::fabs(out.margin_mm) <= tol) {
     // Within rounding of tangency: decide exactly with a polygon provably around the ellipse.
     const double scale = (1.0 + 1e-12) / std::cos(kPi / kExactPolygon);
-    out.inside = region.contains_polygon_exact(ellipse_polygon(target, kExactPolygon, scale));
+    out.inside = region().contains_polygon_exact(ellipse_polygon(target, kExactPolygon, scale));
     std::ostringstream s;
     s << "; |margin| <= " << tol << " mm: exact CGAL test of a circumscribed " << kExactPolygon
       << "-gon (conservative by <= " << 0.5 * std::max(target.axes.x(), target.axes.y()) * (scale - 1.0) << " mm)";
@@ -315,7 +434,7 @@ CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse&
     out.covered_fraction = 1.0;
   } else {
     const auto poly = ellipse_polygon(target, kFractionPolygon, 1.0);
-    out.covered_fraction = std::clamp(region.polygon_overlap_area(poly) / polygon_area(poly), 0.0, 1.0);
+    out.covered_fraction = std::clamp(region().polygon_overlap_area(poly) / polygon_area(poly), 0.0, 1.0);
   }
   conditioning_over(m, target, options, out);
   out.covered = out.inside && out.lci_ok && out.assembly_ok;
@@ -328,30 +447,33 @@ CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse&
   return out;
 }
 
+}  // namespace
+
+CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse& target,
+                        const CoverageOptions& options) {
+  return coverage_impl(m, &region, target, options);
+}
+
 CoverageResult coverage(const Mechanism& m, const Ellipse& target, const CoverageOptions& options) {
-  if (!m.joint_limits) {
-    // The closed form needs no region but for the covered fraction and the exact fallback.
-    const Region region = reachable_region(m);
-    return coverage(m, region, target, options);
-  }
-  return coverage(m, reachable_region(m), target, options);
+  // The exact region is built only when needed: the covered fraction of an ellipse that is not
+  // inside, or the exact test near tangency.
+  return coverage_impl(m, nullptr, target, options);
 }
 
 CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, const Ellipse& target,
                                const CoverageOptions& options) {
-  const Region rl = reachable_region(lower), ru = reachable_region(upper);
-  const CoverageResult cl = coverage(lower, rl, target, options);
-  const CoverageResult cu = coverage(upper, ru, target, options);
+  const CoverageResult cl = coverage_impl(lower, nullptr, target, options);
+  const CoverageResult cu = coverage_impl(upper, nullptr, target, options);
   CoverageResult out;
   // Distance to the complement of an intersection is the smaller of the two distances.
   const bool lower_worse = cl.margin_mm <= cu.margin_mm;
   out.margin_mm = lower_worse ? cl.margin_mm : cu.margin_mm;
   out.worst_point = lower_worse ? cl.worst_point : cu.worst_point;
   out.inside = cl.inside && cu.inside;
-  const Region shared = rl.intersection(ru);
   if (out.inside) {
     out.covered_fraction = 1.0;
   } else {
+    const Region shared = reachable_region(lower).intersection(reachable_region(upper));
     const auto poly = ellipse_polygon(target, kFractionPolygon, 1.0);
     out.covered_fraction = std::clamp(shared.polygon_overlap_area(poly) / polygon_area(poly), 0.0, 1.0);
   }
@@ -362,7 +484,8 @@ CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, c
   out.lci_ok = cl.lci_ok && cu.lci_ok;
   out.assembly_ok = cl.assembly_ok && cu.assembly_ok;
   out.covered = cl.covered && cu.covered;
-  out.method = "smaller of the two mechanisms' margins; fraction on the exact intersection";
+  out.method = "smaller of the two mechanisms' margins (exact for an intersection); fraction on the exact "
+               "intersection";
   if (!out.covered) {
     out.reason = cl.covered ? "upper: " + cu.reason : cu.covered ? "lower: " + cl.reason
                                                                   : "lower: " + cl.reason + "; upper: " + cu.reason;

@@ -18,8 +18,8 @@ namespace fivebar {
 
 struct CoverageOptions {
   /// Samples over the filled ellipse for min LCI / force / assembly side (rings x angles).
-  int rings = 8;
-  int angles = 64;
+  int rings = 6;
+  int angles = 48;
 };
 
 struct CoverageResult {
