@@ -123,6 +123,7 @@ void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Ve
 // --- Subcommands (one file each) ----------------------------------------------------------------
 void setup_fk(CLI::App& app);
 void setup_ik(CLI::App& app);
+void setup_sweep(CLI::App& app);
 void setup_run(CLI::App& app);
 
 }  // namespace fivebar::cli

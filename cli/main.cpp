@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
       "3 internal error.");
   setup_fk(app);
   setup_ik(app);
+  setup_sweep(app);
   setup_run(app);
 
   try {

@@ -86,10 +86,18 @@ EllipseExtremes ellipse_distance_extremes(const Ellipse& e, const Vec2& p) {
     const double dx = a * std::cos(t) - x, dy = b * std::sin(t) - y;
     return dx * dx + dy * dy;
   };
+  // g and g' from one sincos (cos 2t = c^2 - s^2).
   auto g = [&](double t) {
-    return (b * b - a * a) * std::sin(t) * std::cos(t) + a * x * std::sin(t) - b * y * std::cos(t);
+    double st, ct;
+    ::sincos(t, &st, &ct);
+    return (b * b - a * a) * st * ct + a * x * st - b * y * ct;
   };
-  auto dg = [&](double t) { return (b * b - a * a) * std::cos(2 * t) + a * x * std::cos(t) + b * y * std::sin(t); };
+  auto g_and_dg = [&](double t, double& gv, double& dv) {
+    double st, ct;
+    ::sincos(t, &st, &ct);
+    gv = (b * b - a * a) * st * ct + a * x * st - b * y * ct;
+    dv = (b * b - a * a) * (ct * ct - st * st) + a * x * ct + b * y * st;
+  };
   constexpr int N = 48;
   thread_local std::vector<double> uc, us;
   if (uc.size() != N) unit_circle(N, uc, us);
@@ -108,26 +116,30 @@ EllipseExtremes ellipse_distance_extremes(const Ellipse& e, const Vec2& p) {
     double glo = g(lo), ghi = g(hi);
     if ((glo > 0.0) != (ghi > 0.0)) {
       for (int it = 0; it < 60; ++it) {
-        const double gt = g(t), d = dg(t);
+        double gt, d;
+        g_and_dg(t, gt, d);
+        if (gt == 0.0) break;
         double tn = d != 0.0 ? t - gt / d : 0.5 * (lo + hi);
+        // Newton converges quadratically: stop once its step is at rounding level.
+        if (std::fabs(tn - t) <= 1e-14 * (1.0 + std::fabs(t))) {
+          t = tn;
+          break;
+        }
         if ((gt > 0.0) == (glo > 0.0)) {
           lo = t;
           glo = gt;
         } else {
           hi = t;
         }
-        if (!(tn > lo && tn < hi)) tn = 0.5 * (lo + hi);
-        if (std::fabs(tn - t) <= 4 * tol::kEps * (1.0 + std::fabs(t))) {
-          t = tn;
-          break;
-        }
+        if (!(tn >= lo && tn <= hi)) tn = 0.5 * (lo + hi);  // safeguard: stay in the bracket
         t = tn;
       }
     }
-    const double ft = std::min(f(t), fc);
-    const double tt = f(t) <= fc ? t : 2 * kPi * k / N;
-    const double fx = std::max(f(t), fc);
-    const double tx = f(t) >= fc ? t : 2 * kPi * k / N;
+    const double fr_t = f(t);
+    const double ft = std::min(fr_t, fc);
+    const double tt = fr_t <= fc ? t : 2 * kPi * k / N;
+    const double fx = std::max(fr_t, fc);
+    const double tx = fr_t >= fc ? t : 2 * kPi * k / N;
     if (is_min && ft < best_min) {
       best_min = ft;
       t_min = tt;
@@ -346,17 +358,54 @@ void conditioning_over(const Mechanism& m, const Ellipse& e, const CoverageOptio
     if (m.assembly_mode != AssemblyMode::Any && assembly[k] != std::int8_t(m.assembly_mode)) out.assembly_ok = false;
   }
   out.min_lci_point = {px[best], py[best]};
-  // Refine the minimum LCI by a compass search inside the ellipse (the field is smooth there):
-  // four candidates a step, evaluated together.
-  if (out.min_lci > 0.0) {
-    Vec2 p = out.min_lci_point;
+  if (!(out.min_lci > 0.0)) {
+    out.lci_ok = out.min_lci >= m.min_lci;
+    return;
+  }
+  // Refinement. The minimum of a smooth field over the filled ellipse lies on the boundary or is
+  // an interior local minimum: refine the best boundary sample along the boundary (golden
+  // section in the parameter t), the best interior sample by compass search, keep the smaller.
+  auto lci_at = [&](const Vec2& q) {
+    double x = q.x(), y = q.y(), l, f;
+    std::int8_t a;
+    Status st;
+    conditioning_batch(m, {&x, 1}, {&y, 1}, {&l, 1}, {&f, 1}, {&a, 1}, {&st, 1});
+    return st == Status::ok ? l : 0.0;
+  };
+  const std::size_t outer = 1 + std::size_t(options.rings - 1) * std::size_t(options.angles);
+  std::size_t best_b = outer, best_i = 0;
+  for (std::size_t k = outer; k < n; ++k) best_b = lci[k] < lci[best_b] ? k : best_b;
+  for (std::size_t k = 0; k < outer; ++k) best_i = lci[k] < lci[best_i] ? k : best_i;
+  const double tol = options.lci_refine * std::max(fr.a, fr.b);
+  {
+    const double dt = 2 * kPi / options.angles;
+    double lo = double(best_b - outer) * dt - dt, hi = lo + 2 * dt;
+    const double r = 0.5 * (std::sqrt(5.0) - 1.0);
+    double x1 = hi - r * (hi - lo), x2 = lo + r * (hi - lo);
+    double f1 = lci_at(fr.at(1.0, x1)), f2 = lci_at(fr.at(1.0, x2));
+    while ((hi - lo) * std::max(fr.a, fr.b) > tol) {
+      if (f1 < f2) {
+        hi = x2, x2 = x1, f2 = f1, x1 = hi - r * (hi - lo), f1 = lci_at(fr.at(1.0, x1));
+      } else {
+        lo = x1, x1 = x2, f1 = f2, x2 = lo + r * (hi - lo), f2 = lci_at(fr.at(1.0, x2));
+      }
+    }
+    const double f = std::min(f1, f2);
+    if (f < out.min_lci) {
+      out.min_lci = f;
+      out.min_lci_point = fr.at(1.0, f1 < f2 ? x1 : x2);
+    }
+  }
+  if (lci[best_i] <= out.min_lci) {
+    // Compass search from the best interior sample, four candidates a step evaluated together.
+    Vec2 p(px[best_i], py[best_i]);
+    double value = lci[best_i];
     double step = std::max(fr.a, fr.b) / std::max(2, options.rings);
     const Vec2 dirs[4] = {Vec2(1, 0), Vec2(-1, 0), Vec2(0, 1), Vec2(0, -1)};
     double cx[4], cy[4], cl[4], cf[4];
     std::int8_t ca[4];
     Status cs[4];
-    // LCI is smooth: a location to 1e-6 of the ellipse size gives its minimum to ~1e-12.
-    for (int it = 0; it < 60 && step > 1e-6 * std::max(fr.a, fr.b); ++it) {
+    for (int it = 0; it < 80 && step > tol; ++it) {
       for (int k = 0; k < 4; ++k) {
         cx[k] = p.x() + step * dirs[k].x();
         cy[k] = p.y() + step * dirs[k].y();
@@ -366,8 +415,8 @@ void conditioning_over(const Mechanism& m, const Ellipse& e, const CoverageOptio
       for (int k = 0; k < 4; ++k) {
         const Vec2 q = fr.to_local({cx[k], cy[k]});
         const bool in = (q.x() / fr.a) * (q.x() / fr.a) + (q.y() / fr.b) * (q.y() / fr.b) <= 1.0;
-        if (cs[k] == Status::ok && cl[k] < out.min_lci && in) {
-          out.min_lci = cl[k];
+        if (cs[k] == Status::ok && cl[k] < value && in) {
+          value = cl[k];
           pick = k;
         }
       }
@@ -377,7 +426,10 @@ void conditioning_over(const Mechanism& m, const Ellipse& e, const CoverageOptio
         step *= 0.5;
       }
     }
-    out.min_lci_point = p;
+    if (value < out.min_lci) {
+      out.min_lci = value;
+      out.min_lci_point = p;
+    }
   }
   out.lci_ok = out.min_lci >= m.min_lci;
 }
@@ -407,6 +459,21 @@ LegFit fit_mechanism(const Mechanism& m, const Ellipse& e, std::string* method) 
   return out;
 }
 
+/// Within rounding of tangency: decide exactly with a polygon provably around the ellipse.
+bool exact_inside(const Region& region, const Ellipse& target) {
+  const double scale = (1.0 + 1e-12) / std::cos(kPi / kExactPolygon);
+  return region.contains_polygon_exact(ellipse_polygon(target, kExactPolygon, scale));
+}
+
+std::string exact_method(const Mechanism& m, const Ellipse& target) {
+  const double scale = (1.0 + 1e-12) / std::cos(kPi / kExactPolygon);
+  std::ostringstream s;
+  s << "; |margin| <= " << kMarginRel * m.length_scale() << " mm: exact CGAL test of a circumscribed "
+    << kExactPolygon << "-gon (conservative by <= " << 0.5 * std::max(target.axes.x(), target.axes.y()) * (scale - 1.0)
+    << " mm)";
+  return s.str();
+}
+
 CoverageResult coverage_impl(const Mechanism& m, const Region* given, const Ellipse& target,
                              const CoverageOptions& options) {
   CoverageResult out;
@@ -420,15 +487,9 @@ CoverageResult coverage_impl(const Mechanism& m, const Region* given, const Elli
   out.margin_mm = fit.margin;
   out.worst_point = fit.worst;
   out.inside = fit.inside;
-  const double tol = kMarginRel * m.length_scale();
-  if (std::fabs(out.margin_mm) <= tol) {
-    // Within rounding of tangency: decide exactly with a polygon provably around the ellipse.
-    const double scale = (1.0 + 1e-12) / std::cos(kPi / kExactPolygon);
-    out.inside = region().contains_polygon_exact(ellipse_polygon(target, kExactPolygon, scale));
-    std::ostringstream s;
-    s << "; |margin| <= " << tol << " mm: exact CGAL test of a circumscribed " << kExactPolygon
-      << "-gon (conservative by <= " << 0.5 * std::max(target.axes.x(), target.axes.y()) * (scale - 1.0) << " mm)";
-    out.method += s.str();
+  if (std::fabs(out.margin_mm) <= kMarginRel * m.length_scale()) {
+    out.inside = exact_inside(region(), target);
+    out.method += exact_method(m, target);
   }
   if (out.inside) {
     out.covered_fraction = 1.0;
@@ -452,6 +513,24 @@ CoverageResult coverage_impl(const Mechanism& m, const Region* given, const Elli
 CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse& target,
                         const CoverageOptions& options) {
   return coverage_impl(m, &region, target, options);
+}
+
+Containment containment(const Mechanism& m, const Ellipse& target) {
+  std::string method;
+  const LegFit fit = fit_mechanism(m, target, &method);
+  Containment c;
+  c.inside = fit.inside;
+  c.margin_mm = fit.margin;
+  c.worst_point = fit.worst;
+  if (std::fabs(c.margin_mm) <= kMarginRel * m.length_scale()) {
+    c.inside = exact_inside(reachable_region(m), target);
+    c.exact_fallback = true;
+  }
+  return c;
+}
+
+void conditioning(const Mechanism& m, const Ellipse& target, const CoverageOptions& options, CoverageResult& out) {
+  conditioning_over(m, target, options, out);
 }
 
 CoverageResult coverage(const Mechanism& m, const Ellipse& target, const CoverageOptions& options) {

@@ -138,6 +138,32 @@ struct PrintSettings {
   void validate() const;
 };
 
+/// One swept design variable (`sweep.vary`): NAME = LO:HI:N, in file units (mm).
+struct SweepVariable {
+  std::string name;  ///< one of sweep_variable_names()
+  double lo = 0.0;
+  double hi = 0.0;
+  int n = 1;  ///< grid points (grid sampling); ignored by random / sobol
+};
+
+/// A link-dimension sweep (`sweep:`) over one station.
+struct SweepSettings {
+  std::string station;
+  std::string mechanism;             ///< "lower", "upper" or empty: every mechanism and shared
+  std::vector<SweepVariable> vary;
+  std::string sample = "grid";       ///< grid | random | sobol
+  std::uint64_t count = 0;           ///< random / sobol designs (0: the grid's size)
+  std::uint64_t seed = 1;
+  std::vector<std::string> objectives{"margin", "min_lci"};  ///< see sweep_objective_names()
+  /// Rules that need no design (names, ranges, counts); the design checks the station.
+  void validate() const;
+};
+/// L1 L2 L3 L4, L12 (L1 = L2), L34 (L3 = L4), spacing (base spacing), upper_height (y of the
+/// upper bases), ellipse_a, ellipse_b (full axes of the target).
+const std::vector<std::string>& sweep_variable_names();
+/// margin (max), min_lci (max), force (max), footprint (min: bounding-box area of the linkage).
+const std::vector<std::string>& sweep_objective_names();
+
 /// A whole design (and scene).
 struct Design {
   std::string name;                   ///< used for outputs/<name>/: a safe file name
@@ -146,6 +172,7 @@ struct Design {
   std::optional<std::vector<std::string>> products;  ///< absent: every product the data allows
   std::optional<Geometry> geometry;       ///< `geometry:`; absent: collision and parts left out
   std::optional<PrintSettings> print;     ///< `print:`; parts use defaults when absent
+  std::optional<SweepSettings> sweep;     ///< `sweep:`; the sweep product of `fivebar run`
 
   void validate() const;
   const Station* station(std::string_view name) const;
@@ -157,6 +184,10 @@ bool is_safe_name(std::string_view name);
 
 /// Product names a scene may list, in build order.
 const std::vector<std::string>& known_products();
+
+/// The design as a design file (YAML, file units, numbers in shortest round-trip form) that
+/// load_design_from_string() reads back to an equal design.
+std::string to_yaml(const Design& design);
 
 /// Loads and validates a design file. Throws InputError whose message names the file, line, full
 /// key path, value and the rule broken ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2]

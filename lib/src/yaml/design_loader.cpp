@@ -36,7 +36,7 @@ using detail::key_index;
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 /// Top-level sections that later versions fill in (DESIGN.md); rejected clearly until then.
-constexpr std::string_view kReservedSections[] = {"controller", "sweep", "patterns"};
+constexpr std::string_view kReservedSections[] = {"controller", "patterns"};
 
 constexpr std::size_t kMaxShownValue = 60;
 
@@ -174,6 +174,8 @@ class Loader {
   Ellipse target(const Entry& entry);
   Geometry geometry(const Entry& entry);
   PrintSettings print(const Entry& entry);
+  SweepSettings sweep(const Entry& entry);
+  std::uint64_t whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const;
   /// An optional number: `fallback` when the key is absent.
   double optional_number(const Entries& all, std::string_view name, double fallback, std::string_view unit) const;
   Mechanism mechanism(const Entry& entry);
@@ -378,6 +380,51 @@ PrintSettings Loader::print(const Entry& entry) {
   return p;
 }
 
+std::uint64_t Loader::whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const {
+  const double v = number(node, path, line, "");
+  if (v != std::floor(v) || v < lo || v > hi) {
+    std::ostringstream rule;
+    rule << "must be a whole number from " << lo << " to " << hi;
+    fail_value(node, line, path, rule.str());
+  }
+  return std::uint64_t(v);
+}
+
+SweepSettings Loader::sweep(const Entry& entry) {
+  SweepSettings sw;
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"station", "mechanism", "vary", "sample", "count", "seed", "objectives"},
+                              "(station, mechanism, vary, sample, count, seed, objectives)");
+  const Entry& st = require(all, "station", entry.path, entry.line);
+  sw.station = string(st.value, st.path, st.line, "must be a station name");
+  if (const Entry* m = find(all, "mechanism")) sw.mechanism = string(m->value, m->path, m->line, "must be lower or upper");
+  const Entry& vary = require(all, "vary", entry.path, entry.line);
+  for (const Entry& v : entries(vary.value, vary.path, vary.line, {}, "of variable names to [lo, hi, n]",
+                                /*any_key=*/true)) {
+    const auto items = list(v.value, v.path, v.line, 3, "a list [lo, hi, n] (mm, mm, points)");
+    SweepVariable var;
+    var.name = v.name;
+    var.lo = number(items[0], key_index(v.path, 0), line_of(items[0], v.line), "mm");
+    var.hi = number(items[1], key_index(v.path, 1), line_of(items[1], v.line), "mm");
+    var.n = int(whole(items[2], key_index(v.path, 2), line_of(items[2], v.line), 1, 1e8));
+    sw.vary.push_back(var);
+  }
+  if (const Entry* sample = find(all, "sample")) sw.sample = string(sample->value, sample->path, sample->line, "must be grid, random or sobol");
+  if (const Entry* count = find(all, "count")) sw.count = whole(count->value, count->path, count->line, 1, 1e15);
+  if (const Entry* seed = find(all, "seed")) sw.seed = whole(seed->value, seed->path, seed->line, 0, 9007199254740992.0);
+  if (const Entry* obj = find(all, "objectives")) {
+    if (!obj->value.IsSequence()) fail_value(obj->value, obj->line, obj->path, "must be a list of objectives");
+    sw.objectives.clear();
+    for (std::size_t i = 0; i < obj->value.size(); ++i) {
+      const std::string path = key_index(obj->path, i);
+      const int line = line_of(obj->value[i], obj->line);
+      note(path, line);
+      sw.objectives.push_back(string(obj->value[i], path, line, "must be an objective name"));
+    }
+  }
+  return sw;
+}
+
 Mechanism Loader::mechanism(const Entry& entry) {
   const Entries all = entries(entry.value, entry.path, entry.line,
                               {"bases", "links", "working_mode", "assembly_mode", "joint_limits", "min_lci"},
@@ -469,8 +516,8 @@ Design Loader::load(const std::string& text) {
 
   Design design;
   try {
-    const Entries all = entries(root, "", root_line, {"name", "stations", "products", "geometry", "print"},
-                                "at the top level (name, stations, products, geometry, print)");
+    const Entries all = entries(root, "", root_line, {"name", "stations", "products", "geometry", "print", "sweep"},
+                                "at the top level (name, stations, products, geometry, print, sweep)");
     const Entry& name = require(all, "name", "", root_line);
     design.name = string(name.value, name.path, name.line, "must be a name (letters, digits, _ . -)");
 
@@ -482,6 +529,7 @@ Design Loader::load(const std::string& text) {
 
     if (const Entry* g = find(all, "geometry")) design.geometry = geometry(*g);
     if (const Entry* p = find(all, "print")) design.print = print(*p);
+    if (const Entry* sw = find(all, "sweep")) design.sweep = sweep(*sw);
 
     if (const Entry* products = find(all, "products")) {
       if (!products->value.IsSequence()) fail_value(products->value, products->line, products->path, "must be a list of product names");
