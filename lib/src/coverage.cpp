@@ -99,8 +99,13 @@ EllipseExtremes ellipse_distance_extremes(const Ellipse& e, const Vec2& p) {
     dv = (b * b - a * a) * (ct * ct - st * st) + a * x * ct + b * y * st;
   };
   constexpr int N = 48;
-  thread_local std::vector<double> uc, us;
-  if (uc.size() != N) unit_circle(N, uc, us);
+  struct Table {
+    std::vector<double> c, s;
+    Table() { unit_circle(N, c, s); }
+  };
+  static const Table table;  // built once; a static, not thread_local: no TLS wrapper per access
+  const double* uc = table.c.data();
+  const double* us = table.s.data();
   double fs[N];
   for (int k = 0; k < N; ++k) {
     const double dx = a * uc[k] - x, dy = b * us[k] - y;
@@ -435,7 +440,7 @@ void conditioning_over(const Mechanism& m, const Ellipse& e, const CoverageOptio
 }
 
 /// Containment and margin of the ellipse in the mechanism's region (legs one by one).
-LegFit fit_mechanism(const Mechanism& m, const Ellipse& e, std::string* method) {
+LegFit fit_mechanism(const Mechanism& m, const Ellipse& e, const char** method) {
   const JointRange* l1 = m.joint_limits ? &(*m.joint_limits)[0] : nullptr;
   const JointRange* l2 = m.joint_limits ? &(*m.joint_limits)[1] : nullptr;
   const LegSet legs[2] = {make_leg(m.O1, m.L[0], m.L[2], m.working_mode.sign1, l1),
@@ -455,7 +460,7 @@ LegFit fit_mechanism(const Mechanism& m, const Ellipse& e, std::string* method) 
   }
   *method = limited ? "distance from the ellipse to each leg's boundary arcs (closed form for annuli; sampled + "
                       "golden-section refined for joint-limit arcs)"
-                    : "closed form: ellipse against both annuli (robust point-ellipse extremes)";
+                    : "closed form: ellipse against both annuli (robust point-ellipse extremes)";  // no allocation
   return out;
 }
 
@@ -483,7 +488,9 @@ CoverageResult coverage_impl(const Mechanism& m, const Region* given, const Elli
     if (!built) built = reachable_region(m);
     return *built;
   };
-  const LegFit fit = fit_mechanism(m, target, &out.method);
+  const char* method = "";
+  const LegFit fit = fit_mechanism(m, target, &method);
+  out.method = method;
   out.margin_mm = fit.margin;
   out.worst_point = fit.worst;
   out.inside = fit.inside;
@@ -516,7 +523,7 @@ CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse&
 }
 
 Containment containment(const Mechanism& m, const Ellipse& target) {
-  std::string method;
+  const char* method = "";
   const LegFit fit = fit_mechanism(m, target, &method);
   Containment c;
   c.inside = fit.inside;

@@ -103,12 +103,12 @@ void unit_points(const SweepSettings& s, std::uint64_t first, std::uint64_t coun
   }
 }
 
-void to_values(const SweepSettings& s, const double* u, std::vector<double>& values) {
+void to_values(const SweepSettings& s, const double* u, std::vector<double>& values, bool grid) {
   values.resize(s.vary.size());
   for (std::size_t d = 0; d < s.vary.size(); ++d) {
     const SweepVariable& v = s.vary[d];
     values[d] = v.lo + (v.hi - v.lo) * u[d];
-    if (s.sample == "grid" && u[d] == 1.0) values[d] = v.hi;  // exact end points
+    if (grid && u[d] == 1.0) values[d] = v.hi;  // exact end points
   }
 }
 
@@ -117,7 +117,7 @@ void to_values(const SweepSettings& s, const double* u, std::vector<double>& val
 std::vector<double> sweep_point(const SweepSettings& settings, std::uint64_t index) {
   std::vector<double> u, values;
   unit_points(settings, index, 1, u);
-  to_values(settings, u.data(), values);
+  to_values(settings, u.data(), values, settings.sample == "grid");
   return values;
 }
 
@@ -242,10 +242,10 @@ void footprint(const Station& st, const std::vector<const Mechanism*>& targets, 
   row.footprint_mm2 = row.footprint_w_mm * row.footprint_h_mm;
 }
 
-std::string fmt_margin(const char* which, double margin) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "not covered: %s margin %.6g mm", which, margin);
-  return buf;
+std::string fmt_margin(const std::string& which, double margin) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, margin, std::chars_format::general, 6);
+  return "not covered: " + which + " margin " + std::string(buf, r.ptr) + " mm";
 }
 
 SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint64_t index, std::vector<double> values,
@@ -269,7 +269,7 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
     const Containment c = containment(*m, st.target);
     (m->name == "lower" ? row.margin_lower_mm : row.margin_upper_mm) = c.margin_mm;
     if (!c.inside) {
-      row.status = fmt_margin(m->name.c_str(), c.margin_mm);
+      row.status = fmt_margin(m->name, c.margin_mm);
       return row;
     }
   }
@@ -500,6 +500,7 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
   std::vector<double> u;
   std::vector<SweepRow> rows;
   const std::size_t dims = s.vary.size();
+  const bool is_grid = s.sample == "grid";
   while (next < end) {
     const std::uint64_t n = std::min<std::uint64_t>(options.chunk, end - next);
     unit_points(s, next, n, u);
@@ -508,7 +509,7 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
 #pragma omp parallel for schedule(dynamic, 64) num_threads(options.threads > 0 ? options.threads : omp_get_max_threads())
     for (std::int64_t k = 0; k < count; ++k) {
       std::vector<double> values;
-      to_values(s, u.data() + std::size_t(k) * dims, values);
+      to_values(s, u.data() + std::size_t(k) * dims, values, is_grid);
       rows[std::size_t(k)] = evaluate_values(design, s, next + std::uint64_t(k), std::move(values), options.coverage);
     }
     for (const SweepRow& r : rows) {
