@@ -199,6 +199,7 @@ struct LegSet {
   double lp = 0, ld = 0, r_out = 0, r_in = 0;
   int sigma = 1;
   const JointRange* limits = nullptr;
+  Vec2 e_lo{1.0, 0.0}, e_hi{1.0, 0.0};  // directions of the joint limits
   std::vector<CurvePiece> pieces;  // the boundary (limited legs only)
 
   bool contains(const Vec2& p) const {
@@ -207,7 +208,7 @@ struct LegSet {
     if (!limits) return true;
     const CircleIntersection x = intersect_circles(O, lp, p, ld, -sigma);
     if (x.status == Status::unreachable) return false;
-    return limits->contains(std::atan2(x.offset.y(), x.offset.x()));
+    return direction_within_arc(e_lo, e_hi, true, x.offset);  // theta in [lo, hi] without atan2
   }
   double boundary_distance(const Vec2& p) const {
     double best = std::numeric_limits<double>::infinity();
@@ -239,6 +240,8 @@ LegSet make_leg(const Vec2& O, double lp, double ld, int sigma, const JointRange
   leg.limits = limits;
   const double lo = limits->lo, hi = limits->lo + limits->span();
   const Vec2 e_lo(std::cos(lo), std::sin(lo)), e_hi(std::cos(hi), std::sin(hi));
+  leg.e_lo = e_lo;
+  leg.e_hi = e_hi;
   const Vec2 a_lo = O + lp * e_lo, a_hi = O + lp * e_hi;
   const Vec2 s_lo = O + leg.r_out * e_lo, s_hi = O + leg.r_out * e_hi;
   const Vec2 f_lo = O + (lp - ld) * e_lo, f_hi = O + (lp - ld) * e_hi;

@@ -24,6 +24,16 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 
 // --- CurvePiece ----------------------------------------------------------------------------------
 
+bool direction_within_arc(const Vec2& from, const Vec2& to, bool ccw, const Vec2& v) {
+  // A clockwise arc from a to b is the counter-clockwise arc from b to a.
+  const Vec2& a = ccw ? from : to;
+  const Vec2& b = ccw ? to : from;
+  const double w = cross2(a, b);
+  const bool minor = w > 0.0 || (w == 0.0 && a.dot(b) < 0.0);  // ccw span in (0, pi]
+  if (minor) return cross2(a, v) >= 0.0 && cross2(v, b) >= 0.0;
+  return !(cross2(b, v) > 0.0 && cross2(v, a) > 0.0);  // outside only in the complementary minor arc
+}
+
 double CurvePiece::sweep() const {
   if (!is_arc) return 0.0;
   const Vec2 a = source - center, b = target - center;
@@ -52,14 +62,8 @@ Vec2 CurvePiece::closest_point(const Vec2& p) const {
   }
   const Vec2 v = p - center;
   const double r = v.norm();
-  if (r > 0.0) {
-    // Is the direction of v within the arc's angular span (measured the arc's way round)?
-    const Vec2 a = source - center;
-    double phi = std::atan2(cross2(a, v), a.dot(v));
-    const double sw = sweep();
-    if (sw >= 0.0 ? (phi < 0.0 ? phi + 2 * kPi : phi) <= sw : (phi > 0.0 ? phi - 2 * kPi : phi) >= sw) {
-      return center + (radius / r) * v;
-    }
+  if (r > 0.0 && direction_within_arc(source - center, target - center, ccw, v)) {
+    return center + (radius / r) * v;
   }
   return (p - source).squaredNorm() <= (p - target).squaredNorm() ? source : target;
 }
