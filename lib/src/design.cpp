@@ -470,6 +470,7 @@ const std::vector<std::string>& known_products() {
   // In build order; each capability appends its product here.
   static const std::vector<std::string> products{
       "kinematics",
+      "sweep",
   };
   return products;
 }
