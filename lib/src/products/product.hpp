@@ -64,5 +64,9 @@ const Product* find_product(std::string_view name);
 // --- Entries (one file each) -----------------------------------------------------------------
 /// Link data, modes and the pose at the target centre and axis ends of every mechanism.
 Product kinematics_product();
+/// Exact regions, restricted areas, VTK files and the picture of every station (workspace/).
+Product workspace_product();
+/// Coverage of every station's target ellipse by each mechanism and the shared region.
+Product coverage_product();
 
 }  // namespace fivebar::products
