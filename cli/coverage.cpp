@@ -17,7 +17,8 @@ namespace {
 struct CoverageCliOptions {
   std::string design;
   std::string station;
-  std::string ellipse;  ///< "CX,CY,AX,AY,ANGLE"; empty: each station's target
+  std::string ellipse;  ///< "CX,CY,AX,AY,ANGLE"
+  bool ellipse_given = false;
   bool json = false;
 };
 
@@ -49,7 +50,7 @@ void print_station(const Station& s, const Ellipse& e, bool overridden, const St
 int run_coverage(const CoverageCliOptions& opt) {
   // The override is checked before the design is read: a typo in it is the user's first problem.
   std::optional<Ellipse> override_target;
-  if (!opt.ellipse.empty()) override_target = parse_ellipse(opt.ellipse, "--ellipse");
+  if (opt.ellipse_given) override_target = parse_ellipse(opt.ellipse, "--ellipse");
   const Design design = load(opt.design);
   const auto stations = select_stations(design, opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
@@ -83,7 +84,7 @@ void setup_coverage(CLI::App& app) {
       "fraction, min LCI and force capability over the ellipse");
   add_design_argument(*sub, opt->design);
   sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
-  sub->add_option("--ellipse", opt->ellipse,
+  CLI::Option* ellipse = sub->add_option("--ellipse", opt->ellipse,
                   "Target instead of the design's: centre CX,CY (mm), full axis lengths AX,AY (mm) and rotation "
                   "ANGLE (deg), e.g. --ellipse 6.25,15.5,15,12,0; applies to every station checked")
       ->type_name("CX,CY,AX,AY,ANGLE");
@@ -93,7 +94,10 @@ void setup_coverage(CLI::App& app) {
       "The margin is the signed distance from the ellipse to the region boundary (negative: outside by that much).\n"
       "Exit status: 0 every mechanism covers the target (inside, assembly side kept, LCI >= min_lci), 1 otherwise, "
       "2 bad input, 3 internal error.");
-  sub->callback([opt]() { finish(run_coverage(*opt)); });
+  sub->callback([opt, ellipse]() {
+    opt->ellipse_given = ellipse->count() > 0;
+    finish(run_coverage(*opt));
+  });
 }
 
 }  // namespace fivebar::cli

@@ -77,7 +77,7 @@ Product workspace_product() {
     for (const Station& s : ctx.design.stations) {
       if (s.mechanisms().empty()) continue;
       ctx.say("workspace: station " + s.name);
-      const StationWorkspace ws = analyse_workspace(s, options, [&](std::string_view line) { ctx.say("workspace: " + std::string(line)); });
+      const StationWorkspace ws = analyse_workspace(s, options);
       PlotOptions plot;
       plot.subtitle = "design " + ctx.design.name + ", sample spacing " + md::fixed(options.spacing_mm, 2) + " mm";
       const WorkspaceFileNames names = workspace_file_names(ws);

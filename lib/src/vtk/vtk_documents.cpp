@@ -40,6 +40,7 @@ std::string write_document(Writer* writer, const char* what) {
 class CurveBuilder {
  public:
   CurveBuilder() {
+    points_->SetDataTypeToDouble();  // the default float would cost 1e-7 mm at 10 mm
     kind_->SetName("kind");
     mechanism_->SetName("mechanism_id");
     loop_->SetName("loop_index");
