@@ -81,6 +81,16 @@ void text(cairo_t* cr, double x, double y, const std::string& s, double size, Al
   cairo_restore(cr);
 }
 
+double text_width(cairo_t* cr, const std::string& s, double size, bool bold) {
+  cairo_save(cr);
+  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t ext;
+  cairo_text_extents(cr, s.c_str(), &ext);
+  cairo_restore(cr);
+  return ext.x_advance;
+}
+
 /// Data (mm) -> device (px) map of one panel: equal scale on both axes, y up.
 struct Frame {
   double left = 0, top = 0, width = 0, height = 0;  // plot box, device
@@ -632,7 +642,9 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
   const double panel_h = H - top - bottom;
   Frame fa = fit(overview_box(ws), left_margin, top, 0.5 * W - left_margin, panel_h);
   fa.left = left_margin;  // left-aligned: the free width goes to the right column
-  const double col = fa.left + fa.width + gap;
+  const std::string title_a = "Reachable regions, linkages at the target centre";
+  // The right column starts after panel A and after its title (panel A is narrow for tall data).
+  const double col = std::max(fa.left + fa.width + gap, fa.left + text_width(cr, title_a, 17, true) + 60);
   const double bar_room = 110;
   Frame fb = fit(detail_box(ws), col, top, W - col - bar_room - right_margin, 0.56 * panel_h);
   fb.left = col;
@@ -647,7 +659,7 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
   const double dash[] = {7.0, 4.0};
 
   // Panel A: regions, shared region, assembly-side limits, target, linkages.
-  axes(cr, fa, "Reachable regions, linkages at the target centre");
+  axes(cr, fa, title_a);
   cairo_save(cr);
   clip_to_frame(cr, fa);
   for (const MechanismWorkspace& w : ws.mechanisms) {
@@ -749,9 +761,15 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
   for (const MechanismWorkspace& w : ws.mechanisms) lg.swatch_fill(fill_of(w.mechanism), w.mechanism.name + " mechanism: reachable region");
   if (ws.shared) lg.swatch_hatch("shared region: both tactors reach");
   for (const MechanismWorkspace& w : ws.mechanisms)
-    lg.swatch_line(ink_of(w.mechanism), 1.8, true, w.mechanism.name + ": limit of the assembly side");
+    lg.swatch_line(ink_of(w.mechanism), 1.8, true,
+                   w.mechanism.name + ": limit of the assembly side" +
+                       (w.mechanism.min_lci > 0.0 ? " (right: of LCI ≥ " + format("%.2f", w.mechanism.min_lci) + ")" : ""));
   lg.swatch_ellipse("target fingertip ellipse");
-  for (const MechanismWorkspace& w : ws.mechanisms) lg.swatch_linkage(ink_of(w.mechanism), w.mechanism.name + " linkage and tactor");
+  for (const MechanismWorkspace& w : ws.mechanisms) {
+    lg.swatch_linkage(ink_of(w.mechanism), w.centre.status == Status::unreachable
+                                               ? w.mechanism.name + " linkage: target centre unreachable"
+                                               : w.mechanism.name + " linkage and tactor");
+  }
   lg.swatch_ground("base joint (motor)");
   lg.swatch_nodata(several ? "LCI panel: not reached by both" : "LCI panel: not reached");
 
