@@ -186,7 +186,8 @@ void hatch(cairo_t* cr, double x0, double y0, double x1, double y1, double gap, 
 // --- pieces of the picture ----------------------------------------------------------------------
 
 void axes(cairo_t* cr, const Frame& f, const std::string& title) {
-  const double step = nice_step(std::max(f.xmax - f.xmin, f.ymax - f.ymin), 8.0);
+  // About one labelled tick per 80 px of the longer side; the same step on both (equal) axes.
+  const double step = nice_step(std::max(f.xmax - f.xmin, f.ymax - f.ymin), std::max(f.width, f.height) / 80.0);
   const char* fmt = step < 1.0 ? "%.1f" : "%.0f";
   cairo_save(cr);
   cairo_set_line_width(cr, 1.0);
