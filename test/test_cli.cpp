@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -552,13 +553,19 @@ TEST_F(Cli, RunWritesTheTwoSummariesAndNothingElse) {
   const fs::path out = dir_ / "out";
   const Outcome r = run({"run", kDesign, "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(tree(out), (std::vector<std::string>{"iros2022", "iros2022/summary.json", "iros2022/summary.md"}));
+  // The summaries, and the workspace product's files (test_cli_workspace.cpp checks those).
+  std::vector<std::string> files = tree(out);
+  files.erase(std::remove_if(files.begin(), files.end(),
+                             [](const std::string& f) { return f.starts_with("iros2022/workspace/"); }),
+              files.end());
+  EXPECT_EQ(files, (std::vector<std::string>{"iros2022", "iros2022/summary.json", "iros2022/summary.md",
+                                             "iros2022/workspace"}));
   EXPECT_THAT(r.out, AllOf(HasSubstr("kinematics"), HasSubstr("summary.md")));
 
   const json s = json::parse(slurp(out / "iros2022" / "summary.json"));
   EXPECT_EQ(s["design"]["name"], "iros2022");
   EXPECT_TRUE(s["ok"].get<bool>());
-  ASSERT_EQ(s["built"].size(), 1u);
+  ASSERT_EQ(s["built"].size(), 3u);
   EXPECT_EQ(s["built"][0]["name"], "kinematics");
   const json& stations = s["results"]["kinematics"]["stations"];
   ASSERT_EQ(stations.size(), 2u);

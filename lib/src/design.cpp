@@ -470,6 +470,8 @@ const std::vector<std::string>& known_products() {
   // In build order; each capability appends its product here.
   static const std::vector<std::string> products{
       "kinematics",
+      "workspace",
+      "coverage",
       "sweep",
   };
   return products;

@@ -66,5 +66,9 @@ const Product* find_product(std::string_view name);
 Product kinematics_product();
 /// The scene's `sweep:` section: CSV, Pareto set, best design, plots.
 Product sweep_product();
+/// Exact regions, restricted areas, VTK files and the picture of every station (workspace/).
+Product workspace_product();
+/// Coverage of every station's target ellipse by each mechanism and the shared region.
+Product coverage_product();
 
 }  // namespace fivebar::products

@@ -7,6 +7,8 @@ const std::vector<Product>& registry() {
   // pattern, sweep, parts, export, report).
   static const std::vector<Product> entries = {
       kinematics_product(),
+      workspace_product(),
+      coverage_product(),
       sweep_product(),
   };
   return entries;
