@@ -64,5 +64,7 @@ const Product* find_product(std::string_view name);
 // --- Entries (one file each) -----------------------------------------------------------------
 /// Link data, modes and the pose at the target centre and axis ends of every mechanism.
 Product kinematics_product();
+/// OpenSCAD sources, STL renders, mesh and fit checks and the BOM of every station (parts.hpp).
+Product parts_product();
 
 }  // namespace fivebar::products
