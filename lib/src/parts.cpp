@@ -244,14 +244,14 @@ void check_printable(const Design& design, const Station& s, const Derived& d) {
                            polyhole_vertex_radius(d.hole_d, d.fn) + wall;
       if (m->L[i] < std::max(needed, holes)) {
         std::ostringstream rule;
-        rule << "= " << num(m->L[i]) << " mm: too short to print: its end bosses (" << num(end0) << " and "
-             << num(g.boss_diameter) << " mm) need a centre distance of at least " << fixed(std::max(needed, holes), 3)
+        rule << "= " << num(m->L[i]) << " mm: too short to print: its end bosses (" << fixed(end0, 3) << " and "
+             << fixed(g.boss_diameter, 3) << " mm) need a centre distance of at least " << fixed(std::max(needed, holes), 3)
              << " mm";
         fail(design, detail::key_index(mkey + ".links", i), rule.str());
       }
     }
-    // Motors side by side under the plate.
   }
+  // Motors side by side under the plate.
   std::vector<std::pair<std::string, Vec2>> bases;
   for (const Mechanism* m : s.mechanisms()) {
     bases.emplace_back(detail::key_index(mechanism_key(s, *m) + ".bases", 0), m->O1);
@@ -893,11 +893,40 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
   }
   remove_stale(options.out_dir, plan);
 
+  // What a render depends on: the part's .scad text without its comment lines (which list the
+  // pieces it makes, not its shape), the library and openscad's flags.
+  const std::vector<std::string> flags{"--export-format", "binstl", "--hardwarnings", "--check-parameters", "true",
+                                       "--check-parameter-ranges", "true"};
+  const std::uint64_t common = fnv1a(join(flags, " "), fnv1a(library));
+  const auto inputs_hash = [&](const PartSpec& spec) {
+    std::string code;
+    std::istringstream in(spec.scad);
+    for (std::string line; std::getline(in, line);) {
+      if (!line.starts_with("//")) code += line + "\n";
+    }
+    return "fnv1a64 " + hex64(fnv1a(code, common)) + "\n";
+  };
+  if (!options.render) {
+    // Sources only: an earlier STL that no longer matches its source must not stay behind.
+    for (const PartResult& r : report.parts) {
+      const fs::path stl = options.out_dir / r.stl_file;
+      const fs::path hash_file = fs::path(stl.string() + ".hash");
+      std::error_code ec;
+      if (fs::exists(stl, ec) && read_text(hash_file) != inputs_hash(r.spec)) {
+        fs::remove(stl, ec);
+        fs::remove(hash_file, ec);
+      }
+    }
+  }
+
   if (options.render) {
-    const std::vector<std::string> flags{"--export-format", "binstl", "--hardwarnings", "--check-parameters", "true",
-                                         "--check-parameter-ranges", "true"};
-    const std::uint64_t common = fnv1a(join(flags, " "), fnv1a(report.openscad->string(), fnv1a(library)));
     const std::size_t total = report.parts.size();
+    // Longest renders first (the bases: OpenSCAD 2021's CGAL union), so that two jobs finish together.
+    std::vector<std::size_t> order(total);
+    for (std::size_t k = 0; k < total; ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return (report.parts[a].spec.kind == PartKind::station_base) > (report.parts[b].spec.kind == PartKind::station_base);
+    });
     std::atomic<std::size_t> next{0};
     std::size_t done = 0;
     std::mutex mutex;
@@ -906,13 +935,14 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
         (jobs == 1 ? "" : "s"));
     const auto worker = [&]() {
       while (true) {
-        const std::size_t k = next.fetch_add(1);
-        if (k >= total) return;
+        const std::size_t slot = next.fetch_add(1);
+        if (slot >= total) return;
+        const std::size_t k = order[slot];
         PartResult& r = report.parts[k];
         const fs::path scad = options.out_dir / r.scad_file;
         const fs::path stl = options.out_dir / r.stl_file;
         const fs::path hash_file = fs::path(stl.string() + ".hash");
-        const std::string hash = "fnv1a64 " + hex64(fnv1a(r.spec.scad, common)) + "\n";
+        const std::string hash = inputs_hash(r.spec);
         std::error_code ec;
         if (fs::exists(stl, ec) && read_text(hash_file) == hash) {
           r.render = RenderState::up_to_date;
@@ -976,6 +1006,7 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
     for (const PartResult& r : report.parts) {
       if (r.render != RenderState::failed) {
         report.files.push_back(r.stl_file);
+        report.files.push_back(r.stl_file.string() + ".hash");
       }
     }
   }
