@@ -623,6 +623,8 @@ TEST_F(Parts, UnchangedPartsAreNotRenderedAgainAndAChangedL3LengthensItsLinkBy2m
   EXPECT_NEAR(s17.extent(0) - s15.extent(0), 2.0, 1e-5);
   EXPECT_NEAR(s17.extent(1), s15.extent(1), 1e-6);
   EXPECT_NEAR(s17.extent(2), s15.extent(2), 1e-6);
+  // Only the bar between the bosses grew: 2 mm x 4 mm wide x 2.5 mm thick.
+  EXPECT_NEAR(s17.volume() - s15.volume(), 2.0 * kWidth * kThickness, 1e-3);
   const auto a = hole_centroid(s17, 0.0, 0.0, 0.5 * kHole);
   const auto b = hole_centroid(s17, kL3Index + 2.0, 0.0, 0.5 * kHole);
   ASSERT_TRUE(a && b);

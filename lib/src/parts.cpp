@@ -863,9 +863,14 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
   if (options.render) {
     report.openscad = find_openscad(options.openscad);
     if (!report.openscad) {
-      const std::string name = options.openscad.empty() ? "openscad" : options.openscad;
-      throw ToolError("'" + name +
-                      "' not found: rendering the parts to STL needs OpenSCAD (Debian: apt-get install openscad; "
+      std::string name = options.openscad;
+      if (name.empty()) {
+        const char* env = std::getenv("FIVEBAR_OPENSCAD");
+        name = env != nullptr && *env != '\0' ? env : "openscad";
+      }
+      const bool on_path = name.find('/') == std::string::npos;
+      throw ToolError("'" + name + "' not found" + (on_path ? " on PATH" : "") +
+                      ": rendering the parts to STL needs OpenSCAD (Debian: apt-get install openscad; "
                       "or set FIVEBAR_OPENSCAD). --no-render writes the .scad sources only.");
     }
   }

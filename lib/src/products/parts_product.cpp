@@ -89,8 +89,8 @@ Product parts_product() {
     b.passed = report.passed();
     std::size_t failed = 0;
     for (const auto& part : report.parts) failed += part.passed() ? 0 : 1;
-    b.check = b.passed ? std::to_string(report.parts.size()) + " parts rendered and checked, " +
-                             md::fixed(report.resin_ml(), 1) + " ml of resin"
+    b.check = b.passed ? std::to_string(report.parts.size()) + " parts: meshes watertight, pin centres and holes as " +
+                             "designed; " + md::fixed(report.resin_ml(), 1) + " ml of resin"
                        : std::to_string(failed) + " of " + std::to_string(report.parts.size()) +
                              " parts fail their render, mesh or fit checks";
     return b;
