@@ -974,6 +974,11 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
             fs::remove(stl, ec);
             fs::remove(hash_file, ec);
           } else {
+            // Durable before it replaces the old file (as write_file_atomic does).
+            if (const int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
+              (void)::fsync(fd);
+              ::close(fd);
+            }
             fs::rename(tmp, stl, ec);
             if (ec) {
               r.render = RenderState::failed;
