@@ -135,5 +135,6 @@ void setup_sweep(CLI::App& app);
 void setup_run(CLI::App& app);
 void setup_workspace(CLI::App& app);
 void setup_coverage(CLI::App& app);
+void setup_parts(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -61,6 +61,7 @@ int main(int argc, char** argv) {
   setup_run(app);
   setup_workspace(app);
   setup_coverage(app);
+  setup_parts(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -473,6 +473,7 @@ const std::vector<std::string>& known_products() {
       "workspace",
       "coverage",
       "sweep",
+      "parts",  // after sweep, before export and report
   };
   return products;
 }

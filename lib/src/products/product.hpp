@@ -70,5 +70,7 @@ Product sweep_product();
 Product workspace_product();
 /// Coverage of every station's target ellipse by each mechanism and the shared region.
 Product coverage_product();
+/// OpenSCAD sources, STL renders, mesh and fit checks and the BOM of every station (parts.hpp).
+Product parts_product();
 
 }  // namespace fivebar::products

@@ -10,6 +10,7 @@ const std::vector<Product>& registry() {
       workspace_product(),
       coverage_product(),
       sweep_product(),
+      parts_product(),
   };
   return entries;
 }
