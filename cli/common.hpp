@@ -124,5 +124,7 @@ void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Ve
 void setup_fk(CLI::App& app);
 void setup_ik(CLI::App& app);
 void setup_run(CLI::App& app);
+void setup_collision(CLI::App& app);
+void setup_pattern(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -19,7 +19,8 @@ namespace {
 /// below often start with '-' (modes, branches, negative numbers), so "--mode -+" is rewritten
 /// to "--mode=-+" before parsing.
 std::vector<std::string> join_dash_values(int argc, char** argv) {
-  static const std::set<std::string> takes_value{"-t", "--theta", "-p", "--point", "--mode", "-b", "--branch"};
+  static const std::set<std::string> takes_value{"-t",      "--theta",   "-p",      "--point", "--mode",
+                                                 "-b",      "--branch",  "--upper", "--lower", "--center"};
   std::vector<std::string> args(argv + 1, argv + argc);
   std::vector<std::string> out;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -57,6 +58,8 @@ int main(int argc, char** argv) {
   setup_fk(app);
   setup_ik(app);
   setup_run(app);
+  setup_collision(app);
+  setup_pattern(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -64,5 +64,9 @@ const Product* find_product(std::string_view name);
 // --- Entries (one file each) -----------------------------------------------------------------
 /// Link data, modes and the pose at the target centre and axis ends of every mechanism.
 Product kinematics_product();
+/// Collision map of the two tactors of every station and the priority rule at the centre.
+Product collision_product();
+/// The skin-deformation patterns of `patterns:`, checked, with joint trajectories and pictures.
+Product pattern_product();
 
 }  // namespace fivebar::products

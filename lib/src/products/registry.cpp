@@ -7,6 +7,8 @@ const std::vector<Product>& registry() {
   // pattern, sweep, parts, export, report).
   static const std::vector<Product> entries = {
       kinematics_product(),
+      collision_product(),
+      pattern_product(),
   };
   return entries;
 }
