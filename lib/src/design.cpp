@@ -403,11 +403,19 @@ namespace {
 /// Most samples one pattern may have (10 minutes at 1 kHz is 600000).
 constexpr double kMaxPatternSamples = 1e6;
 
+/// A value for messages as a person types it: 100000, 0.15, 1e-09.
+std::string plain_number(double v) {
+  if (!std::isfinite(v)) return format_number(v);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
 void require_range(const std::string& key, double v, double lo_exclusive, double hi, std::string_view unit) {
   if (!(v > lo_exclusive) || !(v <= hi)) {
     std::ostringstream s;
-    s << "= " << format_number(v) << (unit.empty() ? "" : " ") << unit << ": must be > " << format_number(lo_exclusive)
-      << " and <= " << format_number(hi) << (unit.empty() ? "" : " ") << unit;
+    s << "= " << plain_number(v) << (unit.empty() ? "" : " ") << unit << ": must be > " << plain_number(lo_exclusive)
+      << " and <= " << plain_number(hi) << (unit.empty() ? "" : " ") << unit;
     throw ValidationError(key, s.str());
   }
 }
@@ -424,16 +432,16 @@ void PatternSpec::validate() const {
   require_range("rate_hz", rate_hz, 0.0, 1e4, "Hz");
   if (duration_s * rate_hz > kMaxPatternSamples) {
     std::ostringstream s;
-    s << "= " << format_number(duration_s) << " s: at rate_hz " << format_number(rate_hz)
+    s << "= " << plain_number(duration_s) << " s: at rate_hz " << plain_number(rate_hz)
       << " that is more than 1000000 samples";
     throw ValidationError("duration_s", s.str());
   }
   if (centre) check_point("centre", *centre);
   if (!(separation_mm >= 0.0) || !(separation_mm <= 1e3)) {
-    throw ValidationError("separation_mm", "= " + format_number(separation_mm) + " mm: must be >= 0 and <= 1000 mm");
+    throw ValidationError("separation_mm", "= " + plain_number(separation_mm) + " mm: must be >= 0 and <= 1000 mm");
   }
   if (kind == PatternKind::twist && !(separation_mm > 0.0)) {
-    throw ValidationError("separation_mm", "= " + format_number(separation_mm) +
+    throw ValidationError("separation_mm", "= " + plain_number(separation_mm) +
                                                " mm: twist turns the tactors on a circle of diameter separation_mm: "
                                                "must be > 0");
   }

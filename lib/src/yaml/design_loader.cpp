@@ -388,12 +388,15 @@ PatternSpec Loader::pattern(const Entry& entry, const PatternSpec& base) {
   const Entries all =
       pivot ? entries(entry.value, entry.path, entry.line,
                       {"amplitude_deg", "frequency_hz", "duration_s", "rate_hz", "center", "separation_mm",
-                       "contact_points"},
+                       "contact_points", "amplitude_mm"},
                       "of pivot parameters (amplitude_deg, frequency_hz, duration_s, contact_points, ...)")
             : entries(entry.value, entry.path, entry.line,
                       {"amplitude_mm", "duration_s", "rate_hz", "center", "separation_mm"},
                       "of pattern parameters (amplitude_mm, duration_s, rate_hz, center, separation_mm)");
   if (!pivot) spec.amplitude_mm = optional_number(all, "amplitude_mm", spec.amplitude_mm, "mm");
+  if (const Entry* a = find(all, "amplitude_mm"); a != nullptr && pivot) {
+    fail_value(a->value, a->line, a->path, "a pivot's amplitude is the object's angle: use amplitude_deg");
+  }
   spec.duration_s = optional_number(all, "duration_s", spec.duration_s, "s");
   spec.rate_hz = optional_number(all, "rate_hz", spec.rate_hz, "Hz");
   if (const Entry* c = find(all, "center")) spec.centre = point(c->value, c->path, c->line, "a point [x, y] (mm)");
