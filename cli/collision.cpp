@@ -1,6 +1,8 @@
 // fivebar collision: interference of a station's upper and lower mechanisms for a pair of tactor
 // points, with the paper's priority rule; without points, the collision map over the target ellipse.
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -103,6 +105,13 @@ int run_pair(const CollisionOptions& opt, const Design& design, const Station& s
 int run_map(const CollisionOptions& opt, const Design& design, const Station& s, const Geometry& g) {
   CollisionMapOptions options;
   options.spacing_mm = opt.spacing_mm;
+  if (::isatty(STDERR_FILENO) != 0) {  // progress only for a person watching
+    options.progress = [](std::size_t done, std::size_t total) {
+      std::fprintf(stderr, "\rfivebar collision: map %3zu %%", total > 0 ? 100 * done / total : 100);
+      if (done == total) std::fprintf(stderr, "\r%*s\r", 30, "");
+      std::fflush(stderr);
+    };
+  }
   const CollisionMap map = collision_map(s, g, options);
   const std::filesystem::path dir = output_dir(design, opt.out, "collision");
   const RenderedPlot pic = plot_collision_map(s, g, map);

@@ -186,7 +186,7 @@ TEST_F(PaperPatterns, StretchKeepsThePinBossClearanceOfItsStart) {
 
 TEST_F(PaperPatterns, LongTwistOnTheIndexCollidesAndThePriorityRuleMovesTheLower) {
   // 6 mm of arc on the 8 mm circle turns the pair by 86 degrees: the lower tactor swings up beside
-  // the upper one and meets its distal link.
+  // the upper one and its distal link L3 passes under the upper's tactor joint.
   const PatternResult r = check_pattern(station("index"), geometry(), spec(PatternKind::twist, 6.0, 8.0), max_speed());
   EXPECT_FALSE(r.passed);
   ASSERT_TRUE(r.first_failure.has_value());

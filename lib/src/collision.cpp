@@ -470,6 +470,7 @@ CollisionMap collision_map(const Station& station, const Geometry& g, const Coll
   std::vector<std::size_t> lower_pairs(np, 0), lower_hits(np, 0);
   map.min_free_separation_mm = kInf;
   for (std::size_t i = 0; i < np; ++i) {
+    if (options.progress && i % 16 == 0) options.progress(i, np);
     if (!map.upper_ok[i]) continue;
     std::size_t pairs = 0, hits = 0;
     for (std::size_t j = 0; j < np; ++j) {
@@ -501,6 +502,7 @@ CollisionMap collision_map(const Station& station, const Geometry& g, const Coll
     map.colliding += hits;
     map.upper_fraction[i] = pairs > 0 ? double(hits) / double(pairs) : 0.0;
   }
+  if (options.progress) options.progress(np, np);
   for (std::size_t j = 0; j < np; ++j) {
     map.lower_fraction[j] = lower_pairs[j] > 0 ? double(lower_hits[j]) / double(lower_pairs[j]) : 0.0;
   }

@@ -22,6 +22,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -171,6 +172,8 @@ PriorityResult apply_priority(const Mechanism& upper, const Mechanism& lower, co
 
 struct CollisionMapOptions {
   double spacing_mm = 0.75;  ///< grid spacing of the tactor positions in the target ellipse
+  /// Called now and then with (upper positions done, total), e.g. for a progress line; may be empty.
+  std::function<void(std::size_t, std::size_t)> progress;
 };
 
 /// Fraction of pairs that collide among pairs whose separation falls in [lo, hi).
