@@ -56,8 +56,12 @@ TEST(PatternPath, SamplesTimesAndCentre) {
   PatternSpec moved = s;
   moved.centre = Vec2(5.0, 14.0);
   EXPECT_EQ(pattern_path(moved, {6.25, 15.5}).centre, Vec2(5.0, 14.0));
-  // 0.5 s at 250 Hz: 125 intervals, 126 samples.
+  // 0.5 s at 250 Hz: 125 intervals, 126 samples; 0.29 s at 100 Hz is 28.999999999999996 intervals
+  // in doubles, and still 29 intervals.
   EXPECT_EQ(spec(PatternKind::slip, 1.0, 6.0, 0.5, 250.0).samples(), 126u);
+  ASSERT_LT(0.29 * 100.0, 29.0);
+  EXPECT_EQ(spec(PatternKind::slip, 1.0, 6.0, 0.29, 100.0).samples(), 30u);
+  EXPECT_DOUBLE_EQ(pattern_path(spec(PatternKind::slip, 1.0, 6.0, 0.29, 100.0), {0, 0}).time_s.back(), 0.29);
 }
 
 TEST(PatternPath, StretchMovesApartHorizontally) {

@@ -403,6 +403,10 @@ namespace {
 /// Most samples one pattern may have (10 minutes at 1 kHz is 600000).
 constexpr double kMaxPatternSamples = 1e6;
 
+/// duration * rate within this many intervals of a whole number counts as that number: 0.29 s at
+/// 100 Hz is 28.999999999999996 intervals in doubles and must give 29, not 28.
+constexpr double kSampleCountSlack = 1e-9;
+
 /// A value for messages as a person types it: 100000, 0.15, 1e-09.
 std::string plain_number(double v) {
   if (!std::isfinite(v)) return format_number(v);
@@ -423,7 +427,7 @@ void require_range(const std::string& key, double v, double lo_exclusive, double
 }  // namespace
 
 std::size_t PatternSpec::samples() const {
-  return static_cast<std::size_t>(std::floor(duration_s * rate_hz + 1e-9)) + 1;
+  return static_cast<std::size_t>(std::floor(duration_s * rate_hz + kSampleCountSlack)) + 1;
 }
 
 void PatternSpec::validate() const {

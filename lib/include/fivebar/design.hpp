@@ -163,7 +163,8 @@ struct PatternSpec {
   double pivot_frequency_hz = 0.5;               ///< pivot: angle(t) = amplitude sin(2 pi f t)
   /// Pivot: contact points {upper, lower} relative to the centre (mm); default (0, +-separation/2).
   std::optional<std::array<Vec2, 2>> contact_points;
-  /// Number of samples: floor(duration * rate + 1e-9) + 1 (both ends included).
+  /// Number of samples: floor(duration * rate) + 1, both ends included (a product within rounding
+  /// of a whole number counts as that number).
   std::size_t samples() const;
   /// Throws ValidationError naming the key ("amplitude_mm", "contact_points[1]").
   void validate() const;

@@ -40,8 +40,9 @@ struct PatternPath {
   std::vector<Vec2> lower;
 };
 
-/// The path of `spec` (formulas above), sampled at spec.rate_hz from 0 to duration_s inclusive;
-/// `default_centre` is used when spec.centre is not set (the station's target centre).
+/// The path of `spec` (formulas above) at t = k / rate_hz, k = 0 ... spec.samples() - 1 (up to
+/// duration_s inclusive when duration * rate is whole); `default_centre` is used when spec.centre
+/// is not set (the station's target centre).
 PatternPath pattern_path(const PatternSpec& spec, const Vec2& default_centre);
 
 /// What a sample of one mechanism is, worst first when several apply.
