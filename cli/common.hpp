@@ -136,5 +136,7 @@ void setup_run(CLI::App& app);
 void setup_workspace(CLI::App& app);
 void setup_coverage(CLI::App& app);
 void setup_parts(CLI::App& app);
+void setup_collision(CLI::App& app);
+void setup_pattern(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -19,8 +19,9 @@ namespace {
 /// below often start with '-' (modes, branches, negative numbers), so "--mode -+" is rewritten
 /// to "--mode=-+" before parsing.
 std::vector<std::string> join_dash_values(int argc, char** argv) {
-  static const std::set<std::string> takes_value{"-t", "--theta", "-p", "--point", "--mode", "-b", "--branch",
-                                                   "--ellipse", "--spacing"};
+  static const std::set<std::string> takes_value{"-t",      "--theta",   "-p",        "--point",   "--mode",
+                                                 "-b",      "--branch",  "--ellipse", "--spacing", "--upper",
+                                                 "--lower", "--center"};
   std::vector<std::string> args(argv + 1, argv + argc);
   std::vector<std::string> out;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -62,6 +63,8 @@ int main(int argc, char** argv) {
   setup_workspace(app);
   setup_coverage(app);
   setup_parts(app);
+  setup_collision(app);
+  setup_pattern(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

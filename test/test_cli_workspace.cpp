@@ -406,6 +406,10 @@ TEST_F(CliWorkspace, RunCoverageFailsForAStationThatIsNotCoveredAndOnlyScansTheS
   ASSERT_NE(thumb, std::string::npos);
   ASSERT_NE(geometry, std::string::npos);
   text.erase(thumb, geometry + 1 - thumb);
+  // ... and the patterns' per-station entries, which name the thumb.
+  const auto per_station = text.find("\n  stations:\n    thumb:");
+  ASSERT_NE(per_station, std::string::npos);
+  text.erase(per_station, text.find("\n\n", per_station + 1) - per_station);
   const std::string from = "axes: [15, 12]";
   text.replace(text.find(from), from.size(), "axes: [40, 12]");
   const fs::path design = dir_ / "wide.yaml";

@@ -455,6 +455,124 @@ void SweepSettings::validate() const {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Patterns
+
+std::string_view to_string(PatternKind kind) {
+  switch (kind) {
+    case PatternKind::stretch: return "stretch";
+    case PatternKind::slip: return "slip";
+    case PatternKind::twist: return "twist";
+    case PatternKind::pivot: return "pivot";
+  }
+  return "stretch";
+}
+
+std::optional<PatternKind> parse_pattern_kind(std::string_view text) {
+  for (PatternKind kind : all_pattern_kinds()) {
+    if (text == to_string(kind)) return kind;
+  }
+  return std::nullopt;
+}
+
+std::array<PatternKind, 4> all_pattern_kinds() {
+  return {PatternKind::stretch, PatternKind::slip, PatternKind::twist, PatternKind::pivot};
+}
+
+namespace {
+
+/// Most samples one pattern may have (10 minutes at 1 kHz is 600000).
+constexpr double kMaxPatternSamples = 1e6;
+
+/// duration * rate within this many intervals of a whole number counts as that number: 0.29 s at
+/// 100 Hz is 28.999999999999996 intervals in doubles and must give 29, not 28.
+constexpr double kSampleCountSlack = 1e-9;
+
+/// A value for messages as a person types it: 100000, 0.15, 1e-09.
+std::string plain_number(double v) {
+  if (!std::isfinite(v)) return format_number(v);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
+void require_range(const std::string& key, double v, double lo_exclusive, double hi, std::string_view unit) {
+  if (!(v > lo_exclusive) || !(v <= hi)) {
+    std::ostringstream s;
+    s << "= " << plain_number(v) << (unit.empty() ? "" : " ") << unit << ": must be > " << plain_number(lo_exclusive)
+      << " and <= " << plain_number(hi) << (unit.empty() ? "" : " ") << unit;
+    throw ValidationError(key, s.str());
+  }
+}
+
+}  // namespace
+
+std::size_t PatternSpec::samples() const {
+  return static_cast<std::size_t>(std::floor(duration_s * rate_hz + kSampleCountSlack)) + 1;
+}
+
+void PatternSpec::validate() const {
+  if (kind != PatternKind::pivot) require_range("amplitude_mm", amplitude_mm, 0.0, 1e3, "mm");
+  require_range("duration_s", duration_s, 0.0, 3600.0, "s");
+  require_range("rate_hz", rate_hz, 0.0, 1e4, "Hz");
+  if (duration_s * rate_hz > kMaxPatternSamples) {
+    std::ostringstream s;
+    s << "= " << plain_number(duration_s) << " s: at rate_hz " << plain_number(rate_hz)
+      << " that is more than 1000000 samples";
+    throw ValidationError("duration_s", s.str());
+  }
+  if (centre) check_point("centre", *centre);
+  if (!(separation_mm >= 0.0) || !(separation_mm <= 1e3)) {
+    throw ValidationError("separation_mm", "= " + plain_number(separation_mm) + " mm: must be >= 0 and <= 1000 mm");
+  }
+  if (kind == PatternKind::twist && !(separation_mm > 0.0)) {
+    throw ValidationError("separation_mm", "= " + plain_number(separation_mm) +
+                                               " mm: twist turns the tactors on a circle of diameter separation_mm: "
+                                               "must be > 0");
+  }
+  if (kind == PatternKind::pivot) {
+    if (!(pivot_amplitude > 0.0) || !(pivot_amplitude <= std::numbers::pi * (1.0 + 1e-12))) {
+      throw ValidationError("amplitude_deg", "= " + format_degrees(pivot_amplitude) + " deg: must be > 0 and <= 180 deg");
+    }
+    require_range("frequency_hz", pivot_frequency_hz, 0.0, 1e3, "Hz");
+    if (contact_points) {
+      for (std::size_t i = 0; i < 2; ++i) check_point(detail::key_index("contact_points", i).c_str(), (*contact_points)[i]);
+    }
+  }
+}
+
+std::vector<PatternSpec> PatternSettings::for_station(std::string_view station) const {
+  std::vector<PatternSpec> out;
+  for (PatternKind kind : all_pattern_kinds()) {
+    const PatternSpec* chosen = nullptr;
+    for (const auto& [name, spec] : per_station) {
+      if (name == station && spec.kind == kind) chosen = &spec;
+    }
+    if (chosen == nullptr) {
+      for (const PatternSpec& spec : global) {
+        if (spec.kind == kind) chosen = &spec;
+      }
+    }
+    if (chosen != nullptr) out.push_back(*chosen);
+  }
+  return out;
+}
+
+void PatternSettings::validate() const {
+  require_range("rate_hz", rate_hz, 0.0, 1e4, "Hz");
+  if (!(max_joint_speed > 0.0) || !(max_joint_speed * kDegPerRad <= 1e6)) {
+    throw ValidationError("max_joint_speed_deg_s", "= " + format_degrees(max_joint_speed) +
+                                                       " deg/s: must be > 0 and <= 1000000 deg/s");
+  }
+  for (const PatternSpec& spec : global) {
+    validate_nested(std::string(to_string(spec.kind)), [&] { spec.validate(); });
+  }
+  for (const auto& [station, spec] : per_station) {
+    validate_nested(detail::key_join(detail::key_child("stations", station), to_string(spec.kind)),
+                    [&] { spec.validate(); });
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Design
 
 bool is_safe_name(std::string_view name) {
@@ -472,8 +590,10 @@ const std::vector<std::string>& known_products() {
       "kinematics",
       "workspace",
       "coverage",
+      "collision",
+      "pattern",
       "sweep",
-      "parts",  // after sweep, before export and report
+      "parts",
   };
   return products;
 }
@@ -540,6 +660,17 @@ void Design::validate() const {
     }
   }
 
+  if (patterns) {
+    validate_nested("patterns", [&] { patterns->validate(); });
+    for (const auto& [station_name, spec] : patterns->per_station) {
+      if (station(station_name) == nullptr) {
+        std::string list;
+        for (const Station& s : stations) list += (list.empty() ? "" : ", ") + s.name;
+        throw ValidationError(detail::key_child("patterns.stations", station_name),
+                              "no such station in this design (stations: " + list + ")");
+      }
+    }
+  }
   if (products) {
     const auto& known = known_products();
     for (std::size_t i = 0; i < products->size(); ++i) {

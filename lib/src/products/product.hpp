@@ -72,5 +72,9 @@ Product workspace_product();
 Product coverage_product();
 /// OpenSCAD sources, STL renders, mesh and fit checks and the BOM of every station (parts.hpp).
 Product parts_product();
+/// Collision map of the two tactors of every station and the priority rule at the centre.
+Product collision_product();
+/// The skin-deformation patterns of `patterns:`, checked, with joint trajectories and pictures.
+Product pattern_product();
 
 }  // namespace fivebar::products

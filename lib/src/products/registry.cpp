@@ -11,6 +11,8 @@ const std::vector<Product>& registry() {
       coverage_product(),
       sweep_product(),
       parts_product(),
+      collision_product(),
+      pattern_product(),
   };
   return entries;
 }
