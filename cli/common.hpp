@@ -124,5 +124,6 @@ void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Ve
 void setup_fk(CLI::App& app);
 void setup_ik(CLI::App& app);
 void setup_run(CLI::App& app);
+void setup_report(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -57,6 +57,7 @@ int main(int argc, char** argv) {
   setup_fk(app);
   setup_ik(app);
   setup_run(app);
+  setup_report(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -390,6 +390,7 @@ const std::vector<std::string>& known_products() {
   // In build order; each capability appends its product here.
   static const std::vector<std::string> products{
       "kinematics",
+      "report",
   };
   return products;
 }

@@ -64,5 +64,7 @@ const Product* find_product(std::string_view name);
 // --- Entries (one file each) -----------------------------------------------------------------
 /// Link data, modes and the pose at the target centre and axis ends of every mechanism.
 Product kinematics_product();
+/// Accuracy of the main numbers (quick work-precision) and the stability catalogue.
+Product report_product();
 
 }  // namespace fivebar::products

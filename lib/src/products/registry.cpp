@@ -7,6 +7,7 @@ const std::vector<Product>& registry() {
   // pattern, sweep, parts, export, report).
   static const std::vector<Product> entries = {
       kinematics_product(),
+      report_product(),
   };
   return entries;
 }
