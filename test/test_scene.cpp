@@ -89,7 +89,8 @@ TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(r.out_dir)) files.push_back(e.path().filename().string());
   std::sort(files.begin(), files.end());
-  EXPECT_EQ(files, (std::vector<std::string>{"summary.json", "summary.md"}));
+  // The two summaries, and a folder per product that writes files.
+  EXPECT_EQ(files, (std::vector<std::string>{"report", "summary.json", "summary.md"}));
 
   const auto json = Json::parse(slurp(r.summary_json));
   EXPECT_EQ(json, r.to_json());

@@ -617,11 +617,11 @@ MechanismAccuracy mechanism_accuracy(const Mechanism& m, const Ellipse& target, 
   out.mechanism = m.name;
   Region region;
   const double t_region = median_time(timing_for(o.quick), [&] { region = reachable_region(m); });
-  say(o, "accuracy: " + m.name + ": workspace area");
+  say(o, "accuracy:   workspace area (cell counting, marching squares)");
   area_study(m, region, t_region, o, out);
-  say(o, "accuracy: " + m.name + ": coverage");
+  say(o, "accuracy:   coverage margin and min LCI");
   coverage_study(m, region, target, o, out);
-  say(o, "accuracy: " + m.name + ": restricted regions");
+  say(o, "accuracy:   restricted regions");
   restricted_study(m, region, o, out);
   return out;
 }

@@ -514,6 +514,24 @@ Mechanism dyadic(const Mechanism& m0) {
 
 Vec2 axis_dir(int k) { return k == 0 ? Vec2(1, 0) : k == 1 ? Vec2(0, 1) : k == 2 ? Vec2(-1, 0) : Vec2(0, -1); }
 
+/// Smallest t in (0, hi] with pred(t), for a predicate that holds from some t* on (near 0):
+/// steps down by 1e-3 until it fails, then bisects on a log scale. std::nullopt when pred(hi) fails.
+template <class Pred>
+std::optional<double> smallest_t(Pred&& pred, double hi) {
+  double lo = 0.0;
+  if (!pred(hi)) return std::nullopt;
+  for (int it = 0; it < 400; ++it) {
+    const double mid = lo > 0 ? std::sqrt(lo * hi) : hi * 1e-3;
+    if (pred(mid)) {
+      hi = mid;
+    } else {
+      lo = mid;
+    }
+    if (hi - lo <= 1e-17 * hi) break;
+  }
+  return hi;
+}
+
 /// Type I: leg 1 stretched (R = L1 + L3) or folded (r = |L1 - L3|) with the singular point on an
 /// axis through O1, moved to the origin of the frame so that any distance to it is representable.
 void type1_family(Catalogue& cat, const Mechanism& m0, bool stretched) {
@@ -555,22 +573,15 @@ void type1_family(Catalogue& cat, const Mechanism& m0, bool stretched) {
   if (!stretched) return;
   for (int k = 2; k <= 14; k += 2) {
     const double target = std::pow(10.0, -k);
-    double lo = 0.0, hi = 0.5;  // distance / S, LCI grows with it near the singularity
     auto lci_at = [&](double t) {
       const QPose ref = quadref::ik(QMechanism(mf), quadref::q(Vec2(-t * S * u)), mf.working_mode.sign1,
                                     mf.working_mode.sign2);
       return ref.reachable ? double(ref.lci) : 0.0;
     };
-    if (lci_at(hi) < target) continue;
-    for (int it = 0; it < 200; ++it) {
-      const double mid = k > 6 ? std::sqrt(std::max(lo, 1e-300) * hi) : 0.5 * (lo + hi);
-      if (lci_at(mid) < target) {
-        lo = mid;
-      } else {
-        hi = mid;
-      }
-    }
-    const Vec2 P = -hi * S * u;
+    // Distance / S up to 0.1 (the first row of the distance sweep): LCI grows with it.
+    const auto t = smallest_t([&](double x) { return lci_at(x) >= target; }, 0.1);
+    if (!t) continue;
+    const Vec2 P = -*t * S * u;
     const QPose ref = quadref::ik(QMechanism(mf), quadref::q(P), mf.working_mode.sign1, mf.working_mode.sign2);
     const double cond = ref.lci > 0 ? double(1 / ref.lci) : 0.0;
     cat.ik_case(mf, P, "ill-conditioned Jacobian", "via type I, cond(J) = " + num(std::pow(10.0, k)), cond, true);
@@ -609,21 +620,7 @@ void type2_family(Catalogue& cat, const Mechanism& m0, bool stretched) {
     for (double b : {1.0, -1.0})
       if (gap2(a * 1e-6, b * 1e-6) < gap2(d1 * 1e-6, d2 * 1e-6)) d1 = a, d2 = b;
   auto gap_at = [&](double t) { return gap2(d1 * t, d2 * t); };
-  /// Smallest t in (0, 1] with pred(t) (pred monotone near 0), by bisection on a log scale.
-  auto solve = [&](auto&& pred) -> std::optional<double> {
-    double lo = 0.0, hi = 1.0;
-    if (!pred(hi)) return std::nullopt;
-    for (int it = 0; it < 400; ++it) {
-      const double mid = lo > 0 ? std::sqrt(lo * hi) : hi * 1e-3;
-      if (pred(mid)) {
-        hi = mid;
-      } else {
-        lo = mid;
-      }
-      if (hi - lo <= 1e-17 * hi) break;
-    }
-    return hi;
-  };
+  auto solve = [&](auto&& pred) { return smallest_t(pred, 1.0); };
   for (double delta : kDistances) {
     double t = 0.0;
     if (delta > 0.0) {
