@@ -19,20 +19,23 @@
 //    angle (type II) for FK, the elbow angle of leg i (type I) for IK, whose error is reported as
 //    L_i |d theta_i| (atan2 adds < 1 ulp, in 2e).
 //  * Jacobian J = B^-1 C (B rows (P - A_i)^T, C = diag(cross(A_i - O_i, P - A_i))). From
-//    dJ = B^-1 (dC - dB J) and |C| <= |B| |J|:
-//      |dJ| / |J| <= cond(B) (|dB| / |B| + |dC| / |C|),
+//    (B + dB)^-1 (C + dC) - J = (B + dB)^-1 (dC - dB J), |(B + dB)^-1| <= |B^-1| / (1 - |B^-1| |dB|)
+//    (Neumann series) and |C| <= |B| |J|:
+//      |dJ| / |J| <= cond(B) (|dB|/|B| + |dC|/|C|) / (1 - cond(B) |dB|/|B|),
 //    |dB| <= sqrt(2) (eA + eP), |B| >= max(L3, L4), |dc_i| <= (L_i + L_{i+2})(eA + eP) + 2 eps L_i L_{i+2},
 //    eA, eP the position bounds of the elbows and tactor of the pose the Jacobian is taken at,
-//    cond(B) from the reference; plus 4 eps for the final division; doubled for second-order
-//    terms, and sqrt(2) for comparing Frobenius norms.
+//    cond(B) from the reference; plus 4 eps cond(B) for the rounding of M and det B; sqrt(2) for
+//    comparing Frobenius norms. Valid while cond(B) |dB| / |B| < 1/2; beyond that B + dB may be
+//    singular and J is not determined at all (no bound; the case is flagged ill-conditioned).
 //  * LCI = sigma_min / sigma_max: singular values move by at most |dJ|_2 (Weyl), so
 //    |dLCI| <= 2 r / (1 - r) with r the Jacobian's relative bound (1 when r >= 1/2).
 //  * Exact-region area (Green's theorem over the boundary pieces): every piece's term is computed
 //    from vertices rounded to double (<= eps S each) and an arc angle from atan2 (<= 2 eps S / r):
 //    <= 8 eps S^2 per piece.
-//  * Closed-form annuli area (acos form): acos(c) with c good to 4 eps loses 4 eps / sin(angle)
-//    (capped at sqrt(8 eps)), times r^2, for each of the two half-angles of every lens, plus the
-//    Heron root k/2 whose factors carry eps S each.
+//  * Closed-form annuli area: inclusion-exclusion of four lens areas, each a sum of terms no larger
+//    than pi a^2 and pi b^2; a backward-stable evaluation errs by a few eps per term:
+//    |dA| <= 8 eps pi sum(a_j^2 + b_j^2). (The problem's own sensitivity to the rounding of the
+//    radii, eps sum |dA/dr| r <= eps 2 pi sum r^2, is of the same size.)
 //  * Coverage margin: extremes of |q(t) - O| over the ellipse, a value of a Lipschitz-1 function of
 //    the inputs at a flat extremum: each evaluation carries <= 8 roundings of size <= S and the
 //    extremum's location error enters at second order: |d margin| <= 32 eps S.
@@ -139,22 +142,27 @@ std::string join(const std::vector<Status>& v) {
 }
 bool contains(const std::vector<Status>& v, Status s) { return std::find(v.begin(), v.end(), s) != v.end(); }
 
-/// Relative Jacobian bound (top of the file).
-double jacobian_bound(const Mechanism& m, const QPose& ref, double eA, double eP) {
-  if (ref.cond_B <= 0) return 1.0;
+/// Relative Jacobian bound (top of the file); std::nullopt when the perturbation of B may make
+/// it singular (cond(B) |dB| / |B| >= 1/2): the Jacobian is then not determined at all.
+std::optional<double> jacobian_bound(const Mechanism& m, const QPose& ref, double eA, double eP) {
+  if (ref.cond_B <= 0) return std::nullopt;
   const double e = eA + eP;
   const double dB = std::sqrt(2.0) * e / std::max(m.L[2], m.L[3]);
   const QVec e1 = ref.A1 - quadref::q(m.O1), e2 = ref.A2 - quadref::q(m.O2);
   const double c1 = std::fabs(double(quadref::cross(e1, ref.P - ref.A1)));
   const double c2 = std::fabs(double(quadref::cross(e2, ref.P - ref.A2)));
   const double cmax = std::max(c1, c2);
-  if (!(cmax > 0.0)) return 1.0;
+  if (!(cmax > 0.0)) return std::nullopt;
   const double dC = std::max((m.L[0] + m.L[2]) * e + 2 * kEps * m.L[0] * m.L[2],
                              (m.L[1] + m.L[3]) * e + 2 * kEps * m.L[1] * m.L[3]);
-  const double r = 2.0 * std::sqrt(2.0) * (double(ref.cond_B) * (dB + dC / cmax) + 4 * kEps);
-  return std::min(r, 1e300);
+  const double kB = double(ref.cond_B);
+  if (kB * dB >= 0.5) return std::nullopt;
+  // (B + dB)^-1 (C + dC) - B^-1 C = (B + dB)^-1 (dC - dB J), |(B + dB)^-1| <= |B^-1| / (1 - |B^-1| |dB|).
+  return std::sqrt(2.0) * (kB * (dB + dC / cmax) / (1.0 - kB * dB) + 4 * kEps * kB);
 }
-double lci_bound(double rel_j) { return rel_j < 0.5 ? std::min(1.0, 2.0 * rel_j / (1.0 - rel_j)) : 1.0; }
+double lci_bound(const std::optional<double>& rel_j) {
+  return rel_j && *rel_j < 0.5 ? std::min(1.0, 2.0 * *rel_j / (1.0 - *rel_j)) : 1.0;
+}
 
 double frobenius_rel(const Eigen::Matrix2d& J, const QPose& ref) {
   quad num = 0, den = 0;
@@ -307,7 +315,7 @@ class Catalogue {
   void jacobian_cases(const Mechanism& m, const Pose& pose, const QPose& ref, double eA, double eP,
                       const std::string& group, const std::string& name, double parameter, double S) {
     (void)S;
-    const double rel = jacobian_bound(m, ref, eA, eP);
+    const std::optional<double> rel = jacobian_bound(m, ref, eA, eP);
     if (ref.jacobian_valid && pose.jacobian_valid) {
       StabilityCase& c = add(group, name, "jacobian", parameter);
       c.status = "valid";
@@ -317,9 +325,16 @@ class Catalogue {
       c.finite = pose.J.allFinite();
       c.error = frobenius_rel(pose.J, ref);
       c.bound = rel;
-      judge(c, true, 1.0,
-            "cond(J) = " + sci(ref.lci > 0 ? double(1 / ref.lci) : 0.0) + ", cond(B) = " + sci(double(ref.cond_B)) +
-                ": J is determined only to a relative " + sci(rel));
+      const std::string cond = "cond(J) = " + sci(ref.lci > 0 ? double(1 / ref.lci) : 0.0) +
+                               ", cond(B) = " + sci(double(ref.cond_B));
+      if (rel) {
+        judge(c, true, 1.0, cond + ": J is determined only to a relative " + sci(*rel));
+      } else {
+        judge(c, true, 1.0, "");
+        c.ill_conditioned = true;
+        c.explanation = cond + " with positions known only to " + sci(eA + eP) +
+                        " mm: the perturbed B may be singular, J is not determined in double precision";
+      }
     }
     StabilityCase& c = add(group, name, "lci", parameter);
     c.status = std::string(to_string(pose.status));
@@ -364,26 +379,24 @@ class Catalogue {
       c.finite = std::isfinite(cf);
       c.error = double(quadref::qabs(quad(cf) - qa));
       c.bound = closed_form_bound(qm);
+      if (*c.error > *c.bound) {
+        c.explanation = "annuli_intersection_area's acos form cancels in d^2 + a^2 - b^2 when the base distance is "
+                        "small against the radii; the exact region's area above is the accurate one";
+      }
       judge(c, true, std::max(double(qa), 1e-300),
-            "lens angles near 0 or pi (nearly tangent circles) make the acos form lose digits: bound " + sci(*c.bound) +
-                " mm²");
+            "the area is small against the lens areas it is the difference of: relative accuracy " +
+                sci(*c.bound / std::max(double(qa), 1e-300)));
     }
   }
 
+  /// What a backward-stable inclusion-exclusion of the four lens areas allows: each lens is a sum
+  /// of terms no larger than pi a^2 and pi b^2, evaluated with a few roundings each.
   static double closed_form_bound(const QMechanism& qm) {
-    const quad dist = quadref::norm(qm.O2 - qm.O1);
     const quad R1 = qm.L[0] + qm.L[2], r1 = quadref::qabs(qm.L[0] - qm.L[2]);
     const quad R2 = qm.L[1] + qm.L[3], r2 = quadref::qabs(qm.L[1] - qm.L[3]);
-    const double S = double(std::max({dist, R1, R2}));
-    double total = 8 * kEps * S * S;
+    double total = 0.0;
     for (auto [a, b] : {std::pair{R1, R2}, std::pair{R1, r2}, std::pair{r1, R2}, std::pair{r1, r2}}) {
-      if (a <= 0 || b <= 0 || dist >= a + b || dist <= quadref::qabs(a - b)) continue;
-      const quad K = (dist + a + b) * (-dist + a + b) * (dist - a + b) * (dist + a - b);
-      const quad k = sqrtq(K < 0 ? quad(0) : K);
-      const double sa = double(k / (2 * dist * a)), sb = double(k / (2 * dist * b));
-      const double floor = std::sqrt(8 * kEps);
-      total += double(a * a) * 8 * kEps / std::max(sa, floor) + double(b * b) * 8 * kEps / std::max(sb, floor);
-      total += 4 * kEps * S * S;  // k / 2 from four factors of size <= 2S
+      total += 8 * kEps * kPi * double(a * a + b * b);
     }
     return total;
   }
@@ -793,6 +806,14 @@ StabilityReport stability_catalogue(const Mechanism& m, const Ellipse& target, c
   StabilityReport report;
   Catalogue cat(label, report.cases);
   catalogue(cat, m, target);
+  // Keep each group together (the type I family also yields ill-conditioned Jacobians, ...), in
+  // the order the groups first appear.
+  std::vector<std::string> order;
+  for (const StabilityCase& c : report.cases)
+    if (std::find(order.begin(), order.end(), c.group) == order.end()) order.push_back(c.group);
+  auto rank = [&](const StabilityCase& c) { return std::find(order.begin(), order.end(), c.group) - order.begin(); };
+  std::stable_sort(report.cases.begin(), report.cases.end(),
+                   [&](const StabilityCase& a, const StabilityCase& b) { return rank(a) < rank(b); });
   return report;
 }
 
