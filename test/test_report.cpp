@@ -290,6 +290,8 @@ TEST(FitLogSlope, RecoversPowerLawsAndIgnoresFloorsAndZeros) {
 
 // --- work-precision series -------------------------------------------------------------------------
 
+void expect_finite(const Json& j, const std::string& where = "$");
+
 const MechanismAccuracy& index_lower_accuracy() {
   static const MechanismAccuracy a = [] {
     AccuracyOptions o;
@@ -384,6 +386,29 @@ TEST(Accuracy, RestrictedAreasAgainstTheSixteenTimesFinerGrid) {
       EXPECT_LE(p.error, *p.estimate) << "h " << p.resolution;
     }
   }
+}
+
+TEST(Accuracy, JointLimitsUseTheExactRegionAndNoQuadShortcut) {
+  Mechanism m = paper("index", "lower");
+  m.joint_limits = std::array<JointRange, 2>{JointRange{kPi / 3, 2.6}, JointRange{0.0, 2.6}};
+  AccuracyOptions o;
+  o.quick = true;
+  const MechanismAccuracy a = mechanism_accuracy(m, index_target(), o);
+  // No closed form with limits: the exact region is the reference, and it is smaller.
+  EXPECT_FALSE(a.quad_area_mm2.has_value());
+  EXPECT_FALSE(a.closed_form_area_mm2.has_value());
+  EXPECT_FALSE(a.margin_quad_mm.has_value());
+  EXPECT_LT(a.exact_area_mm2, annuli_intersection_area(paper("index", "lower")));
+  EXPECT_DOUBLE_EQ(a.exact_area_mm2, reachable_region(m).area_mm2());
+  EXPECT_THROW((void)series(a.area, "closed form (double)"), std::runtime_error);
+  const WorkSeries& ms = series(a.area, "marching squares");
+  EXPECT_LT(ms.points.back().error, ms.points.front().error);
+  EXPECT_TRUE(series(a.coverage, "coverage()").points.empty());
+  AccuracyReport r;
+  r.mechanisms.push_back(a);
+  const Json j = to_json(r);
+  expect_finite(j);
+  EXPECT_TRUE(j["mechanisms"][0]["area"]["quad_closed_form_mm2"].is_null());
 }
 
 TEST(Precision, StrataArePopulatedAndErrorsFollowTheConditioning) {
@@ -592,7 +617,7 @@ TEST(Stability, TextAndJsonReportAFailureWithItsReason) {
 // --- output ----------------------------------------------------------------------------------------
 
 /// Every number in the document is finite.
-void expect_finite(const Json& j, const std::string& where = "$") {
+void expect_finite(const Json& j, const std::string& where) {
   if (j.is_number_float()) {
     EXPECT_TRUE(std::isfinite(j.get<double>())) << where;
   } else if (j.is_object()) {

@@ -143,7 +143,7 @@ plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station,
     const std::vector<WorkSeries>* list = kind == "area" ? &m.area : kind == "restricted" ? &m.restricted : &m.coverage;
     for (const WorkSeries& s : *list) {
       const bool wanted = kind == "area" || kind == "restricted" || (kind == "margin" ? s.unit == "mm" : s.unit == "1");
-      if (!wanted) continue;
+      if (!wanted || s.points.empty()) continue;
       plot::PlotSeries ps;
       ps.label = legend(m.mechanism, s);
       ps.line = s.points.size() > 1;

@@ -179,7 +179,10 @@ struct StabilityOptions {
   std::function<void(std::string_view)> progress;  ///< may be empty
 };
 
-/// The catalogue for one mechanism and target ellipse; cases are labelled `label`.
+/// The catalogue for one mechanism and target ellipse; cases are labelled `label`. Its cases are
+/// built from the mechanism without joint limits (the extremes are those of the kinematics; limits
+/// only cut the workspace), with lengths rounded to a dyadic grid where exact singular points need
+/// it (no change for lengths such as the paper's), in frames that make the sensitive input exact.
 StabilityReport stability_catalogue(const Mechanism& m, const Ellipse& target, const std::string& label);
 /// The catalogue for every mechanism of the design (or of one station).
 StabilityReport stability_report(const Design& design, const StabilityOptions& options = {});
