@@ -380,7 +380,8 @@ TEST(Accuracy, RestrictedAreasAgainstTheSixteenTimesFinerGrid) {
   for (const WorkSeries* s : {&as, &ls}) {
     SCOPED_TRACE(s->method);
     EXPECT_LT(s->points.back().error, s->points.front().error / 4);
-    // restricted_area's own estimate bounds the measured error on these regions.
+    // restricted_area's own estimate bounds the measured error on these regions at the quick
+    // spacings (<= 3 mm; at 5.8 mm, in the default run, it does not).
     for (const WorkPoint& p : s->points) {
       ASSERT_TRUE(p.estimate);
       EXPECT_LE(p.error, *p.estimate) << "h " << p.resolution;
