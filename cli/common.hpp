@@ -138,5 +138,6 @@ void setup_coverage(CLI::App& app);
 void setup_parts(CLI::App& app);
 void setup_collision(CLI::App& app);
 void setup_pattern(CLI::App& app);
+void setup_report(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -65,6 +65,7 @@ int main(int argc, char** argv) {
   setup_parts(app);
   setup_collision(app);
   setup_pattern(app);
+  setup_report(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -594,6 +594,7 @@ const std::vector<std::string>& known_products() {
       "pattern",
       "sweep",
       "parts",
+      "report",
   };
   return products;
 }

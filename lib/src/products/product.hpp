@@ -76,5 +76,7 @@ Product parts_product();
 Product collision_product();
 /// The skin-deformation patterns of `patterns:`, checked, with joint trajectories and pictures.
 Product pattern_product();
+/// Accuracy of the main numbers (quick work-precision) and the stability catalogue.
+Product report_product();
 
 }  // namespace fivebar::products
