@@ -379,10 +379,6 @@ class Catalogue {
       c.finite = std::isfinite(cf);
       c.error = double(quadref::qabs(quad(cf) - qa));
       c.bound = closed_form_bound(qm);
-      if (*c.error > *c.bound) {
-        c.explanation = "annuli_intersection_area's acos form cancels in d^2 + a^2 - b^2 when the base distance is "
-                        "small against the radii; the exact region's area above is the accurate one";
-      }
       judge(c, true, std::max(double(qa), 1e-300),
             "the area is small against the lens areas it is the difference of: relative accuracy " +
                 sci(*c.bound / std::max(double(qa), 1e-300)));

@@ -214,14 +214,31 @@ Region reachable_region(const Mechanism& m) {
 
 namespace {
 
-/// Area of the intersection of two disks (radii a, b; centre distance d).
+/// r^2 (alpha - sin(alpha) cos(alpha)): the circular segment of half-angle alpha, without the
+/// cancellation of x - sin x for small x = 2 alpha (series there).
+double segment_area(double r, double alpha) {
+  const double x = 2.0 * alpha;
+  double x_minus_sin;
+  if (x < 0.5) {
+    const double x2 = x * x;
+    x_minus_sin = x * x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0 * (1.0 - x2 / 110.0))));
+  } else {
+    x_minus_sin = x - std::sin(x);
+  }
+  return 0.5 * r * r * x_minus_sin;
+}
+
+/// Area of the intersection of two disks (radii a, b; centre distance d). Half-angles by atan2 of
+/// Heron's product and d^2 +- (a - b)(a + b), which keep their digits for nearly equal radii and
+/// close centres (link ratios of 1e2 and more), then one circular segment per disk.
 double lens_area(double a, double b, double d) {
   if (a <= 0.0 || b <= 0.0 || d >= a + b) return 0.0;
   if (d <= std::fabs(a - b)) return kPi * std::min(a, b) * std::min(a, b);
-  const double ca = std::clamp((d * d + a * a - b * b) / (2 * d * a), -1.0, 1.0);
-  const double cb = std::clamp((d * d + b * b - a * a) / (2 * d * b), -1.0, 1.0);
   const double k = std::sqrt(std::max(0.0, (-d + a + b) * (d + a - b) * (d - a + b) * (d + a + b)));
-  return a * a * std::acos(ca) + b * b * std::acos(cb) - 0.5 * k;
+  const double diff = (a - b) * (a + b);
+  const double alpha = std::atan2(k, d * d + diff);  // half-angle at the centre of disk a
+  const double beta = std::atan2(k, d * d - diff);
+  return segment_area(a, alpha) + segment_area(b, beta);
 }
 
 }  // namespace
