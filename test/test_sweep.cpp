@@ -252,6 +252,7 @@ TEST(Run, ParetoSetIsExactlyTheBruteForceNonDominatedSet) {
   EXPECT_TRUE(brute.count(r.best->index));
   for (const auto& row : rows) EXPECT_LE(row.score("margin"), r.best->score("margin"));
   const Design best = load_design(o.out_dir / "best.yaml");
+  EXPECT_EQ(best.name, "iros2022-best");  // its outputs do not overwrite the swept design's
   EXPECT_EQ(best.station("index")->lower->L[2], r.best->values[0]);
   EXPECT_EQ(best.station("index")->upper->L[0], r.best->values[1]);
   EXPECT_FALSE(best.sweep.has_value());

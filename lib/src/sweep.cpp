@@ -555,6 +555,8 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
     }
     d.sweep.reset();
     d.products.reset();
+    // Its own name, so that `fivebar run best.yaml` does not overwrite the swept design's outputs.
+    d.name = design.name.substr(0, 59) + "-best";
     result.best_design = d;
     const auto path = options.out_dir / ("best" + suffix + ".yaml");
     std::ostringstream head;

@@ -131,6 +131,8 @@ SweepResult run_sweep_mpi(const Design& design, const SweepOptions& options) {
     }
     d.sweep.reset();
     d.products.reset();
+    // Its own name, so that `fivebar run best.yaml` does not overwrite the swept design's outputs.
+    d.name = design.name.substr(0, 59) + "-best";
     merged.best_design = d;
     write_file_atomic(options.out_dir / "best.yaml",
                       "# Best design of the sweep (MPI run, " + std::to_string(size) + " ranks), design #" +
