@@ -279,41 +279,52 @@ LegFit fit_annulus(const LegSet& leg, const Ellipse& e) {
 /// Joint-limited leg: samples of the ellipse boundary, membership of each, distance to the four
 /// boundary arcs; every local minimum of that distance refined by golden section.
 LegFit fit_limited(const LegSet& leg, const Ellipse& e) {
-  constexpr int N = 128;
+  constexpr int N = 64;  // samples of the ellipse boundary; every candidate minimum is refined
   const Frame fr(e);
   thread_local std::vector<double> uc, us;
   if (uc.size() != N) unit_circle(N, uc, us);
-  auto point = [&](double c, double s) { return fr.to_world({fr.a * c, fr.b * s}); };
-  double d[N];
+  auto point = [&](int k) { return fr.to_world({fr.a * uc[k], fr.b * us[k]}); };
+  // Membership first (cheap); distances only where they matter.
+  bool in[N];
   bool all_in = leg.contains(e.center);
-  double deepest = 0.0;
-  Vec2 deepest_at = e.center;
   for (int k = 0; k < N; ++k) {
-    const Vec2 q = point(uc[k], us[k]);
-    d[k] = leg.boundary_distance(q);
-    if (!leg.contains(q)) {
-      all_in = false;
-      if (d[k] > deepest) {
-        deepest = d[k];
-        deepest_at = q;
-      }
-    }
+    in[k] = leg.contains(point(k));
+    all_in = all_in && in[k];
   }
   LegFit f;
   if (!all_in) {
+    double deepest = 0.0;
+    f.worst = e.center;
+    for (int k = 0; k < N; ++k) {
+      if (in[k]) continue;
+      const Vec2 q = point(k);
+      const double d = leg.boundary_distance(q);
+      if (d > deepest) {
+        deepest = d;
+        f.worst = q;
+      }
+    }
     f.margin = -deepest;
-    f.worst = deepest_at;
     return f;
   }
+  double d[N];
+  double sampled_min = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < N; ++k) {
+    d[k] = leg.boundary_distance(point(k));
+    sampled_min = std::min(sampled_min, d[k]);
+  }
+  // Between samples the distance can dip below them by at most |dq/dt| * step <= a_max * 2 pi / N:
+  // only local minima within that of the smallest sample can hold the true minimum.
+  const double dip = std::max(fr.a, fr.b) * 2 * kPi / N;
   double best = std::numeric_limits<double>::infinity();
   for (int k = 0; k < N; ++k) {
-    if (!(d[k] <= d[(k + N - 1) % N] && d[k] <= d[(k + 1) % N])) continue;
+    if (!(d[k] <= d[(k + N - 1) % N] && d[k] <= d[(k + 1) % N]) || d[k] > sampled_min + dip) continue;
     auto dist = [&](double t) { return leg.boundary_distance(fr.at(1.0, t)); };
     double lo = 2 * kPi * (k - 1) / N, hi = 2 * kPi * (k + 1) / N;
     const double r = 0.5 * (std::sqrt(5.0) - 1.0);
     double x1 = hi - r * (hi - lo), x2 = lo + r * (hi - lo);
     double f1 = dist(x1), f2 = dist(x2);
-    for (int it = 0; it < 48; ++it) {
+    for (int it = 0; it < 38; ++it) {  // bracket 0.2 rad * 0.618^38: 2e-9 rad
       if (f1 < f2) {
         hi = x2, x2 = x1, f2 = f1, x1 = hi - r * (hi - lo), f1 = dist(x1);
       } else {
@@ -323,7 +334,7 @@ LegFit fit_limited(const LegSet& leg, const Ellipse& e) {
     const double v = std::min({f1, f2, d[k]});
     if (v < best) {
       best = v;
-      f.worst = v == d[k] ? point(uc[k], us[k]) : fr.at(1.0, f1 < f2 ? x1 : x2);
+      f.worst = v == d[k] ? point(k) : fr.at(1.0, f1 < f2 ? x1 : x2);
     }
   }
   f.margin = best;
