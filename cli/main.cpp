@@ -1,5 +1,6 @@
-// fivebar: command-line entry point. Subcommands live in one file each (setup_<cmd> / run_<cmd>);
-// this file maps every outcome to the exit codes of DESIGN.md.
+// fivebar: command-line front end, fivebar::cli::main (cli/cli.hpp). Subcommands live in one file
+// each (setup_<cmd> / run_<cmd>); this file maps every outcome to the exit codes of DESIGN.md. The
+// process entry point is fivebar_main.cpp; the fuzzer (test/fuzz/fuzz_cli.cpp) calls this in-process.
 
 #include <algorithm>
 #include <cctype>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cli.hpp"
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
@@ -41,8 +43,7 @@ std::vector<std::string> join_dash_values(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  using namespace fivebar::cli;
+int fivebar::cli::main(int argc, char** argv) {
   CLI::App app{
       "fivebar " + std::string(fivebar::version()) +
           ": design five-bar-linkage cutaneous haptic devices (IROS 2022).\n"
@@ -60,6 +61,16 @@ int main(int argc, char** argv) {
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);
+    // CLI11 says only "A subcommand is required" for an unknown first word: name it.
+    if (!args.empty() && !args.front().empty() && args.front()[0] != '-') {
+      std::string known;
+      bool found = false;
+      for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+        found = found || sub->check_name(args.front());
+        known += (known.empty() ? "" : ", ") + sub->get_name();
+      }
+      if (!found) throw fivebar::InputError("unknown subcommand '" + args.front() + "' (known: " + known + ")");
+    }
     std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
     app.parse(args);
     return kOk;
@@ -78,6 +89,9 @@ int main(int argc, char** argv) {
     return kInternal;
   } catch (const std::exception& e) {
     std::cerr << "fivebar: internal error: " << e.what() << "\n";
+    return kInternal;
+  } catch (...) {
+    std::cerr << "fivebar: internal error: unknown exception\n";
     return kInternal;
   }
 }

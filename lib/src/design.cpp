@@ -155,6 +155,15 @@ std::string key_parent(std::string_view key) {
 }
 
 std::string quoted(std::string_view text) {
+  // Messages stay readable whatever a file holds: long text is cut and its length given.
+  constexpr std::size_t kShown = 100;
+  std::string suffix;
+  if (text.size() > kShown) {
+    suffix = "...' (" + std::to_string(text.size()) + " bytes)";
+    std::size_t cut = kShown - 3;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0u) == 0x80u) --cut;  // UTF-8 boundary
+    text = text.substr(0, cut);
+  }
   std::string out = "'";
   for (char c : text) {
     const auto u = static_cast<unsigned char>(c);
@@ -166,7 +175,7 @@ std::string quoted(std::string_view text) {
       out += c;
     }
   }
-  out += "'";
+  out += suffix.empty() ? "'" : suffix;
   return out;
 }
 
