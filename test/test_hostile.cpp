@@ -128,6 +128,15 @@ std::vector<Case> cases() {
   c.push_back(design_case("YamlTwoDocuments", kGood + "---\n" + kGood, {"bad.yaml:", "one YAML document"}));
   c.push_back(design_case("YamlUndefinedAlias", good_with("name: hostile", "name: *nowhere"),
                           {"bad.yaml:1:", "YAML syntax error", "anchor is not defined"}));
+  // yaml-cpp 0.7's LoadAll() loops forever, allocating, on a stray ',' (found by fuzz_design_loader).
+  {
+    std::string indented;  // the top-level map indented, then a ',' left of it
+    for (std::size_t at = 0, end; (end = kGood.find('\n', at)) != std::string::npos; at = end + 1) {
+      indented += "  " + kGood.substr(at, end - at + 1);
+    }
+    c.push_back(design_case("YamlStrayComma", indented + " , 12]}\n", {"bad.yaml:11:", "unexpected ','"}));
+  }
+  c.push_back(design_case("YamlOnlyAComma", ",", {"bad.yaml:1:", "unexpected ','"}));
   c.push_back(design_case("YamlBinaryGarbage", random_bytes(4096, 42), {"bad.yaml:", "not UTF-8"}));
 
   // --- Wrong types --------------------------------------------------------------------------------

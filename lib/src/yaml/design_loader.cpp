@@ -6,6 +6,7 @@
 // "FILE:LINE: KEY = VALUE: RULE" (or "FILE:LINE: KEY: RULE") with the full key path; for errors
 // thrown by validate() the line comes from a key-path -> line map filled while parsing.
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -719,11 +720,67 @@ Station Loader::station(const Entry& entry) {
   return s;
 }
 
+/// Where each document of a YAML stream starts, from yaml-cpp's events (no node is built).
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  struct Start {
+    YAML::Mark mark;
+    bool null = false;  ///< the document is a bare null
+  };
+  std::vector<Start> starts;
+
+  void OnDocumentStart(const YAML::Mark&) override { fresh_ = true; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { first(mark, true); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { first(mark, false); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string&) override {
+    first(mark, false);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    first(mark, false);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    first(mark, false);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void first(const YAML::Mark& mark, bool null) {
+    if (fresh_) starts.push_back({mark, null});
+    fresh_ = false;
+  }
+  bool fresh_ = false;
+};
+
 Design Loader::load(const std::string& text) {
   Prescan(origin_).check(text);
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(text);
+    // Not YAML::LoadAll: yaml-cpp 0.7 loops there forever, allocating, on a ',' outside any [ ]
+    // or { } (yaml-cpp issue #1040; fixed upstream in 2024): the parser returns an empty document
+    // for it again and again without moving on. So the documents are counted from the event
+    // stream first, stopping at one that does not advance, and then the first is built.
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentStarts counter;
+    while (parser.HandleNextDocument(counter)) {
+      const auto& starts = counter.starts;
+      const std::size_t n = starts.size();
+      if (n >= 2 && starts[n - 1].mark.pos <= starts[n - 2].mark.pos) {
+        const YAML::Mark& at = starts[n - 1].mark;
+        const char c = at.pos >= 0 && static_cast<std::size_t>(at.pos) < text.size() ? text[static_cast<std::size_t>(at.pos)] : '?';
+        fail(at.line + 1, "", "YAML syntax error: unexpected '" + std::string(1, c) + "' (column " +
+                                  std::to_string(at.column + 1) + ") outside a [ ] or { } list");
+      }
+      if (n > 100) break;  // enough to say there are several
+    }
+    if (counter.starts.size() > 1) {
+      fail(counter.starts[1].mark.line + 1, "", "a design file holds one YAML document, this one has " +
+                                                    std::to_string(counter.starts.size()) +
+                                                    (counter.starts.size() > 100 ? " or more" : ""));
+    }
+    if (!counter.starts.empty()) documents.push_back(YAML::Load(text));
   } catch (const YAML::Exception& e) {
     const int line = e.mark.is_null() ? 1 : e.mark.line + 1;
     std::string rule = "YAML syntax error: " + e.msg + " (column " + std::to_string(e.mark.column + 1) + ")";
@@ -733,10 +790,6 @@ Design Loader::load(const std::string& text) {
   }
   if (documents.empty() || (documents.size() == 1 && documents[0].IsNull())) {
     throw InputError(origin_ + ": empty design file: expected a map with at least 'name' and 'stations'");
-  }
-  if (documents.size() > 1) {
-    fail(line_of(documents[1], 1), "", "a design file holds one YAML document, this one has " +
-                                           std::to_string(documents.size()));
   }
   const YAML::Node& root = documents[0];
   const int root_line = line_of(root, 1);
