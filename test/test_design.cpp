@@ -698,5 +698,14 @@ TEST(DesignLimits, MessagesStayShortWhateverTheInput) {
   }
 }
 
+TEST(DesignLimits, NamesFromAFileCannotInjectLinesOrTerminalEscapes) {
+  // YAML escapes in a quoted key produce control characters; messages show them escaped.
+  const std::string text = "name: m\nstations:\n  \"a\\nfivebar: internal error\\e[31m\": {target: 1}\n";
+  const std::string m = message_of(text);
+  EXPECT_THAT(m, HasSubstr("stations[\"a\\x0afivebar: internal error\\x1b[31m\"]"));
+  EXPECT_EQ(m.find('\n'), std::string::npos);
+  EXPECT_EQ(m.find('\x1b'), std::string::npos);
+}
+
 }  // namespace
 }  // namespace fivebar

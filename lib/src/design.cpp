@@ -113,6 +113,13 @@ std::string key_child(std::string_view parent, std::string_view name) {
   }
   key += "[\"";
   for (char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {  // a name from a file must not bring line breaks or terminal escapes
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned>(u));
+      key += escaped;
+      continue;
+    }
     if (c == '"' || c == '\\') key += '\\';
     key += c;
   }

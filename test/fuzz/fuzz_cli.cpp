@@ -14,8 +14,8 @@
 // /dev/null.
 //
 // Properties checked on every input:
-//   - the exit code is 0, 1, 2 or 3, and never an "internal error" (3 only for output that
-//     could not be written);
+//   - the exit code is 0, 1, 2 or 3, and no line of stderr starts "fivebar: internal error" (3
+//     only for output that could not be written);
 //   - exit 2 comes with a message on stderr;
 //   - stdout holds no "nan" or "inf" value (results carry a status, never NaN);
 //   - no temporary `.NAME.tmp.*` file is left anywhere in the scratch directory.
@@ -183,7 +183,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string message = err.str();
 
   if (code < 0 || code > 3) finding("exit code " + std::to_string(code) + " outside 0..3", args, message);
-  if (message.find("internal error") != std::string::npos) finding("internal error", args, message);
+  if (message.starts_with("fivebar: internal error") || message.find("\nfivebar: internal error") != std::string::npos) {
+    finding("internal error", args, message);
+  }
   if (code == 2 && message.empty()) finding("exit 2 without a message on stderr", args, message);
   if (has_non_finite(out)) finding("nan or inf on stdout:\n" + out.substr(0, 2000), args, message);
 
