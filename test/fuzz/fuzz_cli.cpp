@@ -149,8 +149,7 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
   g_stdout_fd = ::open((g_root / "stdout").c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   if (g_stdout_fd < 0 || ::dup2(g_stdout_fd, STDOUT_FILENO) < 0) std::abort();
   fs::current_path(g_work);
-  static fivebar::WriteFence* fence = new fivebar::WriteFence(g_work);  // for the whole process
-  (void)fence;
+  static const fivebar::WriteFence fence(g_work);  // for the whole process
   return 0;
 }
 
