@@ -12,6 +12,7 @@ FIVEBAR_PACKAGES=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libvtk9-dev libcairo2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libopenmpi-dev openmpi-bin
   openscad
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
   clang libclang-rt-14-dev libomp-dev

@@ -10,6 +10,8 @@
 #include <iostream>
 #include <numbers>
 
+#include <unistd.h>
+
 #include "fivebar/error.hpp"
 #include "fivebar/json.hpp"
 
@@ -106,6 +108,28 @@ Selection select(const Design& design, const Target& target) {
     }
   }
   return sel;
+}
+
+std::vector<const Station*> select_stations(const Design& design, const std::string& station) {
+  std::vector<const Station*> out;
+  if (!station.empty()) {
+    const Station* s = design.station(station);
+    if (s == nullptr) {
+      std::vector<std::string> names;
+      for (const Station& st : design.stations) names.push_back(st.name);
+      throw InputError("unknown station '" + station + "' in design '" + design.name + "' (it has: " + join(names) + ")");
+    }
+    out.push_back(s);
+    return out;
+  }
+  for (const Station& s : design.stations)
+    if (!s.mechanisms().empty()) out.push_back(&s);
+  return out;
+}
+
+std::function<void(std::string_view)> terminal_progress(std::string_view command) {
+  if (::isatty(STDERR_FILENO) == 0) return {};
+  return [name = std::string(command)](std::string_view line) { std::cerr << "fivebar " << name << ": " << line << "\n"; };
 }
 
 // --- Values -----------------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <functional>
 #include <istream>
 #include <memory>
 #include <optional>
@@ -56,6 +57,13 @@ struct Selection {
 /// Resolves --station / --mechanism: an empty choice means "the only one present"; otherwise, or
 /// for a name that is not there, InputError listing the choices.
 Selection select(const Design& design, const Target& target);
+
+/// The stations a whole-station command (workspace, coverage) works on: the one named by
+/// `station` (InputError listing the choices when absent), or every station with a mechanism.
+std::vector<const Station*> select_stations(const Design& design, const std::string& station);
+
+/// Progress lines on stderr, only when it is a terminal (DESIGN.md: long work shows progress).
+std::function<void(std::string_view)> terminal_progress(std::string_view command);
 
 // --- Values -----------------------------------------------------------------------------------
 
@@ -123,6 +131,13 @@ void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Ve
 // --- Subcommands (one file each) ----------------------------------------------------------------
 void setup_fk(CLI::App& app);
 void setup_ik(CLI::App& app);
+void setup_sweep(CLI::App& app);
 void setup_run(CLI::App& app);
+void setup_workspace(CLI::App& app);
+void setup_coverage(CLI::App& app);
+void setup_parts(CLI::App& app);
+void setup_collision(CLI::App& app);
+void setup_pattern(CLI::App& app);
+void setup_report(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -21,7 +21,9 @@ namespace {
 /// below often start with '-' (modes, branches, negative numbers), so "--mode -+" is rewritten
 /// to "--mode=-+" before parsing.
 std::vector<std::string> join_dash_values(int argc, char** argv) {
-  static const std::set<std::string> takes_value{"-t", "--theta", "-p", "--point", "--mode", "-b", "--branch"};
+  static const std::set<std::string> takes_value{"-t",      "--theta",   "-p",        "--point",   "--mode",
+                                                 "-b",      "--branch",  "--ellipse", "--spacing", "--upper",
+                                                 "--lower", "--center"};
   std::vector<std::string> args(argv + 1, argv + argc);
   std::vector<std::string> out;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -57,7 +59,14 @@ int fivebar::cli::main(int argc, char** argv) {
       "3 internal error.");
   setup_fk(app);
   setup_ik(app);
+  setup_sweep(app);
   setup_run(app);
+  setup_workspace(app);
+  setup_coverage(app);
+  setup_parts(app);
+  setup_collision(app);
+  setup_pattern(app);
+  setup_report(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

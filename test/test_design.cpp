@@ -709,3 +709,140 @@ TEST(DesignLimits, NamesFromAFileCannotInjectLinesOrTerminalEscapes) {
 
 }  // namespace
 }  // namespace fivebar
+
+namespace fivebar {
+namespace {
+
+const std::string kPatternStations = R"(stations:
+  index:
+    target: {center: [6.25, 15.5], axes: [15, 12]}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 15, 15], working_mode: "-+"}
+      upper: {bases: [[0, 31], [12.5, 31]], links: [9, 9, 15, 15], working_mode: "+-"}
+  thumb:
+    target: {center: [6.25, 17.5], axes: [15, 14]}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 17.5, 17.5], working_mode: "-+"}
+)";
+
+TEST(Loader, PatternsSectionDefaultsUnitsAndPerStationEntries) {
+  // A bare section: the four kinds with their defaults, at 100 Hz, 360 deg/s.
+  const Design bare = load_design_from_string("name: p\npatterns:\n" + kPatternStations, "<test>");
+  ASSERT_TRUE(bare.patterns.has_value());
+  EXPECT_EQ(bare.patterns->rate_hz, 100.0);
+  EXPECT_DOUBLE_EQ(bare.patterns->max_joint_speed, 2.0 * kPi);
+  ASSERT_EQ(bare.patterns->global.size(), 4u);
+  EXPECT_EQ(bare.patterns->global[3].kind, PatternKind::pivot);
+  EXPECT_EQ(bare.patterns->global[3].duration_s, 2.0);
+  EXPECT_DOUBLE_EQ(bare.patterns->global[3].pivot_amplitude, deg(20));
+
+  const Design d = load_design_from_string(R"(name: p
+patterns:
+  rate_hz: 50
+  max_joint_speed_deg_s: 90
+  stretch: {amplitude_mm: 2.5, separation_mm: 7, center: [6, 16]}
+  pivot: {amplitude_deg: 30, frequency_hz: 2, contact_points: [[1, 3], [-1, -3]]}
+  stations:
+    thumb:
+      stretch: {duration_s: 0.5}
+      twist: {amplitude_mm: 5}
+)" + kPatternStations,
+                                           "<test>");
+  const PatternSettings& p = *d.patterns;
+  EXPECT_EQ(p.rate_hz, 50.0);
+  EXPECT_DOUBLE_EQ(p.max_joint_speed, deg(90));
+  // The index has the two top-level kinds; the section's rate is their default.
+  const auto index = p.for_station("index");
+  ASSERT_EQ(index.size(), 2u);
+  EXPECT_EQ(index[0].kind, PatternKind::stretch);
+  EXPECT_EQ(index[0].amplitude_mm, 2.5);
+  EXPECT_EQ(index[0].separation_mm, 7.0);
+  EXPECT_EQ(index[0].rate_hz, 50.0);
+  EXPECT_EQ(index[0].centre, Vec2(6, 16));
+  EXPECT_EQ(index[0].duration_s, 1.0);
+  EXPECT_EQ(index[1].kind, PatternKind::pivot);
+  EXPECT_DOUBLE_EQ(index[1].pivot_amplitude, deg(30));
+  EXPECT_EQ(index[1].pivot_frequency_hz, 2.0);
+  ASSERT_TRUE(index[1].contact_points.has_value());
+  EXPECT_EQ((*index[1].contact_points)[1], Vec2(-1, -3));
+  // The thumb's stretch keeps the top-level keys it does not give; its twist exists only there.
+  const auto thumb = p.for_station("thumb");
+  ASSERT_EQ(thumb.size(), 3u);
+  EXPECT_EQ(thumb[0].kind, PatternKind::stretch);
+  EXPECT_EQ(thumb[0].duration_s, 0.5);
+  EXPECT_EQ(thumb[0].amplitude_mm, 2.5);
+  EXPECT_EQ(thumb[0].separation_mm, 7.0);
+  EXPECT_EQ(thumb[1].kind, PatternKind::twist);
+  EXPECT_EQ(thumb[1].amplitude_mm, 5.0);
+  EXPECT_EQ(thumb[1].rate_hz, 50.0);
+  EXPECT_EQ(thumb[2].kind, PatternKind::pivot);
+  EXPECT_TRUE(p.for_station("nowhere").size() == 2u);  // the top-level kinds apply to any station
+
+  const Design none = load_design_from_string("name: p\n" + kPatternStations, "<test>");
+  EXPECT_FALSE(none.patterns.has_value());
+}
+
+TEST(Loader, ShowcasePatternsCoverTheFourKindsOnBothStations) {
+  const Design d = load_design(kSourceDir / "designs/iros2022.yaml");
+  ASSERT_TRUE(d.patterns.has_value());
+  for (const char* station : {"index", "thumb"}) {
+    const auto specs = d.patterns->for_station(station);
+    ASSERT_EQ(specs.size(), 4u) << station;
+    for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(specs[i].kind, all_pattern_kinds()[i]) << station;
+  }
+  EXPECT_EQ(d.patterns->for_station("thumb")[2].amplitude_mm, 5.5);
+  EXPECT_EQ(d.patterns->for_station("index")[2].amplitude_mm, 4.0);
+}
+
+TEST(PatternValidate, Rules) {
+  PatternSpec s;
+  EXPECT_NO_THROW(s.validate());
+  const auto bad = [](auto edit, const std::string& message) {
+    PatternSpec p;
+    edit(p);
+    EXPECT_THAT([&] { p.validate(); }, ThrowsMessage<InputError>(HasSubstr(message))) << message;
+  };
+  bad([](PatternSpec& p) { p.amplitude_mm = 0; }, "amplitude_mm = 0 mm: must be > 0");
+  bad([](PatternSpec& p) { p.duration_s = -1; }, "duration_s = -1 s: must be > 0");
+  bad([](PatternSpec& p) { p.rate_hz = 1e5; }, "rate_hz = 100000 Hz: must be > 0 and <= 10000 Hz");
+  bad([](PatternSpec& p) { p.separation_mm = -0.5; }, "separation_mm = -0.5 mm");
+  bad([](PatternSpec& p) { p.centre = Vec2(std::nan(""), 0); }, "centre[0] = nan mm: must be finite");
+  bad([](PatternSpec& p) { p.kind = PatternKind::twist, p.separation_mm = 0; }, "twist turns the tactors");
+  bad([](PatternSpec& p) { p.kind = PatternKind::pivot, p.pivot_amplitude = deg(190); }, "amplitude_deg = 190 deg");
+  bad([](PatternSpec& p) { p.kind = PatternKind::pivot, p.pivot_frequency_hz = 0; }, "frequency_hz = 0 Hz");
+  // A pivot does not use amplitude_mm.
+  PatternSpec pivot;
+  pivot.kind = PatternKind::pivot;
+  pivot.amplitude_mm = -1;
+  EXPECT_NO_THROW(pivot.validate());
+
+  PatternSettings settings;
+  settings.max_joint_speed = 0;
+  EXPECT_THAT([&] { settings.validate(); }, ThrowsMessage<InputError>(HasSubstr("max_joint_speed_deg_s = 0 deg/s")));
+  settings = PatternSettings{};
+  PatternSpec zero;
+  zero.amplitude_mm = 0;
+  settings.per_station.emplace_back("index", zero);
+  EXPECT_THAT([&] { settings.validate(); }, ThrowsMessage<InputError>(HasSubstr("stations.index.stretch.amplitude_mm")));
+}
+
+TEST(PatternKinds, RoundTrip) {
+  for (PatternKind kind : all_pattern_kinds()) EXPECT_EQ(parse_pattern_kind(to_string(kind)), kind);
+  EXPECT_EQ(to_string(PatternKind::twist), "twist");
+  EXPECT_FALSE(parse_pattern_kind("Stretch").has_value());
+  EXPECT_FALSE(parse_pattern_kind("").has_value());
+}
+
+TEST(DesignValidate, PatternStationsMustExist) {
+  Design d = valid_design();
+  d.patterns = PatternSettings{};
+  PatternSpec spec;
+  d.patterns->per_station.emplace_back("middle", spec);
+  EXPECT_THAT([&] { d.validate(); },
+              ThrowsMessage<InputError>(HasSubstr("patterns.stations.middle: no such station in this design (stations: index)")));
+  d.patterns->per_station.front().first = "index";
+  EXPECT_NO_THROW(d.validate());
+}
+
+}  // namespace
+}  // namespace fivebar

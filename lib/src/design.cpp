@@ -75,14 +75,16 @@ void check_coordinate(const std::string& key, double value_mm) {
   }
 }
 
-void check_point(const std::string& key, const Vec2& p_mm) {
-  check_coordinate(detail::key_index(key, 0), p_mm.x());
-  check_coordinate(detail::key_index(key, 1), p_mm.y());
+void check_point(const char* key, const Vec2& p_mm) {
+  // Keys are built only on failure: sweeps validate millions of designs.
+  auto ok = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxLengthMm; };
+  if (!ok(p_mm.x())) check_coordinate(detail::key_index(key, 0), p_mm.x());
+  if (!ok(p_mm.y())) check_coordinate(detail::key_index(key, 1), p_mm.y());
 }
 
 /// Runs a nested validate() and re-throws its error with the key prefixed by `prefix`.
 template <class F>
-void validate_nested(const std::string& prefix, F&& validate) {
+void validate_nested(std::string_view prefix, F&& validate) {
   try {
     validate();
   } catch (const ValidationError& e) {
@@ -255,7 +257,9 @@ void Mechanism::validate() const {
   // Coincident base joints are allowed: degenerate, but valid (extreme-case tests use them).
   check_point("bases[0]", O1);
   check_point("bases[1]", O2);
-  for (std::size_t i = 0; i < L.size(); ++i) check_length(detail::key_index("links", i), L[i]);
+  for (std::size_t i = 0; i < L.size(); ++i) {
+    if (!(L[i] > 0.0 && L[i] <= kMaxLengthMm)) check_length(detail::key_index("links", i), L[i]);
+  }
 
   auto valid_sign = [](std::int8_t s) { return s == 1 || s == -1; };
   if (!valid_sign(working_mode.sign1) || !valid_sign(working_mode.sign2)) {
@@ -272,18 +276,18 @@ void Mechanism::validate() const {
   if (joint_limits) {
     for (std::size_t i = 0; i < 2; ++i) {
       const JointRange& range = (*joint_limits)[i];
-      const std::string key = detail::key_index("joint_limits", i);
+      const auto key_of = [i] { return detail::key_index("joint_limits", i); };
       for (std::size_t j = 0; j < 2; ++j) {
         const double angle = j == 0 ? range.lo : range.hi;
         if (!std::isfinite(angle)) {
-          throw ValidationError(detail::key_index(key, j), "= " + format_number(angle) + " deg: must be finite");
+          throw ValidationError(detail::key_index(key_of(), j), "= " + format_number(angle) + " deg: must be finite");
         }
       }
       const double d = wrap_two_pi(range.hi - range.lo);
       const double tol = kAngleEqualUlps * tol::kEps * std::max({kTwoPi, std::abs(range.lo), std::abs(range.hi)});
       if (d <= tol || d >= kTwoPi - tol) {
-        throw ValidationError(key, "= [" + format_degrees(range.lo) + ", " + format_degrees(range.hi) +
-                                       "] deg: lo and hi must differ (mod 360)");
+        throw ValidationError(key_of(), "= [" + format_degrees(range.lo) + ", " + format_degrees(range.hi) +
+                                            "] deg: lo and hi must differ (mod 360)");
       }
     }
   }
@@ -391,6 +395,200 @@ void PrintSettings::validate() const {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Sweep settings
+
+const std::vector<std::string>& sweep_variable_names() {
+  static const std::vector<std::string> names{"L1", "L2", "L3", "L4", "L12", "L34",
+                                              "spacing", "upper_height", "ellipse_a", "ellipse_b"};
+  return names;
+}
+
+const std::vector<std::string>& sweep_objective_names() {
+  static const std::vector<std::string> names{"margin", "min_lci", "force", "footprint"};
+  return names;
+}
+
+namespace {
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+}  // namespace
+
+void SweepSettings::validate() const {
+  if (station.empty()) throw ValidationError("station", "is required: the station to sweep");
+  if (!mechanism.empty() && mechanism != "lower" && mechanism != "upper") {
+    throw ValidationError("mechanism", "= " + detail::quoted(mechanism) + ": must be lower or upper");
+  }
+  if (vary.empty()) throw ValidationError("vary", "must name at least one variable");
+  const auto& names = sweep_variable_names();
+  long double grid = 1.0L;
+  for (std::size_t i = 0; i < vary.size(); ++i) {
+    const SweepVariable& v = vary[i];
+    const std::string key = detail::key_child("vary", v.name);
+    if (std::find(names.begin(), names.end(), v.name) == names.end()) {
+      throw ValidationError(key, "unknown variable (known: " + joined(names) + ")");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (vary[j].name == v.name) throw ValidationError(key, "is varied twice");
+    }
+    if (!(v.lo > 0.0) || !(v.hi >= v.lo) || !(v.hi <= kMaxLengthMm)) {
+      throw ValidationError(key, "= [" + format_number(v.lo) + ", " + format_number(v.hi) +
+                                     "] mm: needs 0 < lo <= hi <= 1e12");
+    }
+    if (v.n < 1 || v.n > 100000000) {
+      throw ValidationError(key, "= " + std::to_string(v.n) + " points: must be 1 ... 1e8");
+    }
+    if (v.lo == v.hi && v.n > 1) throw ValidationError(key, "lo = hi: use n = 1");
+    grid *= v.n;
+  }
+  // Tied and single names must not both move the same link.
+  auto has = [&](const char* n) {
+    return std::any_of(vary.begin(), vary.end(), [&](const SweepVariable& v) { return v.name == n; });
+  };
+  if (has("L12") && (has("L1") || has("L2"))) throw ValidationError("vary.L12", "conflicts with L1 / L2");
+  if (has("L34") && (has("L3") || has("L4"))) throw ValidationError("vary.L34", "conflicts with L3 / L4");
+  if (sample != "grid" && sample != "random" && sample != "sobol") {
+    throw ValidationError("sample", "= " + detail::quoted(sample) + ": must be grid, random or sobol");
+  }
+  if (sample == "grid" && grid > 1e15L) throw ValidationError("vary", "the grid has more than 1e15 designs");
+  if (sample != "grid" && count == 0) throw ValidationError("count", "is required for " + sample + " sampling");
+  if (count > std::uint64_t(1e15)) throw ValidationError("count", "must be at most 1e15");
+  if (objectives.empty()) throw ValidationError("objectives", "must name at least one objective");
+  const auto& known = sweep_objective_names();
+  for (std::size_t i = 0; i < objectives.size(); ++i) {
+    if (std::find(known.begin(), known.end(), objectives[i]) == known.end()) {
+      throw ValidationError(detail::key_index("objectives", i),
+                            "= " + detail::quoted(objectives[i]) + ": unknown objective (known: " + joined(known) + ")");
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (objectives[j] == objectives[i]) {
+        throw ValidationError(detail::key_index("objectives", i), "= " + detail::quoted(objectives[i]) + ": listed twice");
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Patterns
+
+std::string_view to_string(PatternKind kind) {
+  switch (kind) {
+    case PatternKind::stretch: return "stretch";
+    case PatternKind::slip: return "slip";
+    case PatternKind::twist: return "twist";
+    case PatternKind::pivot: return "pivot";
+  }
+  return "stretch";
+}
+
+std::optional<PatternKind> parse_pattern_kind(std::string_view text) {
+  for (PatternKind kind : all_pattern_kinds()) {
+    if (text == to_string(kind)) return kind;
+  }
+  return std::nullopt;
+}
+
+std::array<PatternKind, 4> all_pattern_kinds() {
+  return {PatternKind::stretch, PatternKind::slip, PatternKind::twist, PatternKind::pivot};
+}
+
+namespace {
+
+/// Most samples one pattern may have (10 minutes at 1 kHz is 600000).
+constexpr double kMaxPatternSamples = 1e6;
+
+/// duration * rate within this many intervals of a whole number counts as that number: 0.29 s at
+/// 100 Hz is 28.999999999999996 intervals in doubles and must give 29, not 28.
+constexpr double kSampleCountSlack = 1e-9;
+
+/// A value for messages as a person types it: 100000, 0.15, 1e-09.
+std::string plain_number(double v) {
+  if (!std::isfinite(v)) return format_number(v);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
+void require_range(const std::string& key, double v, double lo_exclusive, double hi, std::string_view unit) {
+  if (!(v > lo_exclusive) || !(v <= hi)) {
+    std::ostringstream s;
+    s << "= " << plain_number(v) << (unit.empty() ? "" : " ") << unit << ": must be > " << plain_number(lo_exclusive)
+      << " and <= " << plain_number(hi) << (unit.empty() ? "" : " ") << unit;
+    throw ValidationError(key, s.str());
+  }
+}
+
+}  // namespace
+
+std::size_t PatternSpec::samples() const {
+  return static_cast<std::size_t>(std::floor(duration_s * rate_hz + kSampleCountSlack)) + 1;
+}
+
+void PatternSpec::validate() const {
+  if (kind != PatternKind::pivot) require_range("amplitude_mm", amplitude_mm, 0.0, 1e3, "mm");
+  require_range("duration_s", duration_s, 0.0, 3600.0, "s");
+  require_range("rate_hz", rate_hz, 0.0, 1e4, "Hz");
+  if (duration_s * rate_hz > kMaxPatternSamples) {
+    std::ostringstream s;
+    s << "= " << plain_number(duration_s) << " s: at rate_hz " << plain_number(rate_hz)
+      << " that is more than 1000000 samples";
+    throw ValidationError("duration_s", s.str());
+  }
+  if (centre) check_point("centre", *centre);
+  if (!(separation_mm >= 0.0) || !(separation_mm <= 1e3)) {
+    throw ValidationError("separation_mm", "= " + plain_number(separation_mm) + " mm: must be >= 0 and <= 1000 mm");
+  }
+  if (kind == PatternKind::twist && !(separation_mm > 0.0)) {
+    throw ValidationError("separation_mm", "= " + plain_number(separation_mm) +
+                                               " mm: twist turns the tactors on a circle of diameter separation_mm: "
+                                               "must be > 0");
+  }
+  if (kind == PatternKind::pivot) {
+    if (!(pivot_amplitude > 0.0) || !(pivot_amplitude <= std::numbers::pi * (1.0 + 1e-12))) {
+      throw ValidationError("amplitude_deg", "= " + format_degrees(pivot_amplitude) + " deg: must be > 0 and <= 180 deg");
+    }
+    require_range("frequency_hz", pivot_frequency_hz, 0.0, 1e3, "Hz");
+    if (contact_points) {
+      for (std::size_t i = 0; i < 2; ++i) check_point(detail::key_index("contact_points", i).c_str(), (*contact_points)[i]);
+    }
+  }
+}
+
+std::vector<PatternSpec> PatternSettings::for_station(std::string_view station) const {
+  std::vector<PatternSpec> out;
+  for (PatternKind kind : all_pattern_kinds()) {
+    const PatternSpec* chosen = nullptr;
+    for (const auto& [name, spec] : per_station) {
+      if (name == station && spec.kind == kind) chosen = &spec;
+    }
+    if (chosen == nullptr) {
+      for (const PatternSpec& spec : global) {
+        if (spec.kind == kind) chosen = &spec;
+      }
+    }
+    if (chosen != nullptr) out.push_back(*chosen);
+  }
+  return out;
+}
+
+void PatternSettings::validate() const {
+  require_range("rate_hz", rate_hz, 0.0, 1e4, "Hz");
+  if (!(max_joint_speed > 0.0) || !(max_joint_speed * kDegPerRad <= 1e6)) {
+    throw ValidationError("max_joint_speed_deg_s", "= " + format_degrees(max_joint_speed) +
+                                                       " deg/s: must be > 0 and <= 1000000 deg/s");
+  }
+  for (const PatternSpec& spec : global) {
+    validate_nested(std::string(to_string(spec.kind)), [&] { spec.validate(); });
+  }
+  for (const auto& [station, spec] : per_station) {
+    validate_nested(detail::key_join(detail::key_child("stations", station), to_string(spec.kind)),
+                    [&] { spec.validate(); });
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Design
 
 bool is_safe_name(std::string_view name) {
@@ -406,6 +604,13 @@ const std::vector<std::string>& known_products() {
   // In build order; each capability appends its product here.
   static const std::vector<std::string> products{
       "kinematics",
+      "workspace",
+      "coverage",
+      "collision",
+      "pattern",
+      "sweep",
+      "parts",
+      "report",
   };
   return products;
 }
@@ -460,6 +665,29 @@ void Design::validate() const {
     }
   }
 
+  if (sweep) {
+    validate_nested("sweep", [&] { sweep->validate(); });
+    const Station* st = station(sweep->station);
+    if (st == nullptr) {
+      throw ValidationError("sweep.station", "= " + detail::quoted(sweep->station) + ": no such station in the design");
+    }
+    if (!sweep->mechanism.empty() && st->mechanism(sweep->mechanism) == nullptr) {
+      throw ValidationError("sweep.mechanism", "= " + detail::quoted(sweep->mechanism) + ": station " +
+                                                   detail::quoted(sweep->station) + " has no such mechanism");
+    }
+  }
+
+  if (patterns) {
+    validate_nested("patterns", [&] { patterns->validate(); });
+    for (const auto& [station_name, spec] : patterns->per_station) {
+      if (station(station_name) == nullptr) {
+        std::string list;
+        for (const Station& s : stations) list += (list.empty() ? "" : ", ") + s.name;
+        throw ValidationError(detail::key_child("patterns.stations", station_name),
+                              "no such station in this design (stations: " + list + ")");
+      }
+    }
+  }
   if (products) {
     const auto& known = known_products();
     for (std::size_t i = 0; i < products->size(); ++i) {

@@ -24,6 +24,16 @@ double cross2(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x
 
 // --- CurvePiece ----------------------------------------------------------------------------------
 
+bool direction_within_arc(const Vec2& from, const Vec2& to, bool ccw, const Vec2& v) {
+  // A clockwise arc from a to b is the counter-clockwise arc from b to a.
+  const Vec2& a = ccw ? from : to;
+  const Vec2& b = ccw ? to : from;
+  const double w = cross2(a, b);
+  const bool minor = w > 0.0 || (w == 0.0 && a.dot(b) < 0.0);  // ccw span in (0, pi]
+  if (minor) return cross2(a, v) >= 0.0 && cross2(v, b) >= 0.0;
+  return !(cross2(b, v) > 0.0 && cross2(v, a) > 0.0);  // outside only in the complementary minor arc
+}
+
 double CurvePiece::sweep() const {
   if (!is_arc) return 0.0;
   const Vec2 a = source - center, b = target - center;
@@ -52,14 +62,8 @@ Vec2 CurvePiece::closest_point(const Vec2& p) const {
   }
   const Vec2 v = p - center;
   const double r = v.norm();
-  if (r > 0.0) {
-    // Is the direction of v within the arc's angular span (measured the arc's way round)?
-    const Vec2 a = source - center;
-    double phi = std::atan2(cross2(a, v), a.dot(v));
-    const double sw = sweep();
-    if (sw >= 0.0 ? (phi < 0.0 ? phi + 2 * kPi : phi) <= sw : (phi > 0.0 ? phi - 2 * kPi : phi) >= sw) {
-      return center + (radius / r) * v;
-    }
+  if (r > 0.0 && direction_within_arc(source - center, target - center, ccw, v)) {
+    return center + (radius / r) * v;
   }
   return (p - source).squaredNorm() <= (p - target).squaredNorm() ? source : target;
 }
@@ -210,14 +214,31 @@ Region reachable_region(const Mechanism& m) {
 
 namespace {
 
-/// Area of the intersection of two disks (radii a, b; centre distance d).
+/// r^2 (alpha - sin(alpha) cos(alpha)): the circular segment of half-angle alpha, without the
+/// cancellation of x - sin x for small x = 2 alpha (series there).
+double segment_area(double r, double alpha) {
+  const double x = 2.0 * alpha;
+  double x_minus_sin;
+  if (x < 0.5) {
+    const double x2 = x * x;
+    x_minus_sin = x * x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0 * (1.0 - x2 / 110.0))));
+  } else {
+    x_minus_sin = x - std::sin(x);
+  }
+  return 0.5 * r * r * x_minus_sin;
+}
+
+/// Area of the intersection of two disks (radii a, b; centre distance d). Half-angles by atan2 of
+/// Heron's product and d^2 +- (a - b)(a + b), which keep their digits for nearly equal radii and
+/// close centres (link ratios of 1e2 and more), then one circular segment per disk.
 double lens_area(double a, double b, double d) {
   if (a <= 0.0 || b <= 0.0 || d >= a + b) return 0.0;
   if (d <= std::fabs(a - b)) return kPi * std::min(a, b) * std::min(a, b);
-  const double ca = std::clamp((d * d + a * a - b * b) / (2 * d * a), -1.0, 1.0);
-  const double cb = std::clamp((d * d + b * b - a * a) / (2 * d * b), -1.0, 1.0);
   const double k = std::sqrt(std::max(0.0, (-d + a + b) * (d + a - b) * (d - a + b) * (d + a + b)));
-  return a * a * std::acos(ca) + b * b * std::acos(cb) - 0.5 * k;
+  const double diff = (a - b) * (a + b);
+  const double alpha = std::atan2(k, d * d + diff);  // half-angle at the centre of disk a
+  const double beta = std::atan2(k, d * d - diff);
+  return segment_area(a, alpha) + segment_area(b, beta);
 }
 
 }  // namespace

@@ -18,8 +18,11 @@ namespace fivebar {
 
 struct CoverageOptions {
   /// Samples over the filled ellipse for min LCI / force / assembly side (rings x angles).
-  int rings = 8;
-  int angles = 64;
+  int rings = 6;
+  int angles = 48;
+  /// The min-LCI point is refined by compass search down to this fraction of the ellipse size
+  /// (LCI is smooth: its minimum is then known to about the square of it).
+  double lci_refine = 1e-5;
 };
 
 struct CoverageResult {
@@ -56,6 +59,19 @@ struct StationCoverage {
 };
 StationCoverage station_coverage(const Station& station, const std::optional<Ellipse>& override_target = {},
                                  const CoverageOptions& options = {});
+
+/// Containment and signed margin only (no covered fraction, no conditioning), decided as in
+/// coverage(): analytic per-leg fit, exact CGAL fallback within rounding of tangency.
+struct Containment {
+  bool inside = false;
+  double margin_mm = 0.0;
+  Vec2 worst_point{0.0, 0.0};
+  bool exact_fallback = false;  ///< the exact test decided
+};
+Containment containment(const Mechanism& m, const Ellipse& target);
+/// Fills min_lci (+ point), min_force_capability, lci_ok and assembly_ok of `out` over the
+/// filled ellipse, as coverage() does.
+void conditioning(const Mechanism& m, const Ellipse& target, const CoverageOptions& options, CoverageResult& out);
 
 /// Fast verdict without joint limits: closed-form margin of the ellipse against both annuli.
 /// Returns the signed margin (mm) and the worst ellipse point.

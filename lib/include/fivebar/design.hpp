@@ -139,6 +139,78 @@ struct PrintSettings {
   void validate() const;
 };
 
+/// One swept design variable (`sweep.vary`): NAME = LO:HI:N, in file units (mm).
+struct SweepVariable {
+  std::string name;  ///< one of sweep_variable_names()
+  double lo = 0.0;
+  double hi = 0.0;
+  int n = 1;  ///< grid points (grid sampling); ignored by random / sobol
+};
+
+/// A link-dimension sweep (`sweep:`) over one station.
+struct SweepSettings {
+  std::string station;
+  std::string mechanism;             ///< "lower", "upper" or empty: every mechanism and shared
+  std::vector<SweepVariable> vary;
+  std::string sample = "grid";       ///< grid | random | sobol
+  std::uint64_t count = 0;           ///< random / sobol designs (0: the grid's size)
+  std::uint64_t seed = 1;
+  std::vector<std::string> objectives{"margin", "min_lci"};  ///< see sweep_objective_names()
+  /// Rules that need no design (names, ranges, counts); the design checks the station.
+  void validate() const;
+};
+/// L1 L2 L3 L4, L12 (L1 = L2), L34 (L3 = L4), spacing (base spacing), upper_height (y of the
+/// upper bases), ellipse_a, ellipse_b (full axes of the target).
+const std::vector<std::string>& sweep_variable_names();
+/// margin (max), min_lci (max), force (max), footprint (min: bounding-box area of the linkage).
+const std::vector<std::string>& sweep_objective_names();
+/// Skin-deformation patterns (paper Sec. IV-A, Fig. 6) and pivoting (Sec. IV-B).
+enum class PatternKind : std::uint8_t {
+  stretch,  ///< tactors start near the centre and move apart horizontally
+  slip,     ///< tactors start in the upper region and move together to the lower one
+  twist,    ///< tactors start separated about the centre and turn along a circle
+  pivot,    ///< tactors track two contact points of an object rotating about the centre
+};
+std::string_view to_string(PatternKind kind);
+std::optional<PatternKind> parse_pattern_kind(std::string_view text);
+/// stretch, slip, twist, pivot.
+std::array<PatternKind, 4> all_pattern_kinds();
+
+/// One pattern's parameters (`patterns.<kind>` or `patterns.stations.<station>.<kind>`).
+/// Lengths mm, angles radians, times s. The paths themselves are in fivebar/pattern.hpp.
+struct PatternSpec {
+  PatternKind kind = PatternKind::stretch;
+  double amplitude_mm = 3.0;    ///< stretch: travel of each tactor; slip: travel; twist: arc length
+  double duration_s = 1.0;      ///< length of the pattern
+  double rate_hz = 100.0;       ///< samples per second (the controller loop rate)
+  std::optional<Vec2> centre;   ///< default: the station's target centre (mm)
+  double separation_mm = 8.0;   ///< distance between the two tactors at the start
+  double pivot_amplitude = 0.3490658503988659;  ///< pivot: peak object angle (rad; file: amplitude_deg, 20)
+  double pivot_frequency_hz = 0.5;               ///< pivot: angle(t) = amplitude sin(2 pi f t)
+  /// Pivot: contact points {upper, lower} relative to the centre (mm); default (0, +-separation/2).
+  std::optional<std::array<Vec2, 2>> contact_points;
+  /// Number of samples: floor(duration * rate) + 1, both ends included (a product within rounding
+  /// of a whole number counts as that number).
+  std::size_t samples() const;
+  /// Throws ValidationError naming the key ("amplitude_mm", "contact_points[1]").
+  void validate() const;
+};
+
+/// `patterns:`: which patterns to check, on which stations, at what rate and motor speed.
+struct PatternSettings {
+  double rate_hz = 100.0;  ///< default rate of every pattern (paper: 100 Hz control loop)
+  /// Largest motor speed (rad/s; file: max_joint_speed_deg_s, default 360 deg/s). The controller
+  /// section may take this over later.
+  double max_joint_speed = 6.283185307179586;
+  std::vector<PatternSpec> global;  ///< kinds given at the top level: checked on every station
+  /// Kinds given under `stations.<name>`, already merged over the top-level entry of that kind.
+  std::vector<std::pair<std::string, PatternSpec>> per_station;
+  /// The patterns of a station: for each kind in the order stretch, slip, twist, pivot, its own
+  /// entry if any, else the top-level one.
+  std::vector<PatternSpec> for_station(std::string_view station) const;
+  void validate() const;
+};
+
 /// A whole design (and scene).
 struct Design {
   std::string name;                   ///< used for outputs/<name>/: a safe file name
@@ -147,6 +219,8 @@ struct Design {
   std::optional<std::vector<std::string>> products;  ///< absent: every product the data allows
   std::optional<Geometry> geometry;       ///< `geometry:`; absent: collision and parts left out
   std::optional<PrintSettings> print;     ///< `print:`; parts use defaults when absent
+  std::optional<SweepSettings> sweep;     ///< `sweep:`; the sweep product of `fivebar run`
+  std::optional<PatternSettings> patterns;  ///< `patterns:`; absent: the pattern product is left out
 
   void validate() const;
   const Station* station(std::string_view name) const;
@@ -159,6 +233,9 @@ bool is_safe_name(std::string_view name);
 /// Product names a scene may list, in build order.
 const std::vector<std::string>& known_products();
 
+/// The design as a design file (YAML, file units, numbers in shortest round-trip form) that
+/// load_design_from_string() reads back to an equal design.
+std::string to_yaml(const Design& design);
 /// Limits on design files (README "Hardening"), checked before the YAML parser sees the text so
 /// that no file can exhaust the stack or the memory: larger files, deeper nesting, bytes that are
 /// not UTF-8 or characters YAML forbids (control characters) are refused with an InputError.

@@ -29,4 +29,17 @@ inline constexpr double kClosureRel = 256.0 * kEps;
 /// Two base joints closer than this (relative to the length scale) count as coincident.
 inline constexpr double kCoincidentRel = 4.0 * kEps;
 
+// --- Printed parts (fivebar/parts.hpp) ---------------------------------------------------------
+
+/// Design intent of a printed part, measured on its mesh: pin-centre distances, hole diameters and
+/// heights must equal the design within this many mm. A manufacturing specification (resin
+/// printers hold ~0.05 mm), not a rounding epsilon: binary STL stores float32 coordinates, so a
+/// correct part measures within ~1e-5 mm at device sizes.
+inline constexpr double kPartDimensionMm = 0.01;
+
+/// Circle fit of a hole wall: a wall vertex further than this fraction of the radius from the
+/// fitted circle is not on the circle (a corner where a D-bore's flat cuts the arc) and is dropped
+/// before the final fit. Float32 vertices of a true polygon sit within ~1e-6 of the radius.
+inline constexpr double kCircleFitRejectRel = 1e-4;
+
 }  // namespace fivebar::tol

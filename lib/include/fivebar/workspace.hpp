@@ -41,6 +41,10 @@ struct CurvePiece {
   Vec2 point_at(double s) const;
 };
 
+/// Is the direction of v (from an arc's centre) within the arc that runs from direction `from` to
+/// direction `to` (counter-clockwise when ccw)? Cross products only: no angles.
+bool direction_within_arc(const Vec2& from, const Vec2& to, bool ccw, const Vec2& v);
+
 /// A closed boundary curve: counter-clockwise for an outer boundary, clockwise for a hole.
 struct BoundaryLoop {
   std::vector<CurvePiece> pieces;

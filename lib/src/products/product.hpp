@@ -64,5 +64,19 @@ const Product* find_product(std::string_view name);
 // --- Entries (one file each) -----------------------------------------------------------------
 /// Link data, modes and the pose at the target centre and axis ends of every mechanism.
 Product kinematics_product();
+/// The scene's `sweep:` section: CSV, Pareto set, best design, plots.
+Product sweep_product();
+/// Exact regions, restricted areas, VTK files and the picture of every station (workspace/).
+Product workspace_product();
+/// Coverage of every station's target ellipse by each mechanism and the shared region.
+Product coverage_product();
+/// OpenSCAD sources, STL renders, mesh and fit checks and the BOM of every station (parts.hpp).
+Product parts_product();
+/// Collision map of the two tactors of every station and the priority rule at the centre.
+Product collision_product();
+/// The skin-deformation patterns of `patterns:`, checked, with joint trajectories and pictures.
+Product pattern_product();
+/// Accuracy of the main numbers (quick work-precision) and the stability catalogue.
+Product report_product();
 
 }  // namespace fivebar::products

@@ -7,6 +7,13 @@ const std::vector<Product>& registry() {
   // pattern, sweep, parts, export, report).
   static const std::vector<Product> entries = {
       kinematics_product(),
+      workspace_product(),
+      coverage_product(),
+      sweep_product(),
+      parts_product(),
+      collision_product(),
+      pattern_product(),
+      report_product(),
   };
   return entries;
 }

@@ -39,7 +39,7 @@ using detail::key_index;
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 /// Top-level sections that later versions fill in (DESIGN.md); rejected clearly until then.
-constexpr std::string_view kReservedSections[] = {"controller", "sweep", "patterns"};
+constexpr std::string_view kReservedSections[] = {"controller"};
 
 constexpr std::size_t kMaxShownValue = 60;
 /// Longest map key (section, field or station name) accepted, so that key paths in messages stay
@@ -445,6 +445,11 @@ class Loader {
   Ellipse target(const Entry& entry);
   Geometry geometry(const Entry& entry);
   PrintSettings print(const Entry& entry);
+  SweepSettings sweep(const Entry& entry);
+  std::uint64_t whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const;
+  PatternSettings patterns(const Entry& entry);
+  /// One `<kind>:` map of patterns, over `base` (the defaults, or the top-level entry of the kind).
+  PatternSpec pattern(const Entry& entry, const PatternSpec& base);
   /// An optional number: `fallback` when the key is absent.
   double optional_number(const Entries& all, std::string_view name, double fallback, std::string_view unit) const;
   Mechanism mechanism(const Entry& entry);
@@ -653,6 +658,131 @@ PrintSettings Loader::print(const Entry& entry) {
   return p;
 }
 
+std::uint64_t Loader::whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const {
+  const double v = number(node, path, line, "");
+  if (v != std::floor(v) || v < lo || v > hi) {
+    std::ostringstream rule;
+    rule << "must be a whole number from " << lo << " to " << hi;
+    fail_value(node, line, path, rule.str());
+  }
+  return std::uint64_t(v);
+}
+
+SweepSettings Loader::sweep(const Entry& entry) {
+  SweepSettings sw;
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"station", "mechanism", "vary", "sample", "count", "seed", "objectives"},
+                              "(station, mechanism, vary, sample, count, seed, objectives)");
+  const Entry& st = require(all, "station", entry.path, entry.line);
+  sw.station = string(st.value, st.path, st.line, "must be a station name");
+  if (const Entry* m = find(all, "mechanism")) sw.mechanism = string(m->value, m->path, m->line, "must be lower or upper");
+  const Entry& vary = require(all, "vary", entry.path, entry.line);
+  for (const Entry& v : entries(vary.value, vary.path, vary.line, {}, "of variable names to [lo, hi, n]",
+                                /*any_key=*/true)) {
+    const auto items = list(v.value, v.path, v.line, 3, "a list [lo, hi, n] (mm, mm, points)");
+    SweepVariable var;
+    var.name = v.name;
+    var.lo = number(items[0], key_index(v.path, 0), line_of(items[0], v.line), "mm");
+    var.hi = number(items[1], key_index(v.path, 1), line_of(items[1], v.line), "mm");
+    var.n = int(whole(items[2], key_index(v.path, 2), line_of(items[2], v.line), 1, 1e8));
+    sw.vary.push_back(var);
+  }
+  if (const Entry* sample = find(all, "sample")) sw.sample = string(sample->value, sample->path, sample->line, "must be grid, random or sobol");
+  if (const Entry* count = find(all, "count")) sw.count = whole(count->value, count->path, count->line, 1, 1e15);
+  if (const Entry* seed = find(all, "seed")) sw.seed = whole(seed->value, seed->path, seed->line, 0, 9007199254740992.0);
+  if (const Entry* obj = find(all, "objectives")) {
+    if (!obj->value.IsSequence()) fail_value(obj->value, obj->line, obj->path, "must be a list of objectives");
+    sw.objectives.clear();
+    for (std::size_t i = 0; i < obj->value.size(); ++i) {
+      const std::string path = key_index(obj->path, i);
+      const int line = line_of(obj->value[i], obj->line);
+      note(path, line);
+      sw.objectives.push_back(string(obj->value[i], path, line, "must be an objective name"));
+    }
+  }
+  return sw;
+}
+
+PatternSpec Loader::pattern(const Entry& entry, const PatternSpec& base) {
+  PatternSpec spec = base;
+  if (entry.value.IsNull()) return spec;  // `stretch:` alone: the defaults (or the top-level entry)
+  const bool pivot = spec.kind == PatternKind::pivot;
+  const Entries all =
+      pivot ? entries(entry.value, entry.path, entry.line,
+                      {"amplitude_deg", "frequency_hz", "duration_s", "rate_hz", "center", "separation_mm",
+                       "contact_points", "amplitude_mm"},
+                      "of pivot parameters (amplitude_deg, frequency_hz, duration_s, contact_points, ...)")
+            : entries(entry.value, entry.path, entry.line,
+                      {"amplitude_mm", "duration_s", "rate_hz", "center", "separation_mm"},
+                      "of pattern parameters (amplitude_mm, duration_s, rate_hz, center, separation_mm)");
+  if (!pivot) spec.amplitude_mm = optional_number(all, "amplitude_mm", spec.amplitude_mm, "mm");
+  if (const Entry* a = find(all, "amplitude_mm"); a != nullptr && pivot) {
+    fail_value(a->value, a->line, a->path, "a pivot's amplitude is the object's angle: use amplitude_deg");
+  }
+  spec.duration_s = optional_number(all, "duration_s", spec.duration_s, "s");
+  spec.rate_hz = optional_number(all, "rate_hz", spec.rate_hz, "Hz");
+  if (const Entry* c = find(all, "center")) spec.centre = point(c->value, c->path, c->line, "a point [x, y] (mm)");
+  spec.separation_mm = optional_number(all, "separation_mm", spec.separation_mm, "mm");
+  if (pivot) {
+    if (const Entry* a = find(all, "amplitude_deg")) spec.pivot_amplitude = kRadPerDeg * number(a->value, a->path, a->line, "deg");
+    spec.pivot_frequency_hz = optional_number(all, "frequency_hz", spec.pivot_frequency_hz, "Hz");
+    if (const Entry* cp = find(all, "contact_points")) {
+      if (const Entry* sep = find(all, "separation_mm")) {
+        fail(sep->line, sep->path, "give contact_points or separation_mm, not both (separation_mm only places the "
+                                   "default contact points at (0, +-separation/2))");
+      }
+      const auto items = list(cp->value, cp->path, cp->line, 2,
+                              "a list of 2 points [[x, y] upper, [x, y] lower] relative to the center (mm)");
+      std::array<Vec2, 2> points;
+      for (std::size_t i = 0; i < 2; ++i) {
+        points[i] = point(items[i], key_index(cp->path, i), line_of(items[i], cp->line), "a point [x, y] (mm)");
+      }
+      spec.contact_points = points;
+    }
+  }
+  return spec;
+}
+
+PatternSettings Loader::patterns(const Entry& entry) {
+  PatternSettings ps;
+  const auto defaults = [&](PatternKind kind) {
+    PatternSpec spec;
+    spec.kind = kind;
+    spec.rate_hz = ps.rate_hz;
+    if (kind == PatternKind::pivot) spec.duration_s = 2.0;  // one period of the default 0.5 Hz
+    return spec;
+  };
+  if (entry.value.IsNull()) {  // `patterns:` alone: the four patterns with their defaults
+    for (PatternKind kind : all_pattern_kinds()) ps.global.push_back(defaults(kind));
+    return ps;
+  }
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"rate_hz", "max_joint_speed_deg_s", "stretch", "slip", "twist", "pivot", "stations"},
+                              "(rate_hz, max_joint_speed_deg_s, stretch, slip, twist, pivot, stations)");
+  ps.rate_hz = optional_number(all, "rate_hz", ps.rate_hz, "Hz");
+  if (const Entry* v = find(all, "max_joint_speed_deg_s")) {
+    ps.max_joint_speed = kRadPerDeg * number(v->value, v->path, v->line, "deg/s");
+  }
+  for (PatternKind kind : all_pattern_kinds()) {
+    if (const Entry* e = find(all, to_string(kind))) ps.global.push_back(pattern(*e, defaults(kind)));
+  }
+  if (const Entry* stations = find(all, "stations")) {
+    for (const Entry& st : entries(stations->value, stations->path, stations->line, {},
+                                   "of station names to their patterns", /*any_key=*/true)) {
+      for (const Entry& k : entries(st.value, st.path, st.line, {"stretch", "slip", "twist", "pivot"},
+                                    "of pattern kinds (stretch, slip, twist, pivot)")) {
+        const PatternKind kind = *parse_pattern_kind(k.name);
+        PatternSpec base = defaults(kind);
+        for (const PatternSpec& g : ps.global) {
+          if (g.kind == kind) base = g;
+        }
+        ps.per_station.emplace_back(st.name, pattern(k, base));
+      }
+    }
+  }
+  return ps;
+}
+
 Mechanism Loader::mechanism(const Entry& entry) {
   const Entries all = entries(entry.value, entry.path, entry.line,
                               {"bases", "links", "working_mode", "assembly_mode", "joint_limits", "min_lci"},
@@ -797,8 +927,9 @@ Design Loader::load(const std::string& text) {
 
   Design design;
   try {
-    const Entries all = entries(root, "", root_line, {"name", "stations", "products", "geometry", "print"},
-                                "at the top level (name, stations, products, geometry, print)");
+    const Entries all =
+        entries(root, "", root_line, {"name", "stations", "products", "geometry", "print", "patterns", "sweep"},
+                "at the top level (name, stations, products, geometry, print, patterns, sweep)");
     const Entry& name = require(all, "name", "", root_line);
     design.name = string(name.value, name.path, name.line, "must be a name (letters, digits, _ . -)");
 
@@ -810,6 +941,8 @@ Design Loader::load(const std::string& text) {
 
     if (const Entry* g = find(all, "geometry")) design.geometry = geometry(*g);
     if (const Entry* p = find(all, "print")) design.print = print(*p);
+    if (const Entry* sw = find(all, "sweep")) design.sweep = sweep(*sw);
+    if (const Entry* p = find(all, "patterns")) design.patterns = patterns(*p);
 
     if (const Entry* products = find(all, "products")) {
       if (!products->value.IsSequence()) fail_value(products->value, products->line, products->path, "must be a list of product names");

@@ -1,0 +1,103 @@
+// fivebar coverage: is the target ellipse inside each mechanism's reachable region and the shared
+// one, with what margin, conditioning and force capability?
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "common.hpp"
+#include "fivebar/coverage.hpp"
+#include "fivebar/coverage_report.hpp"
+#include "fivebar/error.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct CoverageCliOptions {
+  std::string design;
+  std::string station;
+  std::string ellipse;  ///< "CX,CY,AX,AY,ANGLE"
+  bool ellipse_given = false;
+  bool json = false;
+};
+
+std::string point(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ")"; }
+
+void print_station(const Station& s, const Ellipse& e, bool overridden, const StationCoverage& c) {
+  std::cout << "station " << s.name << "  target" << (overridden ? " (--ellipse)" : "") << ": centre ("
+            << fixed(e.center.x(), 3) << ", " << fixed(e.center.y(), 3) << ") mm, full axes " << fixed(e.axes.x(), 3)
+            << " x " << fixed(e.axes.y(), 3) << " mm, angle " << fixed(angle_deg(e.angle), 2) << " deg\n";
+  std::printf("  %-7s %-12s %11s %9s %-20s %8s %-20s %10s %9s %8s\n", "region", "verdict", "margin (mm)", "covered",
+              "worst point (mm)", "min LCI", "at (mm)", "min force", "assembly", "LCI ok");
+  std::vector<std::pair<const char*, const CoverageResult*>> rows;
+  if (c.lower) rows.emplace_back("lower", &*c.lower);
+  if (c.upper) rows.emplace_back("upper", &*c.upper);
+  if (c.shared) rows.emplace_back("shared", &*c.shared);
+  for (const auto& [name, r] : rows) {
+    std::printf("  %-7s %-12s %11s %8s%% %-20s %8s %-20s %10s %9s %8s\n", name, r->covered ? "covered" : "NOT COVERED",
+                fixed(r->margin_mm, 4).c_str(), fixed(100.0 * r->covered_fraction, 2).c_str(),
+                point(r->worst_point).c_str(), fixed(r->min_lci, 4).c_str(), point(r->min_lci_point).c_str(),
+                fixed(r->min_force_capability, 4).c_str(), r->assembly_ok ? "ok" : "CROSSES", r->lci_ok ? "yes" : "NO");
+  }
+  std::fflush(stdout);
+  for (const auto& [name, r] : rows) {
+    std::cout << "  " << name << ": " << (r->reason.empty() ? "" : r->reason + "; ") << "method: " << r->method << "\n";
+  }
+  std::cout << "\n";
+}
+
+int run_coverage(const CoverageCliOptions& opt) {
+  // The override is checked before the design is read: a typo in it is the user's first problem.
+  std::optional<Ellipse> override_target;
+  if (opt.ellipse_given) override_target = parse_ellipse(opt.ellipse, "--ellipse");
+  const Design design = load(opt.design);
+  const auto stations = select_stations(design, opt.station);
+  if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
+  const auto progress = terminal_progress("coverage");
+
+  Json doc;
+  doc["stations"] = Json::object();
+  bool all = true;
+  for (const Station* s : stations) {
+    if (progress) progress("station " + s->name);
+    const StationCoverage c = station_coverage(*s, override_target);
+    all = all && c.covered();
+    doc["stations"][s->name] = to_json(c);
+    if (!opt.json) print_station(*s, override_target ? *override_target : s->target, override_target.has_value(), c);
+  }
+  if (opt.json) {
+    print_json(doc);
+  } else {
+    std::cout << (all ? "every mechanism covers its target\n" : "NOT every mechanism covers its target\n");
+  }
+  return all ? kOk : kCheckFailed;
+}
+
+}  // namespace
+
+void setup_coverage(CLI::App& app) {
+  auto opt = std::make_shared<CoverageCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "coverage",
+      "Is the target ellipse inside each mechanism's reachable region and the shared one? Margin (mm), covered "
+      "fraction, min LCI and force capability over the ellipse");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
+  CLI::Option* ellipse = sub->add_option("--ellipse", opt->ellipse,
+                  "Target instead of the design's: centre CX,CY (mm), full axis lengths AX,AY (mm) and rotation "
+                  "ANGLE (deg), e.g. --ellipse 6.25,15.5,15,12,0; applies to every station checked")
+      ->type_name("CX,CY,AX,AY,ANGLE");
+  sub->add_flag("--json", opt->json,
+                "Print {\"stations\": {S: {\"lower\": ..., \"upper\": ..., \"shared\": ...}}} on stdout and nothing else");
+  sub->footer(
+      "The margin is the signed distance from the ellipse to the region boundary (negative: outside by that much).\n"
+      "Exit status: 0 every mechanism covers the target (inside, assembly side kept, LCI >= min_lci), 1 otherwise, "
+      "2 bad input, 3 internal error.");
+  sub->callback([opt, ellipse]() {
+    opt->ellipse_given = ellipse->count() > 0;
+    finish(run_coverage(*opt));
+  });
+}
+
+}  // namespace fivebar::cli

@@ -1,0 +1,112 @@
+// fivebar parts: OpenSCAD sources, STL renders, mesh and fit checks and the bill of materials of
+// a design's printed parts, into OUT/<name>/parts/.
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "common.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/parts.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct PartsCliOptions {
+  std::string design;
+  std::string station;
+  std::string out = "outputs";
+  bool no_render = false;
+  bool json = false;
+  int jobs = 2;
+};
+
+void print_table(const PartsReport& r, const std::filesystem::path& dir) {
+  std::printf("%-8s %-28s %5s %10s %12s %9s %10s %-22s %s\n", "station", "part", "count", "length", "measured",
+              "volume", "resin", "render", "checks");
+  std::printf("%-8s %-28s %5s %10s %12s %9s %10s %-22s %s\n", "", "", "", "(mm)", "c-c (mm)", "(mm3)", "(ml)", "",
+              "");
+  for (const PartResult& p : r.parts) {
+    const bool link = p.spec.kind == PartKind::proximal_link || p.spec.kind == PartKind::distal_link;
+    std::string render(to_string(p.render));
+    if (p.render == RenderState::rendered) render += " " + fixed(p.render_seconds, 1) + " s";
+    std::printf("%-8s %-28s %5d %10s %12s %9s %10s %-22s %s\n", p.spec.station.c_str(), p.spec.name.c_str(),
+                p.spec.count, link ? fixed(p.spec.length_mm, 3).c_str() : "-",
+                p.centre_distance_mm ? fixed(*p.centre_distance_mm, 4).c_str() : "-",
+                p.mesh ? fixed(p.mesh->volume_mm3, 1).c_str() : "-",
+                p.mesh ? fixed(p.spec.count * p.mesh->volume_mm3 / 1000.0, 3).c_str() : "-", render.c_str(),
+                !r.rendered ? "-" : p.passed() ? "passed" : "FAILED");
+  }
+  std::fflush(stdout);
+  std::cout << "\n";
+  if (r.rendered) {
+    std::cout << r.count(RenderState::rendered) << " rendered, " << r.count(RenderState::up_to_date)
+              << " up to date, " << r.count(RenderState::failed) << " failed in " << fixed(r.wall_seconds, 1)
+              << " s; resin " << fixed(r.resin_ml(), 2) << " ml for one set\n";
+  } else {
+    std::cout << "sources only (--no-render): " << r.parts.size() << " .scad files\n";
+  }
+  std::cout << "parts: " << dir.generic_string() << "/\n"
+            << "bill of materials: " << (dir / r.bom_csv).generic_string() << "\n";
+  for (const PartResult& p : r.parts) {
+    for (const auto& problem : p.problems) std::cerr << "fivebar parts: " << p.spec.label() << ": " << problem << "\n";
+  }
+}
+
+int run_parts(const PartsCliOptions& opt) {
+  const Design design = load(opt.design);
+  PartsOptions options;
+  options.out_dir = resolve_output_dir(opt.out, design.name) / "parts";
+  if (!opt.station.empty()) options.station = opt.station;
+  options.render = !opt.no_render;
+  options.jobs = opt.jobs;
+  if (::isatty(STDERR_FILENO) != 0) {
+    options.progress = [](std::string_view line) { std::cerr << "fivebar: " << line << "\n"; };
+  }
+  PartsReport report;
+  try {
+    report = build_parts(design, options);
+  } catch (const ToolError& e) {
+    std::cerr << "fivebar parts: " << e.what() << "\n";
+    return kCheckFailed;
+  }
+  if (opt.json) {
+    Json doc{{"command", "parts"}, {"design", design.name}};
+    doc.update(to_json(report));
+    print_json(doc);
+  } else {
+    print_table(report, options.out_dir);
+  }
+  return report.passed() ? kOk : kCheckFailed;
+}
+
+}  // namespace
+
+void setup_parts(CLI::App& app) {
+  auto opt = std::make_shared<PartsCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "parts",
+      "Printable parts: OpenSCAD sources, binary STL renders (openscad), mesh and fit checks, bill of materials");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("-s,--station", opt->station, "Only this station (e.g. index); default: every station")
+      ->type_name("NAME");
+  sub->add_option("-o,--out", opt->out, "Output root; parts go to OUT/<design name>/parts/")
+      ->capture_default_str()
+      ->type_name("DIR");
+  sub->add_flag("--no-render", opt->no_render, "Write the .scad sources (and a BOM without volumes) only");
+  sub->add_option("-j,--jobs", opt->jobs, "openscad processes at once")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64))
+      ->type_name("N");
+  sub->add_flag("--json", opt->json, "Print one JSON document (mm) on stdout and nothing else");
+  sub->footer(
+      "Parts whose .scad text and library are unchanged since their last render are not rendered again.\n"
+      "Exit status: 0 every part rendered and passed its checks, 1 a render or check failed or openscad is not "
+      "installed, 2 bad input, 3 internal error or output not writable.");
+  sub->callback([opt]() { finish(run_parts(*opt)); });
+}
+
+}  // namespace fivebar::cli

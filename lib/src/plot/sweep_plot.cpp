@@ -1,0 +1,296 @@
+// Sweep plots (cairo, SVG and PNG from one drawing routine): a scatter of the first two
+// objectives with the Pareto set marked, and for grid sweeps a heat map of the first objective
+// over the first two variables (best over the others). Both are streamed from the CSV, so memory
+// stays bounded: the scatter keeps a fixed-size deterministic reservoir of points.
+#include <cairo-svg.h>
+#include <cairo.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "fivebar/io.hpp"
+#include "fivebar/sweep.hpp"
+
+namespace fivebar {
+
+namespace {
+
+constexpr int kWidth = 860, kHeight = 640;
+constexpr std::size_t kReservoir = 20000;
+
+struct Axis {
+  double lo = 0, hi = 1;
+  std::string label;
+  void fit(double a, double b) {
+    lo = a;
+    hi = b;
+    if (!(hi > lo)) {
+      lo -= 0.5 * (std::fabs(lo) + 1);
+      hi = lo + std::fabs(lo) + 1;
+    }
+    const double pad = 0.04 * (hi - lo);
+    lo -= pad;
+    hi += pad;
+  }
+};
+
+/// "Nice" tick step for a range (1, 2, 5 times a power of ten), about 6 ticks.
+double tick_step(double span) {
+  const double raw = span / 6.0;
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (raw <= m * p) return m * p;
+  }
+  return 10 * p;
+}
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", std::fabs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+struct Frame {
+  double x0 = 90, y0 = 60, x1 = kWidth - 40, y1 = kHeight - 80;  // plot box in pixels
+  Axis ax, ay;
+  double px(double x) const { return x0 + (x - ax.lo) / (ax.hi - ax.lo) * (x1 - x0); }
+  double py(double y) const { return y1 - (y - ay.lo) / (ay.hi - ay.lo) * (y1 - y0); }
+};
+
+void text(cairo_t* cr, double x, double y, const std::string& s, double size, double align = 0.0, bool bold = false) {
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t e;
+  cairo_text_extents(cr, s.c_str(), &e);
+  cairo_move_to(cr, x - align * e.width, y);
+  cairo_show_text(cr, s.c_str());
+}
+
+void axes(cairo_t* cr, const Frame& f, const std::string& title) {
+  cairo_set_source_rgb(cr, 1, 1, 1);
+  cairo_paint(cr);
+  cairo_set_line_width(cr, 1.0);
+  cairo_set_source_rgb(cr, 0.9, 0.9, 0.9);
+  const double sx = tick_step(f.ax.hi - f.ax.lo), sy = tick_step(f.ay.hi - f.ay.lo);
+  for (double x = std::ceil(f.ax.lo / sx) * sx; x <= f.ax.hi; x += sx) {
+    cairo_move_to(cr, f.px(x), f.y0);
+    cairo_line_to(cr, f.px(x), f.y1);
+  }
+  for (double y = std::ceil(f.ay.lo / sy) * sy; y <= f.ay.hi; y += sy) {
+    cairo_move_to(cr, f.x0, f.py(y));
+    cairo_line_to(cr, f.x1, f.py(y));
+  }
+  cairo_stroke(cr);
+  cairo_set_source_rgb(cr, 0.2, 0.2, 0.2);
+  cairo_rectangle(cr, f.x0, f.y0, f.x1 - f.x0, f.y1 - f.y0);
+  cairo_stroke(cr);
+  for (double x = std::ceil(f.ax.lo / sx) * sx; x <= f.ax.hi; x += sx) text(cr, f.px(x), f.y1 + 18, fmt(x), 12, 0.5);
+  for (double y = std::ceil(f.ay.lo / sy) * sy; y <= f.ay.hi; y += sy) text(cr, f.x0 - 8, f.py(y) + 4, fmt(y), 12, 1.0);
+  text(cr, 0.5 * (f.x0 + f.x1), kHeight - 30, f.ax.label, 14, 0.5);
+  cairo_save(cr);
+  cairo_translate(cr, 24, 0.5 * (f.y0 + f.y1));
+  cairo_rotate(cr, -M_PI / 2);
+  text(cr, 0, 0, f.ay.label, 14, 0.5);
+  cairo_restore(cr);
+  text(cr, 0.5 * (f.x0 + f.x1), 34, title, 17, 0.5, true);
+}
+
+/// Objective value as plotted (footprint positive, in mm^2).
+double plotted(const SweepRow& r, const std::string& objective) {
+  const double v = r.score(objective);
+  return objective == "footprint" ? -v : v;
+}
+
+std::string label_of(const std::string& objective) {
+  if (objective == "margin") return "coverage margin (mm)";
+  if (objective == "min_lci") return "min LCI over the ellipse";
+  if (objective == "force") return "min force capability (N per N*mm)";
+  if (objective == "footprint") return "footprint (mm^2)";
+  return objective;
+}
+
+/// Viridis-like colour map, t in [0, 1].
+void colour(cairo_t* cr, double t) {
+  static const double stops[5][3] = {{0.267, 0.005, 0.329}, {0.230, 0.322, 0.546}, {0.128, 0.567, 0.551},
+                                     {0.369, 0.789, 0.383}, {0.993, 0.906, 0.144}};
+  t = std::clamp(t, 0.0, 1.0) * 4.0;
+  const int i = std::min(3, int(t));
+  const double f = t - i;
+  cairo_set_source_rgb(cr, stops[i][0] + f * (stops[i + 1][0] - stops[i][0]),
+                       stops[i][1] + f * (stops[i + 1][1] - stops[i][1]),
+                       stops[i][2] + f * (stops[i + 1][2] - stops[i][2]));
+}
+
+cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
+  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
+  return CAIRO_STATUS_SUCCESS;
+}
+
+/// Draws with `draw` into an SVG and a PNG next to each other (atomically written).
+template <class Draw>
+std::vector<std::filesystem::path> save(const std::filesystem::path& dir, const std::string& stem, Draw draw) {
+  std::string svg, png;
+  {
+    cairo_surface_t* s = cairo_svg_surface_create_for_stream(append, &svg, kWidth, kHeight);
+    cairo_t* cr = cairo_create(s);
+    draw(cr);
+    cairo_destroy(cr);
+    cairo_surface_finish(s);
+    cairo_surface_destroy(s);
+  }
+  {
+    cairo_surface_t* s = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, kWidth, kHeight);
+    cairo_t* cr = cairo_create(s);
+    draw(cr);
+    cairo_destroy(cr);
+    cairo_surface_write_to_png_stream(s, append, &png);
+    cairo_surface_destroy(s);
+  }
+  write_file_atomic(dir / (stem + ".svg"), svg);
+  write_file_atomic(dir / (stem + ".png"), png);
+  return {dir / (stem + ".svg"), dir / (stem + ".png")};
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> write_sweep_plots(const std::filesystem::path& csv, const SweepSettings& s,
+                                                     const std::vector<SweepRow>& pareto,
+                                                     const std::filesystem::path& out_dir) {
+  std::vector<std::filesystem::path> files;
+  const std::string ox = s.objectives[0];
+  const std::string oy = s.objectives.size() > 1 ? s.objectives[1] : (ox == "margin" ? "min_lci" : "margin");
+  // One pass over the CSV: reservoir of covered points, ranges, heat-map cells.
+  std::vector<std::pair<double, double>> points;
+  std::uint64_t seen = 0, covered = 0, total = 0;
+  std::uint64_t rng = s.seed * 0x9E3779B97F4A7C15ull + 1;
+  double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+  const bool heat = s.sample == "grid" && s.vary.size() >= 2 && s.vary[0].n > 1 && s.vary[1].n > 1;
+  const int n0 = heat ? s.vary[0].n : 0, n1 = heat ? s.vary[1].n : 0;
+  std::vector<double> cells(std::size_t(n0) * std::size_t(n1), std::numeric_limits<double>::quiet_NaN());
+  std::uint64_t inner = 1;
+  for (std::size_t d = 2; d < s.vary.size(); ++d) inner *= std::uint64_t(s.vary[d].n);
+  read_sweep_csv(csv, s, [&](const SweepRow& r, const std::string&) {
+    ++total;
+    if (!r.covered) return;
+    ++covered;
+    const double x = plotted(r, ox), y = plotted(r, oy);
+    if (std::isnan(x) || std::isnan(y)) return;
+    xlo = std::min(xlo, x), xhi = std::max(xhi, x), ylo = std::min(ylo, y), yhi = std::max(yhi, y);
+    ++seen;
+    if (points.size() < kReservoir) {
+      points.emplace_back(x, y);
+    } else {
+      rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+      const std::uint64_t j = (rng >> 11) % seen;
+      if (j < kReservoir) points[j] = {x, y};
+    }
+    if (heat) {
+      const std::uint64_t cell = r.index / inner;  // (i0, i1) of the first two variables
+      double& c = cells[cell];
+      const double v = r.score(ox);
+      if (std::isnan(c) || v > c) c = v;
+    }
+  });
+  files = save(out_dir, "sweep_scatter", [&](cairo_t* cr) {
+    Frame f;
+    f.ax.label = label_of(ox);
+    f.ay.label = label_of(oy);
+    if (seen) {
+      f.ax.fit(xlo, xhi);
+      f.ay.fit(ylo, yhi);
+    }
+    axes(cr, f, "Sweep of " + s.station + ": " + std::to_string(covered) + " of " + std::to_string(total) +
+                    " designs cover the target");
+    cairo_set_source_rgba(cr, 0.25, 0.45, 0.75, 0.45);
+    for (const auto& [x, y] : points) {
+      cairo_arc(cr, f.px(x), f.py(y), 2.2, 0, 2 * M_PI);
+      cairo_fill(cr);
+    }
+    cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
+    for (const SweepRow& r : pareto) {
+      const double x = plotted(r, ox), y = plotted(r, oy);
+      if (std::isnan(x) || std::isnan(y)) continue;
+      cairo_arc(cr, f.px(x), f.py(y), 4.5, 0, 2 * M_PI);
+      cairo_fill(cr);
+    }
+    // Legend.
+    const double lx = f.x1 - 230, ly = f.y0 + 18;
+    cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
+    cairo_rectangle(cr, lx - 10, ly - 14, 232, 46);
+    cairo_fill(cr);
+    cairo_set_source_rgba(cr, 0.25, 0.45, 0.75, 0.8);
+    cairo_arc(cr, lx, ly, 3, 0, 2 * M_PI);
+    cairo_fill(cr);
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    text(cr, lx + 12, ly + 4, "covered design" + std::string(seen > kReservoir ? " (sample)" : ""), 12);
+    cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
+    cairo_arc(cr, lx, ly + 20, 4.5, 0, 2 * M_PI);
+    cairo_fill(cr);
+    cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+    text(cr, lx + 12, ly + 24, "Pareto set (" + std::to_string(pareto.size()) + ")", 12);
+  });
+  if (heat) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (double c : cells) {
+      if (!std::isnan(c)) lo = std::min(lo, c), hi = std::max(hi, c);
+    }
+    for (const auto& f : save(out_dir, "sweep_heatmap", [&](cairo_t* cr) {
+           Frame f;
+           f.x1 = kWidth - 130;
+           const SweepVariable &v0 = s.vary[0], &v1 = s.vary[1];
+           f.ax.lo = v1.lo - 0.5 * (v1.hi - v1.lo) / (n1 - 1);
+           f.ax.hi = v1.hi + 0.5 * (v1.hi - v1.lo) / (n1 - 1);
+           f.ay.lo = v0.lo - 0.5 * (v0.hi - v0.lo) / (n0 - 1);
+           f.ay.hi = v0.hi + 0.5 * (v0.hi - v0.lo) / (n0 - 1);
+           f.ax.label = v1.name + " (mm)";
+           f.ay.label = v0.name + " (mm)";
+           axes(cr, f, label_of(ox) + " over " + v0.name + " x " + v1.name);
+           const double cw = (f.x1 - f.x0) / n1, ch = (f.y1 - f.y0) / n0;
+           for (int i = 0; i < n0; ++i) {
+             for (int j = 0; j < n1; ++j) {
+               const double c = cells[std::size_t(i) * n1 + j];
+               if (std::isnan(c)) {
+                 cairo_set_source_rgb(cr, 0.86, 0.86, 0.86);
+               } else {
+                 colour(cr, hi > lo ? (c - lo) / (hi - lo) : 1.0);
+               }
+               cairo_rectangle(cr, f.x0 + j * cw, f.y1 - (i + 1) * ch, cw + 0.5, ch + 0.5);
+               cairo_fill(cr);
+             }
+           }
+           cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
+           cairo_set_line_width(cr, 2.0);
+           for (const SweepRow& r : pareto) {
+             cairo_arc(cr, f.px(r.values[1]), f.py(r.values[0]), 5, 0, 2 * M_PI);
+             cairo_stroke(cr);
+           }
+           // Colour bar.
+           const double bx = kWidth - 100, by0 = f.y0, by1 = f.y1;
+           for (int k = 0; k < 200; ++k) {
+             colour(cr, k / 199.0);
+             cairo_rectangle(cr, bx, by1 - (k + 1) * (by1 - by0) / 200, 18, (by1 - by0) / 200 + 0.5);
+             cairo_fill(cr);
+           }
+           cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+           const double shown_lo = ox == "footprint" ? -hi : lo, shown_hi = ox == "footprint" ? -lo : hi;
+           text(cr, bx + 22, by1, std::isfinite(lo) ? fmt(ox == "footprint" ? shown_hi : shown_lo) : "-", 11);
+           text(cr, bx + 22, by0 + 10, std::isfinite(hi) ? fmt(ox == "footprint" ? shown_lo : shown_hi) : "-", 11);
+           text(cr, bx - 4, by0 - 10, "best", 11);
+           cairo_set_source_rgb(cr, 0.86, 0.86, 0.86);
+           cairo_rectangle(cr, bx, by1 + 26, 18, 12);
+           cairo_fill(cr);
+           cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
+           text(cr, bx + 22, by1 + 37, "none covered", 11);
+         })) {
+      files.push_back(f);
+    }
+  }
+  return files;
+}
+
+}  // namespace fivebar

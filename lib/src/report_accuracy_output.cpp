@@ -1,0 +1,316 @@
+// Output of `fivebar report accuracy`: JSON (units in the keys), text tables and the
+// work-precision plots.
+#include <algorithm>
+#include <map>
+#include <sstream>
+
+#include "fivebar/io.hpp"
+#include "fivebar/report.hpp"
+#include "plot/work_precision_plot.hpp"
+#include "report_format.hpp"
+
+namespace fivebar {
+
+namespace {
+
+using report_fmt::pad;
+using report_fmt::sci;
+using report_fmt::fixed;
+
+Json opt(const std::optional<double>& v) { return v ? Json(*v) : Json(nullptr); }
+
+std::string unit_suffix(const std::string& unit) { return unit == "1" ? "" : "_" + unit; }
+
+Json series_json(const WorkSeries& s) {
+  Json j;
+  j["method"] = s.method;
+  j["note"] = s.note;
+  Json pts = Json::array();
+  const std::string u = unit_suffix(s.unit);
+  for (const WorkPoint& p : s.points) {
+    Json q;
+    if (s.resolution == "h_mm") {
+      q["h_mm"] = p.resolution > 0 ? Json(p.resolution) : Json(nullptr);
+    } else {
+      q[s.resolution] = p.resolution;
+    }
+    q["time_s"] = p.time_s;
+    q["value" + u] = p.value;
+    q["error" + u] = p.error;
+    q["estimate" + u] = opt(p.estimate);
+    pts.push_back(q);
+  }
+  j["points"] = pts;
+  j["order"] = opt(s.order);
+  j["error_vs_time_slope"] = opt(s.time_slope);
+  return j;
+}
+
+Json study_json(const PrecisionStudy& st) {
+  Json j;
+  j["problem"] = st.problem;
+  j["stratified_by"] = st.stratified_by;
+  Json strata = Json::array();
+  for (std::size_t i = 0; i < st.strata.size(); ++i) {
+    Json s;
+    s["sin_range"] = {st.strata[i][0], std::min(1.0, st.strata[i][1])};
+    s["order_in_eps"] = i < st.order.size() ? opt(st.order[i]) : Json(nullptr);
+    Json methods = Json::array();
+    for (const PrecisionMethod& m : st.methods) {
+      const PrecisionCell& c = m.cells[i];
+      methods.push_back({{"method", m.name},
+                         {"library", m.library},
+                         {"unit_roundoff", m.unit_roundoff},
+                         {"samples", c.samples},
+                         {"failed", c.failed},
+                         {"max_error_mm", c.max_error_mm},
+                         {"rms_error_mm", c.rms_error_mm},
+                         {"max_error_ulp", c.max_error_ulp},
+                         {"rms_error_ulp", c.rms_error_ulp},
+                         {"ns_per_call", c.ns_per_call}});
+    }
+    s["methods"] = methods;
+    strata.push_back(s);
+  }
+  j["strata"] = strata;
+  return j;
+}
+
+std::string label(const MechanismAccuracy& m) { return m.station + "/" + m.mechanism; }
+
+void series_table(std::ostringstream& out, const std::vector<WorkSeries>& series) {
+  if (series.empty()) return;
+  const std::string u = series.front().unit == "mm2" ? "mm²" : series.front().unit;
+  out << "  " << pad("method", 26) << pad("h (mm)", 10, true) << pad("time (s)", 11, true)
+      << pad("value" + (u == "1" ? std::string() : " (" + u + ")"), 18, true)
+      << pad("error" + (u == "1" ? std::string() : " (" + u + ")"), 14, true) << pad("own estimate", 14, true) << "\n";
+  for (const WorkSeries& s : series) {
+    for (const WorkPoint& p : s.points) {
+      out << "  " << pad(s.method, 26) << pad(p.resolution > 0 ? fixed(p.resolution, 4) : "—", 10, true)
+          << pad(sci(p.time_s, 2), 11, true) << pad(fixed(p.value, s.unit == "1" ? 8 : 6), 18, true)
+          << pad(sci(p.error, 2), 14, true) << pad(sci(p.estimate, 2), 14, true) << "\n";
+    }
+  }
+  std::string orders;
+  for (const WorkSeries& s : series) {
+    if (!s.order) continue;
+    orders += (orders.empty() ? "" : "; ") + s.method + " p = " + fixed(*s.order, 2);
+    if (s.time_slope) orders += " (error ~ time^" + fixed(*s.time_slope, 2) + ")";
+  }
+  if (!orders.empty()) out << "  fitted order (error ~ h^p): " << orders << "\n";
+}
+
+std::string order_text(const std::optional<double>& p) { return p ? fixed(*p, 2) : "—"; }
+
+void study_table(std::ostringstream& out, const PrecisionStudy& st) {
+  out << "\n" << (st.problem == "fk" ? "FK" : "IK") << " against the __float128 reference, stratified by "
+      << st.stratified_by << "\n";
+  out << "  error: " << (st.problem == "fk" ? "|P - P_ref| (mm)" : "max_i L_i |theta_i - theta_i,ref| (mm)")
+      << "; ulp = ulp of the length scale in the method's arithmetic\n";
+  out << "  " << pad("|sin| in", 14) << pad("method", 14) << pad("n", 6, true) << pad("fail", 6, true)
+      << pad("max err (mm)", 14, true) << pad("rms err (mm)", 14, true) << pad("max ulp", 10, true)
+      << pad("rms ulp", 10, true) << pad("ns/call", 10, true) << "\n";
+  for (std::size_t i = 0; i < st.strata.size(); ++i) {
+    for (const PrecisionMethod& m : st.methods) {
+      const PrecisionCell& c = m.cells[i];
+      out << "  " << pad(&m == &st.methods.front() ? report_fmt::range(st.strata[i][0], st.strata[i][1]) : "", 14)
+          << pad(m.name, 14) << pad(std::to_string(c.samples), 6, true) << pad(std::to_string(c.failed), 6, true)
+          << pad(sci(c.max_error_mm, 2), 14, true) << pad(sci(c.rms_error_mm, 2), 14, true)
+          << pad(sci(c.max_error_ulp, 1), 10, true) << pad(sci(c.rms_error_ulp, 1), 10, true)
+          << pad(fixed(c.ns_per_call, 1), 10, true) << "\n";
+    }
+    out << "  " << pad("", 14) << "order in eps (float, double, long double): " << order_text(st.order[i]) << "\n";
+  }
+}
+
+// --- plots -------------------------------------------------------------------------------------
+
+std::string legend(const std::string& who, const WorkSeries& s) {
+  std::string l = who.empty() ? s.method : who + ": " + s.method;
+  if (s.order) {
+    l += ", order p = " + fixed(*s.order, 2);
+  } else if (s.points.size() == 1) {
+    l += " (single run)";
+  }
+  return l;
+}
+
+plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station, const std::string& kind) {
+  plot::PlotSpec spec;
+  spec.x_label = "run time (s), median of repeats after a warm-up";
+  for (const MechanismAccuracy& m : r.mechanisms) {
+    if (m.station != station) continue;
+    const std::vector<WorkSeries>* list = kind == "area" ? &m.area : kind == "restricted" ? &m.restricted : &m.coverage;
+    for (const WorkSeries& s : *list) {
+      const bool wanted = kind == "area" || kind == "restricted" || (kind == "margin" ? s.unit == "mm" : s.unit == "1");
+      if (!wanted || s.points.empty()) continue;
+      plot::PlotSeries ps;
+      ps.label = legend(m.mechanism, s);
+      ps.line = s.points.size() > 1;
+      for (const WorkPoint& p : s.points) ps.points.push_back({p.time_s, p.error});
+      spec.series.push_back(std::move(ps));
+    }
+  }
+  if (kind == "area") {
+    spec.title = "Workspace area, station " + station + ": error against run time";
+    spec.y_label = "|area - exact CGAL area| (mm²)";
+    spec.footnote = "The grid spacing h halves along each line; error ~ h^p. Exact region and closed form: single runs "
+                    "against the annuli closed form in __float128.";
+  } else if (kind == "restricted") {
+    spec.title = "Sampled restricted regions, station " + station;
+    spec.y_label = "|area - area on a 16x finer grid| (mm²)";
+    spec.footnote = "restricted_area (refined marching squares) of the assembly- and LCI-restricted regions; the grid "
+                    "spacing halves along each line.";
+  } else if (kind == "margin") {
+    spec.title = "Coverage margin, station " + station;
+    spec.y_label = "|margin - coverage() margin| (mm)";
+    spec.footnote = "Sampled: min signed distance over N boundary points (N doubles along the line); coverage() "
+                    "against the margin in __float128.";
+  } else {
+    spec.title = "Minimum LCI over the target ellipse, station " + station;
+    spec.y_label = "|min LCI - refined minimum| (LCI is dimensionless)";
+    spec.footnote = "Sampled: 1 + 8 n² points over the filled ellipse (n doubles along the line); coverage(): its "
+                    "sampling plus compass search.";
+  }
+  return spec;
+}
+
+plot::PlotSpec study_plot(const PrecisionStudy& st) {
+  plot::PlotSpec spec;
+  const bool fk = st.problem == "fk";
+  spec.title = std::string(fk ? "FK" : "IK") + " work-precision against __float128, by " + st.stratified_by;
+  spec.x_label = "time per call (ns), median of repeats after a warm-up";
+  spec.y_label = fk ? "rms |P - P_ref| over the stratum (mm)" : "rms max_i L_i |Δθ_i| over the stratum (mm)";
+  for (std::size_t i = 0; i < st.strata.size(); ++i) {
+    plot::PlotSeries ps;
+    ps.label = "|sin| in " + report_fmt::range(st.strata[i][0], st.strata[i][1]) + ": float, double, long double; " +
+               "error ~ eps^" + order_text(st.order[i]);
+    for (int k = 0; k < 3; ++k) {
+      const PrecisionCell& c = st.methods[k].cells[i];
+      if (c.samples > c.failed) ps.points.push_back({c.ns_per_call, c.rms_error_mm});
+    }
+    spec.series.push_back(std::move(ps));
+  }
+  for (const PrecisionMethod& m : st.methods) {
+    if (!m.library) continue;
+    plot::PlotSeries ps;
+    ps.label = m.name + " (library, double), one marker per stratum";
+    ps.line = false;
+    for (const PrecisionCell& c : m.cells)
+      if (c.samples > c.failed) ps.points.push_back({c.ns_per_call, c.rms_error_mm});
+    spec.series.push_back(std::move(ps));
+  }
+  spec.footnote = "Lines join float (left), double and long double of the same formulas; |sin| conditions the "
+                  "problem (error ~ eps L / |sin|). Zero errors are not drawn.";
+  return spec;
+}
+
+}  // namespace
+
+Json to_json(const AccuracyReport& r) {
+  Json j;
+  j["command"] = "report accuracy";
+  j["design"] = r.design;
+  j["quick"] = r.quick;
+  j["seconds"] = r.seconds;
+  j["references"] = {
+      {"area", "exact CGAL region; without joint limits also the annuli closed form in __float128"},
+      {"coverage", "coverage() margin (and the margin in __float128 without joint limits); min LCI refined locally"},
+      {"restricted", "restricted_area on a grid 16x finer than the finest of the series"},
+      {"kinematics", "FK/IK in __float128 (law of cosines with Heron products)"}};
+  Json ms = Json::array();
+  for (const MechanismAccuracy& m : r.mechanisms) {
+    Json a;
+    a["station"] = m.station;
+    a["mechanism"] = m.mechanism;
+    Json area;
+    area["exact_mm2"] = m.exact_area_mm2;
+    area["closed_form_mm2"] = opt(m.closed_form_area_mm2);
+    area["quad_closed_form_mm2"] = opt(m.quad_area_mm2);
+    area["series"] = Json::array();
+    for (const WorkSeries& s : m.area) area["series"].push_back(series_json(s));
+    a["area"] = area;
+    Json cov;
+    cov["margin_mm"] = m.margin_mm;
+    cov["margin_quad_mm"] = opt(m.margin_quad_mm);
+    cov["min_lci"] = m.min_lci;
+    cov["min_lci_reference"] = m.min_lci_reference;
+    cov["series"] = Json::array();
+    for (const WorkSeries& s : m.coverage) cov["series"].push_back(series_json(s));
+    a["coverage"] = cov;
+    Json rs;
+    rs["lci_threshold"] = m.lci_threshold;
+    rs["lci_threshold_from_design"] = m.lci_threshold_from_design;
+    rs["reference_h_mm"] = m.reference_spacing_mm;
+    rs["assembly_area_reference_mm2"] = m.assembly_area_reference_mm2;
+    rs["lci_area_reference_mm2"] = m.lci_area_reference_mm2;
+    rs["series"] = Json::array();
+    for (const WorkSeries& s : m.restricted) rs["series"].push_back(series_json(s));
+    a["restricted"] = rs;
+    ms.push_back(a);
+  }
+  j["mechanisms"] = ms;
+  j["fk"] = study_json(r.fk);
+  j["ik"] = study_json(r.ik);
+  return j;
+}
+
+std::string to_text(const AccuracyReport& r) {
+  std::ostringstream out;
+  out << "fivebar report accuracy: design " << r.design << (r.quick ? " (quick)" : "") << ", " << fixed(r.seconds, 1)
+      << " s\n";
+  out << "Times are medians of repeated runs after a warm-up; errors against exact or __float128 references.\n";
+  for (const MechanismAccuracy& m : r.mechanisms) {
+    out << "\n== " << label(m) << " ==\n";
+    out << "Workspace area: exact (CGAL) " << fixed(m.exact_area_mm2, 9) << " mm²";
+    if (m.quad_area_mm2) {
+      out << "; annuli closed form in quad " << fixed(*m.quad_area_mm2, 9) << " mm² (CGAL differs by "
+          << sci(std::fabs(m.exact_area_mm2 - *m.quad_area_mm2), 1) << ")";
+    }
+    out << "\n";
+    series_table(out, m.area);
+    out << "Coverage of the target: margin " << fixed(m.margin_mm, 9) << " mm by coverage()";
+    if (m.margin_quad_mm) out << " (quad: " << fixed(*m.margin_quad_mm, 9) << " mm)";
+    out << "; min LCI " << fixed(m.min_lci, 9) << " by coverage(), refined minimum " << fixed(m.min_lci_reference, 9)
+        << "\n";
+    std::vector<WorkSeries> cov_lci, cov_margin;
+    for (const WorkSeries& s : m.coverage) {
+      if (!s.points.empty()) (s.unit == "1" ? cov_lci : cov_margin).push_back(s);
+    }
+    series_table(out, cov_margin);
+    series_table(out, cov_lci);
+    out << "Restricted regions (LCI >= " << fixed(m.lci_threshold, 2)
+        << (m.lci_threshold_from_design ? ", the design's min_lci" : ", illustrative: the design sets no min_lci")
+        << "); reference: h = " << fixed(m.reference_spacing_mm, 4) << " mm, assembly "
+        << fixed(m.assembly_area_reference_mm2, 6) << " mm², LCI " << fixed(m.lci_area_reference_mm2, 6) << " mm²\n";
+    series_table(out, m.restricted);
+  }
+  study_table(out, r.fk);
+  study_table(out, r.ik);
+  return out.str();
+}
+
+std::vector<std::filesystem::path> write_accuracy_plots(const AccuracyReport& r, const std::filesystem::path& dir) {
+  make_directories(dir);
+  std::vector<std::pair<std::string, plot::PlotSpec>> plots;
+  std::vector<std::string> stations;
+  for (const MechanismAccuracy& m : r.mechanisms)
+    if (std::find(stations.begin(), stations.end(), m.station) == stations.end()) stations.push_back(m.station);
+  for (const std::string& s : stations) {
+    for (const char* kind : {"area", "margin", "min_lci", "restricted"}) {
+      plots.push_back({"accuracy_" + s + "_" + kind, station_plot(r, s, kind)});
+    }
+  }
+  if (!r.fk.methods.empty()) plots.push_back({"accuracy_fk", study_plot(r.fk)});
+  if (!r.ik.methods.empty()) plots.push_back({"accuracy_ik", study_plot(r.ik)});
+  std::vector<std::filesystem::path> written;
+  for (const auto& [name, spec] : plots) {
+    write_file_atomic(dir / (name + ".svg"), plot::render_svg(spec));
+    written.push_back(name + ".svg");
+    write_file_atomic(dir / (name + ".png"), plot::render_png(spec));
+    written.push_back(name + ".png");
+  }
+  return written;
+}
+
+}  // namespace fivebar

@@ -1,0 +1,72 @@
+#pragma once
+// FK and IK in a chosen floating-point type (float, double, long double) for the work-precision
+// study of `fivebar report accuracy` (private). The formulas are the library's stable ones
+// (STYLE.md; lib/src/kinematics_common.hpp): chord foot a measured from the smaller circle,
+// h = sqrt((r - a)(r + a)) clamped at rounding-level tangency, angles from atan2. Only the
+// arithmetic type changes, so the series show what precision alone buys.
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "fivebar/design.hpp"
+
+namespace fivebar::precision {
+
+template <class T>
+struct MechanismT {
+  T o1x, o1y, o2x, o2y;
+  T L[4];
+  int w1, w2;
+  explicit MechanismT(const Mechanism& m)
+      : o1x(T(m.O1.x())), o1y(T(m.O1.y())), o2x(T(m.O2.x())), o2y(T(m.O2.y())),
+        L{T(m.L[0]), T(m.L[1]), T(m.L[2]), T(m.L[3])}, w1(m.working_mode.sign1), w2(m.working_mode.sign2) {}
+};
+
+/// Intersection of circles (c1, r1), (c2, r2): offset of the point from c1 on side `side`
+/// (+1: left of c1->c2). False when they miss each other by more than rounding.
+template <class T>
+inline bool chord_offset(T c1x, T c1y, T r1, T c2x, T c2y, T r2, T side, T& ox, T& oy) {
+  const T dx = c2x - c1x, dy = c2y - c1y;
+  const T d = std::sqrt(dx * dx + dy * dy);
+  if (!(d > T(0))) return false;
+  const bool small1 = r1 <= r2;
+  const T rs = small1 ? r1 : r2, rb = small1 ? r2 : r1;
+  const T dd = (rs - rb) * (rs + rb);
+  const T as = T(0.5) * (d + dd / d);
+  const T h2 = (rs - as) * (rs + as);
+  const T tol = T(16) * std::numeric_limits<T>::epsilon() * rs * std::max(rs, std::fabs(as));
+  if (h2 < -tol) return false;
+  const T a = small1 ? as : d - as;
+  const T h = std::sqrt(std::max(T(0), h2));
+  const T ux = dx / d, uy = dy / d;
+  ox = a * ux - side * h * uy;
+  oy = a * uy + side * h * ux;
+  return true;
+}
+
+/// FK on branch `side` (+1: cross(A2 - A1, P - A1) >= 0); false when unreachable.
+template <class T>
+inline bool fk(const MechanismT<T>& m, T theta1, T theta2, int side, T& px, T& py) {
+  const T a1x = m.o1x + m.L[0] * std::cos(theta1), a1y = m.o1y + m.L[0] * std::sin(theta1);
+  const T a2x = m.o2x + m.L[1] * std::cos(theta2), a2y = m.o2y + m.L[1] * std::sin(theta2);
+  T ox, oy;
+  if (!chord_offset(a1x, a1y, m.L[2], a2x, a2y, m.L[3], T(side), ox, oy)) return false;
+  px = a1x + ox;
+  py = a1y + oy;
+  return true;
+}
+
+/// IK in the mechanism's working mode; false when unreachable.
+template <class T>
+inline bool ik(const MechanismT<T>& m, T px, T py, T& theta1, T& theta2) {
+  T e1x, e1y, e2x, e2y;
+  // cross(A - O, P - A) = -s h d for the side s: working-mode sign sigma takes s = -sigma.
+  if (!chord_offset(m.o1x, m.o1y, m.L[0], px, py, m.L[2], T(-m.w1), e1x, e1y)) return false;
+  if (!chord_offset(m.o2x, m.o2y, m.L[1], px, py, m.L[3], T(-m.w2), e2x, e2y)) return false;
+  theta1 = std::atan2(e1y, e1x);
+  theta2 = std::atan2(e2y, e2x);
+  return true;
+}
+
+}  // namespace fivebar::precision

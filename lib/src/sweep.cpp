@@ -1,0 +1,577 @@
+// Link-dimension sweeps: enumeration, evaluation with early exit, CSV streaming, Pareto archive,
+// resume. Parallel with OpenMP over chunks of designs; rows are written in index order, so the
+// output does not depend on the number of threads.
+#include "fivebar/sweep.hpp"
+
+#include <boost/random/sobol.hpp>
+#include <omp.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include "fivebar/io.hpp"
+#include "fivebar/kinematics.hpp"
+
+namespace fivebar {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::uint64_t splitmix64(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
+/// Uniform [0, 1) from 53 random bits.
+double unit(std::uint64_t bits) { return double(bits >> 11) * 0x1.0p-53; }
+
+std::string num(double v) {
+  if (std::isnan(v)) return "";
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c == '\n' ? ' ' : c;
+  }
+  return out + "\"";
+}
+
+const Vec2 kX(1.0, 0.0);
+
+}  // namespace
+
+// --- enumeration ---------------------------------------------------------------------------------
+
+std::uint64_t sweep_size(const SweepSettings& s) {
+  if (s.sample != "grid") return s.count;
+  std::uint64_t n = 1;
+  for (const SweepVariable& v : s.vary) n *= std::uint64_t(v.n);
+  return n;
+}
+
+namespace {
+
+/// Unit-cube coordinates of design `index`, for `count` consecutive designs (sequential Sobol).
+void unit_points(const SweepSettings& s, std::uint64_t first, std::uint64_t count, std::vector<double>& u) {
+  const std::size_t dims = s.vary.size();
+  u.resize(count * dims);
+  if (s.sample == "grid") {
+    for (std::uint64_t k = 0; k < count; ++k) {
+      std::uint64_t rest = first + k;
+      for (std::size_t d = dims; d-- > 0;) {  // the last variable runs fastest
+        const std::uint64_t n = std::uint64_t(s.vary[d].n);
+        const std::uint64_t i = rest % n;
+        rest /= n;
+        u[k * dims + d] = n > 1 ? double(i) / double(n - 1) : 0.0;
+      }
+    }
+  } else if (s.sample == "random") {
+    for (std::uint64_t k = 0; k < count; ++k) {
+      for (std::size_t d = 0; d < dims; ++d) {
+        u[k * dims + d] = unit(splitmix64(splitmix64(s.seed) ^ ((first + k) * dims + d)));
+      }
+    }
+  } else {  // sobol, with a Cranley-Patterson shift by the seed (seed 0: the plain sequence)
+    boost::random::sobol engine(dims);
+    engine.discard(first * dims);
+    for (std::uint64_t k = 0; k < count; ++k) {
+      for (std::size_t d = 0; d < dims; ++d) {
+        double v = double(engine() - engine.min()) / (double(engine.max() - engine.min()) + 1.0);
+        if (s.seed != 0) {
+          v += unit(splitmix64(s.seed * 0x100000001B3ull + d));
+          v -= std::floor(v);
+        }
+        u[k * dims + d] = v;
+      }
+    }
+  }
+}
+
+void to_values(const SweepSettings& s, const double* u, std::vector<double>& values, bool grid) {
+  values.resize(s.vary.size());
+  for (std::size_t d = 0; d < s.vary.size(); ++d) {
+    const SweepVariable& v = s.vary[d];
+    values[d] = v.lo + (v.hi - v.lo) * u[d];
+    if (grid && u[d] == 1.0) values[d] = v.hi;  // exact end points
+  }
+}
+
+}  // namespace
+
+std::vector<double> sweep_point(const SweepSettings& settings, std::uint64_t index) {
+  std::vector<double> u, values;
+  unit_points(settings, index, 1, u);
+  to_values(settings, u.data(), values, settings.sample == "grid");
+  return values;
+}
+
+Station apply_sweep(const Design& design, const SweepSettings& s, const std::vector<double>& values) {
+  const Station* base = design.station(s.station);
+  if (base == nullptr) throw ValidationError("station", "no such station: " + s.station);
+  Station st = *base;
+  std::vector<Mechanism*> targets;
+  for (Mechanism* m : {st.lower ? &*st.lower : nullptr, st.upper ? &*st.upper : nullptr}) {
+    if (m && (s.mechanism.empty() || s.mechanism == m->name)) targets.push_back(m);
+  }
+  for (std::size_t d = 0; d < s.vary.size(); ++d) {
+    const std::string& name = s.vary[d].name;
+    const double v = values[d];
+    if (name == "ellipse_a") {
+      st.target.axes.x() = v;
+    } else if (name == "ellipse_b") {
+      st.target.axes.y() = v;
+    } else if (name == "upper_height") {
+      if (!st.upper) throw ValidationError("mechanisms.upper", "upper_height is swept but there is no upper mechanism");
+      st.upper->O1.y() = v;
+      st.upper->O2.y() = v;
+    } else {
+      for (Mechanism* m : targets) {
+        if (name == "L1") m->L[0] = v;
+        if (name == "L2") m->L[1] = v;
+        if (name == "L3") m->L[2] = v;
+        if (name == "L4") m->L[3] = v;
+        if (name == "L12") m->L[0] = m->L[1] = v;
+        if (name == "L34") m->L[2] = m->L[3] = v;
+        if (name == "spacing") {
+          const Vec2 dir = m->O2 != m->O1 ? Vec2((m->O2 - m->O1).normalized()) : kX;
+          m->O2 = m->O1 + v * dir;
+        }
+      }
+    }
+  }
+  st.validate();
+  if (design.geometry) {
+    for (const Mechanism* m : targets) {
+      for (std::size_t i = 0; i < 4; ++i) {
+        if (m->L[i] < design.geometry->boss_diameter) {
+          throw ValidationError("mechanisms." + m->name + ".links[" + std::to_string(i) + "]",
+                                "= " + num(m->L[i]) + " mm: shorter than geometry.boss_diameter");
+        }
+      }
+    }
+  }
+  return st;
+}
+
+// --- evaluation ----------------------------------------------------------------------------------
+
+SweepRow::SweepRow()
+    : margin_lower_mm(kNaN), margin_upper_mm(kNaN), margin_shared_mm(kNaN), min_lci(kNaN),
+      min_force_capability(kNaN), footprint_w_mm(kNaN), footprint_h_mm(kNaN), footprint_mm2(kNaN) {}
+
+double SweepRow::score(const std::string& objective) const {
+  if (objective == "margin") {
+    return !std::isnan(margin_shared_mm) ? margin_shared_mm
+                                         : std::fmin(margin_lower_mm, margin_upper_mm);  // fmin skips NaN
+  }
+  if (objective == "min_lci") return min_lci;
+  if (objective == "force") return min_force_capability;
+  if (objective == "footprint") return -footprint_mm2;
+  return kNaN;
+}
+
+CoverageOptions sweep_coverage_options() {
+  // Min LCI from 1 + 2 x 24 samples refined by compass search to 1e-3 of the ellipse size: the
+  // minimum is then known to ~1e-6 (the LCI field is smooth; its minimum over the ellipse lies on
+  // the boundary for the usual designs). `fivebar coverage` refines further.
+  CoverageOptions o;
+  o.rings = 2;
+  o.angles = 24;
+  o.lci_refine = 1e-3;
+  return o;
+}
+
+namespace {
+
+void footprint(const Station& st, const std::vector<const Mechanism*>& targets, const Design& design, SweepRow& row) {
+  double x0 = st.target.center.x(), x1 = x0, y0 = st.target.center.y(), y1 = y0;
+  auto add = [&](const Vec2& p) {
+    x0 = std::min(x0, p.x());
+    x1 = std::max(x1, p.x());
+    y0 = std::min(y0, p.y());
+    y1 = std::max(y1, p.y());
+  };
+  // The elbow angles take their extremes on the ellipse's boundary (no interior critical points:
+  // d theta_i / dP is a row of J^-1, never zero away from singularities), so boundary samples
+  // bound the linkage; the tactor sweeps the ellipse itself.
+  constexpr int kSamples = 32;
+  thread_local std::vector<double> uc, us;
+  if (uc.empty()) {
+    for (int k = 0; k < kSamples; ++k) {
+      uc.push_back(std::cos(2 * std::numbers::pi * k / kSamples));
+      us.push_back(std::sin(2 * std::numbers::pi * k / kSamples));
+    }
+  }
+  const double c = std::cos(st.target.angle), s = std::sin(st.target.angle);
+  const double a = 0.5 * st.target.axes.x(), b = 0.5 * st.target.axes.y();
+  add(st.target.center + Vec2(std::hypot(a * c, b * s), std::hypot(a * s, b * c)));
+  add(st.target.center - Vec2(std::hypot(a * c, b * s), std::hypot(a * s, b * c)));
+  for (const Mechanism* m : targets) {
+    add(m->O1);
+    add(m->O2);
+    for (int k = 0; k < kSamples; ++k) {
+      const Vec2 q = st.target.center + Vec2(c * a * uc[k] - s * b * us[k], s * a * uc[k] + c * b * us[k]);
+      const auto x1i = intersect_circles(m->O1, m->L[0], q, m->L[2], -m->working_mode.sign1);
+      const auto x2i = intersect_circles(m->O2, m->L[1], q, m->L[3], -m->working_mode.sign2);
+      if (x1i.status != Status::unreachable) add(x1i.point);
+      if (x2i.status != Status::unreachable) add(x2i.point);
+    }
+  }
+  const double pad = design.geometry ? 0.5 * std::max(design.geometry->boss_diameter,
+                                                      *std::max_element(design.geometry->link_width.begin(),
+                                                                        design.geometry->link_width.end()))
+                                     : 0.0;
+  row.footprint_w_mm = x1 - x0 + 2 * pad;
+  row.footprint_h_mm = y1 - y0 + 2 * pad;
+  row.footprint_mm2 = row.footprint_w_mm * row.footprint_h_mm;
+}
+
+std::string fmt_margin(const std::string& which, double margin) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, margin, std::chars_format::general, 6);
+  return "not covered: " + which + " margin " + std::string(buf, r.ptr) + " mm";
+}
+
+SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint64_t index, std::vector<double> values,
+                         const CoverageOptions& cov) {
+  SweepRow row;
+  row.index = index;
+  row.values = std::move(values);
+  Station st;
+  try {
+    st = apply_sweep(design, s, row.values);
+  } catch (const ValidationError& e) {
+    row.status = std::string("invalid: ") + e.what();
+    return row;
+  }
+  std::vector<const Mechanism*> targets;
+  for (const Mechanism* m : st.mechanisms()) {
+    if (s.mechanism.empty() || s.mechanism == m->name) targets.push_back(m);
+  }
+  // Hard constraints in order of cost; the first failure ends the evaluation.
+  for (const Mechanism* m : targets) {
+    const Containment c = containment(*m, st.target);
+    (m->name == "lower" ? row.margin_lower_mm : row.margin_upper_mm) = c.margin_mm;
+    if (!c.inside) {
+      row.status = fmt_margin(m->name, c.margin_mm);
+      return row;
+    }
+  }
+  if (targets.size() == 2) row.margin_shared_mm = std::min(row.margin_lower_mm, row.margin_upper_mm);
+  row.min_lci = std::numeric_limits<double>::infinity();
+  row.min_force_capability = std::numeric_limits<double>::infinity();
+  for (const Mechanism* m : targets) {
+    CoverageResult r;
+    conditioning(*m, st.target, cov, r);
+    row.min_lci = std::min(row.min_lci, r.min_lci);
+    row.min_force_capability = std::min(row.min_force_capability, r.min_force_capability);
+    if (!r.assembly_ok) {
+      row.status = "not covered: " + m->name + " tactor crosses to the wrong assembly side";
+      return row;
+    }
+    if (!r.lci_ok) {
+      std::ostringstream why;
+      why << "not covered: " << m->name << " min LCI " << r.min_lci << " < " << m->min_lci;
+      row.status = why.str();
+      return row;
+    }
+  }
+  footprint(st, targets, design, row);
+  row.covered = true;
+  row.status = "covered";
+  return row;
+}
+
+}  // namespace
+
+SweepRow evaluate_sweep_design(const Design& design, const SweepSettings& settings, std::uint64_t index,
+                               const CoverageOptions& coverage) {
+  return evaluate_values(design, settings, index, sweep_point(settings, index), coverage);
+}
+
+// --- Pareto --------------------------------------------------------------------------------------
+
+bool ParetoArchive::dominates(const SweepRow& a, const SweepRow& b) const {
+  bool better = false;
+  for (const std::string& o : objectives_) {
+    const double x = a.score(o), y = b.score(o);
+    if (x < y) return false;
+    if (x > y) better = true;
+  }
+  return better;
+}
+
+void ParetoArchive::insert(const SweepRow& row) {
+  if (!row.covered) return;
+  for (const SweepRow& r : rows_) {
+    if (dominates(r, row)) return;
+  }
+  rows_.erase(std::remove_if(rows_.begin(), rows_.end(), [&](const SweepRow& r) { return dominates(row, r); }),
+              rows_.end());
+  rows_.push_back(row);
+}
+
+// --- CSV -----------------------------------------------------------------------------------------
+
+std::string sweep_csv_header(const SweepSettings& s) {
+  std::string h = "index";
+  for (const SweepVariable& v : s.vary) h += "," + v.name + (v.name.rfind("ellipse", 0) == 0 ? "_mm" : "_mm");
+  h += ",status,covered,margin_lower_mm,margin_upper_mm,margin_shared_mm,min_lci,min_force_capability,"
+       "footprint_w_mm,footprint_h_mm,footprint_mm2";
+  return h;
+}
+
+std::string sweep_csv_row(const SweepRow& r) {
+  std::string line = std::to_string(r.index);
+  for (double v : r.values) line += "," + num(v);
+  line += "," + csv_field(r.status) + "," + (r.covered ? "1" : "0");
+  for (double v : {r.margin_lower_mm, r.margin_upper_mm, r.margin_shared_mm, r.min_lci, r.min_force_capability,
+                   r.footprint_w_mm, r.footprint_h_mm, r.footprint_mm2}) {
+    line += "," + num(v);
+  }
+  return line;
+}
+
+namespace {
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        cur += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        cur += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+bool parse_double(const std::string& text, double& v) {
+  if (text.empty()) {
+    v = kNaN;
+    return true;
+  }
+  const auto r = std::from_chars(text.data(), text.data() + text.size(), v);
+  return r.ec == std::errc{} && r.ptr == text.data() + text.size();
+}
+
+}  // namespace
+
+void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& settings,
+                    const std::function<void(const SweepRow&, const std::string& line)>& row) {
+  std::ifstream in(csv);
+  if (!in) throw InputError(csv.string() + ": cannot read the sweep CSV");
+  std::string line;
+  if (!std::getline(in, line) || line != sweep_csv_header(settings)) {
+    throw InputError(csv.string() + ":1: header differs from this sweep's (" + sweep_csv_header(settings) +
+                     "): not the same sweep");
+  }
+  const std::size_t nv = settings.vary.size();
+  std::uint64_t line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty()) continue;
+    const auto f = split_csv(line);
+    auto bad = [&](const std::string& why) {
+      throw InputError(csv.string() + ":" + std::to_string(line_no) + ": " + why);
+    };
+    if (f.size() != nv + 11) bad("expected " + std::to_string(nv + 11) + " fields, found " + std::to_string(f.size()));
+    SweepRow r;
+    const auto res = std::from_chars(f[0].data(), f[0].data() + f[0].size(), r.index);
+    if (res.ec != std::errc{} || f[0].empty()) bad("index '" + f[0] + "' is not a whole number");
+    r.values.resize(nv);
+    for (std::size_t d = 0; d < nv; ++d) {
+      if (!parse_double(f[1 + d], r.values[d]) || std::isnan(r.values[d])) bad("bad value '" + f[1 + d] + "'");
+    }
+    r.status = f[1 + nv];
+    if (f[2 + nv] != "0" && f[2 + nv] != "1") bad("covered must be 0 or 1");
+    r.covered = f[2 + nv] == "1";
+    double* metrics[] = {&r.margin_lower_mm, &r.margin_upper_mm, &r.margin_shared_mm, &r.min_lci,
+                         &r.min_force_capability, &r.footprint_w_mm, &r.footprint_h_mm, &r.footprint_mm2};
+    for (std::size_t k = 0; k < 8; ++k) {
+      if (!parse_double(f[3 + nv + k], *metrics[k])) bad("bad number '" + f[3 + nv + k] + "'");
+    }
+    row(r, line);
+  }
+}
+
+std::pair<std::uint64_t, std::uint64_t> parse_shard(const std::string& text) {
+  const auto slash = text.find('/');
+  std::uint64_t k = 0, n = 0;
+  bool ok = slash != std::string::npos;
+  if (ok) {
+    const auto a = std::from_chars(text.data(), text.data() + slash, k);
+    const auto b = std::from_chars(text.data() + slash + 1, text.data() + text.size(), n);
+    ok = a.ec == std::errc{} && a.ptr == text.data() + slash && b.ec == std::errc{} &&
+         b.ptr == text.data() + text.size() && slash > 0 && n > 0 && k < n;
+  }
+  if (!ok) throw InputError("--shard = '" + text + "': must be K/N with 0 <= K < N (e.g. 0/4)");
+  return {k, n};
+}
+
+// --- run -----------------------------------------------------------------------------------------
+
+namespace {
+
+bool better_lexicographic(const SweepRow& a, const SweepRow& b, const std::vector<std::string>& objectives) {
+  for (const std::string& o : objectives) {
+    const double x = a.score(o), y = b.score(o);
+    if (x > y) return true;
+    if (x < y) return false;
+  }
+  return a.index < b.index;
+}
+
+std::string csv_name(const SweepOptions& o) {
+  if (o.shards <= 1) return "sweep.csv";
+  return "sweep.shard-" + std::to_string(o.shard) + "-of-" + std::to_string(o.shards) + ".csv";
+}
+
+}  // namespace
+
+SweepResult run_sweep(const Design& design, const SweepOptions& options) {
+  if (!design.sweep) throw InputError(design.name + ": the design has no sweep: section");
+  const SweepSettings& s = *design.sweep;
+  if (options.shards == 0 || options.shard >= options.shards) throw InputError("shard out of range");
+  SweepResult result;
+  const std::uint64_t all = sweep_size(s);
+  result.first = all / options.shards * options.shard + std::min(options.shard, all % options.shards);
+  result.total = all / options.shards + (options.shard < all % options.shards ? 1 : 0);
+  const std::uint64_t end = result.first + result.total;
+  make_directories(options.out_dir);
+  result.csv = options.out_dir / csv_name(options);
+
+  ParetoArchive archive(s.objectives);
+  std::optional<SweepRow> best;
+  auto account = [&](const SweepRow& r) {
+    archive.insert(r);
+    if (r.covered && (!best || better_lexicographic(r, *best, s.objectives))) best = r;
+  };
+
+  AtomicFile csv(result.csv);
+  csv.stream() << sweep_csv_header(s) << '\n';
+  std::uint64_t next = result.first;
+  if (options.resume && std::filesystem::exists(result.csv)) {
+    read_sweep_csv(result.csv, s, [&](const SweepRow& r, const std::string& line) {
+      if (r.index != next || next >= end) {
+        throw InputError(result.csv.string() + ": row with index " + std::to_string(r.index) + " where " +
+                         std::to_string(next) + " was expected: not a prefix of this sweep");
+      }
+      csv.stream() << line << '\n';
+      account(r);
+      ++next;
+    });
+  }
+  result.done = next - result.first;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<double> u;
+  std::vector<SweepRow> rows;
+  const std::size_t dims = s.vary.size();
+  const bool is_grid = s.sample == "grid";
+  while (next < end) {
+    const std::uint64_t n = std::min<std::uint64_t>(options.chunk, end - next);
+    unit_points(s, next, n, u);
+    rows.assign(n, SweepRow{});
+    const std::int64_t count = std::int64_t(n);
+#pragma omp parallel for schedule(dynamic, 64) num_threads(options.threads > 0 ? options.threads : omp_get_max_threads())
+    for (std::int64_t k = 0; k < count; ++k) {
+      std::vector<double> values;
+      to_values(s, u.data() + std::size_t(k) * dims, values, is_grid);
+      rows[std::size_t(k)] = evaluate_values(design, s, next + std::uint64_t(k), std::move(values), options.coverage);
+    }
+    for (const SweepRow& r : rows) {
+      csv.stream() << sweep_csv_row(r) << '\n';
+      account(r);
+      result.covered += r.covered;
+      result.invalid += r.status.rfind("invalid", 0) == 0;
+    }
+    next += n;
+    result.evaluated += n;
+    result.done = next - result.first;
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (options.progress) options.progress(result.done, result.total, seconds);
+    if (options.stop && options.stop->load() && next < end) {
+      result.interrupted = true;
+      break;
+    }
+  }
+  csv.commit();  // a valid CSV of every completed row, interrupted or not
+  result.files.push_back(result.csv);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.designs_per_s = result.seconds > 0 ? double(result.evaluated) / result.seconds : 0.0;
+
+  result.pareto = archive.rows();
+  std::sort(result.pareto.begin(), result.pareto.end(),
+            [](const SweepRow& a, const SweepRow& b) { return a.index < b.index; });
+  const std::string suffix = options.shards > 1 ? ".shard-" + std::to_string(options.shard) + "-of-" +
+                                                      std::to_string(options.shards)
+                                                : "";
+  {
+    std::string text = sweep_csv_header(s) + "\n";
+    for (const SweepRow& r : result.pareto) text += sweep_csv_row(r) + "\n";
+    const auto path = options.out_dir / ("pareto" + suffix + ".csv");
+    write_file_atomic(path, text);
+    result.files.push_back(path);
+  }
+  result.best = best;
+  if (best) {
+    Design d = design;
+    Station st = apply_sweep(design, s, best->values);
+    for (Station& x : d.stations) {
+      if (x.name == st.name) x = st;
+    }
+    d.sweep.reset();
+    d.products.reset();
+    // Its own name, so that `fivebar run best.yaml` does not overwrite the swept design's outputs.
+    d.name = design.name.substr(0, 59) + "-best";
+    result.best_design = d;
+    const auto path = options.out_dir / ("best" + suffix + ".yaml");
+    std::ostringstream head;
+    head << "# Best design of the sweep of " << design.name << " (station " << s.station << "), design #"
+         << best->index << " by the objectives " ;
+    for (std::size_t i = 0; i < s.objectives.size(); ++i) head << (i ? ", " : "") << s.objectives[i];
+    head << ".\n# Written by fivebar sweep: a complete design file (fivebar run " << path.filename().string()
+         << ").\n";
+    write_file_atomic(path, head.str() + to_yaml(d));
+    result.files.push_back(path);
+  }
+  if (options.plots && options.shards <= 1 && !result.interrupted) {
+    for (const auto& f : write_sweep_plots(result.csv, s, result.pareto, options.out_dir)) result.files.push_back(f);
+  }
+  return result;
+}
+
+}  // namespace fivebar

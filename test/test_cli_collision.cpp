@@ -1,0 +1,409 @@
+// End-to-end tests of `fivebar collision`, `fivebar pattern` and the `collision` / `pattern`
+// products of `fivebar run`: real processes, their output, files and exit codes. Expected values are
+// derived here from the paper's geometry (Table 1) and the showcase's `geometry:` (pin bosses 5 mm,
+// min_clearance 0.3 mm), independently of the library.
+
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+
+const fs::path kSource = FIVEBAR_SOURCE_DIR;
+const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+struct Outcome {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+class CliTactors : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::random_device rd;
+    dir_ = fs::temp_directory_path() / ("fivebar_test_cli_tactors_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  Outcome run(const std::vector<std::string>& args) {
+    const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
+    std::vector<std::string> argv_s{FIVEBAR_BINARY};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addchdir_np(&actions, dir_.c_str());
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    Outcome r;
+    if (rc != 0) {
+      ADD_FAILURE() << "cannot spawn " << argv[0] << ": " << std::strerror(rc);
+      return r;
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  /// The paper design with `from` replaced by `to`.
+  fs::path design_with(const std::string& name, const std::string& from, const std::string& to) {
+    std::string text = slurp(kDesign);
+    const auto pos = text.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    if (pos != std::string::npos) text.replace(pos, from.size(), to);
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+
+  /// The paper design with the block from `start` up to (not including) `end` removed.
+  fs::path design_without(const std::string& name, const std::string& start, const std::string& end) {
+    std::string text = slurp(kDesign);
+    const auto a = text.find(start);
+    const auto b = text.find(end, a);
+    EXPECT_TRUE(a != std::string::npos && b != std::string::npos) << start;
+    if (a != std::string::npos && b != std::string::npos) text.erase(a, b - a);
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+json parse(const Outcome& r) {
+  json j;
+  EXPECT_NO_THROW(j = json::parse(r.out)) << "stdout is not exactly one JSON document:\n" << r.out;
+  return j;
+}
+
+std::array<double, 2> xy(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>()}; }
+
+// --- collision: a pair of points --------------------------------------------------------------------
+
+TEST_F(CliTactors, PairClearOfEachOther) {
+  // Index: tactors 8 mm apart on the vertical through the centre; the P bosses (2.5 + 2.5) leave 3 mm.
+  const Outcome r = run({"collision", kDesign, "--station", "index", "--upper", "6.25,19.5", "--lower", "6.25,11.5"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, AllOf(HasSubstr("no collision"), HasSubstr("3.0000 mm"), HasSubstr("plane 1")));
+  EXPECT_THAT(r.err, IsEmpty());
+
+  const Outcome j = run({"collision", kDesign, "-s", "index", "--upper", "6.25,19.5", "--lower", "6.25,11.5", "--json"});
+  EXPECT_EQ(j.code, 0);
+  const json doc = parse(j);
+  EXPECT_FALSE(doc["collides"].get<bool>());
+  EXPECT_EQ(doc["status"], "clear");
+  EXPECT_NEAR(doc["before"]["min_clearance_mm"].get<double>(), 3.0, 1e-9);
+  EXPECT_EQ(doc["moved_mm"].get<double>(), 0.0);
+  EXPECT_EQ(xy(doc["lower_point_mm"]), (std::array<double, 2>{6.25, 11.5}));
+}
+
+TEST_F(CliTactors, PairCollidingMovesTheLowerAndExitsOne) {
+  // Both targets at the index centre: the lower moves 5.3 mm (boss radii 2.5 + 2.5 + clearance 0.3).
+  const Outcome r = run({"collision", kDesign, "--station", "index", "--upper", "6.25,15.5", "--lower", "6.25,15.5"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.out, AllOf(HasSubstr("COLLISION"), HasSubstr("upper.L3 vs lower.L3"), HasSubstr("upper.tactor vs lower.tactor"),
+                           HasSubstr("lower target moved to")));
+  EXPECT_THAT(r.err, HasSubstr("collide"));
+
+  const json doc = parse(run({"collision", kDesign, "-s", "index", "--upper", "6.25,15.5", "--lower", "6.25,15.5", "--json"}));
+  EXPECT_TRUE(doc["collides"].get<bool>());
+  EXPECT_EQ(doc["status"], "moved");
+  EXPECT_DOUBLE_EQ(doc["before"]["min_clearance_mm"].get<double>(), -5.0);
+  const auto moved = xy(doc["lower_point_mm"]);
+  const double d = std::hypot(moved[0] - 6.25, moved[1] - 15.5);
+  EXPECT_NEAR(d, 5.3, 1e-3);
+  EXPECT_NEAR(doc["moved_mm"].get<double>(), d, 1e-12);
+  EXPECT_FALSE(doc["after"]["collides"].get<bool>());
+  EXPECT_GE(doc["after"]["min_clearance_mm"].get<double>(), 0.3);
+  // The upper keeps its IK solution: the same angles `fivebar ik` gives.
+  const json ik = parse(run({"ik", kDesign, "-s", "index", "-m", "upper", "--point", "6.25,15.5", "--json"}));
+  EXPECT_EQ(doc["upper"]["theta_deg"], ik["theta_deg"]);
+}
+
+TEST_F(CliTactors, NegativeCoordinatesAndUnreachableTargets) {
+  // A negative coordinate after --upper is a value, not an option; (-30, 15.5) is out of reach.
+  const Outcome r = run({"collision", kDesign, "-s", "index", "--upper", "-30,15.5", "--lower", "6.25,11.5"});
+  EXPECT_EQ(r.code, 1);
+  EXPECT_THAT(r.out, HasSubstr("unreachable"));
+  EXPECT_THAT(r.err, HasSubstr("the upper target cannot be held"));
+}
+
+TEST_F(CliTactors, BadInputExitsTwo) {
+  const Outcome only_one = run({"collision", kDesign, "-s", "index", "--upper", "6.25,15.5"});
+  EXPECT_EQ(only_one.code, 2);
+  EXPECT_THAT(only_one.err, HasSubstr("give both --upper X,Y and --lower X,Y"));
+  const Outcome bad_pair = run({"collision", kDesign, "-s", "index", "--upper", "6.25", "--lower", "1,2"});
+  EXPECT_EQ(bad_pair.code, 2);
+  EXPECT_THAT(bad_pair.err, HasSubstr("--upper '6.25'"));
+  const Outcome station = run({"collision", kDesign, "-s", "middle"});
+  EXPECT_EQ(station.code, 2);
+  EXPECT_THAT(station.err, AllOf(HasSubstr("middle"), HasSubstr("index, thumb")));
+  const Outcome choose = run({"collision", kDesign});
+  EXPECT_EQ(choose.code, 2);
+  EXPECT_THAT(choose.err, HasSubstr("--station"));
+
+  const fs::path no_geometry = design_without("no-geometry.yaml", "geometry:\n", "# Resin printing");
+  const Outcome g = run({"collision", no_geometry.string(), "-s", "index"});
+  EXPECT_EQ(g.code, 2);
+  EXPECT_THAT(g.err, HasSubstr("has no geometry"));
+  const Outcome index_only = run({"collision", (kSource / "designs" / "iros2022-index.yaml").string()});
+  EXPECT_EQ(index_only.code, 2);  // that design has no geometry section either
+}
+
+// --- collision: the map ------------------------------------------------------------------------------
+
+TEST_F(CliTactors, MapWritesThePictureAndReportsTheSeparations) {
+  const fs::path out = dir_ / "maps";
+  const Outcome r = run({"collision", kDesign, "-s", "thumb", "--spacing", "1.0", "--out", out.string(), "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  EXPECT_EQ(doc["station"], "thumb");
+  EXPECT_EQ(doc["spacing_mm"].get<double>(), 1.0);
+  EXPECT_GT(doc["colliding_fraction"].get<double>(), 0.0);
+  EXPECT_LT(doc["colliding_fraction"].get<double>(), 1.0);
+  // No collision-free pair can be closer than the two P bosses allow: 2.5 + 2.5 + 0.3 mm.
+  EXPECT_GE(doc["min_free_separation_mm"].get<double>(), 5.3);
+  const auto pair = doc["min_free_pair_mm"];
+  const auto u = xy(pair[0]), l = xy(pair[1]);
+  EXPECT_NEAR(std::hypot(u[0] - l[0], u[1] - l[1]), doc["min_free_separation_mm"].get<double>(), 1e-9);
+  // Grid points lie on the 1 mm lattice through the ellipse centre (6.25, 17.5).
+  EXPECT_NEAR(std::remainder(u[0] - 6.25, 1.0), 0.0, 1e-9);
+  EXPECT_NEAR(std::remainder(u[1] - 17.5, 1.0), 0.0, 1e-9);
+  for (const char* f : {"thumb.svg", "thumb.png"}) {
+    EXPECT_TRUE(fs::exists(out / f)) << f;
+    EXPECT_GT(fs::file_size(out / f), 1000u) << f;
+  }
+  EXPECT_EQ(slurp(out / "thumb.png").substr(1, 3), "PNG");
+
+  const Outcome text = run({"collision", kDesign, "-s", "thumb", "--spacing", "1.0", "--out", out.string()});
+  EXPECT_EQ(text.code, 0);
+  EXPECT_THAT(text.out, AllOf(HasSubstr("collision map"), HasSubstr("closest free pair"), HasSubstr("priority, both at centre"),
+                              HasSubstr("thumb.png")));
+}
+
+TEST_F(CliTactors, MapDefaultsToTheOutputsFolder) {
+  const Outcome r = run({"collision", kDesign, "-s", "index", "--spacing", "1.5"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "outputs" / "iros2022" / "collision" / "index.png"));
+}
+
+// --- pattern ------------------------------------------------------------------------------------------
+
+struct Linkage {
+  std::array<double, 2> O1, O2;
+  std::array<double, 4> L;
+};
+constexpr Linkage kIndexUpper{{0.0, 31.0}, {12.5, 31.0}, {9.0, 9.0, 15.0, 15.0}};
+constexpr Linkage kIndexLower{{0.0, 0.0}, {12.5, 0.0}, {9.0, 9.0, 15.0, 15.0}};
+
+TEST_F(CliTactors, StretchWritesTrajectoriesThatCloseTheLoop) {
+  const fs::path out = dir_ / "pat";
+  const Outcome r = run({"pattern", kDesign, "-s", "index", "--pattern", "stretch", "--amplitude", "3", "--duration", "0.5",
+                         "--rate", "50", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, AllOf(HasSubstr("pattern stretch"), HasSubstr("26 samples"), HasSubstr("renderable")));
+  const std::string csv = slurp(out / "index-stretch.csv");
+  std::istringstream in(csv);
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "time_s,station,mechanism,theta1_deg,theta2_deg,x_mm,y_mm,status,target_x_mm,target_y_mm,lci");
+  int rows = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> c;
+    std::stringstream ls(line);
+    std::string cell;
+    while (std::getline(ls, cell, ',')) c.push_back(cell);
+    ASSERT_EQ(c.size(), 11u) << line;
+    EXPECT_EQ(c[1], "index");
+    EXPECT_EQ(c[7], "ok");
+    const Linkage& k = c[2] == "upper" ? kIndexUpper : kIndexLower;
+    // The elbows from the written angles are L1 (L2) from the bases, and the written tactor point is
+    // L3 (L4) from them: the angles reproduce the point.
+    const double t1 = std::stod(c[3]) * kDeg, t2 = std::stod(c[4]) * kDeg;
+    const double x = std::stod(c[5]), y = std::stod(c[6]);
+    const double a1x = k.O1[0] + k.L[0] * std::cos(t1), a1y = k.O1[1] + k.L[0] * std::sin(t1);
+    const double a2x = k.O2[0] + k.L[1] * std::cos(t2), a2y = k.O2[1] + k.L[1] * std::sin(t2);
+    EXPECT_NEAR(std::hypot(x - a1x, y - a1y), k.L[2], 1e-9) << line;
+    EXPECT_NEAR(std::hypot(x - a2x, y - a2y), k.L[3], 1e-9) << line;
+    // Stretch: the upper 4 mm above the centre moving right, the lower 4 mm below moving left.
+    EXPECT_DOUBLE_EQ(y, c[2] == "upper" ? 19.5 : 11.5);
+    EXPECT_TRUE(c[2] == "upper" ? x >= 6.25 : x <= 6.25);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2 * 26);
+  for (const char* f : {"index-stretch.svg", "index-stretch.png"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+}
+
+TEST_F(CliTactors, LongTwistIsNotRenderableOnTheIndex) {
+  const fs::path out = dir_ / "pat";
+  const Outcome r = run({"pattern", kDesign, "-s", "index", "--pattern", "twist", "--amplitude", "6", "--out", out.string(),
+                         "--json"});
+  EXPECT_EQ(r.code, 1);
+  const json doc = parse(r);
+  EXPECT_FALSE(doc["passed"].get<bool>());
+  EXPECT_EQ(doc["first_failure"]["status"], "collision_moved");
+  EXPECT_EQ(doc["first_failure"]["mechanism"], "lower");
+  EXPECT_GT(doc["worst"]["moved_samples"].get<int>(), 0);
+  EXPECT_THAT(r.err, HasSubstr("not renderable"));
+  // The trajectory is still written, moved samples marked.
+  EXPECT_THAT(slurp(out / "index-twist.csv"), HasSubstr(",collision_moved,"));
+  // The thumb's longer links let the same twist pass.
+  EXPECT_EQ(run({"pattern", kDesign, "-s", "thumb", "--pattern", "twist", "--amplitude", "5", "--out", out.string()}).code, 0);
+}
+
+TEST_F(CliTactors, PatternParametersFromTheDesignAndOverrides) {
+  const fs::path out = dir_ / "pat";
+  // The showcase gives the thumb a 5.5 mm twist; the index keeps 4 mm.
+  const json thumb = parse(run({"pattern", kDesign, "-s", "thumb", "--pattern", "twist", "--out", out.string(), "--json"}));
+  EXPECT_EQ(thumb["spec"]["amplitude_mm"].get<double>(), 5.5);
+  const json index = parse(run({"pattern", kDesign, "-s", "index", "--pattern", "twist", "--out", out.string(), "--json"}));
+  EXPECT_EQ(index["spec"]["amplitude_mm"].get<double>(), 4.0);
+  const json pivot = parse(run({"pattern", kDesign, "-s", "index", "--pattern", "pivot", "--amplitude-deg", "10",
+                                "--frequency", "1", "--out", out.string(), "--json", "--samples"}));
+  EXPECT_EQ(pivot["spec"]["amplitude_deg"].get<double>(), 10.0);
+  EXPECT_EQ(pivot["spec"]["samples"].get<int>(), 201);  // 2 s at 100 Hz from the design
+  EXPECT_EQ(pivot["samples"].size(), 201u);
+  const json centred = parse(run({"pattern", kDesign, "-s", "index", "--pattern", "slip", "--center", "-1,15",
+                                  "--separation", "6", "--out", out.string(), "--json"}));
+  EXPECT_EQ(xy(centred["spec"]["center_mm"]), (std::array<double, 2>{-1.0, 15.0}));
+  // A motor limit below the pattern's peak speed fails it.
+  const Outcome slow = run({"pattern", kDesign, "-s", "index", "--pattern", "stretch", "--max-joint-speed", "5",
+                            "--out", out.string(), "--json"});
+  EXPECT_EQ(slow.code, 1);
+  EXPECT_EQ(parse(slow)["first_failure"]["status"], "too_fast");
+}
+
+TEST_F(CliTactors, PatternBadInputExitsTwo) {
+  const Outcome kind = run({"pattern", kDesign, "-s", "index", "--pattern", "wiggle"});
+  EXPECT_EQ(kind.code, 2);
+  EXPECT_THAT(kind.err, HasSubstr("stretch, slip, twist or pivot"));
+  const Outcome mm = run({"pattern", kDesign, "-s", "index", "--pattern", "pivot", "--amplitude", "3"});
+  EXPECT_EQ(mm.code, 2);
+  EXPECT_THAT(mm.err, HasSubstr("--amplitude-deg"));
+  const Outcome neg = run({"pattern", kDesign, "-s", "index", "--pattern", "stretch", "--amplitude", "-2"});
+  EXPECT_EQ(neg.code, 2);
+  EXPECT_THAT(neg.err, HasSubstr("amplitude_mm = -2 mm"));
+  const Outcome none = run({"pattern", kDesign, "-s", "index"});
+  EXPECT_EQ(none.code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "outputs")) << "bad input writes nothing";
+}
+
+// --- run ----------------------------------------------------------------------------------------------
+
+TEST_F(CliTactors, RunBuildsBothProductsWithTheirFiles) {
+  const fs::path out = dir_ / "out";
+  const Outcome r = run({"run", kDesign, "--out", out.string(), "--products", "collision,pattern", "--json", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json s = parse(r);
+  std::vector<std::string> built;
+  for (const auto& b : s["built"]) built.push_back(b["name"]);
+  EXPECT_EQ(built, (std::vector<std::string>{"collision", "pattern"}));
+  const fs::path scene = out / "iros2022";
+  for (const char* f : {"collision/index.png", "collision/thumb.svg", "patterns/index.png", "patterns/thumb.svg",
+                        "patterns/index-stretch.csv", "patterns/thumb-pivot.csv"}) {
+    EXPECT_TRUE(fs::exists(scene / f)) << f;
+  }
+  const json& patterns = s["results"]["pattern"]["stations"];
+  ASSERT_EQ(patterns.size(), 2u);
+  EXPECT_EQ(patterns[0]["patterns"].size(), 4u);
+  const std::string md = slurp(scene / "summary.md");
+  EXPECT_THAT(md, AllOf(HasSubstr("## Collision of the two tactors"), HasSubstr("## Skin-deformation patterns"),
+                        HasSubstr("![patterns of station index](patterns/index.png)")));
+}
+
+TEST_F(CliTactors, RunLeavesTheProductsOutAndSaysWhy) {
+  const fs::path out = dir_ / "out";
+  // Without geometry: both left out for that reason.
+  const fs::path no_geometry = design_without("no-geometry.yaml", "geometry:\n", "# Resin printing");
+  const json a = parse(run({"run", no_geometry.string(), "--out", out.string(), "--json", "--quiet"}));
+  std::map<std::string, std::string> reasons;
+  for (const auto& l : a["left_out"]) reasons[l["name"]] = l["reason"];
+  EXPECT_THAT(reasons["collision"], HasSubstr("geometry"));
+  EXPECT_THAT(reasons["pattern"], HasSubstr("geometry"));
+
+  // Without the upper mechanisms: no station has both.
+  std::string text = slurp(kDesign);
+  for (const char* upper : {"      upper:                              # Table 1: O3, O4; the mirror image of the lower one\n"
+                            "        bases: [[0, 31], [12.5, 31]]\n        links: [9, 9, 15, 15]\n"
+                            "        working_mode: \"+-\"                # elbows outward for a tactor below its bases\n"
+                            "        assembly_mode: \"-\"                # tactor below the elbow line A1A2\n",
+                            "      upper:\n        bases: [[0, 35], [12.5, 35]]\n        links: [9, 9, 17.5, 17.5]\n"
+                            "        working_mode: \"+-\"\n        assembly_mode: \"-\"\n"}) {
+    const auto pos = text.find(upper);
+    ASSERT_NE(pos, std::string::npos) << upper;
+    text.erase(pos, std::strlen(upper));
+  }
+  const fs::path lower_only = dir_ / "lower-only.yaml";
+  std::ofstream(lower_only) << text;
+  const Outcome b = run({"run", lower_only.string(), "--out", out.string(), "--json", "--quiet"});
+  ASSERT_EQ(b.code, 0) << b.err;
+  reasons.clear();
+  const json bj = parse(b);
+  for (const auto& l : bj["left_out"]) reasons[l["name"]] = l["reason"];
+  EXPECT_THAT(reasons["collision"], HasSubstr("both a lower and an upper"));
+  EXPECT_THAT(reasons["pattern"], HasSubstr("both a lower and an upper"));
+
+  // Without patterns: only the pattern product is left out.
+  const fs::path no_patterns = design_without("no-patterns.yaml", "patterns:\n", "# Later versions");
+  const json c = parse(run({"run", no_patterns.string(), "--out", out.string(), "--json", "--quiet", "--products",
+                            "collision,pattern"}));
+  EXPECT_EQ(c["built"][0]["name"], "collision");
+  EXPECT_EQ(c["missing"], json::array({"pattern"}));
+  std::string pattern_reason;
+  for (const auto& l : c["left_out"]) {
+    if (l["name"] == "pattern") pattern_reason = l["reason"].get<std::string>();
+  }
+  EXPECT_THAT(pattern_reason, HasSubstr("patterns:"));
+}
+
+}  // namespace

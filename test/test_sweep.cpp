@@ -1,0 +1,290 @@
+// Sweeps: enumeration, agreement with single-design coverage, shards and threads equal the
+// serial run, resume after an interruption equals an uninterrupted run, the Pareto set is the
+// brute-force non-dominated set, the best design is a loadable design file.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <set>
+#include <sstream>
+#include <unistd.h>
+
+#include "fivebar/coverage.hpp"
+#include "fivebar/sweep.hpp"
+
+namespace fivebar {
+namespace {
+
+std::uint64_t test_seed() {
+  if (const char* s = std::getenv("FIVEBAR_TEST_SEED")) return std::strtoull(s, nullptr, 10);
+  return 20221023;
+}
+
+Design paper_design() { return load_design(std::filesystem::path(FIVEBAR_SOURCE_DIR) / "designs/iros2022.yaml"); }
+
+Design with_sweep(SweepSettings s) {
+  Design d = paper_design();
+  d.sweep = std::move(s);
+  d.validate();
+  return d;
+}
+
+SweepSettings grid(std::vector<SweepVariable> vars, std::string mechanism = "") {
+  SweepSettings s;
+  s.station = "index";
+  s.mechanism = std::move(mechanism);
+  s.vary = std::move(vars);
+  return s;
+}
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::filesystem::path temp_dir(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("fivebar_test_sweep_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+TEST(Enumeration, GridVisitsEveryCombinationWithExactEnds) {
+  const SweepSettings s = grid({{"L3", 10, 20, 3}, {"L4", 12, 13, 5}});
+  ASSERT_EQ(sweep_size(s), 15u);
+  std::set<std::pair<double, double>> seen;
+  for (std::uint64_t i = 0; i < 15; ++i) {
+    const auto v = sweep_point(s, i);
+    seen.insert({v[0], v[1]});
+  }
+  EXPECT_EQ(seen.size(), 15u);
+  EXPECT_EQ(sweep_point(s, 0), (std::vector<double>{10, 12}));
+  EXPECT_EQ(sweep_point(s, 1), (std::vector<double>{10, 12.25}));  // the last variable runs fastest
+  EXPECT_EQ(sweep_point(s, 14), (std::vector<double>{20, 13}));
+  EXPECT_EQ(sweep_point(s, 5), (std::vector<double>{15, 12}));
+}
+
+TEST(Enumeration, RandomAndSobolStayInRangeAndDependOnlyOnIndexAndSeed) {
+  for (const char* sample : {"random", "sobol"}) {
+    SweepSettings s = grid({{"L3", 10, 20, 1}, {"L4", 12, 13, 1}});
+    s.sample = sample;
+    s.count = 1000;
+    s.seed = 7;
+    double mean0 = 0;
+    for (std::uint64_t i = 0; i < 1000; ++i) {
+      const auto v = sweep_point(s, i);
+      EXPECT_GE(v[0], 10.0);
+      EXPECT_LT(v[0], 20.0);
+      EXPECT_GE(v[1], 12.0);
+      EXPECT_LT(v[1], 13.0);
+      mean0 += v[0] / 1000;
+    }
+    EXPECT_NEAR(mean0, 15.0, 0.3) << sample;  // uniform on [10, 20)
+    EXPECT_EQ(sweep_point(s, 123), sweep_point(s, 123));
+    SweepSettings other = s;
+    other.seed = 8;
+    EXPECT_NE(sweep_point(s, 123), sweep_point(other, 123)) << sample;
+  }
+}
+
+TEST(Enumeration, SobolIsMoreUniformThanRandom) {
+  // Star discrepancy proxy: worst count deviation over a grid of anchored boxes.
+  auto discrepancy = [](const SweepSettings& s) {
+    double worst = 0;
+    for (double a = 0.1; a <= 1.0; a += 0.1) {
+      for (double b = 0.1; b <= 1.0; b += 0.1) {
+        int in = 0;
+        for (std::uint64_t i = 0; i < 1024; ++i) {
+          const auto v = sweep_point(s, i);
+          in += (v[0] - 1) < a && (v[1] - 1) < b;
+        }
+        worst = std::max(worst, std::fabs(in / 1024.0 - a * b));
+      }
+    }
+    return worst;
+  };
+  SweepSettings s = grid({{"L3", 1, 2, 1}, {"L4", 1, 2, 1}});
+  s.count = 1024;
+  s.sample = "sobol";
+  s.seed = 0;
+  const double sobol = discrepancy(s);
+  s.sample = "random";
+  const double random = discrepancy(s);
+  EXPECT_LT(sobol, random);
+  EXPECT_LT(sobol, 0.01);
+}
+
+TEST(Evaluation, RowsAgreeWithSingleDesignCoverage) {
+  const Design d = with_sweep(grid({{"L34", 11, 19, 25}, {"L12", 6, 12, 25}}));
+  std::mt19937_64 rng(test_seed());
+  std::uniform_int_distribution<std::uint64_t> pick(0, sweep_size(*d.sweep) - 1);
+  int covered = 0, not_covered = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const std::uint64_t i = pick(rng);
+    const SweepRow row = evaluate_sweep_design(d, *d.sweep, i);
+    const Station st = apply_sweep(d, *d.sweep, row.values);
+    EXPECT_EQ(st.lower->L[2], row.values[0]);
+    EXPECT_EQ(st.upper->L[0], row.values[1]);
+    const StationCoverage ref = station_coverage(st);
+    SCOPED_TRACE(testing::Message() << "design " << i << ": " << row.status);
+    EXPECT_EQ(row.covered, ref.covered());
+    EXPECT_NEAR(row.margin_lower_mm, ref.lower->margin_mm, 1e-12);
+    if (row.covered) {
+      ++covered;
+      EXPECT_NEAR(row.margin_upper_mm, ref.upper->margin_mm, 1e-12);
+      EXPECT_NEAR(row.margin_shared_mm, ref.shared->margin_mm, 1e-12);
+      EXPECT_NEAR(row.min_lci, ref.shared->min_lci, 1e-4);  // the sweep refines more coarsely
+      EXPECT_GT(row.footprint_mm2, 15.0 * 12.0);
+    } else {
+      ++not_covered;
+    }
+  }
+  EXPECT_GT(covered, 3);
+  EXPECT_GT(not_covered, 3);
+}
+
+TEST(Evaluation, InvalidDesignsAreRowsNotErrors) {
+  // L12 down to 2 mm is shorter than the geometry's 5 mm pin bosses.
+  const Design d = with_sweep(grid({{"L12", 2, 9, 8}}));
+  const SweepRow bad = evaluate_sweep_design(d, *d.sweep, 0);
+  EXPECT_THAT(bad.status, testing::StartsWith("invalid: "));
+  EXPECT_THAT(bad.status, testing::HasSubstr("boss_diameter"));
+  EXPECT_FALSE(bad.covered);
+  EXPECT_TRUE(std::isnan(bad.margin_lower_mm));
+}
+
+TEST(Run, ShardsAndThreadsReproduceTheSerialRowsAndResumeContinuesExactly) {
+  const Design d = with_sweep(grid({{"L3", 11, 19, 23}, {"L4", 11, 19, 19}}, "lower"));
+  const auto serial_dir = temp_dir("serial");
+  SweepOptions o;
+  o.out_dir = serial_dir;
+  o.threads = 1;
+  o.chunk = 100;
+  o.plots = false;
+  const SweepResult serial = run_sweep(d, o);
+  ASSERT_EQ(serial.done, 23u * 19u);
+  const std::string rows = slurp(serial.csv);
+
+  SweepOptions two = o;
+  two.threads = 2;
+  two.out_dir = temp_dir("threads");
+  EXPECT_EQ(slurp(run_sweep(d, two).csv), rows);
+
+  std::string joined = sweep_csv_header(*d.sweep) + "\n";
+  for (std::uint64_t k = 0; k < 3; ++k) {
+    SweepOptions shard = o;
+    shard.out_dir = temp_dir("shards");
+    shard.shard = k;
+    shard.shards = 3;
+    if (k > 0) shard.out_dir = temp_dir("shards" + std::to_string(k));
+    const std::string text = slurp(run_sweep(d, shard).csv);
+    joined += text.substr(text.find('\n') + 1);
+  }
+  EXPECT_EQ(joined, rows);
+
+  // Interrupt after the first chunk (the stop flag is already set), then resume.
+  std::atomic<bool> stop{true};
+  SweepOptions first = o;
+  first.out_dir = temp_dir("resume");
+  first.stop = &stop;
+  const SweepResult part = run_sweep(d, first);
+  EXPECT_TRUE(part.interrupted);
+  EXPECT_EQ(part.done, 100u);
+  SweepOptions rest = first;
+  rest.stop = nullptr;
+  rest.resume = true;
+  const SweepResult whole = run_sweep(d, rest);
+  EXPECT_FALSE(whole.interrupted);
+  EXPECT_EQ(whole.evaluated, 23u * 19u - 100u);
+  EXPECT_EQ(slurp(whole.csv), rows);
+  EXPECT_EQ(slurp(first.out_dir / "pareto.csv"), slurp(serial_dir / "pareto.csv"));
+  for (const auto& dir : {serial_dir, two.out_dir, first.out_dir}) std::filesystem::remove_all(dir);
+}
+
+TEST(Run, ResumeRefusesAnotherSweepsCsv) {
+  const Design a = with_sweep(grid({{"L3", 11, 19, 5}}, "lower"));
+  const Design b = with_sweep(grid({{"L4", 11, 19, 5}}, "lower"));
+  SweepOptions o;
+  o.out_dir = temp_dir("refuse");
+  o.plots = false;
+  run_sweep(a, o);
+  o.resume = true;
+  EXPECT_THAT([&] { run_sweep(b, o); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("not the same sweep")));
+  std::filesystem::remove_all(o.out_dir);
+}
+
+TEST(Run, ParetoSetIsExactlyTheBruteForceNonDominatedSet) {
+  SweepSettings s = grid({{"L34", 12, 18, 13}, {"L12", 7, 12, 11}});
+  s.objectives = {"margin", "min_lci", "footprint"};
+  const Design d = with_sweep(s);
+  SweepOptions o;
+  o.out_dir = temp_dir("pareto");
+  o.plots = false;
+  const SweepResult r = run_sweep(d, o);
+  std::vector<SweepRow> rows;
+  read_sweep_csv(r.csv, s, [&](const SweepRow& row, const std::string&) {
+    if (row.covered) rows.push_back(row);
+  });
+  ASSERT_GT(rows.size(), 10u);
+  auto dominates = [&](const SweepRow& a, const SweepRow& b) {
+    bool better = false;
+    for (const auto& obj : s.objectives) {
+      if (a.score(obj) < b.score(obj)) return false;
+      if (a.score(obj) > b.score(obj)) better = true;
+    }
+    return better;
+  };
+  std::set<std::uint64_t> brute;
+  for (const auto& a : rows) {
+    bool dominated = false;
+    for (const auto& b : rows) dominated = dominated || dominates(b, a);
+    if (!dominated) brute.insert(a.index);
+  }
+  std::set<std::uint64_t> got;
+  for (const auto& p : r.pareto) got.insert(p.index);
+  EXPECT_EQ(got, brute);
+  // The best design is on the front and is the lexicographic optimum; its file loads.
+  ASSERT_TRUE(r.best.has_value());
+  EXPECT_TRUE(brute.count(r.best->index));
+  for (const auto& row : rows) EXPECT_LE(row.score("margin"), r.best->score("margin"));
+  const Design best = load_design(o.out_dir / "best.yaml");
+  EXPECT_EQ(best.name, "iros2022-best");  // its outputs do not overwrite the swept design's
+  EXPECT_EQ(best.station("index")->lower->L[2], r.best->values[0]);
+  EXPECT_EQ(best.station("index")->upper->L[0], r.best->values[1]);
+  EXPECT_FALSE(best.sweep.has_value());
+  std::filesystem::remove_all(o.out_dir);
+}
+
+TEST(DesignFile, ToYamlRoundTrips) {
+  Design d = paper_design();
+  d.stations[0].lower->joint_limits = std::array<JointRange, 2>{JointRange{0.1, 3.0}, JointRange{-0.5, 2.0}};
+  d.stations[0].lower->min_lci = 0.125;
+  d.stations[1].target.angle = 0.3;
+  d.sweep = grid({{"L34", 12, 18, 13}});
+  d.products = std::vector<std::string>{"kinematics"};
+  const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
+  EXPECT_EQ(to_yaml(back), to_yaml(d));
+  const Mechanism& m = *back.stations[0].lower;
+  EXPECT_EQ(m.L, d.stations[0].lower->L);
+  EXPECT_NEAR(m.joint_limits->at(0).lo, 0.1, 1e-12);
+  EXPECT_NEAR(m.joint_limits->at(1).span(), 2.5, 1e-12);
+  EXPECT_EQ(m.min_lci, 0.125);
+  EXPECT_NEAR(back.stations[1].target.angle, 0.3, 1e-12);
+  EXPECT_EQ(back.geometry->link_width, d.geometry->link_width);
+  EXPECT_EQ(back.print->material, d.print->material);
+}
+
+TEST(Shard, ParseRules) {
+  EXPECT_EQ(parse_shard("0/4"), (std::pair<std::uint64_t, std::uint64_t>{0, 4}));
+  EXPECT_EQ(parse_shard("3/4"), (std::pair<std::uint64_t, std::uint64_t>{3, 4}));
+  for (const char* bad : {"4/4", "1", "/2", "a/b", "1/0", "-1/3", "1/2x"}) {
+    EXPECT_THAT([&] { parse_shard(bad); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("--shard"))) << bad;
+  }
+}
+
+}  // namespace
+}  // namespace fivebar
