@@ -70,15 +70,24 @@ int fivebar::cli::main(int argc, char** argv) {
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);
-    // CLI11 says only "A subcommand is required" for an unknown first word: name it.
-    if (!args.empty() && !args.front().empty() && args.front()[0] != '-') {
+    // CLI11 says only "A subcommand is required" for an unknown word where a subcommand must be
+    // (fivebar WORD, fivebar report WORD): name the word and the choices.
+    CLI::App* level = &app;
+    std::string path;
+    for (const std::string& word : args) {
+      if (word.empty() || word[0] == '-' || level->get_require_subcommand_min() == 0) break;
       std::string known;
-      bool found = false;
-      for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
-        found = found || sub->check_name(args.front());
+      CLI::App* match = nullptr;
+      for (CLI::App* sub : level->get_subcommands([](CLI::App*) { return true; })) {
+        if (sub->check_name(word)) match = sub;
         known += (known.empty() ? "" : ", ") + sub->get_name();
       }
-      if (!found) throw fivebar::InputError("unknown subcommand '" + args.front() + "' (known: " + known + ")");
+      if (match == nullptr) {
+        throw fivebar::InputError("unknown subcommand '" + word + "'" + (path.empty() ? "" : " of '" + path + "'") +
+                                  " (known: " + known + ")");
+      }
+      path += (path.empty() ? "" : " ") + match->get_name();
+      level = match;
     }
     std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
     app.parse(args);

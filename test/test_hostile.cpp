@@ -45,6 +45,14 @@ const std::string kGood =
     "        working_mode: \"-+\"\n"                                    // 9
     "        assembly_mode: \"+\"\n";                                   // 10
 
+// The upper mechanism, for the subcommands that need both (lines 11-15 when appended).
+const std::string kUpper =
+    "      upper:\n"
+    "        bases: [[0, 31], [12.5, 31]]\n"
+    "        links: [9, 9, 15, 15]\n"
+    "        working_mode: \"+-\"\n"
+    "        assembly_mode: \"-\"\n";
+
 std::string good_with(const std::string& from, const std::string& to) {
   std::string text = kGood;
   const auto pos = text.find(from);
@@ -88,7 +96,8 @@ struct Case {
   std::vector<Input> inputs;          ///< created first, in the scratch directory
   std::vector<std::string> messages;  ///< each must appear on stderr
   int exit_code = 2;
-  bool rows_may_stream = false;  ///< a batch without --output may print rows before the bad one
+  bool rows_may_stream = false;          ///< a batch without --output may print rows before the bad one
+  std::vector<std::string> not_messages;  ///< none of these may appear on stderr
 };
 
 std::ostream& operator<<(std::ostream& os, const Case& c) { return os << c.name; }
@@ -311,6 +320,49 @@ std::vector<Case> cases() {
                {"in.csv:3: theta2_deg = 'eighty'"}, 2, /*rows_may_stream=*/true});
   c.push_back({"PointAndPointFileTogether", ik({"--point", "1,2", "--point-file", "points.csv"}), {good, points},
                {"--point"}});
+  c.push_back({"UnknownNestedSubcommand", {"report", "frobnicate", "good.yaml"}, {good},
+               {"unknown subcommand 'frobnicate' of 'report'", "stability"}});
+
+  // --- Other subcommands: absurd sizes and values ----------------------------------------------
+  const Input both = text("both.yaml", kGood + kUpper + "geometry:\n");  // default link geometry
+  const auto sub = [&](std::vector<std::string> head, std::vector<std::string> tail) {
+    return cat(cat(std::move(head), {"both.yaml"}), cat(std::move(tail), {"--out", "out"}));
+  };
+  c.push_back({"WorkspaceSpacingNotANumber", sub({"workspace"}, {"--spacing", "abc"}), {both}, {"--spacing", "abc"}});
+  c.push_back({"WorkspaceSpacingZero", sub({"workspace"}, {"--spacing", "0"}), {both}, {"--spacing = 0 mm", "> 0"}});
+  c.push_back({"WorkspaceSpacingNaN", sub({"workspace"}, {"--spacing", "nan"}), {both}, {"--spacing = nan", "finite"}});
+  c.push_back({"WorkspaceSpacingTooFine", sub({"workspace"}, {"--spacing", "1e-9"}), {both},
+               {"spacing 1e-09 mm needs about ", "e+21 samples", "at most 4000000"}, 2, false,
+               {"needs about -"}});
+  c.push_back({"WorkspaceSpacingHuge", sub({"workspace"}, {"--spacing", "1e300"}), {both},
+               {"spacing 1e+300 mm is larger than the"}, 2, false, {"cairo"}});
+  c.push_back({"CoverageEllipseThreeNumbers", {"coverage", "both.yaml", "--ellipse", "1,2,3"}, {both},
+               {"--ellipse '1,2,3'", "need 5"}});
+  c.push_back({"CoverageEllipseNaN", {"coverage", "both.yaml", "--ellipse", "1,2,3,4,nan"}, {both},
+               {"--ellipse '1,2,3,4,nan'", "finite"}});
+  c.push_back({"CoverageEllipseNegativeAxis", {"coverage", "both.yaml", "--ellipse", "1,2,-3,4,0"}, {both},
+               {"axis lengths must be > 0"}});
+  c.push_back({"CollisionPointNotANumber", sub({"collision"}, {"-s", "index", "--upper", "abc", "--lower", "1,2"}),
+               {both}, {"--upper 'abc'"}});
+  c.push_back({"CollisionSpacingTooFine", sub({"collision"}, {"-s", "index", "--spacing", "1e-9"}), {both},
+               {"too fine"}});
+  c.push_back({"PatternUnknownKind", sub({"pattern"}, {"-s", "index", "--pattern", "wiggle"}), {both},
+               {"--pattern 'wiggle'", "stretch"}});
+  c.push_back({"PatternDurationOfYears", sub({"pattern"}, {"-s", "index", "--pattern", "stretch", "--duration", "1e9"}),
+               {both}, {"duration_s = 1000000000 s", "<= 3600"}});
+  c.push_back({"PatternRateHuge", sub({"pattern"}, {"-s", "index", "--pattern", "stretch", "--rate", "1e9"}), {both},
+               {"rate_hz = 1000000000 Hz"}});
+  c.push_back({"PatternAmplitudeNaN", sub({"pattern"}, {"-s", "index", "--pattern", "stretch", "--amplitude", "nan"}),
+               {both}, {"amplitude_mm = nan"}});
+  c.push_back({"PartsNoJobs", sub({"parts"}, {"--jobs", "0"}), {both}, {"--jobs", "0"}});
+  c.push_back({"SweepBillionSteps", sub({"sweep"}, {"-s", "index", "--vary", "L1=1:2:1000000000"}), {both},
+               {"--vary 'L1=1:2:1000000000'"}});
+  c.push_back({"SweepVaryNotANumber", sub({"sweep"}, {"-s", "index", "--vary", "L1=abc"}), {both},
+               {"--vary 'L1=abc'", "NAME=LO:HI:N"}});
+  c.push_back({"SweepShardOutOfRange", sub({"sweep"}, {"-s", "index", "--vary", "L1=8:10:3", "--shard", "5/2"}), {both},
+               {"--shard = '5/2'"}});
+  c.push_back({"SweepRandomWithoutCount", sub({"sweep"}, {"-s", "index", "--vary", "L1=8:10:3", "--sample", "random"}), {both},
+               {"sweep.count", "required for random sampling"}});
   return c;
 }
 
@@ -334,6 +386,7 @@ TEST_P(Hostile, RefusedCleanlyAndNothingWritten) {
   EXPECT_EQ(r.signal, 0) << "killed by signal " << r.signal;
   EXPECT_EQ(r.code, k.exit_code);
   for (const auto& m : k.messages) EXPECT_THAT(r.err, HasSubstr(m));
+  for (const auto& m : k.not_messages) EXPECT_THAT(r.err, Not(HasSubstr(m)));
   EXPECT_FALSE(r.err.empty());
   EXPECT_LT(r.err.size(), 2000u) << "the message should name the problem, not dump the input";
   EXPECT_THAT(r.err, Not(HasSubstr("internal error")));
