@@ -1,7 +1,56 @@
 #!/usr/bin/env bash
 # Quick start 2/2: install what is missing, build (Release) and run the whole test suite.
+#
+#   ./test.sh              the test suite through ctest (build/, Release)
+#   ./test.sh --sanitize   the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer
+#                          (build-sanitize/, Debug at -O1, gcc)
+#   ./test.sh --fuzz       each libFuzzer target for FIVEBAR_FUZZ_SECONDS seconds (default 60)
+#                          (build-fuzz/, clang; test/fuzz/run_fuzzers.sh)
+#   ./test.sh --all        the three in that order; what `./test.sh` does when CI=true (.ci/run)
+#
+# Other arguments go to ctest (e.g. ./test.sh -R hostile).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 source .ci/setup.sh
-fivebar_setup
-exec ctest --test-dir build --output-on-failure -j2
+
+normal=0 sanitize=0 fuzz=0
+ctest_args=()
+for arg in "$@"; do
+  case "$arg" in
+    --sanitize) sanitize=1 ;;
+    --fuzz) fuzz=1 ;;
+    --all) normal=1 sanitize=1 fuzz=1 ;;
+    *) ctest_args+=("$arg") ;;
+  esac
+done
+if ((normal + sanitize + fuzz == 0)); then
+  normal=1
+  if [[ "${CI:-}" == "true" ]]; then sanitize=1 fuzz=1; fi
+fi
+
+fivebar_install_packages
+
+if ((normal)); then
+  fivebar_build_in build "Release" --
+  fivebar_log "test suite (build/)"
+  ctest --test-dir build --output-on-failure -j2 "${ctest_args[@]}"
+fi
+
+if ((sanitize)); then
+  fivebar_build_in build-sanitize "ASan + UBSan, Debug -O1" -DCMAKE_BUILD_TYPE=Debug -DFIVEBAR_SANITIZE=ON --
+  # Any sanitizer report fails the test that triggered it, also in a child `fivebar` process: the
+  # distinctive exit code 86 never matches an expected one. Leaks are reported too.
+  export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:check_initialization_order=1:strict_init_order=1:detect_stack_use_after_return=0:exitcode=86}"
+  export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1:exitcode=86}"
+  export FIVEBAR_TEST_CHILD_TIMEOUT_S="${FIVEBAR_TEST_CHILD_TIMEOUT_S:-60}"
+  # The whole suite, bench_smoke included (it takes under a second here). Should a later benchmark
+  # make it slow under ASan, leave it out here with -E '^bench_smoke$': the normal suite runs it.
+  fivebar_log "test suite under ASan + UBSan (build-sanitize/)"
+  ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 1500 "${ctest_args[@]}"
+fi
+
+if ((fuzz)); then
+  fivebar_build_in build-fuzz "libFuzzer, clang, ASan + UBSan" -DCMAKE_BUILD_TYPE=Debug -DFIVEBAR_FUZZ=ON \
+    -DFIVEBAR_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang -- fuzz_design_loader fuzz_cli
+  test/fuzz/run_fuzzers.sh build-fuzz
+fi

@@ -14,6 +14,8 @@ FIVEBAR_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
   openscad
+  # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
+  clang libclang-rt-14-dev libomp-dev
 )
 
 fivebar_log() { printf '[fivebar] %s\n' "$*" >&2; }
@@ -50,18 +52,32 @@ fivebar_install_packages() {
 
 # Configures build/ (Release) once and builds the given targets (default: everything).
 fivebar_build() {
+  fivebar_build_in build "Release" -- "$@"
+}
+
+# fivebar_build_in DIR DESCRIPTION [CMAKE_ARG...] -- [TARGET...]: configures $FIVEBAR_ROOT/DIR with
+# the given cmake arguments (Release unless they say otherwise) and builds the targets.
+fivebar_build_in() {
+  local dir="$FIVEBAR_ROOT/$1" description="$2"
+  shift 2
+  local cmake_args=(-DCMAKE_BUILD_TYPE=Release)
+  while (($# > 0)) && [[ "$1" != "--" ]]; do
+    cmake_args+=("$1")
+    shift
+  done
+  (($# > 0)) && shift
   local generator=()
-  # The generator of an existing build/ is kept; a fresh one uses Ninja when it is installed.
-  if [[ ! -f "$FIVEBAR_ROOT/build/CMakeCache.txt" ]] && command -v ninja >/dev/null 2>&1; then
+  # The generator of an existing build directory is kept; a fresh one uses Ninja when installed.
+  if [[ ! -f "$dir/CMakeCache.txt" ]] && command -v ninja >/dev/null 2>&1; then
     generator=(-G Ninja)
   fi
-  fivebar_log "configuring build/ (Release)"
-  cmake -S "$FIVEBAR_ROOT" -B "$FIVEBAR_ROOT/build" -DCMAKE_BUILD_TYPE=Release "${generator[@]}"
+  fivebar_log "configuring ${dir#"$FIVEBAR_ROOT"/}/ ($description)"
+  cmake -S "$FIVEBAR_ROOT" -B "$dir" "${cmake_args[@]}" "${generator[@]}"
   local targets=()
   local t
   for t in "$@"; do targets+=(--target "$t"); done
   fivebar_log "building with $(nproc) jobs"
-  cmake --build "$FIVEBAR_ROOT/build" -j"$(nproc)" "${targets[@]}"
+  cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
 }
 
 # Packages, configure, build.

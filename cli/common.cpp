@@ -1,8 +1,11 @@
 #include "common.hpp"
 
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <numbers>
@@ -225,8 +228,14 @@ CsvReader::CsvReader(const std::string& path, std::vector<std::string> columns) 
     in_ = &std::cin;
   } else {
     name_ = path;
-    file_ = std::make_unique<std::ifstream>(path);
-    if (!*file_) throw InputError("cannot open '" + path + "'");
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory, not a CSV file");
+    errno = 0;
+    file_ = std::make_unique<std::ifstream>(path, std::ios::binary);
+    if (!*file_) {
+      const int err = errno;
+      throw InputError("cannot open '" + path + "'" + (err != 0 ? std::string(": ") + std::strerror(err) : ""));
+    }
     in_ = file_.get();
   }
   std::string header;
@@ -248,9 +257,46 @@ CsvReader::CsvReader(const std::string& path, std::vector<std::string> columns) 
 
 CsvReader::~CsvReader() = default;
 
+namespace {
+
+/// Longest CSV line read: far beyond any row of numbers, short enough that an endless stream
+/// without line breaks (/dev/zero, a binary file) is refused instead of exhausting memory.
+constexpr std::size_t kMaxCsvLineBytes = std::size_t{1} << 20;
+
+/// std::getline with a length limit: false at the end of the stream, `too_long` set when the
+/// line has more than kMaxCsvLineBytes bytes (the rest of the line is not read).
+bool getline_bounded(std::istream& in, std::string& line, bool& too_long) {
+  line.clear();
+  too_long = false;
+  std::streambuf* buf = in.rdbuf();
+  if (buf == nullptr || !in.good()) return false;
+  bool any = false;
+  while (true) {
+    const auto c = buf->sbumpc();
+    if (std::char_traits<char>::eq_int_type(c, std::char_traits<char>::eof())) {
+      in.setstate(std::ios::eofbit);
+      return any;
+    }
+    any = true;
+    if (std::char_traits<char>::to_char_type(c) == '\n') return true;
+    if (line.size() >= kMaxCsvLineBytes) {
+      too_long = true;
+      return true;
+    }
+    line.push_back(std::char_traits<char>::to_char_type(c));
+  }
+}
+
+}  // namespace
+
 bool CsvReader::next_line(std::string& line) {
-  while (std::getline(*in_, line)) {
+  bool too_long = false;
+  while (getline_bounded(*in_, line, too_long)) {
     ++line_no_;
+    if (too_long) {
+      throw InputError(where() + ": line longer than " + std::to_string(kMaxCsvLineBytes) +
+                       " bytes: not a CSV file of numbers");
+    }
     const auto t = trim(line);
     if (t.empty() || t.front() == '#') continue;
     return true;

@@ -1,5 +1,6 @@
-// fivebar: command-line entry point. Subcommands live in one file each (setup_<cmd> / run_<cmd>);
-// this file maps every outcome to the exit codes of DESIGN.md.
+// fivebar: command-line front end, fivebar::cli::main (cli/cli.hpp). Subcommands live in one file
+// each (setup_<cmd> / run_<cmd>); this file maps every outcome to the exit codes of DESIGN.md. The
+// process entry point is fivebar_main.cpp; the fuzzer (test/fuzz/fuzz_cli.cpp) calls this in-process.
 
 #include <algorithm>
 #include <cctype>
@@ -8,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cli.hpp"
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
@@ -43,8 +45,7 @@ std::vector<std::string> join_dash_values(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  using namespace fivebar::cli;
+int fivebar::cli::main(int argc, char** argv) {
   CLI::App app{
       "fivebar " + std::string(fivebar::version()) +
           ": design five-bar-linkage cutaneous haptic devices (IROS 2022).\n"
@@ -69,6 +70,25 @@ int main(int argc, char** argv) {
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);
+    // CLI11 says only "A subcommand is required" for an unknown word where a subcommand must be
+    // (fivebar WORD, fivebar report WORD): name the word and the choices.
+    CLI::App* level = &app;
+    std::string path;
+    for (const std::string& word : args) {
+      if (word.empty() || word[0] == '-' || level->get_require_subcommand_min() == 0) break;
+      std::string known;
+      CLI::App* match = nullptr;
+      for (CLI::App* sub : level->get_subcommands([](CLI::App*) { return true; })) {
+        if (sub->check_name(word)) match = sub;
+        known += (known.empty() ? "" : ", ") + sub->get_name();
+      }
+      if (match == nullptr) {
+        throw fivebar::InputError("unknown subcommand '" + word + "'" + (path.empty() ? "" : " of '" + path + "'") +
+                                  " (known: " + known + ")");
+      }
+      path += (path.empty() ? "" : " ") + match->get_name();
+      level = match;
+    }
     std::reverse(args.begin(), args.end());  // CLI11 consumes a reversed vector
     app.parse(args);
     return kOk;
@@ -87,6 +107,9 @@ int main(int argc, char** argv) {
     return kInternal;
   } catch (const std::exception& e) {
     std::cerr << "fivebar: internal error: " << e.what() << "\n";
+    return kInternal;
+  } catch (...) {
+    std::cerr << "fivebar: internal error: unknown exception\n";
     return kInternal;
   }
 }

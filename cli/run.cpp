@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "common.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/io.hpp"
 #include "fivebar/scene.hpp"
 
 namespace fivebar::cli {
@@ -47,6 +49,9 @@ void print_report(const SceneReport& report) {
 
 int run_run(const RunOptions& opt) {
   const Design design = load(opt.design);
+  if (opt.out.empty()) throw InputError("--out: empty output directory (give a directory, e.g. --out .)");
+  // Every file of the scene lands under --out, whatever a product asks for (fivebar/io.hpp).
+  const WriteFence fence(opt.out);
   SceneOptions options;
   options.out_root = opt.out;
   if (!opt.products.empty()) options.products = opt.products;

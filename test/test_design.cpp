@@ -4,6 +4,7 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -560,6 +561,150 @@ TEST(GeometryValidate, Rules) {
   EXPECT_NO_THROW(p.validate());
   p.pin_clearance = -0.1;
   EXPECT_THAT([&] { p.validate(); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("pin_clearance")));
+}
+
+}  // namespace
+}  // namespace fivebar
+
+// ---------------------------------------------------------------------------------------------
+// Input limits (design.hpp kMaxDesignFileBytes, kMaxDesignNesting; README "Hardening"): checked
+// before yaml-cpp parses; real designs, however written, must never trip them.
+
+namespace fivebar {
+namespace {
+
+using ::testing::Not;
+
+std::string message_of(const std::string& text) {
+  try {
+    load_design_from_string(text, "lim.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string repeat(std::string_view s, std::size_t n) {
+  std::string out;
+  for (std::size_t i = 0; i < n; ++i) out += s;
+  return out;
+}
+
+TEST(DesignLimits, NestingIsCountedAcrossIndentationItemsAndBrackets) {
+  // `products:` sits at the first indentation level; each bracket adds one: 1 + k levels.
+  const auto products_nested = [](std::size_t k) {
+    return kMinimal + "products: " + repeat("[", k) + "kinematics" + repeat("]", k) + "\n";
+  };
+  EXPECT_THAT(message_of(products_nested(kMaxDesignNesting - 1)), Not(HasSubstr("nested")));
+  EXPECT_THAT(message_of(products_nested(kMaxDesignNesting - 1)), HasSubstr("lim.yaml:10: products[0]"));
+  EXPECT_THAT(message_of(products_nested(kMaxDesignNesting)),
+              StartsWith("lim.yaml:10: nested more than 64 levels deep"));
+  // Items: "products:" (1) then 63 compact "- " on the next line, one of them indented (level 2).
+  const std::string items = kMinimal + "products:\n  " + repeat("- ", kMaxDesignNesting - 1) + "kinematics\n";
+  EXPECT_THAT(message_of(items), StartsWith("lim.yaml:11: nested more than 64 levels deep"));
+  const std::string fewer = kMinimal + "products:\n  " + repeat("- ", kMaxDesignNesting - 2) + "kinematics\n";
+  EXPECT_THAT(message_of(fewer), Not(HasSubstr("nested")));
+  // Indentation alone: line k + 2 holds key k at depth k + 1 (stations: is depth 1).
+  std::string indented = "name: m\nstations:\n";
+  for (int i = 1; i <= 70; ++i) indented += std::string(static_cast<std::size_t>(i), ' ') + "k" + std::to_string(i) + ":\n";
+  EXPECT_THAT(message_of(indented), StartsWith("lim.yaml:66: nested more than 64 levels deep"));
+}
+
+TEST(DesignLimits, BracketsOutsideFlowCollectionsAreNotNesting) {
+  // Plain and quoted scalars, comments and block scalars may hold any number of brackets.
+  const std::string many = repeat("[{", 40);
+  const std::string text = "# " + many + " \"unbalanced ' quotes in a comment\n" + kMinimal +
+                           "print:\n"
+                           "  material: Tough 2000 " + many + "   # plain scalar with brackets\n";
+  EXPECT_EQ(message_of(text), "");
+  const std::string block = kMinimal + "print:\n  material: |\n    " + many + "\n    \"never closed\n      {[\n";
+  EXPECT_EQ(message_of(block), "");
+  const std::string quoted = kMinimal + "print:\n  material: \"a " + many + "\n    continued \\\" [[[ \"\n";
+  EXPECT_EQ(message_of(quoted), "");
+  EXPECT_EQ(load_design_from_string(quoted, "q.yaml").print->material.substr(0, 4), "a [{");
+  const std::string single = kMinimal + "print:\n  material: 'it''s [[[ {{{'\n";
+  EXPECT_EQ(load_design_from_string(single, "s.yaml").print->material, "it's [[[ {{{");
+}
+
+TEST(DesignLimits, UnclosedQuoteIsNamedWhereItOpens) {
+  EXPECT_THAT(message_of(kMinimal + "print:\n  material: 'tough\n"),
+              StartsWith("lim.yaml:11: the quoted string that starts at column 13 is never closed"));
+  EXPECT_THAT(message_of("name: m\nproducts: [\"kin, x]\n"),
+              StartsWith("lim.yaml:2: the quoted string that starts at column 12 is never closed"));
+}
+
+TEST(DesignLimits, SizeLimitIsExact) {
+  const auto padded = [](std::size_t total) {
+    std::string text = kMinimal + "# ";
+    text += std::string(total - text.size() - 1, 'x');
+    return text + "\n";
+  };
+  EXPECT_EQ(padded(kMaxDesignFileBytes).size(), kMaxDesignFileBytes);
+  EXPECT_EQ(message_of(padded(kMaxDesignFileBytes)), "");
+  EXPECT_EQ(message_of(padded(kMaxDesignFileBytes + 1)),
+            "lim.yaml: 1048577 bytes: a design file may have at most 1048576 bytes (1 MiB)");
+}
+
+TEST(DesignLimits, SizeLimitOnFilesAndEndlessDevices) {
+  const fs::path path = fs::temp_directory_path() / ("fivebar-test-design-big-" + std::to_string(::getpid()) + ".yaml");
+  { std::ofstream(path) << kMinimal; }
+  fs::resize_file(path, kMaxDesignFileBytes + 10);  // sparse: refused from its size, before reading
+  EXPECT_THAT([&] { load_design(path); },
+              ThrowsMessage<InputError>(StartsWith(path.string() + ": 1048586 bytes: a design file may have at most")));
+  fs::remove(path);
+  EXPECT_THAT([] { load_design("/dev/zero"); },
+              ThrowsMessage<InputError>(StartsWith("/dev/zero: more than 1048576 bytes")));
+}
+
+TEST(DesignLimits, Utf8IsRequiredAndValidated) {
+  // Accepted: multi-byte characters, a byte-order mark, CRLF line ends, tabs inside values.
+  EXPECT_EQ(message_of("\xEF\xBB\xBF# caf\xC3\xA9 \xE2\x9C\x93 \xF0\x9F\x96\x90\r\n" + kMinimal), "");
+  std::string crlf;
+  for (char c : kMinimal) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  EXPECT_EQ(message_of(crlf), "");
+  EXPECT_EQ(message_of(kMinimal + "print: {material: \"a\tb\"}\n"), "");
+  // Refused, with line and column (in characters): overlong, surrogate, beyond U+10FFFF, cut short.
+  EXPECT_EQ(message_of("name: m\n# \xC3\xA9\xC0\xAF\n"),
+            "lim.yaml:2: byte 0xC0 at column 4 is not UTF-8: design files must be UTF-8 text");
+  EXPECT_THAT(message_of("# \xED\xA0\x80\n"), StartsWith("lim.yaml:1: byte 0xED at column 3 is not UTF-8"));
+  EXPECT_THAT(message_of("# \xF4\x90\x80\x80\n"), StartsWith("lim.yaml:1: byte 0xF4 at column 3 is not UTF-8"));
+  EXPECT_THAT(message_of("name: m\n# \xE2\x82"), StartsWith("lim.yaml:2: byte 0xE2 at column 3 is not UTF-8"));
+  EXPECT_THAT(message_of("\xFF\xFEn\0"), StartsWith("lim.yaml: the file is UTF-16 encoded"));
+  EXPECT_THAT(message_of(std::string("\0\0\xFE\xFF", 4)), StartsWith("lim.yaml: the file is UTF-32 encoded"));
+  // Characters YAML excludes: C0 controls but tab and line breaks, DEL, C1 controls.
+  EXPECT_EQ(message_of("name: a\x7F"),
+            "lim.yaml:1: character U+007F at column 8 is a control character, which YAML does not allow "
+            "(only tab and line breaks)");
+  EXPECT_THAT(message_of("name: \xC2\x80"), StartsWith("lim.yaml:1: character U+0080 at column 7"));
+  EXPECT_THAT(message_of(std::string("name: m\0", 8)), StartsWith("lim.yaml:1: character U+0000 at column 8"));
+}
+
+TEST(DesignLimits, MessagesStayShortWhateverTheInput) {
+  const std::string name(100000, 'n');
+  const std::string m = message_of("name: " + name + "\nstations: {}\n");
+  EXPECT_THAT(m, HasSubstr("'" + std::string(97, 'n') + "...' (100000 bytes)"));
+  EXPECT_LT(m.size(), 400u);
+  const std::string key(300, 'k');
+  const std::string k = message_of(kMinimal + key + ": 1\n");
+  EXPECT_THAT(k, StartsWith("lim.yaml:10: key '"));
+  EXPECT_THAT(k, HasSubstr("(300 bytes) is too long for a key of a design file (at most 128 bytes)"));
+  EXPECT_LT(k.size(), 400u);
+  // A long value cut in the middle of a multi-byte character keeps whole characters.
+  const std::string accents = repeat("\xC3\xA9", 200);
+  const std::string a = message_of("name: " + accents + "\nstations: {}\n");
+  EXPECT_THAT(a, HasSubstr("..."));
+  for (std::size_t i = 0; i + 1 < a.size(); ++i) {
+    if (static_cast<unsigned char>(a[i]) == 0xC3) EXPECT_EQ(static_cast<unsigned char>(a[i + 1]), 0xA9);
+  }
+}
+
+TEST(DesignLimits, NamesFromAFileCannotInjectLinesOrTerminalEscapes) {
+  // YAML escapes in a quoted key produce control characters; messages show them escaped.
+  const std::string text = "name: m\nstations:\n  \"a\\nfivebar: internal error\\e[31m\": {target: 1}\n";
+  const std::string m = message_of(text);
+  EXPECT_THAT(m, HasSubstr("stations[\"a\\x0afivebar: internal error\\x1b[31m\"]"));
+  EXPECT_EQ(m.find('\n'), std::string::npos);
+  EXPECT_EQ(m.find('\x1b'), std::string::npos);
 }
 
 }  // namespace

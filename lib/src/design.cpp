@@ -115,6 +115,13 @@ std::string key_child(std::string_view parent, std::string_view name) {
   }
   key += "[\"";
   for (char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {  // a name from a file must not bring line breaks or terminal escapes
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\x%02x", static_cast<unsigned>(u));
+      key += escaped;
+      continue;
+    }
     if (c == '"' || c == '\\') key += '\\';
     key += c;
   }
@@ -157,6 +164,15 @@ std::string key_parent(std::string_view key) {
 }
 
 std::string quoted(std::string_view text) {
+  // Messages stay readable whatever a file holds: long text is cut and its length given.
+  constexpr std::size_t kShown = 100;
+  std::string suffix;
+  if (text.size() > kShown) {
+    suffix = "...' (" + std::to_string(text.size()) + " bytes)";
+    std::size_t cut = kShown - 3;
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0u) == 0x80u) --cut;  // UTF-8 boundary
+    text = text.substr(0, cut);
+  }
   std::string out = "'";
   for (char c : text) {
     const auto u = static_cast<unsigned char>(c);
@@ -168,7 +184,7 @@ std::string quoted(std::string_view text) {
       out += c;
     }
   }
-  out += "'";
+  out += suffix.empty() ? "'" : suffix;
   return out;
 }
 

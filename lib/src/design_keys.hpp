@@ -21,7 +21,8 @@ std::string key_join(std::string_view parent, std::string_view relative);
 /// The key path without its last component; empty for a top-level key.
 std::string key_parent(std::string_view key);
 
-/// Text in single quotes with control characters escaped, for messages.
+/// Text in single quotes with control characters escaped, for messages; text longer than 100
+/// bytes is cut and followed by its length: 'abc...' (5000 bytes).
 std::string quoted(std::string_view text);
 
 }  // namespace fivebar::detail

@@ -1,14 +1,17 @@
 #include "fivebar/io.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <random>
 #include <streambuf>
+#include <vector>
 
 #include "fivebar/error.hpp"
 
@@ -75,12 +78,107 @@ std::uint64_t random_token() {
   return engine();
 }
 
+// --- Temporaries still open, for the signal handler -------------------------------------------
+//
+// A fixed table in static storage: the handler may only read memory that no allocator touches and
+// call async-signal-safe functions (unlink, raise). A slot is 0 free, 1 being filled, 2 live.
+
+constexpr std::size_t kTempSlots = 256;
+constexpr std::size_t kTempPathBytes = 4096;  // PATH_MAX on Linux
+
+struct TempSlot {
+  std::atomic<int> state{0};
+  char path[kTempPathBytes]{};
+};
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+
+TempSlot g_temp_slots[kTempSlots];
+
+/// Records `path` for removal on a signal; -1 when the table is full or the path too long (the
+/// temporary is then still removed on every normal path, only not on a signal).
+int register_temp(const fs::path& path) {
+  const std::string& text = path.native();
+  if (text.size() >= kTempPathBytes) return -1;
+  for (std::size_t i = 0; i < kTempSlots; ++i) {
+    int expected = 0;
+    if (g_temp_slots[i].state.compare_exchange_strong(expected, 1, std::memory_order_acquire)) {
+      std::memcpy(g_temp_slots[i].path, text.c_str(), text.size() + 1);
+      g_temp_slots[i].state.store(2, std::memory_order_release);
+      return static_cast<int>(i);
+    }
+  }
+  return -1;
+}
+
+void unregister_temp(int slot) noexcept {
+  if (slot >= 0) g_temp_slots[slot].state.store(0, std::memory_order_release);
+}
+
+extern "C" void remove_temporaries_and_reraise(int sig) {
+  const int saved_errno = errno;
+  for (TempSlot& slot : g_temp_slots) {
+    if (slot.state.load(std::memory_order_acquire) == 2) (void)::unlink(slot.path);
+  }
+  errno = saved_errno;
+  // SA_RESETHAND restored the default action; the re-raised signal is delivered when this
+  // handler returns, so the process ends exactly as the signal would have ended it.
+  (void)::raise(sig);
+}
+
+// --- Write fences ----------------------------------------------------------------------------------
+
+std::vector<fs::path>& fences() {
+  static std::vector<fs::path> live;
+  return live;
+}
+
+fs::path absolute_normal(const fs::path& p) {
+  std::error_code ec;
+  fs::path a = fs::absolute(p, ec);
+  if (ec) a = p;
+  a = a.lexically_normal();
+  if (!a.has_filename() && a != a.root_path()) a = a.parent_path();  // "dir/" -> "dir"
+  return a;
+}
+
+/// IoError unless `target` is inside every live fence.
+void check_fences(const fs::path& target) {
+  if (fences().empty()) return;
+  const fs::path t = absolute_normal(target);
+  for (const fs::path& root : fences()) {
+    const fs::path inside = t.lexically_relative(root);
+    if (inside.empty() || *inside.begin() == "..") {
+      throw IoError("refusing to write '" + target.string() + "': outside the output directory '" + root.string() +
+                    "'");
+    }
+  }
+}
+
 }  // namespace
+
+void install_interrupt_cleanup() {
+  static std::atomic<bool> installed{false};
+  if (installed.exchange(true)) return;
+  for (const int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
+    struct sigaction old_action {};
+    if (::sigaction(sig, nullptr, &old_action) != 0) continue;
+    if (old_action.sa_handler == SIG_IGN) continue;  // nohup, background jobs: keep ignoring
+    struct sigaction action {};
+    action.sa_handler = remove_temporaries_and_reraise;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    (void)::sigaction(sig, &action, nullptr);
+  }
+}
+
+WriteFence::WriteFence(const fs::path& root) { fences().push_back(absolute_normal(root)); }
+WriteFence::~WriteFence() { fences().pop_back(); }
 
 struct AtomicFile::Impl {
   fs::path target;
   fs::path temp;
   int fd = -1;
+  int slot = -1;  ///< in the signal handler's table
   std::unique_ptr<FdStreambuf> buf;
   std::unique_ptr<std::ostream> os;
   bool committed = false;
@@ -91,6 +189,8 @@ struct AtomicFile::Impl {
     if (fd >= 0) ::close(fd);
     fd = -1;
     if (!temp.empty()) ::unlink(temp.c_str());
+    unregister_temp(slot);  // after the unlink: a signal in between finds the name and unlinks it again
+    slot = -1;
     temp.clear();
   }
 };
@@ -101,15 +201,20 @@ AtomicFile::AtomicFile(fs::path path) : impl_(std::make_unique<Impl>()) {
   if (name.empty() || name == "." || name == "..") {
     throw_io(impl_->target, "not a file name", 0);
   }
+  check_fences(impl_->target);
   const fs::path dir = impl_->target.parent_path();
   for (int attempt = 0; attempt < 16; ++attempt) {
     char token[17];
     std::snprintf(token, sizeof token, "%016llx", static_cast<unsigned long long>(random_token()));
     const std::string temp_name = "." + name.string() + ".tmp." + std::to_string(::getpid()) + "." + token;
     const fs::path temp = dir.empty() ? fs::path(temp_name) : dir / temp_name;
+    // Registered before it exists, so that no signal can fall between creation and registration.
+    const int slot = register_temp(temp);
     const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) unregister_temp(slot);
     if (fd >= 0) {
       impl_->temp = temp;
+      impl_->slot = slot;
       impl_->fd = fd;
       impl_->buf = std::make_unique<FdStreambuf>(fd);
       impl_->os = std::make_unique<std::ostream>(impl_->buf.get());
@@ -163,6 +268,8 @@ void AtomicFile::commit() {
     f.close_and_remove();
     throw_io(f.target, "rename failed", err);
   }
+  unregister_temp(f.slot);
+  f.slot = -1;
   f.temp.clear();
   f.committed = true;
   // Make the rename itself durable; best effort (some file systems refuse fsync on directories).
@@ -189,6 +296,7 @@ void write_file_atomic(const fs::path& path, std::string_view content) {
 
 void make_directories(const fs::path& dir) {
   if (dir.empty()) return;
+  check_fences(dir);
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw IoError("cannot create directory '" + dir.string() + "': " + ec.message());

@@ -23,6 +23,7 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -510,7 +511,7 @@ ProcessResult run_process(const fs::path& exe, const std::vector<std::string>& a
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);  // hygiene: allowed (the child's stdout)
   posix_spawn_file_actions_adddup2(&actions, fds[1], 2);
   std::vector<std::string> storage;
   storage.push_back(exe.string());
@@ -774,38 +775,49 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
         if (fs::exists(stl, ec) && read_text(hash_file) == hash) {
           r.render = RenderState::up_to_date;
         } else {
-          // openscad writes a temporary next to the target; only a complete render is renamed.
-          const fs::path tmp = stl.parent_path() / ("." + stl.filename().string() + ".tmp." +
-                                                    std::to_string(::getpid()) + "." + std::to_string(k) + ".stl");
-          std::vector<std::string> args{"-o", tmp.string()};
-          args.insert(args.end(), flags.begin(), flags.end());
-          args.push_back(scad.string());
-          const auto t0 = std::chrono::steady_clock::now();
-          const ProcessResult pr = run_process(*report.openscad, args);
-          r.render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          if (!pr.started || pr.exit_code != 0 || !fs::exists(tmp, ec)) {
+          // openscad writes the temporary of an AtomicFile (fivebar/io.hpp): removed on failure and
+          // on SIGINT/SIGTERM, refused outside a write fence; only a complete render is committed
+          // (fsync, rename). --export-format names the format: the temporary's extension is not .stl.
+          std::optional<AtomicFile> file;
+          try {
+            file.emplace(stl);
+          } catch (const IoError& e) {
+            r.render_error = e.what();
+          }
+          const fs::path tmp = file ? file->temp_path() : fs::path();
+          ProcessResult pr;
+          if (file) {
+            std::vector<std::string> args{"-o", tmp.string()};
+            args.insert(args.end(), flags.begin(), flags.end());
+            args.push_back(scad.string());
+            const auto t0 = std::chrono::steady_clock::now();
+            pr = run_process(*report.openscad, args);
+            r.render_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          }
+          if (!file || !pr.started || pr.exit_code != 0 || fs::file_size(tmp, ec) == 0 || ec) {
             r.render = RenderState::failed;
-            if (!pr.started) {
+            if (!file) {
+              // r.render_error says why the temporary could not be made
+            } else if (!pr.started) {
               r.render_error = "cannot start " + report.openscad->string() + ": " + pr.start_error;
             } else {
               r.render_error = openscad_message(pr.err);
               if (pr.signal != 0) r.render_error += "\n(killed by signal " + std::to_string(pr.signal) + ")";
             }
-            fs::remove(tmp, ec);
+            file.reset();  // removes the temporary
             // Never leave an STL that no longer matches its .scad.
             fs::remove(stl, ec);
             fs::remove(hash_file, ec);
           } else {
-            // Durable before it replaces the old file (as write_file_atomic does).
-            if (const int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
-              (void)::fsync(fd);
-              ::close(fd);
+            std::string commit_error;
+            try {
+              file->commit();
+            } catch (const IoError& e) {
+              commit_error = e.what();
             }
-            fs::rename(tmp, stl, ec);
-            if (ec) {
+            if (!commit_error.empty()) {
               r.render = RenderState::failed;
-              r.render_error = "cannot rename the render to '" + stl.string() + "': " + ec.message();
-              fs::remove(tmp, ec);
+              r.render_error = commit_error;
             } else {
               try {
                 write_file_atomic(hash_file, hash);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -82,10 +83,20 @@ StationWorkspace analyse_workspace(const Station& station, const WorkspaceOption
     out.mechanisms.push_back(std::move(w));
   }
   const double h = options.spacing_mm;
-  const double samples = ((bounds[2] - bounds[0]) / h + 5.0) * ((bounds[3] - bounds[1]) / h + 5.0);
-  if (samples > kMaxSamples) {
+  const double width = bounds[2] - bounds[0], height = bounds[3] - bounds[1];
+  // Coarser than the workspace itself samples nothing (and a margin of 2h would dwarf it).
+  if (h > std::max(width, height)) {
     std::ostringstream msg;
-    msg << "spacing " << h << " mm needs about " << std::llround(samples) << " samples per field over the "
+    msg << "spacing " << h << " mm is larger than the " << width << " x " << height << " mm workspace of station '"
+        << station.name << "': use a finer spacing";
+    throw InputError(msg.str());
+  }
+  const double samples = (width / h + 5.0) * (height / h + 5.0);
+  if (samples > kMaxSamples) {
+    char count[32];  // a double: the count may exceed every integer type
+    std::snprintf(count, sizeof count, "%.3g", samples);
+    std::ostringstream msg;
+    msg << "spacing " << h << " mm needs about " << count << " samples per field over the "
         << (bounds[2] - bounds[0]) << " x " << (bounds[3] - bounds[1]) << " mm workspace of station '" << station.name
         << "' (at most " << std::llround(kMaxSamples) << "): use a coarser spacing";
     throw InputError(msg.str());

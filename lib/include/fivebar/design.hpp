@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -235,6 +236,12 @@ const std::vector<std::string>& known_products();
 /// The design as a design file (YAML, file units, numbers in shortest round-trip form) that
 /// load_design_from_string() reads back to an equal design.
 std::string to_yaml(const Design& design);
+/// Limits on design files (README "Hardening"), checked before the YAML parser sees the text so
+/// that no file can exhaust the stack or the memory: larger files, deeper nesting, bytes that are
+/// not UTF-8 or characters YAML forbids (control characters) are refused with an InputError.
+inline constexpr std::size_t kMaxDesignFileBytes = std::size_t{1} << 20;  ///< 1 MiB
+/// Levels of block indentation, "- " / "? " items and [ { brackets, counted together.
+inline constexpr int kMaxDesignNesting = 64;
 
 /// Loads and validates a design file. Throws InputError whose message names the file, line, full
 /// key path, value and the rule broken ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2]

@@ -27,7 +27,10 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view conte
 
 /// Streaming counterpart of write_file_atomic (CSV streams, large exports): write through
 /// stream(), then commit() to fsync and rename. Destroying the object without commit() (an
-/// exception, a bad input row) removes the temporary and leaves the target untouched.
+/// exception, a bad input row) removes the temporary and leaves the target untouched, and so does
+/// a signal (install_interrupt_cleanup). A file made by another program (openscad -o) goes the
+/// same way: let the program write temp_path() (naming the format explicitly, as the temporary's
+/// extension is not the target's), then commit().
 class AtomicFile {
  public:
   /// Creates the temporary next to `path`; throws IoError when it cannot.
@@ -53,6 +56,28 @@ class AtomicFile {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+};
+
+/// Interrupted runs (DESIGN.md "a failed run leaves no partial file"): installs handlers for SIGINT,
+/// SIGTERM, SIGHUP and SIGPIPE that remove the temporary of every AtomicFile still open in this
+/// process and then let the signal take its default action, so the process still ends as killed by
+/// that signal. Files already renamed into place are complete; nothing else is left behind. Call
+/// once at the start of main(); further calls do nothing. Signals whose disposition is "ignore"
+/// (nohup, a shell's background job) stay ignored.
+void install_interrupt_cleanup();
+
+/// Confines this process's writes: while a WriteFence on `root` is alive, AtomicFile,
+/// write_file_atomic and make_directories refuse with IoError any target that is not `root` or
+/// lexically inside it (both made absolute against the current directory and normalised; symbolic
+/// links are not resolved). Fences nest: every live fence must contain the target. `fivebar run`
+/// fences its --out root, so no product can write outside it. Create and destroy fences on one
+/// thread while no other thread writes.
+class WriteFence {
+ public:
+  explicit WriteFence(const std::filesystem::path& root);
+  ~WriteFence();
+  WriteFence(const WriteFence&) = delete;
+  WriteFence& operator=(const WriteFence&) = delete;
 };
 
 /// Creates `dir` and its missing parents (no-op when it exists); IoError naming the path otherwise.

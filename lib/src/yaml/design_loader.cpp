@@ -6,6 +6,7 @@
 // "FILE:LINE: KEY = VALUE: RULE" (or "FILE:LINE: KEY: RULE") with the full key path; for errors
 // thrown by validate() the line comes from a key-path -> line map filled while parsing.
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -13,6 +14,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <initializer_list>
@@ -39,6 +42,9 @@ constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 constexpr std::string_view kReservedSections[] = {"controller"};
 
 constexpr std::size_t kMaxShownValue = 60;
+/// Longest map key (section, field or station name) accepted, so that key paths in messages stay
+/// short; every real key is far shorter (station names: at most 64 characters).
+constexpr std::size_t kMaxKeyBytes = 128;
 
 const std::string kYamlFloatTag = "tag:yaml.org,2002:float";
 const std::string kYamlIntTag = "tag:yaml.org,2002:int";
@@ -107,11 +113,276 @@ void render(const YAML::Node& node, std::string& out) {
 std::string render(const YAML::Node& node) {
   std::string out;
   render(node, out);
+  const bool cut = out.size() > kMaxShownValue;
+  if (cut) {
+    std::size_t keep = kMaxShownValue;
+    while (keep > 0 && (static_cast<unsigned char>(out[keep]) & 0xC0u) == 0x80u) --keep;  // UTF-8 boundary
+    out.resize(keep);
+  }
   std::string shown = detail::quoted(out);
   shown = shown.substr(1, shown.size() - 2);  // control characters escaped, no quotes
-  if (shown.size() > kMaxShownValue) shown = shown.substr(0, kMaxShownValue) + "...";
+  if (cut) shown += "...";
   return shown;
 }
+
+// --- Pre-scan ----------------------------------------------------------------------------------------
+//
+// yaml-cpp recurses once per nesting level (and only stops at 2000 levels), keeps every node of a
+// document in memory and passes bytes through unchecked. Before it sees a file, the text is
+// checked against the limits of design.hpp, with messages that name the line.
+
+/// Length of the UTF-8 sequence at text[i] (its code point in `code`), 0 when it is not valid
+/// UTF-8 (overlong forms, surrogates and values above U+10FFFF are invalid).
+std::size_t utf8_sequence(std::string_view text, std::size_t i, char32_t& code) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b0 = byte(i);
+  std::size_t length = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // allowed range of the second byte
+  if (b0 < 0x80) {
+    code = b0;
+    return 1;
+  } else if (b0 >= 0xC2 && b0 <= 0xDF) {
+    length = 2, code = b0 & 0x1Fu;
+  } else if (b0 >= 0xE0 && b0 <= 0xEF) {
+    length = 3, code = b0 & 0x0Fu;
+    if (b0 == 0xE0) lo = 0xA0;  // overlong
+    if (b0 == 0xED) hi = 0x9F;  // surrogates
+  } else if (b0 >= 0xF0 && b0 <= 0xF4) {
+    length = 4, code = b0 & 0x07u;
+    if (b0 == 0xF0) lo = 0x90;  // overlong
+    if (b0 == 0xF4) hi = 0x8F;  // above U+10FFFF
+  } else {
+    return 0;
+  }
+  if (i + length > text.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k) {
+    const unsigned char b = byte(i + k);
+    if (b < (k == 1 ? lo : 0x80) || b > (k == 1 ? hi : 0xBF)) return 0;
+    code = (code << 6) | (b & 0x3Fu);
+  }
+  return length;
+}
+
+/// YAML 1.2 c-printable: tab, line feed, carriage return, and printable characters.
+bool yaml_printable(char32_t c) {
+  return c == 0x09 || c == 0x0A || c == 0x0D || (c >= 0x20 && c <= 0x7E) || c == 0x85 || (c >= 0xA0 && c <= 0xD7FF) ||
+         (c >= 0xE000 && c <= 0xFFFD) || (c >= 0x10000 && c <= 0x10FFFF);
+}
+
+class Prescan {
+ public:
+  explicit Prescan(const std::string& origin) : origin_(origin) {}
+
+  void check(std::string_view text) {
+    if (text.size() > kMaxDesignFileBytes) {
+      throw InputError(origin_ + ": " + std::to_string(text.size()) + " bytes: a design file may have at most " +
+                       std::to_string(kMaxDesignFileBytes) + " bytes (1 MiB)");
+    }
+    check_encoding(text);
+    std::size_t start = 0;
+    int line_no = 0;
+    while (start <= text.size()) {
+      const std::size_t end = std::min(text.find('\n', start), text.size());
+      std::string_view line = text.substr(start, end - start);
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      scan_line(line, ++line_no);
+      start = end + 1;
+    }
+    // yaml-cpp quietly ends such a string at the end of the file, swallowing the keys after it.
+    if (quote_ != 0) {
+      fail(quote_line_, "the quoted string that starts at column " + std::to_string(quote_column_) +
+                            " is never closed");
+    }
+  }
+
+ private:
+  [[noreturn]] void fail(int line, const std::string& what) const {
+    throw InputError(origin_ + ":" + std::to_string(line) + ": " + what);
+  }
+
+  void check_encoding(std::string_view text) const {
+    const auto starts = [&](std::string_view bom) { return text.substr(0, bom.size()) == bom; };
+    using namespace std::string_view_literals;
+    if (starts("\x00\x00\xFE\xFF"sv) || starts("\xFF\xFE\x00\x00"sv)) {
+      throw InputError(origin_ + ": the file is UTF-32 encoded: design files must be UTF-8");
+    }
+    if (starts("\xFE\xFF"sv) || starts("\xFF\xFE"sv)) {
+      throw InputError(origin_ + ": the file is UTF-16 encoded: design files must be UTF-8");
+    }
+    int line = 1, column = 1;
+    for (std::size_t i = 0; i < text.size(); ++column) {
+      char32_t code = 0;
+      const std::size_t length = utf8_sequence(text, i, code);
+      if (length == 0) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(text[i])));
+        fail(line, "byte " + std::string(hex) + " at column " + std::to_string(column) +
+                       " is not UTF-8: design files must be UTF-8 text");
+      }
+      if (!yaml_printable(code)) {
+        char name[16];
+        std::snprintf(name, sizeof name, "U+%04X", static_cast<unsigned>(code));
+        fail(line, "character " + std::string(name) + " at column " + std::to_string(column) +
+                       " is a control character, which YAML does not allow (only tab and line breaks)");
+      }
+      if (code == '\n') ++line, column = 0;
+      i += length;
+    }
+  }
+
+  void deeper_than_allowed(int line, int depth) const {
+    if (depth > kMaxDesignNesting) {
+      fail(line, "nested more than " + std::to_string(kMaxDesignNesting) +
+                     " levels deep (indentation, '- ' items and [ { brackets): refused before parsing; "
+                     "a design needs fewer than 10");
+    }
+  }
+
+  /// Index just past the quoted scalar whose opening quote `q` precedes `from`; npos when it does
+  /// not close on this line.
+  static std::size_t skip_quoted(std::string_view line, std::size_t from, char q) {
+    for (std::size_t i = from; i < line.size(); ++i) {
+      if (q == '"' && line[i] == '\\') {
+        ++i;
+      } else if (line[i] == q) {
+        if (q == '\'' && i + 1 < line.size() && line[i + 1] == '\'') {
+          ++i;  // '' inside a single-quoted scalar
+        } else {
+          return i + 1;
+        }
+      }
+    }
+    return std::string_view::npos;
+  }
+
+  void open_quote(char q, int line_no, std::size_t index) {
+    quote_ = q;
+    quote_line_ = line_no;
+    quote_column_ = static_cast<int>(index) + 1;
+  }
+
+  static bool blank_at(std::string_view line, std::size_t i) { return i >= line.size() || line[i] == ' ' || line[i] == '\t'; }
+
+  void scan_line(std::string_view line, int line_no) {
+    std::size_t indent = 0;
+    while (indent < line.size() && line[indent] == ' ') ++indent;
+    const bool blank = indent == line.size();
+    if (block_scalar_parent_ >= 0) {  // inside a literal / folded block scalar: content only
+      if (blank || static_cast<long>(indent) > block_scalar_parent_) return;
+      block_scalar_parent_ = -1;
+    }
+    std::size_t pos = 0;
+    int depth = flow_base_;
+    if (quote_ != 0) {  // a quoted scalar continued from an earlier line
+      pos = skip_quoted(line, 0, quote_);
+      if (pos == std::string_view::npos) return;
+      quote_ = 0;
+    } else if (flow_ == 0) {
+      if (blank || line[indent] == '#') return;
+      if (line.substr(0, 3) == "---" || line.substr(0, 3) == "...") {
+        if (blank_at(line, 3)) indents_.clear();
+        pos = 3;
+      } else {
+        while (!indents_.empty() && indents_.back() >= indent) indents_.pop_back();
+        indents_.push_back(indent);
+        pos = indent;
+      }
+      depth = static_cast<int>(indents_.size());
+      // Compact nested items: "- - - x" or "? " / ": " indicators open one level each.
+      while (pos < line.size()) {
+        if (line[pos] == ' ') {
+          ++pos;
+        } else if ((line[pos] == '-' || line[pos] == '?' || line[pos] == ':') && blank_at(line, pos + 1)) {
+          ++depth, ++pos;
+          deeper_than_allowed(line_no, depth);
+        } else {
+          break;
+        }
+      }
+      deeper_than_allowed(line_no, depth);
+    }
+    scan(line, pos, line_no, depth, static_cast<long>(indent));
+  }
+
+  /// The rest of a line from `pos`: flow brackets, quoted scalars, comments, block scalars.
+  void scan(std::string_view line, std::size_t pos, int line_no, int block_depth, long indent) {
+    bool node_start = flow_ == 0;  // where a block value may begin with [ { " ' | >
+    bool token_start = true;       // in flow context: where a quoted scalar may begin
+    while (pos < line.size()) {
+      const char c = line[pos];
+      if (c == ' ' || c == '\t') {
+        ++pos;
+        continue;
+      }
+      if (c == '#' && (pos == 0 || line[pos - 1] == ' ' || line[pos - 1] == '\t')) return;  // comment
+      if (flow_ == 0) {
+        if (node_start) {
+          if (c == '&' || c == '!') {  // anchor or tag before the value
+            while (pos < line.size() && !blank_at(line, pos)) ++pos;
+            continue;
+          }
+          if (c == '[' || c == '{') {
+            flow_ = 1, flow_base_ = block_depth;
+            deeper_than_allowed(line_no, flow_base_ + flow_);
+            ++pos, token_start = true;
+            continue;
+          }
+          if (c == '"' || c == '\'') {
+            const std::size_t open = pos;
+            pos = skip_quoted(line, pos + 1, c);
+            if (pos == std::string_view::npos) {
+              open_quote(c, line_no, open);
+              return;
+            }
+            node_start = false;
+            continue;
+          }
+          if (c == '|' || c == '>') {
+            block_scalar_parent_ = indent;
+            return;
+          }
+          node_start = false;
+        }
+        if (c == ':' && blank_at(line, pos + 1)) node_start = true;  // a mapping value follows
+        ++pos;
+        continue;
+      }
+      // Flow context: every bracket outside quotes counts.
+      if ((c == '"' || c == '\'') && token_start) {
+        const std::size_t open = pos;
+        pos = skip_quoted(line, pos + 1, c);
+        if (pos == std::string_view::npos) {
+          open_quote(c, line_no, open);
+          return;
+        }
+        token_start = false;
+        continue;
+      }
+      if (c == '[' || c == '{') {
+        ++flow_;
+        deeper_than_allowed(line_no, flow_base_ + flow_);
+        token_start = true;
+      } else if (c == ']' || c == '}') {
+        if (--flow_ == 0) {
+          flow_base_ = 0;
+          node_start = false;
+        }
+        token_start = false;
+      } else {
+        token_start = c == ',' || c == ':' || c == '?';
+      }
+      ++pos;
+    }
+  }
+
+  const std::string& origin_;
+  std::vector<std::size_t> indents_;  ///< block indentation levels open
+  int flow_ = 0;                      ///< [ { open
+  int flow_base_ = 0;                 ///< block depth where the open flow collection began
+  char quote_ = 0;                    ///< quoted scalar still open at the end of a line
+  int quote_line_ = 0, quote_column_ = 0;  ///< where it opened (column in bytes, 1-based)
+  long block_scalar_parent_ = -1;     ///< indentation of the line that opened a | or > scalar
+};
 
 class Loader {
  public:
@@ -203,6 +474,10 @@ Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, 
       fail(key_line, path, "key " + render(pair.first) + " is not a name: keys must be plain strings");
     }
     const std::string name = pair.first.Scalar();
+    if (name.size() > kMaxKeyBytes) {
+      fail(key_line, path, "key " + detail::quoted(name) + " is too long for a key of a design file (at most " +
+                               std::to_string(kMaxKeyBytes) + " bytes)");
+    }
     const std::string key = key_child(path, name);
     if (const auto it = first_line.find(name); it != first_line.end()) {
       fail(key_line, key, "duplicate key (first given at line " + std::to_string(it->second) + ")");
@@ -575,10 +850,67 @@ Station Loader::station(const Entry& entry) {
   return s;
 }
 
+/// Where each document of a YAML stream starts, from yaml-cpp's events (no node is built).
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  struct Start {
+    YAML::Mark mark;
+    bool null = false;  ///< the document is a bare null
+  };
+  std::vector<Start> starts;
+
+  void OnDocumentStart(const YAML::Mark&) override { fresh_ = true; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { first(mark, true); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { first(mark, false); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string&) override {
+    first(mark, false);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    first(mark, false);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {
+    first(mark, false);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void first(const YAML::Mark& mark, bool null) {
+    if (fresh_) starts.push_back({mark, null});
+    fresh_ = false;
+  }
+  bool fresh_ = false;
+};
+
 Design Loader::load(const std::string& text) {
+  Prescan(origin_).check(text);
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(text);
+    // Not YAML::LoadAll: yaml-cpp 0.7 loops there forever, allocating, on a ',' outside any [ ]
+    // or { } (yaml-cpp issue #1040; fixed upstream in 2024): the parser returns an empty document
+    // for it again and again without moving on. So the documents are counted from the event
+    // stream first, stopping at one that does not advance, and then the first is built.
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentStarts counter;
+    while (parser.HandleNextDocument(counter)) {
+      const auto& starts = counter.starts;
+      const std::size_t n = starts.size();
+      if (n >= 2 && starts[n - 1].mark.pos <= starts[n - 2].mark.pos) {
+        const YAML::Mark& at = starts[n - 1].mark;
+        const char c = at.pos >= 0 && static_cast<std::size_t>(at.pos) < text.size() ? text[static_cast<std::size_t>(at.pos)] : '?';
+        fail(at.line + 1, "", "YAML syntax error: unexpected '" + std::string(1, c) + "' (column " +
+                                  std::to_string(at.column + 1) + ") outside a [ ] or { } list");
+      }
+      if (n > 100) break;  // enough to say there are several
+    }
+    if (counter.starts.size() > 1) {
+      fail(counter.starts[1].mark.line + 1, "", "a design file holds one YAML document, this one has " +
+                                                    std::to_string(counter.starts.size()) +
+                                                    (counter.starts.size() > 100 ? " or more" : ""));
+    }
+    if (!counter.starts.empty()) documents.push_back(YAML::Load(text));
   } catch (const YAML::Exception& e) {
     const int line = e.mark.is_null() ? 1 : e.mark.line + 1;
     std::string rule = "YAML syntax error: " + e.msg + " (column " + std::to_string(e.mark.column + 1) + ")";
@@ -588,10 +920,6 @@ Design Loader::load(const std::string& text) {
   }
   if (documents.empty() || (documents.size() == 1 && documents[0].IsNull())) {
     throw InputError(origin_ + ": empty design file: expected a map with at least 'name' and 'stations'");
-  }
-  if (documents.size() > 1) {
-    fail(line_of(documents[1], 1), "", "a design file holds one YAML document, this one has " +
-                                           std::to_string(documents.size()));
   }
   const YAML::Node& root = documents[0];
   const int root_line = line_of(root, 1);
@@ -653,17 +981,29 @@ Design load_design(const std::filesystem::path& path) {
   if (ec || !std::filesystem::exists(status)) throw InputError(origin + ": no such design file");
   if (std::filesystem::is_directory(status)) throw InputError(origin + ": is a directory, not a design file");
 
+  const auto too_large = [&](std::uintmax_t bytes, const std::string& at_least) {
+    return InputError(origin + ": " + at_least + std::to_string(bytes) + " bytes: a design file may have at most " +
+                      std::to_string(kMaxDesignFileBytes) + " bytes (1 MiB)");
+  };
+  if (std::filesystem::is_regular_file(status)) {
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (!ec && size > kMaxDesignFileBytes) throw too_large(size, "");
+  }
+
   errno = 0;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     const int error = errno;
     throw InputError(origin + ": cannot read the design file" + (error != 0 ? std::string(": ") + std::strerror(error) : ""));
   }
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most one byte more than the limit: a device or pipe (/dev/zero) may never end.
+  std::string text(kMaxDesignFileBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw InputError(origin + ": cannot read the design file");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxDesignFileBytes) throw too_large(kMaxDesignFileBytes, "more than ");
 
-  Design design = load_design_from_string(text.str(), origin);
+  Design design = load_design_from_string(text, origin);
   design.source = path;
   return design;
 }
