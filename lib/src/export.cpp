@@ -111,20 +111,38 @@ const ControllerSettings& require_controller(const Design& d) {
   return *d.controller;
 }
 
-/// The branch an angle is reported on: near the joint's limits when it has some (lo in (-pi, pi],
-/// angles up to lo + span, those outside towards the nearer end), else within pi of `reference`.
+/// The branch a joint's angles are written on, one for the gate, the limits and the potentiometer
+/// map: the one holding the joint's angle at the target centre normalised to (-pi, pi]
+/// (`reference`). Without limits an angle is represented within pi of the reference; with limits
+/// the arc starts at the representative of lo at most one turn below the reference (so the arc
+/// holds the reference when the centre is within the limits), and an angle outside the arc is put
+/// next to its nearer end.
 struct Branch {
   std::optional<JointRange> limits;
   double reference = 0.0;
+  double lo() const { return reference - wrap_two_pi(reference - limits->lo); }
+  double hi() const { return lo() + limits->span(); }
   double represent(double theta) const {
     if (!limits) return reference + std::remainder(theta - reference, kTwoPi);
-    const double lo = normalized(limits->lo);
-    const double offset = wrap_two_pi(theta - lo);
+    const double offset = wrap_two_pi(theta - lo());
     const double span = limits->span();
-    if (offset <= span) return lo + offset;
-    return (offset - span) < (kTwoPi - offset) ? lo + offset : lo + offset - kTwoPi;
+    if (offset <= span) return lo() + offset;
+    return (offset - span) < (kTwoPi - offset) ? lo() + offset : lo() + offset - kTwoPi;
   }
 };
+
+/// The branches of both joints of `m` for the target `e`.
+std::array<Branch, 2> branches(const Mechanism& m, const Ellipse& e) {
+  std::array<Branch, 2> b;
+  const Pose centre = ik(m, e.center);
+  for (int j = 0; j < 2; ++j) {
+    if (m.joint_limits) b[j].limits = (*m.joint_limits)[j];
+    // An unreachable centre fails the gate anyway; the limits then start at lo in (-pi, pi].
+    b[j].reference = centre.status == Status::unreachable ? (m.joint_limits ? normalized((*m.joint_limits)[j].lo) : 0.0)
+                                                          : normalized(j == 0 ? centre.theta1 : centre.theta2);
+  }
+  return b;
+}
 
 /// Joint angles over the filled ellipse: boundary samples for the ranges, and rings for the limits.
 struct JointSamples {
@@ -135,17 +153,13 @@ struct JointSamples {
   int worst_joint = 0;
   double worst_theta = 0.0;   ///< on the branch
   Vec2 worst_point{0.0, 0.0};
+  std::array<Branch, 2> branch;
 };
 
 JointSamples sample_joints(const Mechanism& m, const Ellipse& e, const ExportOptions& options) {
   JointSamples out;
-  std::array<Branch, 2> branch;
-  const Pose centre = ik(m, e.center);
-  for (int j = 0; j < 2; ++j) {
-    if (m.joint_limits) branch[j].limits = (*m.joint_limits)[j];
-    branch[j].reference = centre.status == Status::unreachable ? 0.0 : normalized(j == 0 ? centre.theta1 : centre.theta2);
-  }
-  bool reference_set = centre.status != Status::unreachable;
+  std::array<Branch, 2> branch = branches(m, e);
+  bool reference_set = ik(m, e.center).status != Status::unreachable;
   const auto visit = [&](const Vec2& p) {
     ++out.samples;
     const Pose pose = ik(m, p);
@@ -162,9 +176,7 @@ JointSamples sample_joints(const Mechanism& m, const Ellipse& e, const ExportOpt
       out.lo[j] = out.any ? std::min(out.lo[j], theta[j]) : theta[j];
       out.hi[j] = out.any ? std::max(out.hi[j], theta[j]) : theta[j];
       if (branch[j].limits) {
-        const double lo = normalized(branch[j].limits->lo);
-        const double hi = lo + branch[j].limits->span();
-        const double excess = std::max(lo - theta[j], theta[j] - hi);
+        const double excess = std::max(branch[j].lo() - theta[j], theta[j] - branch[j].hi());
         if (excess > out.worst_excess) {
           out.worst_excess = excess, out.worst_joint = j, out.worst_theta = theta[j], out.worst_point = p;
         }
@@ -173,6 +185,7 @@ JointSamples sample_joints(const Mechanism& m, const Ellipse& e, const ExportOpt
     out.any = true;
     if (!pose.within_joint_limits) ++out.outside;
   };
+  out.branch = branch;
   visit(e.center);
   const int n = std::max(8, options.boundary_samples);
   for (int k = 0; k < n; ++k) visit(e.boundary_point(kTwoPi * k / n));
@@ -301,23 +314,20 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
       if (!m->joint_limits) {
         add("joint_limits", subject, true, "no joint limits in the design (has_position_limits: false)");
       } else {
-        const auto& lim = *m->joint_limits;
         std::string detail;
         if (js.outside == 0) {
           for (int j = 0; j < 2; ++j) {
-            const double lo = normalized(lim[j].lo);
             detail += std::string(j ? "; " : "") + "theta" + std::to_string(j + 1) + " " +
                       (js.any ? deg_range(js.lo[j], js.hi[j]) : std::string("-")) + " within " +
-                      deg_range(lo, lo + lim[j].span());
+                      deg_range(js.branch[j].lo(), js.branch[j].hi());
           }
           detail += " (" + std::to_string(js.samples - js.unreachable) + " samples)";
         } else {
           const int j = js.worst_joint;
-          const double lo = normalized(lim[j].lo);
           detail = std::to_string(js.outside) + " of " + std::to_string(js.samples) +
                    " samples outside the limits; worst: theta" + std::to_string(j + 1) + " = " +
                    fixed(js.worst_theta * kDegPerRad, 2) + " deg at " + point_text(js.worst_point) + ", outside " +
-                   deg_range(lo, lo + lim[j].span());
+                   deg_range(js.branch[j].lo(), js.branch[j].hi());
         }
         add("joint_limits", subject, js.outside == 0, detail);
       }
@@ -330,8 +340,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
           const JointControl jc = c.joint(name, m->name, j + 1);
           double lo = 0.0, hi = 0.0;
           if (m->joint_limits) {
-            lo = normalized((*m->joint_limits)[j].lo);
-            hi = lo + (*m->joint_limits)[j].span();
+            lo = js.branch[j].lo(), hi = js.branch[j].hi();
           } else if (js.any) {
             lo = js.lo[j], hi = js.hi[j];
           } else {
@@ -480,6 +489,7 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
     for (const Mechanism* m : s.mechanisms()) mechanisms.push_back(m->name);
     st["mechanisms"] = mechanisms;
     for (const Mechanism* m : s.mechanisms()) {
+      const std::array<Branch, 2> branch = branches(*m, s.target);
       Json names = Json::array();
       for (int j = 1; j <= 2; ++j) names.push_back(joint_name(name, m->name, j));
       Json links = Json::array();
@@ -497,10 +507,8 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
         Json lim = Json::object();
         lim["has_position_limits"] = m->joint_limits.has_value();
         if (m->joint_limits) {
-          const JointRange& r = (*m->joint_limits)[j - 1];
-          const double lo = normalized(r.lo);
-          lim["min_position"] = lo;
-          lim["max_position"] = lo + r.span();
+          lim["min_position"] = branch[j - 1].lo();
+          lim["max_position"] = branch[j - 1].hi();
         }
         lim["has_velocity_limits"] = true;
         lim["max_velocity"] = c.max_velocity;
@@ -567,6 +575,14 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
   const std::string stem = export_stem(d, result.gate.stations);
   for (ExportFormat f : formats) {
     documents.emplace_back(dir / (stem + std::string(file_extension(f))), render(f, result.parameters));
+  }
+  // A target that cannot be replaced (a directory of that name) fails before anything is written.
+  for (const auto& [path, text] : documents) {
+    std::error_code ec;
+    const auto status = std::filesystem::symlink_status(path, ec);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+      throw IoError(path.string() + ": exists and is not a regular file; nothing written");
+    }
   }
   make_directories(dir);
   std::vector<AtomicFile> files;

@@ -22,10 +22,15 @@
 ///     link_thickness_m, layers, layer_gap_m, pin_diameter_m, boss_diameter_m, tactor_diameter_m,
 ///     tactor_height_m, motor_shaft_diameter_m}
 ///   joint_limits.<joint>: ros2_control layout: has_position_limits, min_position, max_position
-///     (only with limits: the design's ccw arc, min in (-pi, pi], max = min + span), has_velocity_limits,
+///     (only with limits: the design's ccw arc, max = min + span), has_velocity_limits,
 ///     max_velocity (rad/s), has_acceleration_limits, has_jerk_limits, has_effort_limits (false)
 ///   gains.<joint>: {p, i, d, i_clamp} (duty per rad, see PidGains)
 ///   potentiometers.<joint>: {volts_at_zero, rad_per_volt}: theta = rad_per_volt (V - volts_at_zero)
+///
+/// Joint angles are continuous on one branch per joint, the one holding its angle at the target
+/// centre normalised to (-pi, pi]: min_position is the representative of the design's lo at most
+/// one turn below it, and the potentiometer map and the gate's ranges use the same branch (so an
+/// upper mechanism's limits [-200, -60] deg stay [-200, -60], not [160, 300]).
 ///
 /// Joint names: `<station>_<mechanism>_theta<1|2>`, e.g. `index_lower_theta1` (motor at O1 of
 /// the index station's lower mechanism). Every double is written as a double (`5.0`, never `5`)
@@ -80,8 +85,7 @@ struct GateCheck {
   std::string detail;   ///< one line: the measured value against its threshold, or why it failed
 };
 
-/// Angles one joint takes over the target ellipse (boundary samples), rad, on the branch of the
-/// export: [lo, hi] with lo in (-pi, pi] + k 2 pi near the design's limits or the centre's angle.
+/// Angles one joint takes over the target ellipse (samples), rad, on the joint's branch (above).
 struct JointSweep {
   std::string name;  ///< joint name
   double lo = 0.0;
@@ -162,8 +166,9 @@ struct ExportResult {
 std::string export_stem(const Design& design, const std::vector<std::string>& stations);
 
 /// Runs the gate; only when it passes, renders every requested format in memory, creates `dir`
-/// and writes each file atomically (all temporaries written before the first rename). A failed
-/// gate creates and writes nothing. IoError when the files cannot be written.
+/// and writes each file atomically (all temporaries written before the first rename; a target
+/// that is not a regular file is refused before anything is written). A failed gate creates and
+/// writes nothing. IoError when the files cannot be written.
 ExportResult export_controller(const Design& design, const std::vector<ExportFormat>& formats,
                                const std::filesystem::path& dir, const ExportOptions& options = {});
 
