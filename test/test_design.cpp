@@ -792,6 +792,36 @@ controller:
   }
 }
 
+TEST(Loader, ControllerMechanismScopesApplyToEveryStationBelowAnyStationScope) {
+  const Design d = load_design_from_string(R"(name: c
+controller:
+  pid: {kp: 5}
+  mechanisms:
+    lower:
+      pid: {kp: 3, kd: 0.01}
+      theta1: {pid: {kp: 2.5}, potentiometer: {volts_at_zero: 0.25}}
+    upper: {pid: {ki: 0.5}}
+  stations:
+    index: {pid: {kp: 4}}
+)" + kControllerStations,
+                                           "<test>");
+  const ControllerSettings& c = *d.controller;
+  // A scope naming a station beats every station-less one, however narrow.
+  EXPECT_EQ(c.joint("index", "lower", 1).pid.kp, 4.0);
+  EXPECT_EQ(c.joint("index", "lower", 1).pid.kd, 0.01);  // not given by the station: the mechanisms'
+  EXPECT_EQ(c.joint("index", "lower", 1).potentiometer.volts_at_zero, 0.25);
+  EXPECT_EQ(c.joint("thumb", "lower", 1).pid.kp, 2.5);
+  EXPECT_EQ(c.joint("thumb", "lower", 2).pid.kp, 3.0);
+  EXPECT_EQ(c.joint("thumb", "lower", 2).potentiometer.volts_at_zero, 2.5);
+  EXPECT_EQ(c.joint("index", "upper", 2).pid.ki, 0.5);
+  EXPECT_EQ(c.joint("index", "upper", 2).pid.kp, 4.0);
+  // The thumb has no upper mechanism: a rule for every upper mechanism is simply unused there.
+  const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
+  EXPECT_EQ(to_yaml(back), to_yaml(d));
+  EXPECT_EQ(back.controller->joint("thumb", "lower", 1).pid.kp, 2.5);
+  EXPECT_EQ(back.controller->joint("index", "lower", 1).pid.kp, 4.0);
+}
+
 TEST(Loader, PatternsTakeTheControllersRateAndTheOneSpeedLimit) {
   const Design d = load_design_from_string(R"(name: c
 patterns:

@@ -620,10 +620,16 @@ void Potentiometer::validate() const {
 }
 
 std::string ControlOverride::key() const {
-  std::string k = detail::key_child("stations", station);
+  std::string k = station.empty() ? std::string("mechanisms") : detail::key_child("stations", station);
   if (!mechanism.empty()) k = detail::key_join(k, mechanism);
   if (joint != 0) k = detail::key_join(k, "theta" + std::to_string(joint));
   return k;
+}
+
+int ControlOverride::level() const {
+  if (station.empty()) return joint == 0 ? 0 : 1;
+  if (mechanism.empty()) return 2;
+  return joint == 0 ? 3 : 4;
 }
 
 JointControl ControllerSettings::joint(std::string_view station, std::string_view mechanism, int j) const {
@@ -636,12 +642,11 @@ JointControl ControllerSettings::joint(std::string_view station, std::string_vie
     if (o.volts_at_zero) out.potentiometer.volts_at_zero = *o.volts_at_zero;
     if (o.rad_per_volt) out.potentiometer.rad_per_volt = *o.rad_per_volt;
   };
-  // Widest scope first, so that a joint's own keys win whatever the order of the file.
-  for (int level = 0; level < 3; ++level) {
+  // Widest scope first, so that the narrower keys win whatever the order of the list.
+  for (int level = 0; level <= 4; ++level) {
     for (const ControlOverride& o : overrides) {
-      if (o.station != station) continue;
-      const int o_level = o.mechanism.empty() ? 0 : (o.joint == 0 ? 1 : 2);
-      if (o_level != level) continue;
+      if (o.level() != level) continue;
+      if (!o.station.empty() && o.station != station) continue;
       if (!o.mechanism.empty() && o.mechanism != mechanism) continue;
       if (o.joint != 0 && o.joint != j) continue;
       apply(o);
@@ -700,6 +705,9 @@ void ControllerSettings::validate() const {
     const std::string scope = o.key();
     if (!o.mechanism.empty() && o.mechanism != "lower" && o.mechanism != "upper") {
       throw ValidationError(scope, "mechanism " + detail::quoted(o.mechanism) + " must be lower or upper");
+    }
+    if (o.station.empty() && o.mechanism.empty()) {
+      throw ValidationError(scope, "an override names a station, a mechanism (lower, upper) or both");
     }
     if (o.joint < 0 || o.joint > 2 || (o.joint != 0 && o.mechanism.empty())) {
       throw ValidationError(scope, "joint " + std::to_string(o.joint) + " must be 1 or 2 within a mechanism");
@@ -818,6 +826,7 @@ void Design::validate() const {
   if (controller) {
     validate_nested("controller", [&] { controller->validate(); });
     for (const ControlOverride& o : controller->overrides) {
+      if (o.station.empty()) continue;  // every station's lower / upper: none is fine
       const Station* st = station(o.station);
       const std::string key = detail::key_join("controller", o.key());
       if (st == nullptr) {

@@ -443,7 +443,9 @@ Design export_view(const Design& d, const std::vector<std::string>& wanted) {
   v.patterns = d.patterns;
   if (v.patterns) std::erase_if(v.patterns->per_station, [&](const auto& e) { return !kept(e.first); });
   v.controller = d.controller;
-  if (v.controller) std::erase_if(v.controller->overrides, [&](const ControlOverride& o) { return !kept(o.station); });
+  if (v.controller) {
+    std::erase_if(v.controller->overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
+  }
   return v;
 }
 

@@ -236,17 +236,22 @@ struct JointControl {
   Potentiometer potentiometer;
 };
 
-/// An override of some PID or potentiometer keys for a station, one of its mechanisms, or one
-/// joint (`controller.stations.<station>[.<mechanism>[.theta1|theta2]]`). Unset keys keep the
-/// value of the wider scope.
+/// An override of some PID or potentiometer keys. Scopes, from the widest: the lower or upper
+/// mechanism of every station (`controller.mechanisms.<mechanism>`), one of its joints
+/// (`...<mechanism>.theta1|theta2`), a station (`controller.stations.<station>`), one of its
+/// mechanisms, one of their joints. A scope naming a station is narrower than any that does not.
+/// Unset keys keep the value of the wider scope.
 struct ControlOverride {
-  std::string station;
+  std::string station;    ///< empty: every station (then `mechanism` is set)
   std::string mechanism;  ///< "lower", "upper", or empty: every mechanism of the station
   int joint = 0;          ///< 1 or 2 (theta1, theta2), or 0: both joints
   std::optional<double> kp, ki, kd, i_clamp;
   std::optional<double> volts_at_zero, rad_per_volt;
-  /// Key path of this scope relative to `controller` ("stations.index.lower.theta1").
+  /// Key path of this scope relative to `controller` ("stations.index.lower.theta1",
+  /// "mechanisms.upper").
   std::string key() const;
+  /// 0 ... 4, widest first, in the order above.
+  int level() const;
 };
 
 /// The ROS controller on the device (`controller:`; paper Sec. II-D): per mechanism an IK module,
@@ -273,7 +278,7 @@ struct ControllerSettings {
   std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first
 
   /// Gains and calibration of joint `joint` (1 or 2) of a mechanism: the defaults, then the
-  /// overrides of the station, of the mechanism, of the joint.
+  /// overrides from the widest scope to the narrowest (ControlOverride), in file order within one.
   JointControl joint(std::string_view station, std::string_view mechanism, int joint) const;
   /// Rules that need no design (ranges, names); Design::validate() checks the override scopes.
   void validate() const;

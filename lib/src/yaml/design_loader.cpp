@@ -548,9 +548,9 @@ ControllerSettings Loader::controller(const Entry& entry) {
   if (entry.value.IsNull()) return c;  // `controller:` alone: every default
   const Entries all = entries(entry.value, entry.path, entry.line,
                               {"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                               "min_lci", "pid", "potentiometer", "stations"},
+                               "min_lci", "pid", "potentiometer", "mechanisms", "stations"},
                               "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                              "pid, potentiometer, stations)");
+                              "pid, potentiometer, mechanisms, stations)");
   if (const Entry* n = find(all, "node")) c.node = string(n->value, n->path, n->line, "must be a ROS 2 node name");
   c.loop_rate_hz = optional_number(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = optional_number(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -580,6 +580,30 @@ ControllerSettings Loader::controller(const Entry& entry) {
   if (defaults.volts_at_zero) c.potentiometer.volts_at_zero = *defaults.volts_at_zero;
   if (defaults.rad_per_volt) c.potentiometer.rad_per_volt = *defaults.rad_per_volt;
 
+  // One mechanism's scope (of a station, or of every station when `station` is empty) and its joints.
+  const auto mechanism_scope = [&](const Entry& m, const std::string& station) {
+    const Entries mech_keys = entries(m.value, m.path, m.line, {"pid", "potentiometer", "theta1", "theta2"},
+                                      "(pid, potentiometer, theta1, theta2)");
+    ControlOverride mo;
+    mo.station = station;
+    mo.mechanism = m.name;
+    control_keys(mech_keys, mo);
+    c.overrides.push_back(mo);
+    for (const Entry& j : mech_keys) {
+      if (j.name != "theta1" && j.name != "theta2") continue;
+      ControlOverride jo = mo;
+      jo.kp = jo.ki = jo.kd = jo.i_clamp = jo.volts_at_zero = jo.rad_per_volt = std::nullopt;
+      jo.joint = j.name == "theta1" ? 1 : 2;
+      control_keys(entries(j.value, j.path, j.line, {"pid", "potentiometer"}, "(pid, potentiometer)"), jo);
+      c.overrides.push_back(jo);
+    }
+  };
+  if (const Entry* mechanisms = find(all, "mechanisms")) {
+    for (const Entry& m : entries(mechanisms->value, mechanisms->path, mechanisms->line, {"lower", "upper"},
+                                  "with keys lower and/or upper (every station's)")) {
+      mechanism_scope(m, "");
+    }
+  }
   if (const Entry* stations = find(all, "stations")) {
     for (const Entry& st : entries(stations->value, stations->path, stations->line, {},
                                    "of station names to their overrides", /*any_key=*/true)) {
@@ -590,23 +614,7 @@ ControllerSettings Loader::controller(const Entry& entry) {
       control_keys(station_keys, so);
       c.overrides.push_back(so);
       for (const Entry& m : station_keys) {
-        if (m.name != "lower" && m.name != "upper") continue;
-        const Entries mech_keys = entries(m.value, m.path, m.line, {"pid", "potentiometer", "theta1", "theta2"},
-                                          "(pid, potentiometer, theta1, theta2)");
-        ControlOverride mo;
-        mo.station = st.name;
-        mo.mechanism = m.name;
-        control_keys(mech_keys, mo);
-        c.overrides.push_back(mo);
-        for (const Entry& j : mech_keys) {
-          if (j.name != "theta1" && j.name != "theta2") continue;
-          ControlOverride jo;
-          jo.station = st.name;
-          jo.mechanism = m.name;
-          jo.joint = j.name == "theta1" ? 1 : 2;
-          control_keys(entries(j.value, j.path, j.line, {"pid", "potentiometer"}, "(pid, potentiometer)"), jo);
-          c.overrides.push_back(jo);
-        }
+        if (m.name == "lower" || m.name == "upper") mechanism_scope(m, st.name);
       }
     }
   }

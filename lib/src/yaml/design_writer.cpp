@@ -175,7 +175,8 @@ void controller(YAML::Emitter& out, const Design& d, const ControllerSettings& c
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;
   control_keys(out, defaults);
 
-  // Overrides in canonical form: by station (design order), then mechanism, then joint.
+  // Overrides in canonical form: every station's mechanisms, then by station (design order), then
+  // mechanism, then joint.
   const auto scope = [&](const std::string& station, const std::string& mechanism, int joint) {
     std::vector<const ControlOverride*> found;
     for (const ControlOverride& o : c.overrides) {
@@ -183,6 +184,30 @@ void controller(YAML::Emitter& out, const Design& d, const ControllerSettings& c
     }
     return merged(found);
   };
+  // One mechanism's scope and its joints under an open map; false when it gives nothing.
+  const auto mechanism_scope = [&](const std::string& station, const char* mechanism, const auto& open) {
+    const ControlOverride mech_keys = scope(station, mechanism, 0);
+    const ControlOverride joint_keys[2] = {scope(station, mechanism, 1), scope(station, mechanism, 2)};
+    if (!has_keys(mech_keys) && !has_keys(joint_keys[0]) && !has_keys(joint_keys[1])) return;
+    open();
+    out << YAML::Key << mechanism << YAML::Value << YAML::BeginMap;
+    control_keys(out, mech_keys);
+    for (int j = 0; j < 2; ++j) {
+      if (!has_keys(joint_keys[j])) continue;
+      out << YAML::Key << ("theta" + std::to_string(j + 1)) << YAML::Value << YAML::BeginMap;
+      control_keys(out, joint_keys[j]);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  };
+  bool mechanisms_open = false;
+  for (const char* mechanism : {"lower", "upper"}) {
+    mechanism_scope("", mechanism, [&] {
+      if (!mechanisms_open) out << YAML::Key << "mechanisms" << YAML::Value << YAML::BeginMap, mechanisms_open = true;
+    });
+  }
+  if (mechanisms_open) out << YAML::EndMap;
+
   bool any = false;
   for (const Station& s : d.stations) {
     const ControlOverride station_keys = scope(s.name, "", 0);
@@ -195,21 +220,7 @@ void controller(YAML::Emitter& out, const Design& d, const ControllerSettings& c
       open_station();
       control_keys(out, station_keys);
     }
-    for (const char* mechanism : {"lower", "upper"}) {
-      const ControlOverride mech_keys = scope(s.name, mechanism, 0);
-      const ControlOverride joint_keys[2] = {scope(s.name, mechanism, 1), scope(s.name, mechanism, 2)};
-      if (!has_keys(mech_keys) && !has_keys(joint_keys[0]) && !has_keys(joint_keys[1])) continue;
-      open_station();
-      out << YAML::Key << mechanism << YAML::Value << YAML::BeginMap;
-      control_keys(out, mech_keys);
-      for (int j = 0; j < 2; ++j) {
-        if (!has_keys(joint_keys[j])) continue;
-        out << YAML::Key << ("theta" + std::to_string(j + 1)) << YAML::Value << YAML::BeginMap;
-        control_keys(out, joint_keys[j]);
-        out << YAML::EndMap;
-      }
-      out << YAML::EndMap;
-    }
+    for (const char* mechanism : {"lower", "upper"}) mechanism_scope(s.name, mechanism, open_station);
     if (station_open) out << YAML::EndMap;
   }
   if (any) out << YAML::EndMap;
