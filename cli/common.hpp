@@ -139,5 +139,6 @@ void setup_parts(CLI::App& app);
 void setup_collision(CLI::App& app);
 void setup_pattern(CLI::App& app);
 void setup_report(CLI::App& app);
+void setup_export(CLI::App& app);
 
 }  // namespace fivebar::cli

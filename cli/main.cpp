@@ -67,6 +67,7 @@ int fivebar::cli::main(int argc, char** argv) {
   setup_collision(app);
   setup_pattern(app);
   setup_report(app);
+  setup_export(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

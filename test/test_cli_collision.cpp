@@ -394,7 +394,7 @@ TEST_F(CliTactors, RunLeavesTheProductsOutAndSaysWhy) {
   EXPECT_THAT(reasons["pattern"], HasSubstr("both a lower and an upper"));
 
   // Without patterns: only the pattern product is left out.
-  const fs::path no_patterns = design_without("no-patterns.yaml", "patterns:\n", "# Later versions");
+  const fs::path no_patterns = design_without("no-patterns.yaml", "patterns:\n", "# The ROS controller on the device");
   const json c = parse(run({"run", no_patterns.string(), "--out", out.string(), "--json", "--quiet", "--products",
                             "collision,pattern"}));
   EXPECT_EQ(c["built"][0]["name"], "collision");

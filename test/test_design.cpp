@@ -846,3 +846,285 @@ TEST(DesignValidate, PatternStationsMustExist) {
 
 }  // namespace
 }  // namespace fivebar
+
+// ---------------------------------------------------------------------------------------------
+// The controller section (loader, rules, overrides) and the design writer's round trip.
+
+namespace fivebar {
+namespace {
+
+const std::string kControllerStations = R"(stations:
+  index:
+    target: {center: [6.25, 15.5], axes: [15, 12]}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 15, 15], working_mode: "-+"}
+      upper: {bases: [[0, 31], [12.5, 31]], links: [9, 9, 15, 15], working_mode: "+-"}
+  thumb:
+    target: {center: [6.25, 17.5], axes: [15, 14]}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 17.5, 17.5], working_mode: "-+"}
+)";
+
+TEST(Loader, ControllerSectionAloneTakesEveryDefault) {
+  const Design d = load_design_from_string("name: c\ncontroller:\n" + kControllerStations, "<test>");
+  ASSERT_TRUE(d.controller.has_value());
+  const ControllerSettings& c = *d.controller;
+  EXPECT_EQ(c.node, "fivebar_controller");
+  EXPECT_EQ(c.loop_rate_hz, 100.0);  // paper: PID at 100 Hz
+  EXPECT_EQ(c.pwm_hz, 1000.0);       // paper: 1 kHz PWM
+  EXPECT_EQ(c.adc_bits, 16);         // paper: 16-bit DAQ
+  EXPECT_EQ(c.adc_range_v, (std::array<double, 2>{-10.0, 10.0}));
+  EXPECT_DOUBLE_EQ(c.max_velocity, deg(360));
+  EXPECT_EQ(c.collision_priority, "upper");
+  EXPECT_TRUE(c.overrides.empty());
+  // 5 V over 300 deg of travel: 60 deg per volt.
+  EXPECT_DOUBLE_EQ(c.potentiometer.rad_per_volt, deg(60));
+  const Design none = load_design_from_string("name: c\n" + kControllerStations, "<test>");
+  EXPECT_FALSE(none.controller.has_value());
+}
+
+TEST(Loader, ControllerUnitsAndOverridesFromTheWidestScopeToTheJoint) {
+  const Design d = load_design_from_string(R"(name: c
+controller:
+  node: haptics_node
+  loop_rate_hz: 250
+  pwm_hz: 20000
+  adc: {bits: 12, range_v: [0, 5]}
+  max_velocity_deg_s: 90
+  min_lci: 0.1
+  pid: {kp: 5, ki: 1, kd: 0.05, i_clamp: 0.2}
+  potentiometer: {volts_at_zero: 2.5, volts_per_rad: 0.5}
+  stations:
+    index:
+      pid: {kp: 4}
+      lower:
+        pid: {kp: 3, ki: 0.7}
+        theta2:
+          pid: {kp: 2}
+          potentiometer: {volts_at_zero: 1.25, rad_per_volt: -4}
+)" + kControllerStations,
+                                           "<test>");
+  const ControllerSettings& c = *d.controller;
+  EXPECT_EQ(c.node, "haptics_node");
+  EXPECT_EQ(c.loop_rate_hz, 250.0);
+  EXPECT_EQ(c.pwm_hz, 20000.0);
+  EXPECT_EQ(c.adc_bits, 12);
+  EXPECT_EQ(c.adc_range_v, (std::array<double, 2>{0.0, 5.0}));
+  EXPECT_DOUBLE_EQ(c.max_velocity, kPi / 2);
+  EXPECT_EQ(c.min_lci, 0.1);
+  EXPECT_EQ(c.potentiometer.rad_per_volt, 2.0);  // 1 / (0.5 V/rad)
+  // The joint's own keys, then its mechanism's, then its station's, then the defaults.
+  const JointControl j = c.joint("index", "lower", 2);
+  EXPECT_EQ(j.pid.kp, 2.0);
+  EXPECT_EQ(j.pid.ki, 0.7);
+  EXPECT_EQ(j.pid.kd, 0.05);
+  EXPECT_EQ(j.potentiometer.volts_at_zero, 1.25);
+  EXPECT_EQ(j.potentiometer.rad_per_volt, -4.0);
+  EXPECT_EQ(c.joint("index", "lower", 1).pid.kp, 3.0);
+  EXPECT_EQ(c.joint("index", "lower", 1).potentiometer.rad_per_volt, 2.0);
+  EXPECT_EQ(c.joint("index", "upper", 1).pid.kp, 4.0);
+  EXPECT_EQ(c.joint("index", "upper", 1).pid.ki, 1.0);
+  EXPECT_EQ(c.joint("thumb", "lower", 2).pid.kp, 5.0);
+
+  // The precedence is by scope, not by position in the list: reversed, the same gains.
+  ControllerSettings reversed = c;
+  std::reverse(reversed.overrides.begin(), reversed.overrides.end());
+  for (const char* m : {"lower", "upper"}) {
+    for (int k = 1; k <= 2; ++k) {
+      EXPECT_EQ(reversed.joint("index", m, k).pid.kp, c.joint("index", m, k).pid.kp) << m << k;
+      EXPECT_EQ(reversed.joint("index", m, k).pid.ki, c.joint("index", m, k).pid.ki) << m << k;
+    }
+  }
+}
+
+TEST(Loader, ControllerMechanismScopesApplyToEveryStationBelowAnyStationScope) {
+  const Design d = load_design_from_string(R"(name: c
+controller:
+  pid: {kp: 5}
+  mechanisms:
+    lower:
+      pid: {kp: 3, kd: 0.01}
+      theta1: {pid: {kp: 2.5}, potentiometer: {volts_at_zero: 0.25}}
+    upper: {pid: {ki: 0.5}}
+  stations:
+    index: {pid: {kp: 4}}
+)" + kControllerStations,
+                                           "<test>");
+  const ControllerSettings& c = *d.controller;
+  // A scope naming a station beats every station-less one, however narrow.
+  EXPECT_EQ(c.joint("index", "lower", 1).pid.kp, 4.0);
+  EXPECT_EQ(c.joint("index", "lower", 1).pid.kd, 0.01);  // not given by the station: the mechanisms'
+  EXPECT_EQ(c.joint("index", "lower", 1).potentiometer.volts_at_zero, 0.25);
+  EXPECT_EQ(c.joint("thumb", "lower", 1).pid.kp, 2.5);
+  EXPECT_EQ(c.joint("thumb", "lower", 2).pid.kp, 3.0);
+  EXPECT_EQ(c.joint("thumb", "lower", 2).potentiometer.volts_at_zero, 2.5);
+  EXPECT_EQ(c.joint("index", "upper", 2).pid.ki, 0.5);
+  EXPECT_EQ(c.joint("index", "upper", 2).pid.kp, 4.0);
+  // The thumb has no upper mechanism: a rule for every upper mechanism is simply unused there.
+  const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
+  EXPECT_EQ(to_yaml(back), to_yaml(d));
+  EXPECT_EQ(back.controller->joint("thumb", "lower", 1).pid.kp, 2.5);
+  EXPECT_EQ(back.controller->joint("index", "lower", 1).pid.kp, 4.0);
+}
+
+TEST(Loader, PatternsTakeTheControllersRateAndTheOneSpeedLimit) {
+  const Design d = load_design_from_string(R"(name: c
+patterns:
+  stretch: {}
+  twist: {rate_hz: 50}
+controller:
+  loop_rate_hz: 200
+  max_velocity_deg_s: 90
+)" + kControllerStations,
+                                           "<test>");
+  ASSERT_TRUE(d.patterns.has_value());
+  EXPECT_EQ(d.patterns->rate_hz, 200.0);
+  EXPECT_DOUBLE_EQ(d.patterns->max_joint_speed, kPi / 2);
+  EXPECT_EQ(d.patterns->max_joint_speed, d.controller->max_velocity);
+  const auto specs = d.patterns->for_station("index");
+  ASSERT_EQ(specs.size(), 2u);
+  EXPECT_EQ(specs[0].rate_hz, 200.0);  // the loop rate, unless the pattern says otherwise
+  EXPECT_EQ(specs[1].rate_hz, 50.0);
+}
+
+TEST(ControllerValidate, Rules) {
+  EXPECT_NO_THROW(ControllerSettings{}.validate());
+  const auto bad = [](auto edit, const std::string& message) {
+    ControllerSettings c;
+    edit(c);
+    EXPECT_THAT([&] { c.validate(); }, ThrowsMessage<InputError>(HasSubstr(message))) << message;
+  };
+  bad([](ControllerSettings& c) { c.node = "a-b"; }, "node = 'a-b': must be a ROS 2 node name");
+  bad([](ControllerSettings& c) { c.node = ""; }, "node = '': must be a ROS 2 node name");
+  bad([](ControllerSettings& c) { c.loop_rate_hz = 0; }, "loop_rate_hz = 0 Hz: must be > 0");
+  bad([](ControllerSettings& c) { c.pwm_hz = std::nan(""); }, "pwm_hz = nan Hz");
+  bad([](ControllerSettings& c) { c.adc_bits = 0; }, "adc.bits = 0: must be 1 ... 32");
+  bad([](ControllerSettings& c) { c.adc_range_v = {1.0, 1.0}; }, "adc.range_v = [1, 1] V");
+  bad([](ControllerSettings& c) { c.max_velocity = -1; }, "max_velocity_deg_s");
+  bad([](ControllerSettings& c) { c.min_lci = -0.1; }, "min_lci = -0.1: must be in [0, 1]");
+  bad([](ControllerSettings& c) { c.pid.kd = 2e6; }, "pid.kd = 2000000 s per rad");
+  bad([](ControllerSettings& c) { c.pid.i_clamp = -0.5; }, "pid.i_clamp = -0.5: must be in [0, 1]");
+  bad([](ControllerSettings& c) { c.potentiometer.rad_per_volt = 0; }, "potentiometer.rad_per_volt = 0 rad/V");
+  bad([](ControllerSettings& c) { c.potentiometer.volts_at_zero = 1e4; }, "potentiometer.volts_at_zero = 10000 V");
+  bad(
+      [](ControllerSettings& c) {
+        ControlOverride o;
+        o.station = "index", o.mechanism = "lower", o.joint = 1, o.kp = -2;
+        c.overrides.push_back(o);
+      },
+      "stations.index.lower.theta1.pid.kp = -2 per rad");
+  bad(
+      [](ControllerSettings& c) {
+        ControlOverride o;
+        o.station = "index", o.joint = 2;  // a joint needs its mechanism
+        c.overrides.push_back(o);
+      },
+      "joint 2 must be 1 or 2 within a mechanism");
+  // A reversed potentiometer (negative slope) is fine.
+  ControllerSettings reversed;
+  reversed.potentiometer.rad_per_volt = -1.0;
+  EXPECT_NO_THROW(reversed.validate());
+  EXPECT_TRUE(is_ros_node_name("_private9"));
+  EXPECT_FALSE(is_ros_node_name("9lives"));
+  EXPECT_FALSE(is_ros_node_name("with space"));
+}
+
+TEST(DesignValidate, OneJointSpeedLimitWithAController) {
+  Design d = valid_design();
+  d.controller = ControllerSettings{};
+  d.patterns = PatternSettings{};
+  EXPECT_NO_THROW(d.validate());  // both 360 deg/s by default
+  d.patterns->max_joint_speed = deg(180);
+  EXPECT_THAT([&] { d.validate(); },
+              ThrowsMessage<InputError>(HasSubstr("patterns.max_joint_speed_deg_s = 180 deg/s: differs from "
+                                                  "controller.max_velocity_deg_s (360 deg/s)")));
+  d.controller->max_velocity = deg(180);
+  EXPECT_NO_THROW(d.validate());
+  ControlOverride o;
+  o.station = "index", o.mechanism = "upper";  // valid_design() has only the lower mechanism
+  d.controller->overrides.push_back(o);
+  EXPECT_THAT([&] { d.validate(); }, ThrowsMessage<InputError>(HasSubstr("controller.stations.index.upper: station "
+                                                                           "'index' has no upper mechanism")));
+}
+
+// The writer: every section, read back, is the same design (to_yaml is canonical, so equal text
+// means equal values), and the values that matter are checked one by one as well.
+TEST(DesignWriter, ShowcaseRoundTripsWithPatternsAndController) {
+  const Design d = load_design(kSourceDir / "designs/iros2022.yaml");
+  ASSERT_TRUE(d.patterns && d.controller);
+  const std::string text = to_yaml(d);
+  EXPECT_THAT(text, HasSubstr("patterns:"));
+  EXPECT_THAT(text, HasSubstr("controller:"));
+  EXPECT_THAT(text, ::testing::Not(HasSubstr("max_joint_speed_deg_s")));  // the controller owns the limit
+  const Design back = load_design_from_string(text, "<to_yaml>");
+  EXPECT_EQ(to_yaml(back), text);
+  ASSERT_TRUE(back.patterns && back.controller);
+  EXPECT_EQ(back.patterns->max_joint_speed, d.patterns->max_joint_speed);
+  for (const char* station : {"index", "thumb"}) {
+    const auto a = d.patterns->for_station(station), b = back.patterns->for_station(station);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].kind, b[i].kind);
+      EXPECT_EQ(a[i].amplitude_mm, b[i].amplitude_mm);
+      EXPECT_EQ(a[i].duration_s, b[i].duration_s);
+      EXPECT_EQ(a[i].rate_hz, b[i].rate_hz);
+      EXPECT_EQ(a[i].separation_mm, b[i].separation_mm);
+      EXPECT_EQ(a[i].pivot_amplitude, b[i].pivot_amplitude);
+      EXPECT_EQ(a[i].pivot_frequency_hz, b[i].pivot_frequency_hz);
+    }
+    for (const char* m : {"lower", "upper"}) {
+      for (int j = 1; j <= 2; ++j) {
+        const JointControl x = d.controller->joint(station, m, j), y = back.controller->joint(station, m, j);
+        EXPECT_EQ(x.pid.kp, y.pid.kp);
+        EXPECT_EQ(x.pid.ki, y.pid.ki);
+        EXPECT_EQ(x.pid.kd, y.pid.kd);
+        EXPECT_EQ(x.pid.i_clamp, y.pid.i_clamp);
+        EXPECT_EQ(x.potentiometer.volts_at_zero, y.potentiometer.volts_at_zero);
+        EXPECT_EQ(x.potentiometer.rad_per_volt, y.potentiometer.rad_per_volt);
+      }
+    }
+  }
+  EXPECT_EQ(back.patterns->for_station("thumb")[2].amplitude_mm, 5.5);  // the thumb's own twist
+  EXPECT_EQ(back.controller->node, d.controller->node);
+  EXPECT_EQ(back.controller->max_velocity, d.controller->max_velocity);
+  EXPECT_EQ(back.controller->adc_range_v, d.controller->adc_range_v);
+  EXPECT_EQ(back.controller->joint("index", "upper", 1).potentiometer.volts_at_zero, 4.75);
+}
+
+TEST(DesignWriter, PatternsWithoutControllerKeepTheirSpeedAndPivotContactPoints) {
+  Design d = load_design_from_string("name: w\n" + kControllerStations, "<test>");
+  PatternSettings ps;
+  ps.rate_hz = 50.0;
+  ps.max_joint_speed = deg(123.5);
+  PatternSpec pivot;
+  pivot.kind = PatternKind::pivot;
+  pivot.rate_hz = 50.0;
+  pivot.pivot_amplitude = deg(12.5);
+  pivot.contact_points = std::array<Vec2, 2>{Vec2(0.1, 3.3), Vec2(-0.7, -2.9)};
+  pivot.centre = Vec2(6.0, 15.0);
+  ps.global.push_back(pivot);
+  PatternSpec slip;
+  slip.kind = PatternKind::slip;
+  slip.amplitude_mm = 0.1 + 0.2;  // not a short decimal: must still come back bit for bit
+  ps.per_station.emplace_back("thumb", slip);
+  d.patterns = ps;
+  d.validate();
+  const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
+  ASSERT_TRUE(back.patterns.has_value());
+  EXPECT_EQ(back.patterns->rate_hz, 50.0);
+  EXPECT_EQ(back.patterns->max_joint_speed, deg(123.5));
+  ASSERT_EQ(back.patterns->global.size(), 1u);
+  const PatternSpec& p = back.patterns->global[0];
+  EXPECT_EQ(p.pivot_amplitude, deg(12.5));
+  ASSERT_TRUE(p.contact_points.has_value());
+  EXPECT_EQ((*p.contact_points)[1], Vec2(-0.7, -2.9));
+  EXPECT_EQ(p.centre, Vec2(6.0, 15.0));
+  const auto thumb = back.patterns->for_station("thumb");
+  ASSERT_EQ(thumb.size(), 2u);
+  EXPECT_EQ(thumb[0].kind, PatternKind::slip);
+  EXPECT_EQ(thumb[0].amplitude_mm, 0.1 + 0.2);
+  EXPECT_EQ(to_yaml(back), to_yaml(d));
+}
+
+}  // namespace
+}  // namespace fivebar

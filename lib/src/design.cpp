@@ -589,6 +589,156 @@ void PatternSettings::validate() const {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Controller
+
+namespace {
+
+/// Largest gain accepted: far beyond any duty-per-radian a motor loop uses, it keeps every product
+/// of a gain and an angle (or rate) finite.
+constexpr double kMaxGain = 1e6;
+
+void require_gain(const std::string& key, double v, std::string_view unit) {
+  if (!(v >= 0.0) || !(v <= kMaxGain)) {
+    throw ValidationError(key, "= " + plain_number(v) + " " + std::string(unit) + ": must be >= 0 and <= 1000000");
+  }
+}
+
+void require_i_clamp(const std::string& key, double v) {
+  if (!(v >= 0.0) || !(v <= 1.0)) {
+    throw ValidationError(key, "= " + plain_number(v) + ": must be in [0, 1] (a PWM duty cycle)");
+  }
+}
+
+void require_volts_at_zero(const std::string& key, double v) {
+  if (!(std::abs(v) <= 1000.0)) throw ValidationError(key, "= " + plain_number(v) + " V: must be within [-1000, 1000] V");
+}
+
+void require_rad_per_volt(const std::string& key, double v) {
+  // Zero would read every voltage as the same angle; the bounds keep 1/v finite and meaningful.
+  if (!(std::abs(v) >= 1e-6) || !(std::abs(v) <= 1e6)) {
+    throw ValidationError(key, "= " + plain_number(v) + " rad/V: |rad_per_volt| must be in [1e-6, 1e6] "
+                                   "(negative when the potentiometer is wired reversed, never 0)");
+  }
+}
+
+}  // namespace
+
+void PidGains::validate() const {
+  require_gain("kp", kp, "per rad");
+  require_gain("ki", ki, "per rad s");
+  require_gain("kd", kd, "s per rad");
+  require_i_clamp("i_clamp", i_clamp);
+}
+
+void Potentiometer::validate() const {
+  require_volts_at_zero("volts_at_zero", volts_at_zero);
+  require_rad_per_volt("rad_per_volt", rad_per_volt);
+}
+
+std::string ControlOverride::key() const {
+  std::string k = station.empty() ? std::string("mechanisms") : detail::key_child("stations", station);
+  if (!mechanism.empty()) k = detail::key_join(k, mechanism);
+  if (joint != 0) k = detail::key_join(k, "theta" + std::to_string(joint));
+  return k;
+}
+
+int ControlOverride::level() const {
+  if (station.empty()) return joint == 0 ? 0 : 1;
+  if (mechanism.empty()) return 2;
+  return joint == 0 ? 3 : 4;
+}
+
+JointControl ControllerSettings::joint(std::string_view station, std::string_view mechanism, int j) const {
+  JointControl out{pid, potentiometer};
+  const auto apply = [&out](const ControlOverride& o) {
+    if (o.kp) out.pid.kp = *o.kp;
+    if (o.ki) out.pid.ki = *o.ki;
+    if (o.kd) out.pid.kd = *o.kd;
+    if (o.i_clamp) out.pid.i_clamp = *o.i_clamp;
+    if (o.volts_at_zero) out.potentiometer.volts_at_zero = *o.volts_at_zero;
+    if (o.rad_per_volt) out.potentiometer.rad_per_volt = *o.rad_per_volt;
+  };
+  // Widest scope first, so that the narrower keys win whatever the order of the list.
+  for (int level = 0; level <= 4; ++level) {
+    for (const ControlOverride& o : overrides) {
+      if (o.level() != level) continue;
+      if (!o.station.empty() && o.station != station) continue;
+      if (!o.mechanism.empty() && o.mechanism != mechanism) continue;
+      if (o.joint != 0 && o.joint != j) continue;
+      apply(o);
+    }
+  }
+  return out;
+}
+
+bool is_ros_node_name(std::string_view name) {
+  if (name.empty() || name.size() > 255) return false;
+  const auto alpha = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
+  if (!alpha(name.front())) return false;
+  return std::all_of(name.begin(), name.end(), [&](char c) { return alpha(c) || (c >= '0' && c <= '9'); });
+}
+
+void ControllerSettings::validate() const {
+  if (!is_ros_node_name(node)) {
+    throw ValidationError("node", "= " + detail::quoted(node) +
+                                      ": must be a ROS 2 node name: letters, digits and _, not starting with a digit");
+  }
+  require_range("loop_rate_hz", loop_rate_hz, 0.0, 1e5, "Hz");
+  require_range("pwm_hz", pwm_hz, 0.0, 1e7, "Hz");
+  if (pwm_hz < loop_rate_hz) {
+    throw ValidationError("pwm_hz", "= " + plain_number(pwm_hz) + " Hz: must be >= loop_rate_hz (" +
+                                        plain_number(loop_rate_hz) +
+                                        " Hz): every control step needs at least one PWM period");
+  }
+  if (adc_bits < 1 || adc_bits > 32) {
+    throw ValidationError("adc.bits", "= " + std::to_string(adc_bits) + ": must be 1 ... 32");
+  }
+  for (std::size_t i = 0; i < 2; ++i) {
+    if (!(std::abs(adc_range_v[i]) <= 1000.0)) {
+      throw ValidationError(detail::key_index("adc.range_v", i),
+                            "= " + plain_number(adc_range_v[i]) + " V: must be within [-1000, 1000] V");
+    }
+  }
+  if (!(adc_range_v[0] < adc_range_v[1])) {
+    throw ValidationError("adc.range_v", "= [" + plain_number(adc_range_v[0]) + ", " + plain_number(adc_range_v[1]) +
+                                             "] V: the low end must be below the high end");
+  }
+  if (!(max_velocity > 0.0) || !(max_velocity * kDegPerRad <= 1e6)) {
+    throw ValidationError("max_velocity_deg_s", "= " + format_degrees(max_velocity) +
+                                                    " deg/s: must be > 0 and <= 1000000 deg/s");
+  }
+  if (collision_priority != "upper") {
+    throw ValidationError("collision_priority",
+                          "= " + detail::quoted(collision_priority) +
+                              ": must be upper (the paper's rule, the one fivebar's collision and pattern checks apply)");
+  }
+  if (!(min_lci >= 0.0) || !(min_lci <= 1.0)) {
+    throw ValidationError("min_lci", "= " + plain_number(min_lci) + ": must be in [0, 1]");
+  }
+  validate_nested("pid", [&] { pid.validate(); });
+  validate_nested("potentiometer", [&] { potentiometer.validate(); });
+  for (const ControlOverride& o : overrides) {
+    const std::string scope = o.key();
+    if (!o.mechanism.empty() && o.mechanism != "lower" && o.mechanism != "upper") {
+      throw ValidationError(scope, "mechanism " + detail::quoted(o.mechanism) + " must be lower or upper");
+    }
+    if (o.station.empty() && o.mechanism.empty()) {
+      throw ValidationError(scope, "an override names a station, a mechanism (lower, upper) or both");
+    }
+    if (o.joint < 0 || o.joint > 2 || (o.joint != 0 && o.mechanism.empty())) {
+      throw ValidationError(scope, "joint " + std::to_string(o.joint) + " must be 1 or 2 within a mechanism");
+    }
+    const auto at = [&](std::string_view what) { return detail::key_join(scope, what); };
+    if (o.kp) require_gain(at("pid.kp"), *o.kp, "per rad");
+    if (o.ki) require_gain(at("pid.ki"), *o.ki, "per rad s");
+    if (o.kd) require_gain(at("pid.kd"), *o.kd, "s per rad");
+    if (o.i_clamp) require_i_clamp(at("pid.i_clamp"), *o.i_clamp);
+    if (o.volts_at_zero) require_volts_at_zero(at("potentiometer.volts_at_zero"), *o.volts_at_zero);
+    if (o.rad_per_volt) require_rad_per_volt(at("potentiometer.rad_per_volt"), *o.rad_per_volt);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Design
 
 bool is_safe_name(std::string_view name) {
@@ -610,6 +760,7 @@ const std::vector<std::string>& known_products() {
       "pattern",
       "sweep",
       "parts",
+      "export",
       "report",
   };
   return products;
@@ -686,6 +837,31 @@ void Design::validate() const {
         throw ValidationError(detail::key_child("patterns.stations", station_name),
                               "no such station in this design (stations: " + list + ")");
       }
+    }
+  }
+  if (controller) {
+    validate_nested("controller", [&] { controller->validate(); });
+    for (const ControlOverride& o : controller->overrides) {
+      if (o.station.empty()) continue;  // every station's lower / upper: none is fine
+      const Station* st = station(o.station);
+      const std::string key = detail::key_join("controller", o.key());
+      if (st == nullptr) {
+        std::string list;
+        for (const Station& s : stations) list += (list.empty() ? "" : ", ") + s.name;
+        throw ValidationError(detail::key_join("controller", detail::key_child("stations", o.station)),
+                              "no such station in this design (stations: " + list + ")");
+      }
+      if (!o.mechanism.empty() && st->mechanism(o.mechanism) == nullptr) {
+        throw ValidationError(key, "station " + detail::quoted(o.station) + " has no " + o.mechanism + " mechanism");
+      }
+    }
+    // One source of truth for the joint speed limit (ControllerSettings).
+    if (patterns && patterns->max_joint_speed != controller->max_velocity) {
+      throw ValidationError("patterns.max_joint_speed_deg_s",
+                            "= " + format_degrees(patterns->max_joint_speed) +
+                                " deg/s: differs from controller.max_velocity_deg_s (" +
+                                format_degrees(controller->max_velocity) +
+                                " deg/s), the one joint speed limit of a design with a controller");
     }
   }
   if (products) {

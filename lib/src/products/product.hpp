@@ -76,6 +76,8 @@ Product parts_product();
 Product collision_product();
 /// The skin-deformation patterns of `patterns:`, checked, with joint trajectories and pictures.
 Product pattern_product();
+/// The validated controller configuration (`controller:`): gate, ROS 2 YAML, JSON, C++ header.
+Product export_product();
 /// Accuracy of the main numbers (quick work-precision) and the stability catalogue.
 Product report_product();
 

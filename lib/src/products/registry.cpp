@@ -13,6 +13,7 @@ const std::vector<Product>& registry() {
       parts_product(),
       collision_product(),
       pattern_product(),
+      export_product(),
       report_product(),
   };
   return entries;

@@ -38,9 +38,6 @@ using detail::key_index;
 
 constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
-/// Top-level sections that later versions fill in (DESIGN.md); rejected clearly until then.
-constexpr std::string_view kReservedSections[] = {"controller"};
-
 constexpr std::size_t kMaxShownValue = 60;
 /// Longest map key (section, field or station name) accepted, so that key paths in messages stay
 /// short; every real key is far shorter (station names: at most 64 characters).
@@ -447,7 +444,11 @@ class Loader {
   PrintSettings print(const Entry& entry);
   SweepSettings sweep(const Entry& entry);
   std::uint64_t whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const;
-  PatternSettings patterns(const Entry& entry);
+  /// `patterns:`; `controller` (parsed first) supplies the default rate and the speed limit.
+  PatternSettings patterns(const Entry& entry, const std::optional<ControllerSettings>& controller);
+  ControllerSettings controller(const Entry& entry);
+  /// The `pid:` and `potentiometer:` keys of one scope of `controller:` into `o`.
+  void control_keys(const Entries& all, ControlOverride& o);
   /// One `<kind>:` map of patterns, over `base` (the defaults, or the top-level entry of the kind).
   PatternSpec pattern(const Entry& entry, const PatternSpec& base);
   /// An optional number: `fallback` when the key is absent.
@@ -483,10 +484,6 @@ Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, 
       fail(key_line, key, "duplicate key (first given at line " + std::to_string(it->second) + ")");
     }
     if (!any_key && std::find(allowed.begin(), allowed.end(), name) == allowed.end()) {
-      if (path.empty() && std::find(std::begin(kReservedSections), std::end(kReservedSections), name) !=
-                              std::end(kReservedSections)) {
-        fail(key_line, key, "key '" + name + "' is not supported by this version of fivebar");
-      }
       std::string rule = "unknown key";
       std::string_view closest;
       std::size_t best = 3;  // suggest only near misses: up to 2 edits
@@ -743,8 +740,12 @@ PatternSpec Loader::pattern(const Entry& entry, const PatternSpec& base) {
   return spec;
 }
 
-PatternSettings Loader::patterns(const Entry& entry) {
+PatternSettings Loader::patterns(const Entry& entry, const std::optional<ControllerSettings>& controller) {
   PatternSettings ps;
+  if (controller) {  // the patterns run at the controller's rate and speed limit
+    ps.rate_hz = controller->loop_rate_hz;
+    ps.max_joint_speed = controller->max_velocity;
+  }
   const auto defaults = [&](PatternKind kind) {
     PatternSpec spec;
     spec.kind = kind;
@@ -761,6 +762,10 @@ PatternSettings Loader::patterns(const Entry& entry) {
                               "(rate_hz, max_joint_speed_deg_s, stretch, slip, twist, pivot, stations)");
   ps.rate_hz = optional_number(all, "rate_hz", ps.rate_hz, "Hz");
   if (const Entry* v = find(all, "max_joint_speed_deg_s")) {
+    if (controller) {
+      fail(v->line, v->path, "the joint speed limit of a design with a controller: section is "
+                             "controller.max_velocity_deg_s (patterns take it from there): remove this key");
+    }
     ps.max_joint_speed = kRadPerDeg * number(v->value, v->path, v->line, "deg/s");
   }
   for (PatternKind kind : all_pattern_kinds()) {
@@ -781,6 +786,114 @@ PatternSettings Loader::patterns(const Entry& entry) {
     }
   }
   return ps;
+}
+
+void Loader::control_keys(const Entries& all, ControlOverride& o) {
+  if (const Entry* pid = find(all, "pid")) {
+    for (const Entry& k : entries(pid->value, pid->path, pid->line, {"kp", "ki", "kd", "i_clamp"},
+                                  "of PID gains (kp, ki, kd, i_clamp)")) {
+      const double v = number(k.value, k.path, k.line, "");
+      (k.name == "kp" ? o.kp : k.name == "ki" ? o.ki : k.name == "kd" ? o.kd : o.i_clamp) = v;
+    }
+  }
+  if (const Entry* pot = find(all, "potentiometer")) {
+    const Entries keys = entries(pot->value, pot->path, pot->line, {"volts_at_zero", "volts_per_rad", "rad_per_volt"},
+                                 "(volts_at_zero, and volts_per_rad or rad_per_volt)");
+    if (const Entry* v0 = find(keys, "volts_at_zero")) o.volts_at_zero = number(v0->value, v0->path, v0->line, "V");
+    const Entry* vpr = find(keys, "volts_per_rad");
+    const Entry* rpv = find(keys, "rad_per_volt");
+    if (vpr != nullptr && rpv != nullptr) {
+      fail(rpv->line, rpv->path, "give volts_per_rad or rad_per_volt, not both (one is 1 / the other)");
+    }
+    if (rpv != nullptr) o.rad_per_volt = number(rpv->value, rpv->path, rpv->line, "rad/V");
+    if (vpr != nullptr) {
+      const double v = number(vpr->value, vpr->path, vpr->line, "V/rad");
+      if (!(std::abs(v) >= 1e-6) || !(std::abs(v) <= 1e6)) {
+        fail_value(vpr->value, vpr->line, vpr->path, "|volts_per_rad| must be in [1e-6, 1e6] (never 0)");
+      }
+      o.rad_per_volt = 1.0 / v;
+      // validate() names rad_per_volt; a rule broken there is this key's.
+      note(detail::key_join(detail::key_parent(vpr->path), "rad_per_volt"), vpr->line);
+    }
+  }
+}
+
+ControllerSettings Loader::controller(const Entry& entry) {
+  ControllerSettings c;
+  if (entry.value.IsNull()) return c;  // `controller:` alone: every default
+  const Entries all = entries(entry.value, entry.path, entry.line,
+                              {"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
+                               "min_lci", "pid", "potentiometer", "mechanisms", "stations"},
+                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
+                              "pid, potentiometer, mechanisms, stations)");
+  if (const Entry* n = find(all, "node")) c.node = string(n->value, n->path, n->line, "must be a ROS 2 node name");
+  c.loop_rate_hz = optional_number(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
+  c.pwm_hz = optional_number(all, "pwm_hz", c.pwm_hz, "Hz");
+  if (const Entry* adc = find(all, "adc")) {
+    const Entries keys = entries(adc->value, adc->path, adc->line, {"bits", "range_v"}, "(bits, range_v)");
+    if (const Entry* b = find(keys, "bits")) c.adc_bits = int(whole(b->value, b->path, b->line, 1, 32));
+    if (const Entry* r = find(keys, "range_v")) {
+      const auto ends = list(r->value, r->path, r->line, 2, "a list [low, high] (V)");
+      for (std::size_t i = 0; i < 2; ++i) {
+        c.adc_range_v[i] = number(ends[i], key_index(r->path, i), line_of(ends[i], r->line), "V");
+      }
+    }
+  }
+  if (const Entry* v = find(all, "max_velocity_deg_s")) {
+    c.max_velocity = kRadPerDeg * number(v->value, v->path, v->line, "deg/s");
+  }
+  if (const Entry* p = find(all, "collision_priority")) {
+    c.collision_priority = string(p->value, p->path, p->line, "must be upper");
+  }
+  c.min_lci = optional_number(all, "min_lci", c.min_lci, "");
+  ControlOverride defaults;
+  control_keys(all, defaults);
+  if (defaults.kp) c.pid.kp = *defaults.kp;
+  if (defaults.ki) c.pid.ki = *defaults.ki;
+  if (defaults.kd) c.pid.kd = *defaults.kd;
+  if (defaults.i_clamp) c.pid.i_clamp = *defaults.i_clamp;
+  if (defaults.volts_at_zero) c.potentiometer.volts_at_zero = *defaults.volts_at_zero;
+  if (defaults.rad_per_volt) c.potentiometer.rad_per_volt = *defaults.rad_per_volt;
+
+  // One mechanism's scope (of a station, or of every station when `station` is empty) and its joints.
+  const auto mechanism_scope = [&](const Entry& m, const std::string& station) {
+    const Entries mech_keys = entries(m.value, m.path, m.line, {"pid", "potentiometer", "theta1", "theta2"},
+                                      "(pid, potentiometer, theta1, theta2)");
+    ControlOverride mo;
+    mo.station = station;
+    mo.mechanism = m.name;
+    control_keys(mech_keys, mo);
+    c.overrides.push_back(mo);
+    for (const Entry& j : mech_keys) {
+      if (j.name != "theta1" && j.name != "theta2") continue;
+      ControlOverride jo = mo;
+      jo.kp = jo.ki = jo.kd = jo.i_clamp = jo.volts_at_zero = jo.rad_per_volt = std::nullopt;
+      jo.joint = j.name == "theta1" ? 1 : 2;
+      control_keys(entries(j.value, j.path, j.line, {"pid", "potentiometer"}, "(pid, potentiometer)"), jo);
+      c.overrides.push_back(jo);
+    }
+  };
+  if (const Entry* mechanisms = find(all, "mechanisms")) {
+    for (const Entry& m : entries(mechanisms->value, mechanisms->path, mechanisms->line, {"lower", "upper"},
+                                  "with keys lower and/or upper (every station's)")) {
+      mechanism_scope(m, "");
+    }
+  }
+  if (const Entry* stations = find(all, "stations")) {
+    for (const Entry& st : entries(stations->value, stations->path, stations->line, {},
+                                   "of station names to their overrides", /*any_key=*/true)) {
+      const Entries station_keys = entries(st.value, st.path, st.line, {"pid", "potentiometer", "lower", "upper"},
+                                           "(pid, potentiometer, lower, upper)");
+      ControlOverride so;
+      so.station = st.name;
+      control_keys(station_keys, so);
+      c.overrides.push_back(so);
+      for (const Entry& m : station_keys) {
+        if (m.name == "lower" || m.name == "upper") mechanism_scope(m, st.name);
+      }
+    }
+  }
+  return c;
 }
 
 Mechanism Loader::mechanism(const Entry& entry) {
@@ -928,8 +1041,9 @@ Design Loader::load(const std::string& text) {
   Design design;
   try {
     const Entries all =
-        entries(root, "", root_line, {"name", "stations", "products", "geometry", "print", "patterns", "sweep"},
-                "at the top level (name, stations, products, geometry, print, patterns, sweep)");
+        entries(root, "", root_line,
+                {"name", "stations", "products", "geometry", "print", "patterns", "sweep", "controller"},
+                "at the top level (name, stations, products, geometry, print, patterns, sweep, controller)");
     const Entry& name = require(all, "name", "", root_line);
     design.name = string(name.value, name.path, name.line, "must be a name (letters, digits, _ . -)");
 
@@ -942,7 +1056,8 @@ Design Loader::load(const std::string& text) {
     if (const Entry* g = find(all, "geometry")) design.geometry = geometry(*g);
     if (const Entry* p = find(all, "print")) design.print = print(*p);
     if (const Entry* sw = find(all, "sweep")) design.sweep = sweep(*sw);
-    if (const Entry* p = find(all, "patterns")) design.patterns = patterns(*p);
+    if (const Entry* c = find(all, "controller")) design.controller = controller(*c);
+    if (const Entry* p = find(all, "patterns")) design.patterns = patterns(*p, design.controller);
 
     if (const Entry* products = find(all, "products")) {
       if (!products->value.IsSequence()) fail_value(products->value, products->line, products->path, "must be a list of product names");

@@ -1,0 +1,160 @@
+// fivebar export: the validated controller configuration (ROS 2 parameters YAML, JSON, C++17
+// header), written only when the design passes the export gate; --check re-reads an exported file
+// and compares it with the design.
+
+#include <iostream>
+#include <memory>
+
+#include "common.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/export.hpp"
+#include "fivebar/io.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct ExportCliOptions {
+  std::string design;
+  std::string station;
+  std::string format = "all";
+  std::string out;
+  std::string check;
+  bool json = false;
+};
+
+std::vector<ExportFormat> formats_of(const std::string& text) {
+  if (text == "all") return all_export_formats();
+  if (const auto f = parse_export_format(text)) return {*f};
+  throw InputError("--format '" + text + "': expected ros2, json, header or all");
+}
+
+void print_gate(const ExportGate& gate) {
+  std::size_t kind_w = 5, subject_w = 7;
+  for (const GateCheck& c : gate.checks) {
+    kind_w = std::max(kind_w, c.kind.size());
+    subject_w = std::max(subject_w, c.subject.size());
+  }
+  const auto pad = [](std::string s, std::size_t w) {
+    s.resize(std::max(s.size(), w), ' ');
+    return s;
+  };
+  std::cout << "  " << pad("check", kind_w) << "  " << pad("subject", subject_w) << "  verdict  detail\n";
+  for (const GateCheck& c : gate.checks) {
+    std::cout << "  " << pad(c.kind, kind_w) << "  " << pad(c.subject, subject_w) << "  "
+              << (c.passed ? "ok     " : "FAILED ") << "  " << c.detail << "\n";
+  }
+}
+
+int run_check(const ExportCliOptions& opt) {
+  if (!opt.station.empty() || opt.format != "all" || !opt.out.empty()) {
+    throw InputError("--check FILE DESIGN compares a file with a design: --station, --format and --out do not apply");
+  }
+  const Design design = load(opt.design);
+  const ExportCheck c = check_export_file(opt.check, design);
+  if (opt.json) {
+    Json diffs = Json::array();
+    for (const auto& d : c.differences) diffs.push_back({{"path", d.path}, {"expected", d.expected}, {"found", d.found}});
+    print_json({{"command", "export"},
+                {"check", opt.check},
+                {"design", design.name},
+                {"format", to_string(c.format)},
+                {"matches", c.matches()},
+                {"hash_matches", c.hash_matches()},
+                {"file_design", c.file_design},
+                {"file_hash", c.file_hash},
+                {"design_hash", c.design_hash},
+                {"file_tool_version", c.file_tool_version},
+                {"stations", c.stations},
+                {"differences", diffs}});
+  } else {
+    std::cout << opt.check << " (" << to_string(c.format) << ") against design " << design.name << "\n";
+    std::cout << "  design in file    " << c.file_design << "\n";
+    std::cout << "  stations          ";
+    for (std::size_t i = 0; i < c.stations.size(); ++i) std::cout << (i ? ", " : "") << c.stations[i];
+    std::cout << "\n  hash in file      " << c.file_hash << "\n";
+    std::cout << "  hash of design    " << c.design_hash << (c.hash_matches() ? "  (same)" : "  (STALE: differs)") << "\n";
+    std::cout << "  written by        fivebar " << c.file_tool_version << "\n";
+    if (c.matches()) {
+      std::cout << "the file matches the design\n";
+    } else {
+      std::cout << c.differences.size() << " difference(s):\n";
+      for (const auto& d : c.differences) {
+        std::cout << "  " << d.path << ": design " << d.expected << ", file " << d.found << "\n";
+      }
+    }
+  }
+  if (!c.matches()) {
+    std::cerr << "fivebar export --check: " << opt.check << " does not match design " << design.name << " ("
+              << c.differences.size() << " difference(s)" << (c.hash_matches() ? "" : ", stale hash") << ")\n";
+    return kCheckFailed;
+  }
+  return kOk;
+}
+
+int run_export(const ExportCliOptions& opt) {
+  if (!opt.check.empty()) return run_check(opt);
+  const std::vector<ExportFormat> formats = formats_of(opt.format);
+  const Design design = load(opt.design);
+  ExportOptions options;
+  if (!opt.station.empty()) options.stations = {opt.station};
+  options.progress = terminal_progress("export");
+  // The directory is created only once the gate has passed.
+  const std::filesystem::path dir =
+      opt.out.empty() ? resolve_output_dir("outputs", design.name) / "export" : std::filesystem::path(opt.out);
+  const ExportResult r = export_controller(design, formats, dir, options);
+
+  if (opt.json) {
+    Json files = Json::array();
+    for (const auto& f : r.files) files.push_back(f.generic_string());
+    print_json({{"command", "export"},
+                {"design", design.name},
+                {"node", design.controller->node},
+                {"design_hash", r.hash},
+                {"exported", r.gate.passed()},
+                {"files", files},
+                {"gate", to_json(r.gate)}});
+  } else {
+    std::cout << "export of design " << design.name << " for node " << design.controller->node << ", stations ";
+    for (std::size_t i = 0; i < r.gate.stations.size(); ++i) std::cout << (i ? ", " : "") << r.gate.stations[i];
+    std::cout << "\n";
+    print_gate(r.gate);
+    if (r.gate.passed()) {
+      std::cout << "design hash " << r.hash << "\n";
+      for (const auto& f : r.files) std::cout << "  wrote " << f.generic_string() << "\n";
+    }
+  }
+  if (!r.gate.passed()) {
+    std::cerr << "fivebar export: refused, nothing written:\n";
+    for (const std::string& reason : r.gate.reasons()) std::cerr << "  " << reason << "\n";
+    return kCheckFailed;
+  }
+  return kOk;
+}
+
+}  // namespace
+
+void setup_export(CLI::App& app) {
+  auto opt = std::make_shared<ExportCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "export",
+      "Validated controller configuration: ROS 2 parameters YAML, JSON and a C++17 header, written only when the "
+      "design passes the export gate (coverage, singularities, joint limits, calibration, patterns)");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
+  sub->add_option("--format", opt->format, "ros2, json, header or all (default: all)")->type_name("FORMAT");
+  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/export)")
+      ->type_name("DIR");
+  sub->add_option("--check", opt->check,
+                  "Re-read an exported FILE (any format) and confirm it matches DESIGN: hash and every value")
+      ->type_name("FILE");
+  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  sub->footer(
+      "Files: <design>_controller[_<station>].yaml|.json|.hpp, SI units; joints <station>_<mechanism>_theta<1|2>.\n"
+      "Exit status: 0 exported (or --check: the file matches), 1 export refused by the gate (nothing written) or\n"
+      "--check found differences, 2 bad input (design without controller: section, unknown station, ...), "
+      "3 internal error or the files could not be written.");
+  sub->callback([opt]() { finish(run_export(*opt)); });
+}
+
+}  // namespace fivebar::cli

@@ -1,0 +1,83 @@
+// The `export` product: the design's `controller:` section, validated by the export gate and, when
+// it passes, written as ROS 2 parameters, JSON and a C++17 header under export/ (fivebar/export.hpp).
+// A refused export writes nothing and fails the product's check with every reason.
+
+#include <numbers>
+#include <string>
+
+#include "fivebar/export.hpp"
+#include "products/markdown.hpp"
+#include "products/product.hpp"
+
+namespace fivebar::products {
+
+namespace {
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+constexpr const char* kPreamble =
+    "The configuration of the device's ROS controller (paper Sec. II-D: an IK module per mechanism, FK of the "
+    "measured joints for collision checks with the upper mechanism's priority, a PID per motor), written only "
+    "when the export gate passes: every mechanism covers its target, the LCI over the target stays above the "
+    "threshold, the joint limits hold over the whole target, each joint's range reads within the ADC range and "
+    "the declared patterns are renderable. The three files hold the same values (SI units); "
+    "`fivebar export --check FILE DESIGN` confirms a file still matches the design.\n\n";
+
+}  // namespace
+
+Product export_product() {
+  Product p;
+  p.name = "export";
+  p.title = "Controller export";
+  p.unavailable = [](const Design& d) -> std::optional<std::string> {
+    if (!d.controller) return "the design has no `controller:` section";
+    return std::nullopt;
+  };
+  p.build = [](Context& ctx) {
+    const Design& d = ctx.design;
+    ExportOptions options;
+    options.progress = ctx.progress;
+    const ExportResult r = export_controller(d, all_export_formats(), ctx.dir / "export", options);
+    for (const auto& f : r.files) ctx.record(std::filesystem::path("export") / f.filename());
+
+    Built b;
+    std::string markdown = kPreamble;
+    markdown += "Node " + md::code(d.controller->node) + ", design hash " + md::code(r.hash) + ".\n\n";
+    md::Table checks({"check", "subject", "verdict", "detail"}, "llcl");
+    for (const GateCheck& c : r.gate.checks) {
+      checks.row({c.kind, md::code(c.subject), c.passed ? "✓" : "✗ **failed**", c.detail});
+    }
+    markdown += checks.str() + "\n";
+    if (!r.gate.joints.empty()) {
+      md::Table joints({"joint", "angles over the target (deg)"}, "lr");
+      for (const JointSweep& j : r.gate.joints) {
+        joints.row({md::code(j.name), md::fixed(j.lo * kDegPerRad, 2) + " … " + md::fixed(j.hi * kDegPerRad, 2)});
+      }
+      markdown += joints.str() + "\n";
+    }
+    Json files = Json::array();
+    if (r.gate.passed()) {
+      markdown += "Files:";
+      for (const auto& f : r.files) {
+        const std::string rel = "export/" + f.filename().string();
+        markdown += " [" + md::code(rel) + "](" + rel + ")";
+        files.push_back(rel);
+      }
+      markdown += ".\n";
+    } else {
+      markdown += "**Export refused**: no file written.\n";
+    }
+    b.result = {{"node", d.controller->node}, {"design_hash", r.hash}, {"exported", r.gate.passed()},
+                {"files", files}, {"gate", to_json(r.gate)}};
+    b.markdown = markdown;
+    b.passed = r.gate.passed();
+    const auto reasons = r.gate.reasons();
+    b.check = b.passed ? "gate passed (" + std::to_string(r.gate.checks.size()) + " checks); " +
+                             std::to_string(r.files.size()) + " files, hash " + r.hash
+                       : "export refused: " + std::to_string(reasons.size()) + " check(s) failed (" + reasons.front() + ")";
+    return b;
+  };
+  return p;
+}
+
+}  // namespace fivebar::products

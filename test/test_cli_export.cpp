@@ -1,0 +1,293 @@
+// End-to-end tests of `fivebar export`, `fivebar export --check` and the `export` product of
+// `fivebar run`: real processes, their output, the files they write (or do not write) and their
+// exit codes. Expected values come from the paper (Table 1, Sec. II-D) and the showcase's
+// controller section, typed here.
+
+#include <fcntl.h>
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using ::testing::AllOf;
+using ::testing::Contains;
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+using ::testing::Not;
+
+const fs::path kSource = FIVEBAR_SOURCE_DIR;
+const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
+
+struct Outcome {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> listing(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+class CliExport : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::random_device rd;
+    dir_ = fs::temp_directory_path() / ("fivebar_test_cli_export_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+
+  /// Runs the real binary in dir_ (so that a default outputs/ would land there).
+  Outcome run(const std::vector<std::string>& args) {
+    const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
+    std::vector<std::string> argv_s{FIVEBAR_BINARY};
+    argv_s.insert(argv_s.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (auto& a : argv_s) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addchdir_np(&actions, dir_.c_str());
+    pid_t pid = 0;
+    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    Outcome r;
+    if (rc != 0) {
+      ADD_FAILURE() << "cannot spawn " << argv[0] << ": " << std::strerror(rc);
+      return r;
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  /// The paper design with `from` replaced by `to`, saved under dir_.
+  fs::path design_with(const std::string& name, const std::string& from, const std::string& to) {
+    std::string text = slurp(kDesign);
+    const auto pos = text.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    if (pos != std::string::npos) text.replace(pos, from.size(), to);
+    const fs::path p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+json parse(const Outcome& r) {
+  json j;
+  EXPECT_NO_THROW(j = json::parse(r.out)) << "stdout is not exactly one JSON document:\n" << r.out;
+  return j;
+}
+
+TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
+  const Outcome r = run({"export", kDesign, "--out", "ctl"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, AllOf(HasSubstr("export of design iros2022 for node fivebar_controller"),
+                           HasSubstr("design hash fnv1a64:"), HasSubstr("index/lower"), HasSubstr("thumb pivot")));
+  EXPECT_THAT(r.out, Not(HasSubstr("FAILED")));
+  EXPECT_EQ(listing(dir_ / "ctl"), (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
+                                                             "iros2022_controller.yaml"}));
+  // The ROS file with yaml-cpp: the paper's numbers in SI units, doubles as doubles.
+  const YAML::Node p = YAML::LoadFile((dir_ / "ctl" / "iros2022_controller.yaml").string())["fivebar_controller"]["ros__parameters"];
+  EXPECT_EQ(p["loop_rate_hz"].Scalar(), "100.0");
+  EXPECT_EQ(p["pwm_hz"].Scalar(), "1000.0");
+  EXPECT_EQ(p["adc"]["bits"].Scalar(), "16");
+  EXPECT_EQ(p["stations"]["thumb"]["lower"]["link_lengths_m"][3].as<double>(), 0.0175);
+  EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["has_position_limits"].as<bool>(), false);
+  EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["max_velocity"].Scalar(), "6.283185307179586");  // 360 deg/s
+  EXPECT_EQ(p["gains"]["index_upper_theta1"]["p"].Scalar(), "5.0");
+  EXPECT_EQ(p["collision"]["priority"].as<std::string>(), "upper");
+  // The JSON with nlohmann: the same values.
+  const json j = json::parse(slurp(dir_ / "ctl" / "iros2022_controller.json"))["fivebar_controller"]["ros__parameters"];
+  EXPECT_EQ(j["stations"]["thumb"]["lower"]["link_lengths_m"][3], 0.0175);
+  EXPECT_EQ(j["fivebar"]["design_hash"], p["fivebar"]["design_hash"].as<std::string>());
+
+  for (const char* file : {"iros2022_controller.yaml", "iros2022_controller.json", "iros2022_controller.hpp"}) {
+    const Outcome c = run({"export", "--check", (dir_ / "ctl" / file).string(), kDesign});
+    EXPECT_EQ(c.code, 0) << file << "\n" << c.out << c.err;
+    EXPECT_THAT(c.out, AllOf(HasSubstr("the file matches the design"), HasSubstr("(same)")));
+  }
+}
+
+TEST_F(CliExport, JsonOutputAndOneFormatForOneStation) {
+  const Outcome r = run({"export", kDesign, "--station", "index", "--format", "header", "--out", "h", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  EXPECT_EQ(doc["command"], "export");
+  EXPECT_EQ(doc["exported"], true);
+  EXPECT_EQ(doc["node"], "fivebar_controller");
+  EXPECT_EQ(doc["gate"]["passed"], true);
+  EXPECT_EQ(doc["gate"]["stations"], json({"index"}));
+  ASSERT_EQ(doc["files"].size(), 1u);
+  EXPECT_EQ(doc["files"][0], "h/iros2022_controller_index.hpp");
+  const std::string header = slurp(dir_ / "h" / "iros2022_controller_index.hpp");
+  EXPECT_THAT(header, AllOf(HasSubstr("namespace index {"), HasSubstr("inline constexpr double loop_rate_hz = 100.0;"),
+                            Not(HasSubstr("thumb"))));
+  EXPECT_THAT(header, HasSubstr(doc["design_hash"].get<std::string>()));
+  // Every gate check is listed with its verdict.
+  std::vector<std::string> kinds;
+  for (const auto& c : doc["gate"]["checks"]) kinds.push_back(c["kind"].get<std::string>() + " " + c["subject"].get<std::string>());
+  for (const char* k : {"coverage index/lower", "singularity index/upper", "joint_limits index/lower",
+                        "calibration index/upper", "coverage index/shared", "pattern index twist"}) {
+    EXPECT_THAT(kinds, Contains(std::string(k)));
+  }
+}
+
+TEST_F(CliExport, ARefusedExportWritesNothingAndListsEveryReason) {
+  // Above the paper's worst LCI (0.36) and a potentiometer offset that reads 180 deg as 12 V.
+  fs::path bad = design_with("bad.yaml", "  min_lci: 0.05", "  min_lci: 0.5");
+  std::string text = slurp(bad);
+  text.replace(text.find("volts_at_zero: 0.25"), 19, "volts_at_zero: 9.00");
+  std::ofstream(bad) << text;
+
+  const Outcome r = run({"export", bad.string(), "--out", "refused/export"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.err, AllOf(HasSubstr("refused, nothing written"), HasSubstr("index/lower singularity"),
+                           HasSubstr("thumb/upper singularity"), HasSubstr("index/lower calibration")));
+  EXPECT_THAT(r.out, HasSubstr("FAILED"));
+  EXPECT_FALSE(fs::exists(dir_ / "refused"));
+
+  // Without --out the default outputs/<name>/export is not created either.
+  const Outcome d = run({"export", bad.string(), "--json"});
+  EXPECT_EQ(d.code, 1);
+  const json doc = parse(d);
+  EXPECT_EQ(doc["exported"], false);
+  EXPECT_THAT(doc["files"], IsEmpty());
+  EXPECT_GE(doc["gate"]["reasons"].size(), 5u);  // four mechanisms below the LCI threshold, one calibration
+  EXPECT_FALSE(fs::exists(dir_ / "outputs"));
+
+  // An earlier export in the same place is left as it was.
+  ASSERT_EQ(run({"export", kDesign, "--out", "kept"}).code, 0);
+  const std::string before = slurp(dir_ / "kept" / "iros2022_controller.yaml");
+  EXPECT_EQ(run({"export", bad.string(), "--out", "kept"}).code, 1);
+  EXPECT_EQ(slurp(dir_ / "kept" / "iros2022_controller.yaml"), before);
+  EXPECT_EQ(listing(dir_ / "kept").size(), 3u);
+}
+
+TEST_F(CliExport, BadInputIsExitTwo) {
+  const fs::path no_controller = (kSource / "designs" / "iros2022-index.yaml");
+  const Outcome a = run({"export", no_controller.string(), "--out", "x"});
+  EXPECT_EQ(a.code, 2);
+  EXPECT_THAT(a.err, HasSubstr("has no controller: section"));
+  EXPECT_EQ(run({"export", kDesign, "--format", "yaml"}).code, 2);
+  const Outcome s = run({"export", kDesign, "--station", "pinky"});
+  EXPECT_EQ(s.code, 2);
+  EXPECT_THAT(s.err, HasSubstr("unknown station 'pinky'"));
+  EXPECT_EQ(run({"export", "--check", "nowhere.yaml", kDesign}).code, 2);
+  EXPECT_EQ(run({"export", "--check", "nowhere.yaml", kDesign, "--format", "json"}).code, 2);
+  const fs::path broken = design_with("broken.yaml", "  pwm_hz: 1000", "  pwm_hz: 10");
+  const Outcome b = run({"export", broken.string()});
+  EXPECT_EQ(b.code, 2);
+  EXPECT_THAT(b.err, HasSubstr("controller.pwm_hz = 10 Hz: must be >= loop_rate_hz (100 Hz)"));
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
+  EXPECT_FALSE(fs::exists(dir_ / "outputs"));
+}
+
+TEST_F(CliExport, CheckFindsAChangedValueAndAStaleHash) {
+  ASSERT_EQ(run({"export", kDesign, "--out", "c"}).code, 0);
+  const fs::path yaml = dir_ / "c" / "iros2022_controller.yaml";
+  std::string text = slurp(yaml);
+  const auto at = text.find("      i_clamp: 0.2\n");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 19, "      i_clamp: 0.25\n");
+  const fs::path edited = dir_ / "edited.yaml";
+  std::ofstream(edited) << text;
+  const Outcome e = run({"export", "--check", edited.string(), kDesign});
+  EXPECT_EQ(e.code, 1);
+  EXPECT_THAT(e.out, AllOf(HasSubstr("1 difference(s)"),
+                           HasSubstr("fivebar_controller.ros__parameters.gains.index_lower_theta1.i_clamp: design 0.2, file 0.25"),
+                           HasSubstr("(same)")));
+  EXPECT_THAT(e.err, HasSubstr("does not match design iros2022"));
+
+  // The design moves on: the exported header is stale.
+  const fs::path newer = design_with("newer.yaml", "  pwm_hz: 1000", "  pwm_hz: 2000");
+  const Outcome s = run({"export", "--check", (dir_ / "c" / "iros2022_controller.hpp").string(), newer.string(), "--json"});
+  EXPECT_EQ(s.code, 1);
+  const json doc = parse(s);
+  EXPECT_EQ(doc["matches"], false);
+  EXPECT_EQ(doc["hash_matches"], false);
+  EXPECT_EQ(doc["format"], "header");
+  std::vector<std::string> paths;
+  for (const auto& d : doc["differences"]) paths.push_back(d["path"]);
+  EXPECT_THAT(paths, Contains(std::string("fivebar_controller.ros__parameters.pwm_hz")));
+  EXPECT_THAT(paths, Contains(std::string("fivebar_controller.ros__parameters.fivebar.design_hash")));
+  const Outcome text_out = run({"export", "--check", (dir_ / "c" / "iros2022_controller.json").string(), newer.string()});
+  EXPECT_THAT(text_out.out, HasSubstr("STALE"));
+}
+
+TEST_F(CliExport, RunBuildsTheExportProduct) {
+  const Outcome r = run({"run", kDesign, "--products", "export", "--out", "scene", "--json", "--quiet"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  EXPECT_EQ(doc["results"]["export"]["exported"], true);
+  EXPECT_EQ(doc["results"]["export"]["files"],
+            json({"export/iros2022_controller.yaml", "export/iros2022_controller.json", "export/iros2022_controller.hpp"}));
+  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 3u);
+  EXPECT_EQ(run({"export", "--check", (dir_ / "scene" / "iros2022" / "export" / "iros2022_controller.json").string(), kDesign}).code, 0);
+  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"), AllOf(HasSubstr("## Controller export (`export`)"),
+                                                                       HasSubstr("Files:")));
+
+  // A refused export fails the scene and writes no export/ folder.
+  const fs::path bad = design_with("bad.yaml", "  min_lci: 0.05", "  min_lci: 0.5");
+  const Outcome f = run({"run", bad.string(), "--products", "export", "--out", "failing", "--quiet"});
+  EXPECT_EQ(f.code, 1);
+  EXPECT_FALSE(fs::exists(dir_ / "failing" / "iros2022" / "export"));
+  EXPECT_THAT(slurp(dir_ / "failing" / "iros2022" / "summary.md"), HasSubstr("**Export refused**: no file written."));
+
+  // A design without a controller section cannot have the product: asked for, it is missing.
+  const Outcome n = run({"run", (kSource / "designs" / "iros2022-index.yaml").string(), "--products",
+                         "kinematics,export", "--out", "none", "--json", "--quiet"});
+  EXPECT_EQ(n.code, 1) << n.err;
+  const json none = parse(n);
+  EXPECT_EQ(none["missing"], json({"export"}));
+  bool found = false;
+  for (const auto& l : none["left_out"]) {
+    if (l["name"] != "export") continue;
+    found = true;
+    EXPECT_THAT(l["reason"].get<std::string>(), HasSubstr("no `controller:` section"));
+  }
+  EXPECT_TRUE(found);
+}
+
+}  // namespace

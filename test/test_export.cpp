@@ -1,0 +1,640 @@
+// Tests of the controller export (fivebar/export.hpp): number formatting, the hash, the parameter
+// tree against the design (values typed here from the paper's Table 1 and the showcase's
+// controller section), every format read back with an independent reader (yaml-cpp, nlohmann) and
+// with parse_export(), the gate's checks and reasons, atomic writing, and --check's comparison.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fivebar/error.hpp"
+#include "fivebar/export.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/kinematics.hpp"
+#include "fivebar/version.hpp"
+
+namespace fivebar {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::AllOf;
+using ::testing::Contains;
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+using ::testing::Not;
+using ::testing::StartsWith;
+using ::testing::ThrowsMessage;
+
+const fs::path kSource = FIVEBAR_SOURCE_DIR;
+constexpr double kPi = std::numbers::pi;
+double deg(double d) { return d * kPi / 180.0; }
+
+Design paper() { return load_design(kSource / "designs" / "iros2022.yaml"); }
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::uint64_t seed() {
+  const char* env = std::getenv("FIVEBAR_TEST_SEED");
+  return env ? std::strtoull(env, nullptr, 10) : 20220714u;
+}
+
+const Json& params_of(const Json& tree) { return tree.begin().value().at("ros__parameters"); }
+
+// --- Numbers and hash --------------------------------------------------------------------------------
+
+TEST(FormatDouble, AlwaysADoubleInShortestForm) {
+  EXPECT_EQ(format_double(5.0), "5.0");
+  EXPECT_EQ(format_double(-3.0), "-3.0");
+  EXPECT_EQ(format_double(0.0), "0.0");
+  EXPECT_EQ(format_double(-0.0), "-0.0");
+  EXPECT_EQ(format_double(0.1), "0.1");
+  EXPECT_EQ(format_double(0.009), "0.009");
+  EXPECT_EQ(format_double(1e-5), "1.0e-05");
+  EXPECT_EQ(format_double(-2.5e20), "-2.5e+20");
+  EXPECT_EQ(format_double(1e300), "1.0e+300");
+  EXPECT_EQ(format_double(0.1 + 0.2), "0.30000000000000004");
+  EXPECT_EQ(format_double(std::numeric_limits<double>::infinity()), "inf");
+  EXPECT_EQ(format_double(std::nan("")), "nan");
+}
+
+TEST(FormatDouble, ReadsBackBitForBit) {
+  std::mt19937_64 rng(seed());
+  std::uniform_int_distribution<std::uint64_t> bits;
+  SCOPED_TRACE("seed " + std::to_string(seed()) + " (FIVEBAR_TEST_SEED overrides)");
+  for (int i = 0; i < 20000; ++i) {
+    double x = 0.0;
+    const std::uint64_t b = bits(rng);
+    std::memcpy(&x, &b, sizeof x);
+    if (!std::isfinite(x)) continue;
+    const std::string text = format_double(x);
+    ASSERT_NE(text.find('.'), std::string::npos) << text;
+    EXPECT_EQ(std::strtod(text.c_str(), nullptr), x) << text;
+  }
+}
+
+TEST(Hash, Fnv1a64KnownVectors) {
+  // Reference values of the FNV-1a 64-bit function (Fowler, Noll, Vo).
+  EXPECT_EQ(fnv1a64(""), 0xcbf29ce484222325ULL);
+  EXPECT_EQ(fnv1a64("a"), 0xaf63dc4c8601ec8cULL);
+  EXPECT_EQ(fnv1a64("foobar"), 0x85944171f73967e8ULL);
+}
+
+TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
+  const Design d = paper();
+  const std::string h = design_hash(d, {});
+  EXPECT_THAT(h, StartsWith("fnv1a64:"));
+  EXPECT_EQ(h.size(), 8u + 16u);
+  char expected[32];
+  std::snprintf(expected, sizeof expected, "fnv1a64:%016llx",
+                static_cast<unsigned long long>(fnv1a64(to_yaml(export_view(d, {})))));
+  EXPECT_EQ(h, expected);
+  EXPECT_EQ(design_hash(paper(), {}), h);  // deterministic
+
+  const auto changed = [&](auto edit) {
+    Design e = paper();
+    edit(e);
+    return design_hash(e, {});
+  };
+  EXPECT_NE(changed([](Design& e) { e.controller->pid.kp = 5.5; }), h);
+  EXPECT_NE(changed([](Design& e) { e.stations[0].lower->L[2] = 15.25; }), h);
+  EXPECT_NE(changed([](Design& e) { e.patterns->global[0].amplitude_mm = 2.5; }), h);
+  EXPECT_NE(changed([](Design& e) { e.geometry->min_clearance = 0.25; }), h);
+  // Printing, sweeping and the product list do not make a controller file stale.
+  EXPECT_EQ(changed([](Design& e) { e.print->fn = 24; }), h);
+  EXPECT_EQ(changed([](Design& e) { e.sweep.reset(); }), h);
+  EXPECT_EQ(changed([](Design& e) { e.products = std::vector<std::string>{"export"}; }), h);
+  // A one-station export hashes its station only: the thumb's gains do not touch it.
+  const std::string index_only = design_hash(d, {"index"});
+  EXPECT_NE(index_only, h);
+  Design e = paper();
+  ControlOverride o;
+  o.station = "thumb", o.kp = 9.0;
+  e.controller->overrides.push_back(o);
+  EXPECT_EQ(design_hash(e, {"index"}), index_only);
+  EXPECT_NE(design_hash(e, {}), h);
+}
+
+// --- The parameter tree against the design --------------------------------------------------------
+
+TEST(Parameters, HoldThePapersDeviceInSiUnits) {
+  const Design d = paper();
+  const Json tree = controller_parameters(d, {});
+  ASSERT_EQ(tree.size(), 1u);
+  EXPECT_EQ(tree.begin().key(), "fivebar_controller");
+  const Json& p = params_of(tree);
+  EXPECT_EQ(p.at("fivebar").at("design"), "iros2022");
+  EXPECT_EQ(p.at("fivebar").at("design_hash"), design_hash(d, {}));
+  EXPECT_EQ(p.at("fivebar").at("tool_version"), std::string(version()));
+  EXPECT_EQ(p.at("loop_rate_hz"), 100.0);
+  EXPECT_TRUE(p.at("loop_rate_hz").is_number_float());
+  EXPECT_EQ(p.at("pwm_hz"), 1000.0);
+  EXPECT_EQ(p.at("adc").at("bits"), 16);
+  EXPECT_TRUE(p.at("adc").at("bits").is_number_integer());
+  EXPECT_EQ(p.at("adc").at("volts_per_count"), 20.0 / 65536.0);
+  EXPECT_EQ(p.at("station_names"), Json({"index", "thumb"}));
+  EXPECT_EQ(p.at("joint_names"), Json({"index_lower_theta1", "index_lower_theta2", "index_upper_theta1",
+                                       "index_upper_theta2", "thumb_lower_theta1", "thumb_lower_theta2",
+                                       "thumb_upper_theta1", "thumb_upper_theta2"}));
+  // Table 1, in metres.
+  const Json& index = p.at("stations").at("index");
+  EXPECT_EQ(index.at("target").at("center_m"), Json({6.25 / 1000, 15.5 / 1000}));
+  EXPECT_EQ(index.at("target").at("axes_m"), Json({15.0 / 1000, 12.0 / 1000}));
+  EXPECT_EQ(index.at("upper").at("o1_m"), Json({0.0, 31.0 / 1000}));
+  EXPECT_EQ(index.at("upper").at("o2_m"), Json({12.5 / 1000, 31.0 / 1000}));
+  EXPECT_EQ(index.at("lower").at("link_lengths_m"), Json({0.009, 0.009, 0.015, 0.015}));
+  EXPECT_EQ(p.at("stations").at("thumb").at("lower").at("link_lengths_m"), Json({0.009, 0.009, 0.0175, 0.0175}));
+  EXPECT_EQ(index.at("lower").at("working_mode"), "-+");
+  EXPECT_EQ(index.at("upper").at("working_mode"), "+-");
+  EXPECT_EQ(index.at("upper").at("assembly_mode"), "-");
+  // The showcase: no joint limits; 360 deg/s; pots 5 V over 300 deg; mid-travel offsets.
+  const Json& lim = p.at("joint_limits").at("thumb_upper_theta2");
+  EXPECT_EQ(lim.at("has_position_limits"), false);
+  EXPECT_FALSE(lim.contains("min_position"));
+  EXPECT_EQ(lim.at("has_velocity_limits"), true);
+  EXPECT_DOUBLE_EQ(lim.at("max_velocity").get<double>(), 2.0 * kPi);
+  EXPECT_EQ(p.at("gains").at("index_lower_theta1"), Json({{"p", 5.0}, {"i", 1.0}, {"d", 0.05}, {"i_clamp", 0.2}}));
+  EXPECT_DOUBLE_EQ(p.at("potentiometers").at("index_lower_theta1").at("rad_per_volt").get<double>(), deg(60));
+  EXPECT_EQ(p.at("potentiometers").at("index_lower_theta1").at("volts_at_zero"), 0.25);
+  EXPECT_EQ(p.at("potentiometers").at("thumb_upper_theta1").at("volts_at_zero"), 4.75);
+  EXPECT_EQ(p.at("collision").at("priority"), "upper");
+  EXPECT_EQ(p.at("collision").at("min_clearance_m"), 0.3 / 1000);
+  EXPECT_EQ(p.at("collision").at("layers"), Json({0, 0, 1, 1}));
+}
+
+TEST(Parameters, OneStationAndJointLimitsOnTheCentresBranch) {
+  Design d = paper();
+  // Limits that hold over the index ellipse (its lower theta1 spans about 82 ... 180 deg). The
+  // upper's are given from -200 deg: on the branch of its centre angle (about -135 deg) they stay
+  // [-200, -60] deg rather than [160, 300].
+  d.stations[0].lower->joint_limits = std::array<JointRange, 2>{JointRange{deg(60), deg(200)}, JointRange{deg(-30), deg(120)}};
+  d.stations[0].upper->joint_limits = std::array<JointRange, 2>{JointRange{deg(-200), deg(-60)}, JointRange{deg(-120), deg(30)}};
+  d.validate();
+  const Json tree = controller_parameters(d, {"index"});
+  const Json& p = params_of(tree);
+  EXPECT_EQ(p.at("station_names"), Json({"index"}));
+  EXPECT_FALSE(p.at("stations").contains("thumb"));
+  EXPECT_FALSE(p.at("joint_limits").contains("thumb_lower_theta1"));
+  const Json& l1 = p.at("joint_limits").at("index_lower_theta1");
+  EXPECT_EQ(l1.at("has_position_limits"), true);
+  EXPECT_NEAR(l1.at("min_position").get<double>(), deg(60), 1e-12);
+  EXPECT_NEAR(l1.at("max_position").get<double>(), deg(200), 1e-12);
+  const Json& u1 = p.at("joint_limits").at("index_upper_theta1");
+  EXPECT_NEAR(u1.at("min_position").get<double>(), deg(-200), 1e-12);
+  EXPECT_NEAR(u1.at("max_position").get<double>(), deg(-60), 1e-12);
+  // The centre's angle is on the exported arc.
+  const Pose c = ik(*d.stations[0].upper, d.stations[0].target.center);
+  EXPECT_GT(c.theta1, u1.at("min_position").get<double>());
+  EXPECT_LT(c.theta1, u1.at("max_position").get<double>());
+
+  const ExportGate gate = export_gate(d, {.stations = {"index"}});
+  EXPECT_TRUE(gate.passed()) << ::testing::PrintToString(gate.reasons());
+  EXPECT_EQ(gate.stations, std::vector<std::string>{"index"});
+}
+
+// --- Every format read back --------------------------------------------------------------------------
+
+/// Walks a yaml-cpp tree beside the parameter tree: same keys, same values, and every double
+/// written with a '.' (ROS declares these parameters double).
+void expect_yaml_matches(const YAML::Node& y, const Json& j, const std::string& path, int& doubles) {
+  SCOPED_TRACE(path);
+  if (j.is_object()) {
+    ASSERT_TRUE(y.IsMap());
+    EXPECT_EQ(y.size(), j.size());
+    for (const auto& [key, value] : j.items()) {
+      ASSERT_TRUE(y[key]) << key;
+      expect_yaml_matches(y[key], value, path + "." + key, doubles);
+    }
+    return;
+  }
+  if (j.is_array()) {
+    ASSERT_TRUE(y.IsSequence());
+    ASSERT_EQ(y.size(), j.size());
+    for (std::size_t i = 0; i < j.size(); ++i) expect_yaml_matches(y[i], j[i], path + "[" + std::to_string(i) + "]", doubles);
+    return;
+  }
+  ASSERT_TRUE(y.IsScalar());
+  const std::string text = y.Scalar();
+  if (j.is_number_float()) {
+    ++doubles;
+    EXPECT_NE(text.find('.'), std::string::npos) << "double written as " << text;
+    EXPECT_EQ(y.as<double>(), j.get<double>());
+  } else if (j.is_number_integer()) {
+    EXPECT_EQ(text.find_first_of(".e"), std::string::npos) << "integer written as " << text;
+    EXPECT_EQ(y.as<long long>(), j.get<long long>());
+  } else if (j.is_boolean()) {
+    EXPECT_EQ(y.as<bool>(), j.get<bool>());
+  } else {
+    EXPECT_EQ(y.Tag(), "!") << "strings are quoted";
+    EXPECT_EQ(text, j.get<std::string>());
+  }
+}
+
+TEST(Formats, RosYamlReadByYamlCppEqualsTheDesign) {
+  const Design d = paper();
+  const Json tree = controller_parameters(d, {});
+  const std::string text = render_ros2_yaml(tree);
+  const YAML::Node y = YAML::Load(text);
+  int doubles = 0;
+  expect_yaml_matches(y, tree, "", doubles);
+  EXPECT_GT(doubles, 100);
+  // The values a controller reads, by path, against Table 1 and the showcase.
+  const YAML::Node p = y["fivebar_controller"]["ros__parameters"];
+  EXPECT_EQ(p["stations"]["thumb"]["upper"]["o1_m"][1].as<double>(), 35.0 / 1000);
+  EXPECT_EQ(p["stations"]["index"]["lower"]["link_lengths_m"][2].as<double>(), 15.0 / 1000);
+  EXPECT_EQ(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), 0.05);
+  EXPECT_EQ(p["pwm_hz"].Scalar(), "1000.0");
+  EXPECT_EQ(p["adc"]["bits"].Scalar(), "16");
+  EXPECT_EQ(p["fivebar"]["design_hash"].as<std::string>(), design_hash(d, {}));
+  // Our own reader gives the same tree, kinds included.
+  const Json back = parse_export(ExportFormat::ros2, text, "<yaml>");
+  EXPECT_EQ(back, tree);
+}
+
+TEST(Formats, EveryDoubleLineOfTheYamlHasAPointOrExponent) {
+  // Line by line, independent of any YAML reader: a numeric scalar is an integer only for the
+  // integer parameters (format_version, adc.bits, layers).
+  const std::string text = render_ros2_yaml(controller_parameters(paper(), {}));
+  std::istringstream lines(text);
+  std::string line;
+  int numeric = 0;
+  while (std::getline(lines, line)) {
+    if (line.starts_with("#")) continue;
+    const auto colon = line.find(": ");
+    if (colon == std::string::npos) continue;
+    const std::string key = line.substr(line.find_first_not_of(' '), colon - line.find_first_not_of(' '));
+    std::string value = line.substr(colon + 2);
+    if (value.front() == '[') value = value.substr(1, value.size() - 2);
+    std::istringstream items(value);
+    std::string item;
+    while (std::getline(items, item, ',')) {
+      item.erase(0, item.find_first_not_of(' '));
+      if (item.empty() || !(std::isdigit(static_cast<unsigned char>(item[0])) || item[0] == '-')) continue;
+      ++numeric;
+      const bool integer_key = key == "format_version" || key == "bits" || key == "layers";
+      if (integer_key) {
+        EXPECT_EQ(item.find_first_of(".e"), std::string::npos) << line;
+      } else {
+        EXPECT_NE(item.find('.'), std::string::npos) << line;
+      }
+    }
+  }
+  EXPECT_GT(numeric, 100);
+}
+
+TEST(Formats, JsonReadByNlohmannEqualsTheTree) {
+  const Json tree = controller_parameters(paper(), {});
+  const std::string text = render_json(tree);
+  const nlohmann::json plain = nlohmann::json::parse(text);  // an independent (unordered) reader
+  EXPECT_EQ(plain.at("fivebar_controller").at("ros__parameters").at("stations").at("index").at("upper").at("o1_m")[1],
+            31.0 / 1000);
+  EXPECT_TRUE(plain.at("fivebar_controller").at("ros__parameters").at("pwm_hz").is_number_float());
+  EXPECT_TRUE(plain.at("fivebar_controller").at("ros__parameters").at("adc").at("bits").is_number_integer());
+  EXPECT_THAT(text, HasSubstr("\"loop_rate_hz\": 100.0"));
+  EXPECT_EQ(parse_export(ExportFormat::json, text, "<json>"), tree);
+}
+
+TEST(Formats, HeaderReadsBackAndDeclaresEveryValue) {
+  const Json tree = controller_parameters(paper(), {});
+  const std::string text = render_header(tree);
+  EXPECT_THAT(text, HasSubstr("#pragma once"));
+  EXPECT_THAT(text, HasSubstr("namespace fivebar_controller {"));
+  EXPECT_THAT(text, HasSubstr("inline constexpr double pwm_hz = 1000.0;"));
+  EXPECT_THAT(text, HasSubstr("inline constexpr long long bits = 16;"));
+  EXPECT_THAT(text, HasSubstr("inline constexpr double link_lengths_m[4] = {0.009, 0.009, 0.015, 0.015};"));
+  EXPECT_THAT(text, HasSubstr("inline constexpr char working_mode[] = \"-+\";"));
+  EXPECT_EQ(parse_export(ExportFormat::header, text, "<hpp>"), tree);
+}
+
+TEST(Formats, RefuseWhatRosCannotHold) {
+  Json tree = controller_parameters(paper(), {});
+  Json bad = tree;
+  bad.begin().value()["ros__parameters"]["pwm_hz"] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(render_ros2_yaml(bad), std::logic_error);
+  EXPECT_THROW(render_header(bad), std::logic_error);
+  bad = tree;
+  bad.begin().value()["ros__parameters"]["station_names"] = Json::array();
+  EXPECT_THROW(render_ros2_yaml(bad), std::logic_error);
+  bad = tree;
+  bad.begin().value()["ros__parameters"]["adc"]["range_v"] = Json::array({1.0, 2});
+  EXPECT_THROW(render_ros2_yaml(bad), std::logic_error);
+}
+
+TEST(Formats, DetectedByExtensionOrContent) {
+  EXPECT_EQ(detect_export_format("a/b.yaml", ""), ExportFormat::ros2);
+  EXPECT_EQ(detect_export_format("a/b.YML", ""), ExportFormat::ros2);
+  EXPECT_EQ(detect_export_format("b.json", ""), ExportFormat::json);
+  EXPECT_EQ(detect_export_format("b.hpp", ""), ExportFormat::header);
+  EXPECT_EQ(detect_export_format("b.txt", "  {\"a\": 1}"), ExportFormat::json);
+  EXPECT_EQ(detect_export_format("b", "// x\n#pragma once"), ExportFormat::header);
+  EXPECT_EQ(detect_export_format("b", "node:\n  ros__parameters: {}"), ExportFormat::ros2);
+  for (ExportFormat f : all_export_formats()) EXPECT_EQ(parse_export_format(to_string(f)), f);
+  EXPECT_FALSE(parse_export_format("yaml").has_value());
+}
+
+// --- The gate -----------------------------------------------------------------------------------------
+
+std::vector<std::string> failed_kinds(const ExportGate& g) {
+  std::vector<std::string> out;
+  for (const GateCheck& c : g.checks) {
+    if (!c.passed) out.push_back(c.subject + " " + c.kind);
+  }
+  return out;
+}
+
+TEST(Gate, ThePapersDevicePassesEveryCheck) {
+  const ExportGate g = export_gate(paper());
+  EXPECT_TRUE(g.passed()) << ::testing::PrintToString(g.reasons());
+  EXPECT_THAT(g.reasons(), IsEmpty());
+  std::vector<std::string> kinds;
+  for (const GateCheck& c : g.checks) kinds.push_back(c.subject + " " + c.kind);
+  for (const char* expected : {"design names", "design geometry", "index/lower coverage", "index/upper singularity",
+                               "index/shared coverage", "thumb/lower joint_limits", "thumb/upper calibration",
+                               "index stretch pattern", "thumb pivot pattern"}) {
+    EXPECT_THAT(kinds, Contains(std::string(expected)));
+  }
+  // Joint ranges over the index ellipse, against an independent boundary walk with ik().
+  const Station& s = paper().stations[0];
+  double lo = 1e9, hi = -1e9;
+  for (int k = 0; k < 3600; ++k) {
+    const Pose p = ik(*s.lower, s.target.boundary_point(2.0 * kPi * k / 3600));
+    ASSERT_EQ(p.status, Status::ok);
+    const double t = p.theta1 < 0 ? p.theta1 + 2 * kPi : p.theta1;  // lower theta1 stays in (0, 2 pi)
+    lo = std::min(lo, t), hi = std::max(hi, t);
+  }
+  const auto it = std::find_if(g.joints.begin(), g.joints.end(), [](const JointSweep& j) { return j.name == "index_lower_theta1"; });
+  ASSERT_NE(it, g.joints.end());
+  EXPECT_NEAR(it->lo, lo, 1e-3);
+  EXPECT_NEAR(it->hi, hi, 1e-3);
+}
+
+TEST(Gate, SingularityThresholdAgainstTheLciAtTheEllipsesBottom) {
+  // The minimum over the ellipse can be no larger than the LCI at any of its points.
+  Design d = paper();
+  const Station& s = d.stations[0];
+  const Pose bottom = ik(*s.lower, s.target.center - Vec2(0.0, s.target.axes.y() / 2));
+  ASSERT_EQ(bottom.status, Status::ok);
+  d.controller->min_lci = std::min(1.0, bottom.lci + 0.01);
+  const ExportGate g = export_gate(d, {.stations = {"index"}});
+  EXPECT_FALSE(g.passed());
+  EXPECT_THAT(failed_kinds(g), Contains(std::string("index/lower singularity")));
+  EXPECT_THAT(g.reasons(), Contains(AllOf(StartsWith("index/lower singularity: min LCI over the ellipse"),
+                                          HasSubstr("below"))));
+  d.controller->min_lci = 0.0;
+  d.stations[0].lower->min_lci = 0.3;  // a mechanism's own threshold counts too (0.362 > 0.3)
+  EXPECT_TRUE(export_gate(d, {.stations = {"index"}}).passed());
+}
+
+TEST(Gate, JointLimitsThatCutTheEllipseFailWithTheWorstAngle) {
+  Design d = paper();
+  d.stations[0].lower->joint_limits = std::array<JointRange, 2>{JointRange{deg(60), deg(150)}, JointRange{deg(-30), deg(120)}};
+  d.validate();
+  const ExportGate g = export_gate(d, {.stations = {"index"}});
+  EXPECT_FALSE(g.passed());
+  const auto failed = failed_kinds(g);
+  EXPECT_THAT(failed, Contains(std::string("index/lower joint_limits")));
+  EXPECT_THAT(failed, Contains(std::string("index/lower coverage")));  // the joint-limited region misses it too
+  EXPECT_THAT(failed, Not(Contains(std::string("index/upper joint_limits"))));
+  // The boundary needs theta1 up to about 179.9 deg (independent walk in the previous test).
+  EXPECT_THAT(g.reasons(), Contains(AllOf(HasSubstr("index/lower joint_limits"), HasSubstr("worst: theta1 = 179."),
+                                          HasSubstr("outside [60.00, 150.00] deg"))));
+}
+
+TEST(Gate, EveryFailureIsListedAtOnce) {
+  Design d = paper();
+  d.stations[1].target.axes = Vec2(40.0, 40.0);  // the thumb cannot cover this
+  ControlOverride o;
+  o.station = "index", o.mechanism = "lower", o.joint = 1, o.volts_at_zero = 9.0;  // 180 deg reads 12 V
+  d.controller->overrides.push_back(o);
+  PatternSpec twist;  // index twist beyond the ~5.3 mm where L3 meets the upper's tactor joint
+  twist.kind = PatternKind::twist, twist.amplitude_mm = 7.0, twist.separation_mm = 8.0;
+  d.patterns->per_station.emplace_back("index", twist);
+  d.validate();
+  const ExportGate g = export_gate(d);
+  const auto failed = failed_kinds(g);
+  EXPECT_THAT(failed, Contains(std::string("thumb/lower coverage")));
+  EXPECT_THAT(failed, Contains(std::string("thumb/upper coverage")));
+  EXPECT_THAT(failed, Contains(std::string("thumb/shared coverage")));
+  EXPECT_THAT(failed, Contains(std::string("index/lower calibration")));
+  EXPECT_THAT(failed, Contains(std::string("index twist pattern")));
+  EXPECT_THAT(failed, Not(Contains(std::string("index/lower coverage"))));
+  EXPECT_THAT(g.reasons(), Contains(AllOf(HasSubstr("index/lower calibration"), HasSubstr("OUTSIDE"))));
+  EXPECT_EQ(g.reasons().size(), failed.size());
+}
+
+TEST(Gate, NamesMustBeIdentifiersInEveryFormat) {
+  Design d = paper();
+  d.stations[0].name = "int";
+  d.sweep.reset();
+  d.controller->node = "linux";
+  for (auto& o : d.controller->overrides) {
+    if (o.station == "index") o.station = "int";
+  }
+  for (auto& e : d.patterns->per_station) {
+    if (e.first == "index") e.first = "int";
+  }
+  d.validate();
+  const ExportGate g = export_gate(d);
+  EXPECT_THAT(failed_kinds(g), Contains(std::string("design names")));
+  EXPECT_THAT(g.reasons(), Contains(AllOf(HasSubstr("station 'int' is a C++ keyword"), HasSubstr("controller.node 'linux'"))));
+  d.stations[0].name = "a__b";
+  EXPECT_THAT(export_gate(d, {.stations = {"a__b"}}).reasons(), Contains(HasSubstr("must not contain \"__\"")));
+}
+
+TEST(Gate, NeedsTheControllerSectionAndGeometry) {
+  Design d = paper();
+  d.controller.reset();
+  EXPECT_THAT([&] { export_gate(d); }, ThrowsMessage<InputError>(HasSubstr("has no controller: section")));
+  d = paper();
+  EXPECT_THAT([&] { export_gate(d, {.stations = {"pinky"}}); },
+              ThrowsMessage<InputError>(HasSubstr("unknown station 'pinky'")));
+  d.geometry.reset();
+  const ExportGate g = export_gate(d);
+  EXPECT_THAT(failed_kinds(g), Contains(std::string("design geometry")));
+  EXPECT_THAT(failed_kinds(g), Contains(std::string("index stretch pattern")));
+}
+
+// --- Writing ------------------------------------------------------------------------------------------
+
+class ExportFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::random_device rd;
+    dir_ = fs::temp_directory_path() / ("fivebar_test_export_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  fs::path dir_;
+};
+
+Design failing() {
+  Design d = paper();
+  d.controller->min_lci = 0.99;  // no five-bar is that well conditioned over a 15 mm ellipse
+  return d;
+}
+
+TEST_F(ExportFiles, AllFormatsWrittenAndReadBackEqual) {
+  const Design d = paper();
+  const ExportResult r = export_controller(d, all_export_formats(), dir_ / "out");
+  ASSERT_TRUE(r.gate.passed());
+  ASSERT_EQ(r.files.size(), 3u);
+  EXPECT_EQ(r.files[0], dir_ / "out" / "iros2022_controller.yaml");
+  EXPECT_EQ(r.files[1], dir_ / "out" / "iros2022_controller.json");
+  EXPECT_EQ(r.files[2], dir_ / "out" / "iros2022_controller.hpp");
+  for (std::size_t i = 0; i < 3; ++i) {
+    const ExportFormat f = all_export_formats()[i];
+    EXPECT_EQ(parse_export(f, slurp(r.files[i]), r.files[i].string()), r.parameters) << to_string(f);
+    const ExportCheck c = check_export_file(r.files[i], d);
+    EXPECT_TRUE(c.matches()) << to_string(f);
+    EXPECT_TRUE(c.hash_matches());
+    EXPECT_EQ(c.format, f);
+  }
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir_ / "out")) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
+                                             "iros2022_controller.yaml"}));  // no temporaries left
+  const ExportResult one = export_controller(d, {ExportFormat::json}, dir_ / "one", {.stations = {"thumb"}});
+  ASSERT_EQ(one.files.size(), 1u);
+  EXPECT_EQ(one.files[0].filename(), "iros2022_controller_thumb.json");
+}
+
+TEST_F(ExportFiles, AFailingGateCreatesNothing) {
+  const ExportResult r = export_controller(failing(), all_export_formats(), dir_ / "absent" / "export");
+  EXPECT_FALSE(r.gate.passed());
+  EXPECT_THAT(r.files, IsEmpty());
+  EXPECT_TRUE(r.parameters.is_null());
+  EXPECT_FALSE(fs::exists(dir_ / "absent"));
+}
+
+TEST_F(ExportFiles, AFailingGateLeavesAnEarlierExportUntouched) {
+  const fs::path out = dir_ / "out";
+  const ExportResult good = export_controller(paper(), all_export_formats(), out);
+  ASSERT_EQ(good.files.size(), 3u);
+  std::vector<std::string> before;
+  std::vector<fs::file_time_type> times;
+  for (const auto& f : good.files) before.push_back(slurp(f)), times.push_back(fs::last_write_time(f));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const ExportResult bad = export_controller(failing(), all_export_formats(), out);
+  EXPECT_FALSE(bad.gate.passed());
+  for (std::size_t i = 0; i < good.files.size(); ++i) {
+    EXPECT_EQ(slurp(good.files[i]), before[i]);
+    EXPECT_EQ(fs::last_write_time(good.files[i]), times[i]);
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 3);
+}
+
+TEST_F(ExportFiles, AnUnreplaceableTargetWritesNothing) {
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out / "iros2022_controller.json");  // a directory where the JSON goes
+  EXPECT_THROW(export_controller(paper(), all_export_formats(), out), IoError);
+  EXPECT_FALSE(fs::exists(out / "iros2022_controller.yaml"));
+  EXPECT_FALSE(fs::exists(out / "iros2022_controller.hpp"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 1);
+}
+
+// --- --check ------------------------------------------------------------------------------------------
+
+std::string replace_once(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  return text;
+}
+
+TEST(Check, FindsAChangedValueInEveryFormat) {
+  const Design d = paper();
+  const Json tree = controller_parameters(d, {});
+  const std::string yaml = replace_once(render_ros2_yaml(tree), "volts_at_zero: 4.75", "volts_at_zero: 4.7");
+  const ExportCheck y = check_export(yaml, ExportFormat::ros2, d, "f.yaml");
+  EXPECT_TRUE(y.hash_matches());
+  ASSERT_EQ(y.differences.size(), 1u);
+  EXPECT_EQ(y.differences[0].path, "fivebar_controller.ros__parameters.potentiometers.index_upper_theta1.volts_at_zero");
+  EXPECT_EQ(y.differences[0].expected, "4.75");
+  EXPECT_EQ(y.differences[0].found, "4.7");
+
+  const std::string json = replace_once(render_json(tree), "\"pwm_hz\": 1000.0", "\"pwm_hz\": 1000.5");
+  const ExportCheck j = check_export(json, ExportFormat::json, d, "f.json");
+  ASSERT_EQ(j.differences.size(), 1u);
+  EXPECT_EQ(j.differences[0].path, "fivebar_controller.ros__parameters.pwm_hz");
+
+  const std::string header =
+      replace_once(render_header(tree), "link_lengths_m[4] = {0.009, 0.009, 0.015, 0.015}", "link_lengths_m[4] = {0.009, 0.009, 0.015, 0.016}");
+  const ExportCheck h = check_export(header, ExportFormat::header, d, "f.hpp");
+  ASSERT_EQ(h.differences.size(), 1u);
+  EXPECT_EQ(h.differences[0].path, "fivebar_controller.ros__parameters.stations.index.lower.link_lengths_m[3]");
+}
+
+TEST(Check, AnIntegerWhereADoubleIsDeclaredIsADifference) {
+  const Design d = paper();
+  const std::string yaml = replace_once(render_ros2_yaml(controller_parameters(d, {})), "loop_rate_hz: 100.0", "loop_rate_hz: 100");
+  const ExportCheck c = check_export(yaml, ExportFormat::ros2, d, "f.yaml");
+  ASSERT_EQ(c.differences.size(), 1u);
+  EXPECT_EQ(c.differences[0].expected, "100.0 (double)");
+  EXPECT_EQ(c.differences[0].found, "100 (integer)");
+}
+
+TEST(Check, AStaleFileIsReportedByHashAndValue) {
+  const std::string yaml = render_ros2_yaml(controller_parameters(paper(), {}));
+  Design changed = paper();
+  changed.controller->pid.kd = 0.06;
+  const ExportCheck c = check_export(yaml, ExportFormat::ros2, changed, "f.yaml");
+  EXPECT_FALSE(c.hash_matches());
+  EXPECT_FALSE(c.matches());
+  EXPECT_EQ(c.file_hash, design_hash(paper(), {}));
+  EXPECT_EQ(c.design_hash, design_hash(changed, {}));
+  std::vector<std::string> paths;
+  for (const auto& diff : c.differences) paths.push_back(diff.path);
+  EXPECT_THAT(paths, Contains(std::string("fivebar_controller.ros__parameters.fivebar.design_hash")));
+  EXPECT_THAT(paths, Contains(std::string("fivebar_controller.ros__parameters.gains.thumb_lower_theta1.d")));
+  EXPECT_EQ(c.differences.size(), 1u + 8u);  // the hash and kd of every joint
+  // A one-station file is compared with that station's export.
+  const std::string index = render_json(controller_parameters(paper(), {"index"}));
+  EXPECT_TRUE(check_export(index, ExportFormat::json, paper(), "i.json").matches());
+}
+
+TEST(Check, MissingAndExtraKeysAndForeignFiles) {
+  const Design d = paper();
+  std::string yaml = render_ros2_yaml(controller_parameters(d, {}));
+  yaml = replace_once(yaml, "    pwm_hz: 1000.0\n", "    pwm: 1000.0\n");
+  const ExportCheck c = check_export(yaml, ExportFormat::ros2, d, "f.yaml");
+  ASSERT_EQ(c.differences.size(), 2u);
+  EXPECT_EQ(c.differences[0].found, "(absent)");
+  EXPECT_EQ(c.differences[1].expected, "(absent)");
+  EXPECT_THAT([&] { check_export("a: 1\nb: 2\n", ExportFormat::ros2, d, "x.yaml"); },
+              ThrowsMessage<InputError>(HasSubstr("x.yaml: not a fivebar controller export")));
+  EXPECT_THAT([&] { check_export("{\"n\": {\"ros__parameters\": {}}}", ExportFormat::json, d, "x.json"); },
+              ThrowsMessage<InputError>(HasSubstr("no fivebar: block")));
+  EXPECT_THAT([&] { check_export("{\"n\": [1,", ExportFormat::json, d, "x.json"); },
+              ThrowsMessage<InputError>(StartsWith("x.json:1: not valid JSON")));
+  EXPECT_THAT([&] { check_export("namespace n {\nint x = 1;\n}\n", ExportFormat::header, d, "x.hpp"); },
+              ThrowsMessage<InputError>(StartsWith("x.hpp:2: not a line fivebar export writes")));
+  EXPECT_THAT([&] { check_export("a: [1,\n", ExportFormat::ros2, d, "x.yaml"); },
+              ThrowsMessage<InputError>(HasSubstr("YAML syntax error")));
+}
+
+}  // namespace
+}  // namespace fivebar

@@ -1,0 +1,101 @@
+// The exported C++17 header, compiled: test/export_header/values_cpp17.cpp includes the header the
+// build generated with the built `fivebar export --format header designs/iros2022.yaml` (its
+// static_asserts check the paper's numbers at compile time) and hands every value over; here they
+// are compared with the design loaded from the same file.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "fivebar/export.hpp"
+#include "fivebar/version.hpp"
+#include "header_values.hpp"
+
+namespace fivebar {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kSource = FIVEBAR_SOURCE_DIR;
+
+TEST(ExportedHeader, EveryCompiledValueEqualsTheDesign) {
+  const Design d = load_design(kSource / "designs" / "iros2022.yaml");
+  const ControllerSettings& c = *d.controller;
+  const fivebar_test::HeaderValues v = fivebar_test::header_values();
+  EXPECT_EQ(v.design, d.name);
+  EXPECT_EQ(v.design_hash, design_hash(d, {}));
+  EXPECT_EQ(v.tool_version, std::string(version()));
+  EXPECT_EQ(v.format_version, 1);
+  EXPECT_EQ(v.loop_rate_hz, c.loop_rate_hz);
+  EXPECT_EQ(v.pwm_hz, c.pwm_hz);
+  EXPECT_EQ(v.adc_bits, c.adc_bits);
+  EXPECT_EQ(v.adc_range[0], c.adc_range_v[0]);
+  EXPECT_EQ(v.adc_range[1], c.adc_range_v[1]);
+  EXPECT_EQ(v.volts_per_count, (c.adc_range_v[1] - c.adc_range_v[0]) / 65536.0);
+  EXPECT_EQ(v.station_names, (std::vector<std::string>{"index", "thumb"}));
+
+  ASSERT_EQ(v.stations.size(), d.stations.size());
+  for (std::size_t i = 0; i < v.stations.size(); ++i) {
+    const Station& s = d.stations[i];
+    EXPECT_EQ(v.stations[i].name, s.name);
+    EXPECT_EQ(v.stations[i].center[0], s.target.center.x() / 1000);
+    EXPECT_EQ(v.stations[i].center[1], s.target.center.y() / 1000);
+    EXPECT_EQ(v.stations[i].axes[0], s.target.axes.x() / 1000);
+    EXPECT_EQ(v.stations[i].axes[1], s.target.axes.y() / 1000);
+    EXPECT_EQ(v.stations[i].angle, s.target.angle);
+  }
+  ASSERT_EQ(v.mechanisms.size(), 4u);
+  std::vector<std::string> joints;
+  for (const auto& hm : v.mechanisms) {
+    SCOPED_TRACE(hm.station + "/" + hm.name);
+    const Mechanism* m = d.station(hm.station)->mechanism(hm.name);
+    ASSERT_NE(m, nullptr);
+    EXPECT_EQ(hm.o1[0], m->O1.x() / 1000);
+    EXPECT_EQ(hm.o1[1], m->O1.y() / 1000);
+    EXPECT_EQ(hm.o2[0], m->O2.x() / 1000);
+    EXPECT_EQ(hm.o2[1], m->O2.y() / 1000);
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(hm.links[k], m->L[k] / 1000) << k;
+    EXPECT_EQ(hm.working_mode, to_string(m->working_mode));
+    EXPECT_EQ(hm.assembly_mode, to_string(m->assembly_mode));
+    EXPECT_EQ(hm.min_lci, m->min_lci);
+    EXPECT_EQ(hm.joint_names,
+              (std::vector<std::string>{hm.station + "_" + hm.name + "_theta1", hm.station + "_" + hm.name + "_theta2"}));
+    joints.insert(joints.end(), hm.joint_names.begin(), hm.joint_names.end());
+  }
+  EXPECT_EQ(v.joint_names, joints);
+  ASSERT_EQ(v.joints.size(), 8u);
+  for (std::size_t i = 0; i < v.joints.size(); ++i) {
+    const auto& hj = v.joints[i];
+    SCOPED_TRACE(hj.name);
+    EXPECT_EQ(hj.name, joints[i]);
+    const auto& hm = v.mechanisms[i / 2];
+    const JointControl jc = c.joint(hm.station, hm.name, int(i % 2) + 1);
+    EXPECT_EQ(hj.p, jc.pid.kp);
+    EXPECT_EQ(hj.i, jc.pid.ki);
+    EXPECT_EQ(hj.d, jc.pid.kd);
+    EXPECT_EQ(hj.i_clamp, jc.pid.i_clamp);
+    EXPECT_EQ(hj.volts_at_zero, jc.potentiometer.volts_at_zero);
+    EXPECT_EQ(hj.rad_per_volt, jc.potentiometer.rad_per_volt);
+    EXPECT_EQ(hj.has_position_limits, d.station(hm.station)->mechanism(hm.name)->joint_limits.has_value());
+    EXPECT_TRUE(hj.has_velocity_limits);
+    EXPECT_EQ(hj.max_velocity, c.max_velocity);
+  }
+  EXPECT_EQ(v.collision_priority, "upper");
+  EXPECT_EQ(v.min_clearance, d.geometry->min_clearance / 1000);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(v.link_widths[k], d.geometry->link_width[k] / 1000);
+    EXPECT_EQ(v.layers[k], d.geometry->layers[k]);
+  }
+}
+
+TEST(ExportedHeader, TheGeneratedFilePassesCheck) {
+  const Design d = load_design(kSource / "designs" / "iros2022.yaml");
+  const ExportCheck c = check_export_file(FIVEBAR_EXPORTED_HEADER, d);
+  EXPECT_EQ(c.format, ExportFormat::header);
+  EXPECT_TRUE(c.matches()) << ::testing::PrintToString(c.differences.size());
+}
+
+}  // namespace
+}  // namespace fivebar
