@@ -45,6 +45,8 @@ if ((sanitize)); then
   # distinctive exit code 86 never matches an expected one. Leaks are reported too.
   export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:check_initialization_order=1:strict_init_order=1:detect_stack_use_after_return=0:exitcode=86}"
   export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1:exitcode=86}"
+  # Caches of fontconfig, cairo and OpenMPI that live until exit (test/sanitizer/lsan.supp).
+  export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/test/sanitizer/lsan.supp:print_suppressions=0}"
   export FIVEBAR_TEST_CHILD_TIMEOUT_S="${FIVEBAR_TEST_CHILD_TIMEOUT_S:-60}"
   # The whole suite, bench_smoke included (it takes under a second here). Should a later benchmark
   # make it slow under ASan, leave it out here with -E '^bench_smoke$': the normal suite runs it.
