@@ -374,7 +374,8 @@ TEST(Gate, ThePapersDevicePassesEveryCheck) {
     EXPECT_THAT(kinds, Contains(std::string(expected)));
   }
   // Joint ranges over the index ellipse, against an independent boundary walk with ik().
-  const Station& s = paper().stations[0];
+  const Design d = paper();  // owned here: a Station reference into a temporary would dangle
+  const Station& s = d.stations[0];
   double lo = 1e9, hi = -1e9;
   for (int k = 0; k < 3600; ++k) {
     const Pose p = ik(*s.lower, s.target.boundary_point(2.0 * kPi * k / 3600));
