@@ -26,6 +26,7 @@ struct SweepCliOptions {
   std::uint64_t seed = 0;
   bool seed_set = false;
   std::vector<std::string> objectives;
+  std::optional<double> collision_spacing;
   std::string out;
   std::string shard;
   bool resume = false;
@@ -83,6 +84,7 @@ SweepSettings settings_of(const Design& design, const SweepCliOptions& o) {
   if (o.count) s.count = o.count;
   if (o.seed_set) s.seed = o.seed;
   if (!o.objectives.empty()) s.objectives = o.objectives;
+  if (o.collision_spacing) s.collision_spacing_mm = *o.collision_spacing;
   if (s.station.empty()) throw InputError("sweep: choose the station with --station (or a sweep: section)");
   if (s.vary.empty()) throw InputError("sweep: give at least one --vary NAME=LO:HI:N (or a sweep: section)");
   return s;
@@ -118,6 +120,7 @@ Json row_json(const SweepSettings& s, const SweepRow& r) {
   j["min_force_capability"] = opt(r.min_force_capability);
   j["footprint_mm"] = {opt(r.footprint_w_mm), opt(r.footprint_h_mm)};
   j["footprint_mm2"] = opt(r.footprint_mm2);
+  j["collision_fraction"] = opt(r.collision_fraction);
   return j;
 }
 
@@ -203,8 +206,12 @@ int run_sweep_cmd(const SweepCliOptions& o) {
       for (std::size_t d = 0; d < settings.vary.size(); ++d) {
         std::printf(" %s=%s", settings.vary[d].name.c_str(), exact(r.best->values[d]).c_str());
       }
-      std::printf("  margin %s mm, min LCI %s, footprint %s mm^2\n", fixed(r.best->score("margin")).c_str(),
+      std::printf("  margin %s mm, min LCI %s, footprint %s mm^2", fixed(r.best->score("margin")).c_str(),
                   fixed(r.best->min_lci).c_str(), fixed(r.best->footprint_mm2, 1).c_str());
+      if (!std::isnan(r.best->collision_fraction)) {
+        std::printf(", %s %% of tactor pairs collide", fixed(100.0 * r.best->collision_fraction, 1).c_str());
+      }
+      std::printf("\n");
     } else {
       std::printf("  no design covers the target\n");
     }
@@ -237,7 +244,10 @@ void setup_sweep(CLI::App& app) {
     opt->seed = v;
     opt->seed_set = true;
   }, "Seed of random / Sobol sampling (recorded in the output)");
-  sub->add_option("--objective", opt->objectives, "margin, min_lci, force, footprint; repeatable, in priority order")
+  sub->add_option("--collision-spacing", opt->collision_spacing,
+                  "Grid spacing (mm) of the per-design collision fraction when the design has geometry: (0: off; default 2)")
+      ->type_name("MM");
+  sub->add_option("--objective", opt->objectives, "margin, min_lci, force, footprint, collision; repeatable, in priority order")
       ->delimiter(',');
   sub->add_option("-o,--out", opt->out, "Output directory (default outputs/<name>/sweep)")->type_name("DIR");
   sub->add_option("--shard", opt->shard, "Run shard K of N (0-based K/N): contiguous blocks of the designs")->type_name("K/N");

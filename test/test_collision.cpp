@@ -627,6 +627,95 @@ TEST(CollisionMap, PictureAndJson) {
   EXPECT_EQ(j["priority_at_centre"]["status"], "moved");
 }
 
+// ---------------------------------------------------------------------------------------------
+// Collision fraction (what a sweep records) and the pruned pair test behind it.
+
+TEST(OutlinesCollide, SameVerdictAsTheUnprunedMinimumOnRandomPosePairs) {
+  const Design d = load_design(kDesign);
+  const Geometry& g = *d.geometry;
+  const Station& s = *d.station("index");
+  std::mt19937_64 rng(seed());
+  std::uniform_real_distribution<double> ux(-7.5, 7.5), uy(-6.0, 6.0);
+  int hits = 0, misses = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Pose pu = ik(*s.upper, s.target.center + Vec2(ux(rng), uy(rng)));
+    const Pose pl = ik(*s.lower, s.target.center + Vec2(ux(rng), uy(rng)));
+    if (pu.status == Status::unreachable || pl.status == Status::unreachable) continue;
+    const auto up = link_outline(*s.upper, pu, g), low = link_outline(*s.lower, pl, g);
+    // The reference: every same-plane capsule pair, no pruning (interference()).
+    const double exact = interference(*s.upper, pu, *s.lower, pl, g).min_clearance_mm;
+    for (double threshold : {-0.5, 0.0, 0.2, 1.0, 3.0, exact, std::nextafter(exact, 1e9)}) {
+      const bool expected = exact < threshold;
+      EXPECT_EQ(outlines_collide(up, low, threshold), expected) << "threshold " << threshold << ", clearance " << exact;
+      (expected ? hits : misses) += 1;
+    }
+  }
+  EXPECT_GT(hits, 100);
+  EXPECT_GT(misses, 100);
+}
+
+TEST(CollisionFraction, CountsEveryUsablePairLikeAnUnprunedInterferenceCheck) {
+  const Design d = load_design(kDesign);
+  const Geometry& g = *d.geometry;
+  for (const Station& s : d.stations) {
+    SCOPED_TRACE(s.name);
+    const double spacing = 2.0;
+    const CollisionFraction f = collision_fraction(s, g, spacing);
+    // The grid: points 2 mm apart inside the ellipse; their number is the ellipse area over
+    // spacing^2 up to the boundary cells (Gauss circle problem: within the perimeter / spacing).
+    const std::vector<Vec2> pts = ellipse_grid(s.target, spacing);
+    ASSERT_EQ(f.points, pts.size());
+    const double a = 0.5 * s.target.axes.x(), b = 0.5 * s.target.axes.y();
+    const double area_pts = std::numbers::pi * a * b / (spacing * spacing);
+    EXPECT_NEAR(double(pts.size()), area_pts, 2.0 * std::numbers::pi * std::max(a, b) / spacing);
+    // Brute force over every pair with the full interference report.
+    std::size_t pairs = 0, colliding = 0, same_point = 0;
+    for (const Vec2& p : pts) {
+      const Pose pu = ik(*s.upper, p);
+      if (!usable(*s.upper, pu)) continue;
+      same_point += usable(*s.lower, ik(*s.lower, p)) ? 1 : 0;
+      for (const Vec2& q : pts) {
+        const Pose pl = ik(*s.lower, q);
+        if (!usable(*s.lower, pl)) continue;
+        ++pairs;
+        colliding += interference(*s.upper, pu, *s.lower, pl, g).collides ? 1 : 0;
+      }
+    }
+    EXPECT_EQ(f.pairs, pairs);
+    EXPECT_EQ(f.colliding, colliding);
+    EXPECT_DOUBLE_EQ(f.fraction, double(colliding) / double(pairs));
+    // Both tactors on the same grid point always collide (the tactor disks overlap); tactors at
+    // opposite ends of the ellipse do not.
+    ASSERT_GT(same_point, 0u);
+    EXPECT_GE(f.colliding, same_point);
+    EXPECT_LT(f.fraction, 1.0);
+    // The collision map on the same grid counts the same pairs.
+    CollisionMapOptions o;
+    o.spacing_mm = spacing;
+    const CollisionMap map = collision_map(s, g, o);
+    EXPECT_EQ(map.pairs, f.pairs);
+    EXPECT_EQ(map.colliding, f.colliding);
+  }
+}
+
+TEST(CollisionFraction, GrowsWithTheRequiredClearance) {
+  const Design d = load_design(kDesign);
+  const Station& s = *d.station("thumb");
+  Geometry g = *d.geometry;
+  double last = -1.0;
+  for (double clearance : {0.0, 0.5, 1.0, 2.0, 4.0}) {
+    g.min_clearance = clearance;
+    const double f = collision_fraction(s, g, 2.5).fraction;
+    EXPECT_GE(f, last) << "min_clearance " << clearance;  // a pair colliding at c collides at c' > c
+    last = f;
+  }
+  EXPECT_GT(last, 0.0);
+  Station one = s;
+  one.lower.reset();
+  EXPECT_THAT([&] { collision_fraction(one, g, 2.0); }, ThrowsMessage<InputError>(HasSubstr("both")));
+  EXPECT_THROW(collision_fraction(s, g, -1.0), InputError);
+}
+
 TEST(CollisionJson, InterferenceAndRule) {
   const Design d = load_design(kDesign);
   const Station& s = *d.station("index");

@@ -12,6 +12,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "fivebar/collision.hpp"
 #include "fivebar/coverage.hpp"
 #include "fivebar/sweep.hpp"
 
@@ -155,6 +156,69 @@ TEST(Evaluation, InvalidDesignsAreRowsNotErrors) {
   EXPECT_THAT(bad.status, testing::HasSubstr("boss_diameter"));
   EXPECT_FALSE(bad.covered);
   EXPECT_TRUE(std::isnan(bad.margin_lower_mm));
+}
+
+TEST(Evaluation, CollisionFractionOfCoveredDesignsOnly) {
+  // The paper's design has geometry: covered rows carry the collision fraction of their own
+  // station (the swept links), computed on the sweep's grid; uncovered ones do not.
+  SweepSettings s = grid({{"L34", 11, 19, 9}});
+  s.collision_spacing_mm = 2.5;
+  s.objectives = {"margin", "collision"};
+  const Design d = with_sweep(s);
+  int covered = 0;
+  std::set<double> fractions;
+  for (std::uint64_t i = 0; i < sweep_size(s); ++i) {
+    const SweepRow row = evaluate_sweep_design(d, s, i);
+    SCOPED_TRACE(testing::Message() << "design " << i << ": " << row.status);
+    if (!row.covered) {
+      EXPECT_TRUE(std::isnan(row.collision_fraction));
+      continue;
+    }
+    ++covered;
+    const Station st = apply_sweep(d, s, row.values);
+    const CollisionFraction ref = collision_fraction(st, *d.geometry, 2.5);
+    EXPECT_EQ(row.collision_fraction, ref.fraction);
+    EXPECT_GT(row.collision_fraction, 0.0);
+    EXPECT_LT(row.collision_fraction, 1.0);
+    EXPECT_EQ(row.score("collision"), -row.collision_fraction);  // minimised
+    fractions.insert(row.collision_fraction);
+  }
+  EXPECT_GE(covered, 3);
+  EXPECT_GE(fractions.size(), 2u);  // the distal length changes what collides
+  // Off: spacing 0, or no geometry.
+  s.collision_spacing_mm = 0.0;
+  s.objectives = {"margin"};
+  const Design off = with_sweep(s);
+  Design bare = paper_design();
+  bare.geometry.reset();
+  bare.print.reset();
+  bare.controller.reset();
+  bare.patterns.reset();
+  bare.sweep = grid({{"L34", 11, 19, 9}});
+  bare.validate();
+  for (std::uint64_t i = 0; i < sweep_size(s); ++i) {
+    EXPECT_TRUE(std::isnan(evaluate_sweep_design(off, *off.sweep, i).collision_fraction));
+    EXPECT_TRUE(std::isnan(evaluate_sweep_design(bare, *bare.sweep, i).collision_fraction));
+  }
+}
+
+TEST(Evaluation, CollisionObjectiveNeedsGeometryAndBothMechanisms) {
+  SweepSettings s = grid({{"L34", 11, 19, 3}});
+  s.objectives = {"collision"};
+  Design d = paper_design();
+  d.geometry.reset();
+  d.print.reset();
+  d.controller.reset();
+  d.patterns.reset();
+  d.sweep = s;
+  EXPECT_THAT([&] { d.validate(); },
+              testing::ThrowsMessage<ValidationError>(testing::HasSubstr("needs the geometry: section")));
+  Design one = paper_design();
+  one.stations[0].upper.reset();
+  one.controller.reset();
+  one.patterns.reset();
+  one.sweep = s;
+  EXPECT_THAT([&] { one.validate(); }, testing::ThrowsMessage<ValidationError>(testing::HasSubstr("both a lower and an upper")));
 }
 
 TEST(Run, ShardsAndThreadsReproduceTheSerialRowsAndResumeContinuesExactly) {

@@ -137,6 +137,16 @@ std::vector<OutlinePart> link_outline(const Mechanism& m, const Pose& pose, cons
   const int top = tactor_plane(g);
   for (int p = std::max(g.layers[2], g.layers[3]) + 1; p < top; ++p) parts.push_back(disk_part(kPost, p, pose.P, pin_r));
   parts.push_back(disk_part(kTactor, top, pose.P, 0.5 * g.tactor_diameter));
+  for (OutlinePart& part : parts) {
+    part.box_lo = Vec2(kInf, kInf);
+    part.box_hi = Vec2(-kInf, -kInf);
+    for (int i = 0; i < part.count; ++i) {
+      const Capsule& c = part.shapes[i];
+      const Vec2 r(c.radius, c.radius);
+      part.box_lo = part.box_lo.cwiseMin(c.a.cwiseMin(c.b) - r);
+      part.box_hi = part.box_hi.cwiseMax(c.a.cwiseMax(c.b) + r);
+    }
+  }
   return parts;
 }
 
@@ -178,6 +188,20 @@ double min_clearance(const std::vector<OutlinePart>& upper, const std::vector<Ou
     }
   }
   return best;
+}
+
+bool outlines_collide(const std::vector<OutlinePart>& upper, const std::vector<OutlinePart>& lower, double threshold) {
+  for (const OutlinePart& a : upper) {
+    for (const OutlinePart& b : lower) {
+      if (a.plane != b.plane) continue;
+      const double gx = std::max({0.0, a.box_lo.x() - b.box_hi.x(), b.box_lo.x() - a.box_hi.x()});
+      const double gy = std::max({0.0, a.box_lo.y() - b.box_hi.y(), b.box_lo.y() - a.box_hi.y()});
+      const double gap = std::hypot(gx, gy);
+      if (gap > 0.0 && gap >= threshold) continue;  // disjoint boxes: clearance >= gap
+      if (part_clearance(a, b, nullptr, nullptr) < threshold) return true;
+    }
+  }
+  return false;
 }
 
 Interference interference(const Mechanism& upper, const Pose& upper_pose, const Mechanism& lower,
@@ -427,19 +451,71 @@ bool inside_ellipse(const Ellipse& e, const Vec2& p) {
 
 }  // namespace
 
-CollisionMap collision_map(const Station& station, const Geometry& g, const CollisionMapOptions& options) {
+std::vector<Vec2> ellipse_grid(const Ellipse& e, double spacing_mm) {
+  if (!(spacing_mm > 0.0) || !std::isfinite(spacing_mm)) {
+    throw InputError("collision map spacing must be a positive number of mm");
+  }
+  const double half = 0.5 * std::max(e.axes.x(), e.axes.y());
+  if (half / spacing_mm > 400.0) {
+    throw InputError("collision map spacing " + fixed3(spacing_mm) +
+                     " mm is too fine for this ellipse (more than 800 points across)");
+  }
+  std::vector<Vec2> points;
+  const int n = static_cast<int>(std::floor(half / spacing_mm));
+  for (int j = -n; j <= n; ++j) {
+    for (int i = -n; i <= n; ++i) {
+      const Vec2 p = e.center + spacing_mm * Vec2(i, j);
+      if (inside_ellipse(e, p)) points.push_back(p);
+    }
+  }
+  return points;
+}
+
+namespace {
+
+void require_both(const Station& station) {
   if (!station.lower || !station.upper) {
     throw InputError("station " + station.name + ": the collision map needs both a lower and an upper mechanism");
   }
-  if (!(options.spacing_mm > 0.0) || !std::isfinite(options.spacing_mm)) {
-    throw InputError("collision map spacing must be a positive number of mm");
+}
+
+/// Outlines of the usable poses at `points` (empty where the pose is not usable).
+void usable_outlines(const Mechanism& m, const Geometry& g, const std::vector<Vec2>& points,
+                     std::vector<std::uint8_t>& ok, std::vector<std::vector<OutlinePart>>& outlines) {
+  ok.assign(points.size(), 0);
+  outlines.assign(points.size(), {});
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Pose pose = ik(m, points[i]);
+    if (usable(m, pose)) ok[i] = 1, outlines[i] = link_outline(m, pose, g);
   }
+}
+
+}  // namespace
+
+CollisionFraction collision_fraction(const Station& station, const Geometry& g, double spacing_mm) {
+  require_both(station);
+  const std::vector<Vec2> points = ellipse_grid(station.target, spacing_mm);
+  std::vector<std::uint8_t> up_ok, low_ok;
+  std::vector<std::vector<OutlinePart>> up_outline, low_outline;
+  usable_outlines(*station.upper, g, points, up_ok, up_outline);
+  usable_outlines(*station.lower, g, points, low_ok, low_outline);
+  CollisionFraction f;
+  f.points = points.size();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!up_ok[i]) continue;
+    for (std::size_t j = 0; j < points.size(); ++j) {
+      if (!low_ok[j]) continue;
+      ++f.pairs;
+      if (outlines_collide(up_outline[i], low_outline[j], g.min_clearance)) ++f.colliding;
+    }
+  }
+  f.fraction = f.pairs > 0 ? double(f.colliding) / double(f.pairs) : 0.0;
+  return f;
+}
+
+CollisionMap collision_map(const Station& station, const Geometry& g, const CollisionMapOptions& options) {
+  require_both(station);
   const Ellipse& e = station.target;
-  const double half = 0.5 * std::max(e.axes.x(), e.axes.y());
-  if (half / options.spacing_mm > 400.0) {
-    throw InputError("collision map spacing " + fixed3(options.spacing_mm) +
-                     " mm is too fine for this ellipse (more than 800 points across)");
-  }
   const Mechanism& up = *station.upper;
   const Mechanism& low = *station.lower;
 
@@ -447,24 +523,11 @@ CollisionMap collision_map(const Station& station, const Geometry& g, const Coll
   map.station = station.name;
   map.target = e;
   map.spacing_mm = options.spacing_mm;
-  // Grid centred on the ellipse centre, so that the centre itself is a sample.
-  const int n = static_cast<int>(std::floor(half / options.spacing_mm));
-  for (int j = -n; j <= n; ++j) {
-    for (int i = -n; i <= n; ++i) {
-      const Vec2 p = e.center + options.spacing_mm * Vec2(i, j);
-      if (inside_ellipse(e, p)) map.points.push_back(p);
-    }
-  }
+  map.points = ellipse_grid(e, options.spacing_mm);
   const std::size_t np = map.points.size();
-  std::vector<std::vector<OutlinePart>> up_outline(np), low_outline(np);
-  map.upper_ok.assign(np, 0);
-  map.lower_ok.assign(np, 0);
-  for (std::size_t i = 0; i < np; ++i) {
-    const Pose pu = ik(up, map.points[i]);
-    const Pose pl = ik(low, map.points[i]);
-    if (usable(up, pu)) map.upper_ok[i] = 1, up_outline[i] = link_outline(up, pu, g);
-    if (usable(low, pl)) map.lower_ok[i] = 1, low_outline[i] = link_outline(low, pl, g);
-  }
+  std::vector<std::vector<OutlinePart>> up_outline, low_outline;
+  usable_outlines(up, g, map.points, map.upper_ok, up_outline);
+  usable_outlines(low, g, map.points, map.lower_ok, low_outline);
 
   map.upper_fraction.assign(np, 0.0);
   map.lower_fraction.assign(np, 0.0);
@@ -477,7 +540,7 @@ CollisionMap collision_map(const Station& station, const Geometry& g, const Coll
     for (std::size_t j = 0; j < np; ++j) {
       if (!map.lower_ok[j]) continue;
       const double sep = (map.points[i] - map.points[j]).norm();
-      const bool collides = min_clearance(up_outline[i], low_outline[j], g.min_clearance) < g.min_clearance;
+      const bool collides = outlines_collide(up_outline[i], low_outline[j], g.min_clearance);
       ++pairs, ++lower_pairs[j];
       const std::size_t bin = static_cast<std::size_t>(sep / kBinWidthMm);
       if (map.bins.size() <= bin) {
@@ -517,7 +580,7 @@ CollisionMap collision_map(const Station& station, const Geometry& g, const Coll
     const auto centre_outline = link_outline(up, centre_up, g);
     for (std::size_t j = 0; j < np; ++j) {
       if (!map.lower_ok[j]) continue;
-      map.centre_collides[j] = min_clearance(centre_outline, low_outline[j], g.min_clearance) < g.min_clearance ? 1 : 0;
+      map.centre_collides[j] = outlines_collide(centre_outline, low_outline[j], g.min_clearance) ? 1 : 0;
     }
   }
   map.centre_rule = apply_priority(up, low, g, e.center, e.center);

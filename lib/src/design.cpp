@@ -404,7 +404,7 @@ const std::vector<std::string>& sweep_variable_names() {
 }
 
 const std::vector<std::string>& sweep_objective_names() {
-  static const std::vector<std::string> names{"margin", "min_lci", "force", "footprint"};
+  static const std::vector<std::string> names{"margin", "min_lci", "force", "footprint", "collision"};
   return names;
 }
 
@@ -455,6 +455,10 @@ void SweepSettings::validate() const {
   if (sample == "grid" && grid > 1e15L) throw ValidationError("vary", "the grid has more than 1e15 designs");
   if (sample != "grid" && count == 0) throw ValidationError("count", "is required for " + sample + " sampling");
   if (count > std::uint64_t(1e15)) throw ValidationError("count", "must be at most 1e15");
+  if (!(collision_spacing_mm == 0.0 || (collision_spacing_mm >= 0.05 && collision_spacing_mm <= 1e6))) {
+    throw ValidationError("collision_spacing_mm", "= " + format_number(collision_spacing_mm) +
+                                                      " mm: must be 0 (off) or 0.05 ... 1e6");
+  }
   if (objectives.empty()) throw ValidationError("objectives", "must name at least one objective");
   const auto& known = sweep_objective_names();
   for (std::size_t i = 0; i < objectives.size(); ++i) {
@@ -582,8 +586,9 @@ void PatternSettings::validate() const {
   for (const PatternSpec& spec : global) {
     validate_nested(std::string(to_string(spec.kind)), [&] { spec.validate(); });
   }
-  for (const auto& [station, spec] : per_station) {
-    validate_nested(detail::key_join(detail::key_child("stations", station), to_string(spec.kind)),
+  for (const auto& entry : per_station) {  // no structured binding: clang 14 cannot capture one
+    const PatternSpec& spec = entry.second;
+    validate_nested(detail::key_join(detail::key_child("stations", entry.first), to_string(spec.kind)),
                     [&] { spec.validate(); });
   }
 }
@@ -825,6 +830,19 @@ void Design::validate() const {
     if (!sweep->mechanism.empty() && st->mechanism(sweep->mechanism) == nullptr) {
       throw ValidationError("sweep.mechanism", "= " + detail::quoted(sweep->mechanism) + ": station " +
                                                    detail::quoted(sweep->station) + " has no such mechanism");
+    }
+    const auto& obj = sweep->objectives;
+    const auto it = std::find(obj.begin(), obj.end(), "collision");
+    if (it != obj.end()) {
+      const std::string key = detail::key_index("sweep.objectives", std::size_t(it - obj.begin()));
+      if (!geometry) throw ValidationError(key, "= \"collision\": needs the geometry: section (link outlines)");
+      if (!st->lower || !st->upper) {
+        throw ValidationError(key, "= \"collision\": station " + detail::quoted(sweep->station) +
+                                       " needs both a lower and an upper mechanism");
+      }
+      if (sweep->collision_spacing_mm == 0.0) {
+        throw ValidationError(key, "= \"collision\": sweep.collision_spacing_mm is 0 (collision fraction off)");
+      }
     }
   }
 

@@ -16,6 +16,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "fivebar/collision.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/kinematics.hpp"
 
@@ -173,7 +174,8 @@ Station apply_sweep(const Design& design, const SweepSettings& s, const std::vec
 
 SweepRow::SweepRow()
     : margin_lower_mm(kNaN), margin_upper_mm(kNaN), margin_shared_mm(kNaN), min_lci(kNaN),
-      min_force_capability(kNaN), footprint_w_mm(kNaN), footprint_h_mm(kNaN), footprint_mm2(kNaN) {}
+      min_force_capability(kNaN), footprint_w_mm(kNaN), footprint_h_mm(kNaN), footprint_mm2(kNaN),
+      collision_fraction(kNaN) {}
 
 double SweepRow::score(const std::string& objective) const {
   if (objective == "margin") {
@@ -183,6 +185,7 @@ double SweepRow::score(const std::string& objective) const {
   if (objective == "min_lci") return min_lci;
   if (objective == "force") return min_force_capability;
   if (objective == "footprint") return -footprint_mm2;
+  if (objective == "collision") return -collision_fraction;
   return kNaN;
 }
 
@@ -293,6 +296,10 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
     }
   }
   footprint(st, targets, design, row);
+  // Soft: the collision fraction (the costliest metric, so last and only for covered designs).
+  if (design.geometry && st.lower && st.upper && s.collision_spacing_mm > 0.0) {
+    row.collision_fraction = collision_fraction(st, *design.geometry, s.collision_spacing_mm).fraction;
+  }
   row.covered = true;
   row.status = "covered";
   return row;
@@ -333,7 +340,7 @@ std::string sweep_csv_header(const SweepSettings& s) {
   std::string h = "index";
   for (const SweepVariable& v : s.vary) h += "," + v.name + (v.name.rfind("ellipse", 0) == 0 ? "_mm" : "_mm");
   h += ",status,covered,margin_lower_mm,margin_upper_mm,margin_shared_mm,min_lci,min_force_capability,"
-       "footprint_w_mm,footprint_h_mm,footprint_mm2";
+       "footprint_w_mm,footprint_h_mm,footprint_mm2,collision_fraction";
   return h;
 }
 
@@ -342,7 +349,7 @@ std::string sweep_csv_row(const SweepRow& r) {
   for (double v : r.values) line += "," + num(v);
   line += "," + csv_field(r.status) + "," + (r.covered ? "1" : "0");
   for (double v : {r.margin_lower_mm, r.margin_upper_mm, r.margin_shared_mm, r.min_lci, r.min_force_capability,
-                   r.footprint_w_mm, r.footprint_h_mm, r.footprint_mm2}) {
+                   r.footprint_w_mm, r.footprint_h_mm, r.footprint_mm2, r.collision_fraction}) {
     line += "," + num(v);
   }
   return line;
@@ -407,7 +414,7 @@ void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& setti
     auto bad = [&](const std::string& why) {
       throw InputError(csv.string() + ":" + std::to_string(line_no) + ": " + why);
     };
-    if (f.size() != nv + 11) bad("expected " + std::to_string(nv + 11) + " fields, found " + std::to_string(f.size()));
+    if (f.size() != nv + 12) bad("expected " + std::to_string(nv + 12) + " fields, found " + std::to_string(f.size()));
     SweepRow r;
     const auto res = std::from_chars(f[0].data(), f[0].data() + f[0].size(), r.index);
     if (res.ec != std::errc{} || f[0].empty()) bad("index '" + f[0] + "' is not a whole number");
@@ -419,8 +426,9 @@ void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& setti
     if (f[2 + nv] != "0" && f[2 + nv] != "1") bad("covered must be 0 or 1");
     r.covered = f[2 + nv] == "1";
     double* metrics[] = {&r.margin_lower_mm, &r.margin_upper_mm, &r.margin_shared_mm, &r.min_lci,
-                         &r.min_force_capability, &r.footprint_w_mm, &r.footprint_h_mm, &r.footprint_mm2};
-    for (std::size_t k = 0; k < 8; ++k) {
+                         &r.min_force_capability, &r.footprint_w_mm, &r.footprint_h_mm, &r.footprint_mm2,
+                         &r.collision_fraction};
+    for (std::size_t k = 0; k < 9; ++k) {
       if (!parse_double(f[3 + nv + k], *metrics[k])) bad("bad number '" + f[3 + nv + k] + "'");
     }
     row(r, line);

@@ -69,6 +69,8 @@ struct OutlinePart {
   int plane = 0;          ///< link plane (geometry.layers), or tactor_plane() for the tactor disk
   std::array<Capsule, 3> shapes{};
   int count = 0;  ///< shapes used
+  Vec2 box_lo{0.0, 0.0};  ///< bounding box of the shapes (radii included), set by link_outline
+  Vec2 box_hi{0.0, 0.0};
 };
 
 /// Plane of the tactor disks: one above the highest link plane.
@@ -116,6 +118,11 @@ Interference interference(const Mechanism& upper, const Pose& upper_pose, const 
 /// Stops early, returning a value below `stop_below`, as soon as one pair is closer than it.
 double min_clearance(const std::vector<OutlinePart>& upper, const std::vector<OutlinePart>& lower,
                      double stop_below = -1e300);
+
+/// True when some pair of parts in a shared plane is closer than `threshold` (mm); the same verdict
+/// as min_clearance(upper, lower) < threshold, faster: part pairs whose bounding boxes are disjoint
+/// and at least `threshold` apart are skipped (their clearance is at least the boxes' distance).
+bool outlines_collide(const std::vector<OutlinePart>& upper, const std::vector<OutlinePart>& lower, double threshold);
 
 /// A pose the device can hold: it exists, is not singular, is within the joint limits and on the
 /// design's assembly side.
@@ -209,6 +216,21 @@ struct CollisionMap {
 
 /// Samples the collision map of a station with both mechanisms (InputError otherwise).
 CollisionMap collision_map(const Station& station, const Geometry& g, const CollisionMapOptions& options = {});
+
+/// Grid points of spacing `spacing_mm` inside the filled target ellipse, on a square grid centred
+/// on the ellipse centre (the centre is a sample); row by row from the bottom. InputError for a
+/// spacing that is not positive or finer than 1/800 of the larger axis.
+std::vector<Vec2> ellipse_grid(const Ellipse& e, double spacing_mm);
+
+/// The colliding fraction of a collision map alone (no per-point arrays, bins or priority rule):
+/// what a sweep records per design. Same grid, same usable-pose rule, same verdict per pair.
+struct CollisionFraction {
+  std::size_t points = 0;        ///< grid points in the ellipse
+  std::size_t pairs = 0;         ///< pairs with both positions usable
+  std::size_t colliding = 0;
+  double fraction = 0.0;         ///< colliding / pairs (0 when there are no pairs)
+};
+CollisionFraction collision_fraction(const Station& station, const Geometry& g, double spacing_mm);
 
 // --- Output -------------------------------------------------------------------------------------
 

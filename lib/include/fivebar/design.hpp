@@ -156,13 +156,17 @@ struct SweepSettings {
   std::uint64_t count = 0;           ///< random / sobol designs (0: the grid's size)
   std::uint64_t seed = 1;
   std::vector<std::string> objectives{"margin", "min_lci"};  ///< see sweep_objective_names()
+  /// Grid spacing (mm) of the per-design collision fraction (see collision_fraction()), computed
+  /// for covered designs when the design has `geometry:` and the station both mechanisms; 0: off.
+  double collision_spacing_mm = 2.0;
   /// Rules that need no design (names, ranges, counts); the design checks the station.
   void validate() const;
 };
 /// L1 L2 L3 L4, L12 (L1 = L2), L34 (L3 = L4), spacing (base spacing), upper_height (y of the
 /// upper bases), ellipse_a, ellipse_b (full axes of the target).
 const std::vector<std::string>& sweep_variable_names();
-/// margin (max), min_lci (max), force (max), footprint (min: bounding-box area of the linkage).
+/// margin (max), min_lci (max), force (max), footprint (min: bounding-box area of the linkage),
+/// collision (min: fraction of tactor-position pairs in the ellipse whose mechanisms collide).
 const std::vector<std::string>& sweep_objective_names();
 /// Skin-deformation patterns (paper Sec. IV-A, Fig. 6) and pivoting (Sec. IV-B).
 enum class PatternKind : std::uint8_t {

@@ -37,8 +37,9 @@ struct SweepRow {
   double margin_lower_mm, margin_upper_mm, margin_shared_mm;
   double min_lci, min_force_capability;
   double footprint_w_mm, footprint_h_mm, footprint_mm2;
+  double collision_fraction;  ///< see collision_fraction(); NaN without geometry or one mechanism
   SweepRow();
-  /// Objective value oriented so that larger is better (footprint negated); NaN if missing.
+  /// Objective value oriented so that larger is better (footprint, collision negated); NaN if missing.
   double score(const std::string& objective) const;
 };
 

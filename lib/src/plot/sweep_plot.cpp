@@ -103,7 +103,7 @@ void axes(cairo_t* cr, const Frame& f, const std::string& title) {
 /// Objective value as plotted (footprint positive, in mm^2).
 double plotted(const SweepRow& r, const std::string& objective) {
   const double v = r.score(objective);
-  return objective == "footprint" ? -v : v;
+  return objective == "footprint" || objective == "collision" ? -v : v;
 }
 
 std::string label_of(const std::string& objective) {
@@ -111,6 +111,7 @@ std::string label_of(const std::string& objective) {
   if (objective == "min_lci") return "min LCI over the ellipse";
   if (objective == "force") return "min force capability (N per N*mm)";
   if (objective == "footprint") return "footprint (mm^2)";
+  if (objective == "collision") return "colliding fraction of tactor-position pairs";
   return objective;
 }
 
@@ -277,9 +278,10 @@ std::vector<std::filesystem::path> write_sweep_plots(const std::filesystem::path
              cairo_fill(cr);
            }
            cairo_set_source_rgb(cr, 0.1, 0.1, 0.1);
-           const double shown_lo = ox == "footprint" ? -hi : lo, shown_hi = ox == "footprint" ? -lo : hi;
-           text(cr, bx + 22, by1, std::isfinite(lo) ? fmt(ox == "footprint" ? shown_hi : shown_lo) : "-", 11);
-           text(cr, bx + 22, by0 + 10, std::isfinite(hi) ? fmt(ox == "footprint" ? shown_lo : shown_hi) : "-", 11);
+           const bool negated = ox == "footprint" || ox == "collision";  // scores are -value
+           const double shown_lo = negated ? -hi : lo, shown_hi = negated ? -lo : hi;
+           text(cr, bx + 22, by1, std::isfinite(lo) ? fmt(negated ? shown_hi : shown_lo) : "-", 11);
+           text(cr, bx + 22, by0 + 10, std::isfinite(hi) ? fmt(negated ? shown_lo : shown_hi) : "-", 11);
            text(cr, bx - 4, by0 - 10, "best", 11);
            cairo_set_source_rgb(cr, 0.86, 0.86, 0.86);
            cairo_rectangle(cr, bx, by1 + 26, 18, 12);

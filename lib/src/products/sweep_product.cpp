@@ -23,6 +23,7 @@ json row_json(const SweepSettings& s, const SweepRow& r) {
   j["min_lci"] = opt(r.min_lci);
   j["min_force_capability"] = opt(r.min_force_capability);
   j["footprint_mm2"] = opt(r.footprint_mm2);
+  j["collision_fraction"] = opt(r.collision_fraction);
   return j;
 }
 
@@ -75,7 +76,9 @@ Product sweep_product() {
           " cover the target with the design's thresholds.\n\n";
     std::vector<std::string> header{"design"};
     for (const auto& v : s.vary) header.push_back(v.name + " (mm)");
-    for (const char* h : {"margin (mm)", "min LCI", "min force (N per N*mm)", "footprint (mm^2)"}) header.push_back(h);
+    for (const char* h : {"margin (mm)", "min LCI", "min force (N per N*mm)", "footprint (mm^2)", "colliding pairs"}) {
+      header.push_back(h);
+    }
     md::Table t(header);
     auto add = [&](const SweepRow& row, const std::string& label) {
       std::vector<std::string> cells{label};
@@ -84,6 +87,7 @@ Product sweep_product() {
       cells.push_back(md::fixed(row.min_lci, 3));
       cells.push_back(md::fixed(row.min_force_capability, 4));
       cells.push_back(md::fixed(row.footprint_mm2, 1));
+      cells.push_back(std::isnan(row.collision_fraction) ? "-" : md::fixed(100.0 * row.collision_fraction, 1) + " %");
       t.row(cells);
     };
     if (r.best) add(*r.best, "**best** #" + std::to_string(r.best->index));

@@ -668,8 +668,9 @@ std::uint64_t Loader::whole(const YAML::Node& node, const std::string& path, int
 SweepSettings Loader::sweep(const Entry& entry) {
   SweepSettings sw;
   const Entries all = entries(entry.value, entry.path, entry.line,
-                              {"station", "mechanism", "vary", "sample", "count", "seed", "objectives"},
-                              "(station, mechanism, vary, sample, count, seed, objectives)");
+                              {"station", "mechanism", "vary", "sample", "count", "seed", "objectives",
+                               "collision_spacing_mm"},
+                              "(station, mechanism, vary, sample, count, seed, objectives, collision_spacing_mm)");
   const Entry& st = require(all, "station", entry.path, entry.line);
   sw.station = string(st.value, st.path, st.line, "must be a station name");
   if (const Entry* m = find(all, "mechanism")) sw.mechanism = string(m->value, m->path, m->line, "must be lower or upper");
@@ -687,6 +688,9 @@ SweepSettings Loader::sweep(const Entry& entry) {
   if (const Entry* sample = find(all, "sample")) sw.sample = string(sample->value, sample->path, sample->line, "must be grid, random or sobol");
   if (const Entry* count = find(all, "count")) sw.count = whole(count->value, count->path, count->line, 1, 1e15);
   if (const Entry* seed = find(all, "seed")) sw.seed = whole(seed->value, seed->path, seed->line, 0, 9007199254740992.0);
+  if (const Entry* cs = find(all, "collision_spacing_mm")) {
+    sw.collision_spacing_mm = number(cs->value, cs->path, cs->line, "mm");
+  }
   if (const Entry* obj = find(all, "objectives")) {
     if (!obj->value.IsSequence()) fail_value(obj->value, obj->line, obj->path, "must be a list of objectives");
     sw.objectives.clear();

@@ -301,7 +301,9 @@ std::string to_yaml(const Design& d) {
     out << YAML::Key << "seed" << YAML::Value << sw.seed;
     out << YAML::Key << "objectives" << YAML::Value << YAML::Flow << YAML::BeginSeq;
     for (const auto& o : sw.objectives) out << o;
-    out << YAML::EndSeq << YAML::EndMap;
+    out << YAML::EndSeq;
+    out << YAML::Key << "collision_spacing_mm" << YAML::Value << num(sw.collision_spacing_mm);
+    out << YAML::EndMap;
   }
   if (d.patterns) patterns(out, *d.patterns, d.controller.has_value());
   if (d.controller) controller(out, d, *d.controller);
