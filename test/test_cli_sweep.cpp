@@ -133,6 +133,40 @@ TEST_F(CliSweep, BadInputExitsTwoNamingTheProblemAndWritesNothing) {
   EXPECT_THAT(station.err, HasSubstr("pinky"));
 }
 
+TEST_F(CliSweep, CollisionFractionColumnForCoveredDesigns) {
+  // The showcase has geometry: each covered row carries the colliding fraction of its tactor pairs.
+  const auto sweep = [&](const std::string& out, const std::string& spacing) {
+    return run({"sweep", kDesign, "--station", "index", "--vary", "L34=13:19:4", "--vary", "L12=8:12:3",
+                "--collision-spacing", spacing, "--out", (dir_ / out).string(), "--no-plots"});
+  };
+  ASSERT_EQ(sweep("on", "2.5").code, 0);
+  std::istringstream csv(slurp(dir_ / "on" / "sweep.csv"));
+  std::string line;
+  std::getline(csv, line);
+  ASSERT_TRUE(line.ends_with(",footprint_mm2,collision_fraction")) << line;
+  int covered = 0;
+  while (std::getline(csv, line)) {
+    const std::string last = line.substr(line.rfind(',') + 1);
+    if (line.find(",covered,1,") != std::string::npos) {
+      ++covered;
+      const double f = std::stod(last);
+      EXPECT_GT(f, 0.0) << line;
+      EXPECT_LT(f, 1.0) << line;
+    } else {
+      EXPECT_EQ(last, "") << line;
+    }
+  }
+  EXPECT_GT(covered, 0);
+  ASSERT_EQ(sweep("off", "0").code, 0);
+  const std::string off = slurp(dir_ / "off" / "sweep.csv");
+  std::istringstream rows(off.substr(off.find('\n') + 1));
+  while (std::getline(rows, line)) EXPECT_TRUE(line.ends_with(",")) << line;
+  const Outcome bad = sweep("bad", "-1");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("collision_spacing_mm"));
+  EXPECT_FALSE(fs::exists(dir_ / "bad"));
+}
+
 TEST_F(CliSweep, ShardsConcatenateToTheSerialRows) {
   ASSERT_EQ(run(sweep_args(dir_ / "serial")).code, 0);
   const std::string serial = slurp(dir_ / "serial" / "sweep.csv");
