@@ -21,6 +21,8 @@ read -r -a extra <<<"${FIVEBAR_FUZZ_FLAGS:-}"
 
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
+# Caches of fontconfig and cairo that live until exit (the sanitizer suite's suppressions).
+export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$root/test/sanitizer/lsan.supp:print_suppressions=0}"
 
 log() { printf '[fivebar fuzz] %s\n' "$*" >&2; }
 
