@@ -29,7 +29,8 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
                                      int side) {
   CircleIntersection out;
   const Vec2 dv = c2 - c1;
-  const double d = std::sqrt(dv.squaredNorm());
+  const double d2 = dv.squaredNorm();
+  const double d = std::sqrt(d2);
   out.d = d;
   const double scale = std::max({r1, r2, d});
   if (d <= tol::kCoincidentRel * scale) {
@@ -44,7 +45,7 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
     return out;
   }
   // Same expressions, in the same order, as the batch kernels (kinematics_batch.cpp).
-  const double inv_d = 1.0 / d;
+  const double inv_d = d * (1.0 / d2);  // 1/d beside the square root, not after it
   double a, h2;
   if (!detail::chord(detail::CirclePair::make(r1, r2), d, inv_d, a, h2)) return out;
   const double h = std::sqrt(std::max(0.0, h2));

@@ -61,8 +61,10 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
   const double dx = a2x - a1x, dy = a2y - a1y;
   const double d2 = dx * dx + dy * dy;
   const bool coincident = !(d2 > 0.0);
-  const double d = std::sqrt(coincident ? 1.0 : d2);
-  const double inv_d = 1.0 / d;
+  const double d2s = coincident ? 1.0 : d2;
+  // 1/d as d / d^2: the division runs beside the square root instead of after it.
+  const double d = std::sqrt(d2s);
+  const double inv_d = d * (1.0 / d2s);
   double a, h2;
   const bool reach = !coincident & detail::chord(g.distal, d, inv_d, a, h2);
   const double h = std::sqrt(std::max(0.0, h2));
@@ -110,8 +112,10 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, do
   const double dx = px - g.ox, dy = py - g.oy;
   const double d2 = dx * dx + dy * dy;
   const bool coincident = !(d2 > 0.0);
-  const double d = std::sqrt(coincident ? 1.0 : d2);
-  const double inv_d = 1.0 / d;
+  const double d2s = coincident ? 1.0 : d2;
+  // 1/d as d / d^2: the division runs beside the square root instead of after it.
+  const double d = std::sqrt(d2s);
+  const double inv_d = d * (1.0 / d2s);
   double a, h2;
   const bool reach = !coincident & detail::chord(g.circles, d, inv_d, a, h2);
   const double h = std::sqrt(std::max(0.0, h2));
@@ -187,7 +191,7 @@ AnglesResult ik_angles(const Mechanism& m, const Vec2& P) {
 
 // --- batch ---------------------------------------------------------------------------------------
 
-void fk_batch(const Mechanism& m, std::span<const double> theta1, std::span<const double> theta2,
+FIVEBAR_SIMD_CLONES void fk_batch(const Mechanism& m, std::span<const double> theta1, std::span<const double> theta2,
               std::span<double> px, std::span<double> py, std::span<Status> status) {
   const std::size_t n = theta1.size();
   assert(theta2.size() == n && px.size() == n && py.size() == n && status.size() == n);
@@ -208,7 +212,7 @@ void fk_batch(const Mechanism& m, std::span<const double> theta1, std::span<cons
   }
 }
 
-void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
+FIVEBAR_SIMD_CLONES void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
               std::span<double> theta1, std::span<double> theta2, std::span<Status> status) {
   const std::size_t n = px.size();
   assert(py.size() == n && theta1.size() == n && theta2.size() == n && status.size() == n);
@@ -216,7 +220,7 @@ void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const do
   for (std::size_t k = 0; k < n; ++k) ik_one<FastTrig>(g, px[k], py[k], theta1[k], theta2[k], status[k]);
 }
 
-void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
+FIVEBAR_SIMD_CLONES void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
                std::span<double> lci, std::span<Status> status) {
   const std::size_t n = px.size();
   assert(py.size() == n && lci.size() == n && status.size() == n);
@@ -234,7 +238,7 @@ void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const d
   }
 }
 
-void conditioning_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
+FIVEBAR_SIMD_CLONES void conditioning_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
                         std::span<double> lci, std::span<double> force, std::span<std::int8_t> assembly,
                         std::span<Status> status) {
   const std::size_t n = px.size();

@@ -8,6 +8,16 @@
 
 #include <cmath>
 
+/// FIVEBAR_SIMD_CLONES on a function with a vectorisable loop: GCC compiles it twice, for
+/// baseline x86-64 (SSE2, two doubles per vector) and for AVX2 (four), and picks the clone at load
+/// time (ifunc). AVX2 without FMA: the same IEEE operations in the same order, so both clones
+/// give bit-identical results. Elsewhere (other compilers or targets) it expands to nothing.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define FIVEBAR_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define FIVEBAR_SIMD_CLONES
+#endif
+
 namespace fivebar::detail {
 
 /// Largest |x| (rad) for which fast_sincos is accurate: the reduction multiplies the quadrant
