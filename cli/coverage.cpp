@@ -17,6 +17,7 @@ namespace {
 struct CoverageCliOptions {
   std::string design;
   std::string station;
+  std::string mechanism;  ///< "lower" / "upper": that one alone (no shared region); empty: both
   std::string ellipse;  ///< "CX,CY,AX,AY,ANGLE"
   bool ellipse_given = false;
   bool json = false;
@@ -54,17 +55,30 @@ int run_coverage(const CoverageCliOptions& opt) {
   const Design design = load(opt.design);
   const auto stations = select_stations(design, opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
+  // --mechanism: the station with the other mechanism removed, so only that one (and no shared
+  // region) is judged. Checked for every station before any work, like workspace.
+  std::vector<Station> chosen;
+  for (const Station* s : stations) {
+    Station copy = *s;
+    if (!opt.mechanism.empty()) {
+      if (copy.mechanism(opt.mechanism) == nullptr) {
+        throw InputError("station '" + s->name + "' has no " + opt.mechanism + " mechanism");
+      }
+      (opt.mechanism == "lower" ? copy.upper : copy.lower).reset();
+    }
+    chosen.push_back(std::move(copy));
+  }
   const auto progress = terminal_progress("coverage");
 
   Json doc;
   doc["stations"] = Json::object();
   bool all = true;
-  for (const Station* s : stations) {
-    if (progress) progress("station " + s->name);
-    const StationCoverage c = station_coverage(*s, override_target);
+  for (const Station& s : chosen) {
+    if (progress) progress("station " + s.name);
+    const StationCoverage c = station_coverage(s, override_target);
     all = all && c.covered();
-    doc["stations"][s->name] = to_json(c);
-    if (!opt.json) print_station(*s, override_target ? *override_target : s->target, override_target.has_value(), c);
+    doc["stations"][s.name] = to_json(c);
+    if (!opt.json) print_station(s, override_target ? *override_target : s.target, override_target.has_value(), c);
   }
   if (opt.json) {
     print_json(doc);
@@ -84,6 +98,9 @@ void setup_coverage(CLI::App& app) {
       "fraction, min LCI and force capability over the ellipse");
   add_design_argument(*sub, opt->design);
   sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
+  sub->add_option("-m,--mechanism", opt->mechanism,
+                  "Only this mechanism of each station, without the shared region (default: both and shared)")
+      ->check(CLI::IsMember({"lower", "upper"}));
   CLI::Option* ellipse = sub->add_option("--ellipse", opt->ellipse,
                   "Target instead of the design's: centre CX,CY (mm), full axis lengths AX,AY (mm) and rotation "
                   "ANGLE (deg), e.g. --ellipse 6.25,15.5,15,12,0; applies to every station checked")

@@ -356,6 +356,30 @@ TEST_F(CliWorkspace, CoverageFailsOnTheDesignsLciThreshold) {
   EXPECT_TRUE(j["stations"]["thumb"]["shared"]["covered"].get<bool>());
 }
 
+TEST_F(CliWorkspace, CoverageOfOneMechanismJudgesItAloneWithoutTheSharedRegion) {
+  // min_lci 0.9 on the index lower mechanism fails it; --mechanism upper does not look at it.
+  const fs::path design =
+      design_with("strict.yaml", "assembly_mode: \"+\"", "assembly_mode: \"+\"\n        min_lci: 0.9");
+  const Outcome both = run({"coverage", design.string(), "--station", "index", "--json"});
+  const Outcome upper = run({"coverage", design.string(), "--station", "index", "--mechanism", "upper", "--json"});
+  const Outcome lower = run({"coverage", design.string(), "--station", "index", "-m", "lower", "--json"});
+  EXPECT_EQ(both.code, 1) << both.err;
+  EXPECT_EQ(upper.code, 0) << upper.err;
+  EXPECT_EQ(lower.code, 1) << lower.err;
+  const json jb = parse_only_document(both), ju = parse_only_document(upper), jl = parse_only_document(lower);
+  // Only the chosen mechanism, no shared region, and the same numbers as the full run.
+  EXPECT_FALSE(ju["stations"]["index"].contains("lower"));
+  EXPECT_FALSE(ju["stations"]["index"].contains("shared"));
+  EXPECT_EQ(ju["stations"]["index"]["upper"], jb["stations"]["index"]["upper"]);
+  EXPECT_FALSE(jl["stations"]["index"].contains("upper"));
+  EXPECT_EQ(jl["stations"]["index"]["lower"], jb["stations"]["index"]["lower"]);
+  // A mechanism name that does not exist: exit 2 naming the option, nothing printed.
+  const Outcome missing = run({"coverage", kDesign, "--mechanism", "middle"});
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_THAT(missing.err, HasSubstr("--mechanism"));
+  EXPECT_THAT(missing.out, IsEmpty());
+}
+
 TEST_F(CliWorkspace, CoverageBadEllipseIsExitTwoNamingTheOption) {
   for (const char* bad : {"1,2,3", "6,15,0,12,0", "6,15,-3,12,0", "a,b,c,d,e", "6,15,10,12,0,1", "6,15,10,12,nan",
                           "6,15,10,,0", ""}) {
