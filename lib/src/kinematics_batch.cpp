@@ -196,12 +196,25 @@ FIVEBAR_SIMD_CLONES void fk_batch(const Mechanism& m, std::span<const double> th
   const std::size_t n = theta1.size();
   assert(theta2.size() == n && px.size() == n && py.size() == n && status.size() == n);
   const FkConst g(m);
+  // Arguments beyond the fast reduction's range (|theta| > 1e6 rad, or not finite) are rare: the
+  // loop only notes whether there was one (an OR reduction, vectorised with it), and only then a
+  // second pass redoes them exactly.
+  const auto outside = [](double t1, double t2) {
+    return int(!(std::fabs(t1) <= detail::kFastTrigMax)) | int(!(std::fabs(t2) <= detail::kFastTrigMax));
+  };
+  int any_outside = 0;
   if (m.assembly_mode == AssemblyMode::Any) {
-    for (std::size_t k = 0; k < n; ++k) fk_one<FastTrig, true>(g, theta1[k], theta2[k], px[k], py[k], status[k]);
+    for (std::size_t k = 0; k < n; ++k) {
+      fk_one<FastTrig, true>(g, theta1[k], theta2[k], px[k], py[k], status[k]);
+      any_outside |= outside(theta1[k], theta2[k]);
+    }
   } else {
-    for (std::size_t k = 0; k < n; ++k) fk_one<FastTrig, false>(g, theta1[k], theta2[k], px[k], py[k], status[k]);
+    for (std::size_t k = 0; k < n; ++k) {
+      fk_one<FastTrig, false>(g, theta1[k], theta2[k], px[k], py[k], status[k]);
+      any_outside |= outside(theta1[k], theta2[k]);
+    }
   }
-  // Arguments beyond the fast reduction's range (|theta| > 1e6 rad) are rare: redo them exactly.
+  if (!any_outside) return;
   for (std::size_t k = 0; k < n; ++k) {
     if (!(std::fabs(theta1[k]) <= detail::kFastTrigMax && std::fabs(theta2[k]) <= detail::kFastTrigMax)) {
       const PointResult p = fk_point(m, theta1[k], theta2[k]);
