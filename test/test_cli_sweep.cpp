@@ -185,8 +185,10 @@ TEST_F(CliSweep, ShardsConcatenateToTheSerialRows) {
 TEST_F(CliSweep, InterruptLeavesAValidCsvAndResumeCompletesIt) {
   // 160,000 designs on one thread: long enough to interrupt, and --resume then finishes.
   const std::vector<std::string> grid{"L3=11:19:400", "L4=11:19:400"};
+  // Without the collision fraction (250 us per covered design; its own tests are above): this
+  // grid must be long enough to interrupt, yet run twice more within the sanitizer build's timeout.
   auto args = sweep_args(dir_ / "cut", grid[0], grid[1]);
-  args.insert(args.end(), {"--threads", "1"});
+  args.insert(args.end(), {"--collision-spacing", "0", "--threads", "1"});
   const pid_t pid = spawn(FIVEBAR_BINARY, args);
   ASSERT_GT(pid, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(150));
@@ -220,6 +222,7 @@ TEST_F(CliSweep, InterruptLeavesAValidCsvAndResumeCompletesIt) {
   const Outcome rest = run(resume);
   ASSERT_EQ(rest.code, 0) << rest.err;
   auto whole = sweep_args(dir_ / "whole", grid[0], grid[1]);
+  whole.insert(whole.end(), {"--collision-spacing", "0"});
   ASSERT_EQ(run(whole).code, 0);
   EXPECT_EQ(slurp(dir_ / "cut" / "sweep.csv"), slurp(dir_ / "whole" / "sweep.csv"));
   EXPECT_EQ(slurp(dir_ / "cut" / "pareto.csv"), slurp(dir_ / "whole" / "pareto.csv"));
