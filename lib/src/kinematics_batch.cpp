@@ -64,9 +64,10 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
   const double d2s = coincident ? 1.0 : d2;
   // 1/d as d / d^2: the division runs beside the square root instead of after it.
   const double d = std::sqrt(d2s);
-  const double inv_d = d * (1.0 / d2s);
+  const double inv_d2 = 1.0 / d2s;
+  const double inv_d = d * inv_d2;
   double a, h2;
-  const bool reach = !coincident & detail::chord(g.distal, d, inv_d, a, h2);
+  const bool reach = !coincident & detail::chord(g.distal, d, inv_d2, a, h2);
   const double h = std::sqrt(std::max(0.0, h2));
   const double ux = dx * inv_d, uy = dy * inv_d;
   double side = g.fixed_side;
@@ -115,9 +116,10 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, do
   const double d2s = coincident ? 1.0 : d2;
   // 1/d as d / d^2: the division runs beside the square root instead of after it.
   const double d = std::sqrt(d2s);
-  const double inv_d = d * (1.0 / d2s);
+  const double inv_d2 = 1.0 / d2s;
+  const double inv_d = d * inv_d2;
   double a, h2;
-  const bool reach = !coincident & detail::chord(g.circles, d, inv_d, a, h2);
+  const bool reach = !coincident & detail::chord(g.circles, d, inv_d2, a, h2);
   const double h = std::sqrt(std::max(0.0, h2));
   const double ux = dx * inv_d, uy = dy * inv_d;
   ex = reach ? a * ux - g.s * h * uy : 0.0;
