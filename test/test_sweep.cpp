@@ -202,6 +202,22 @@ TEST(Evaluation, CollisionFractionOfCoveredDesignsOnly) {
   }
 }
 
+TEST(Evaluation, CollisionGridIsNeverFinerThanTwentyFourStepsAcross) {
+  // 0.05 mm on the 15 mm index ellipse would be 300 steps across (5e9 pairs per design): the grid
+  // is coarsened to 15/24 mm, and the row equals the collision fraction on that grid.
+  SweepSettings s = grid({{"L34", 15, 15, 1}});
+  s.collision_spacing_mm = 0.05;
+  const Design d = with_sweep(s);
+  const Station st = apply_sweep(d, s, {15.0});
+  EXPECT_DOUBLE_EQ(sweep_collision_spacing(s, st.target), 15.0 / 24.0);
+  const SweepRow row = evaluate_sweep_design(d, s, 0);
+  ASSERT_TRUE(row.covered) << row.status;
+  EXPECT_EQ(row.collision_fraction, collision_fraction(st, *d.geometry, 15.0 / 24.0).fraction);
+  // A spacing coarser than that is kept as it is.
+  s.collision_spacing_mm = 3.0;
+  EXPECT_EQ(sweep_collision_spacing(s, st.target), 3.0);
+}
+
 TEST(Evaluation, CollisionObjectiveNeedsGeometryAndBothMechanisms) {
   SweepSettings s = grid({{"L34", 11, 19, 3}});
   s.objectives = {"collision"};

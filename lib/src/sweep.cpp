@@ -172,6 +172,11 @@ Station apply_sweep(const Design& design, const SweepSettings& s, const std::vec
 
 // --- evaluation ----------------------------------------------------------------------------------
 
+double sweep_collision_spacing(const SweepSettings& settings, const Ellipse& target) {
+  const double widest = std::max(target.axes.x(), target.axes.y());
+  return std::max(settings.collision_spacing_mm, widest / kSweepCollisionStepsAcross);
+}
+
 SweepRow::SweepRow()
     : margin_lower_mm(kNaN), margin_upper_mm(kNaN), margin_shared_mm(kNaN), min_lci(kNaN),
       min_force_capability(kNaN), footprint_w_mm(kNaN), footprint_h_mm(kNaN), footprint_mm2(kNaN),
@@ -298,7 +303,8 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
   footprint(st, targets, design, row);
   // Soft: the collision fraction (the costliest metric, so last and only for covered designs).
   if (design.geometry && st.lower && st.upper && s.collision_spacing_mm > 0.0) {
-    row.collision_fraction = collision_fraction(st, *design.geometry, s.collision_spacing_mm).fraction;
+    row.collision_fraction =
+        collision_fraction(st, *design.geometry, sweep_collision_spacing(s, st.target)).fraction;
   }
   row.covered = true;
   row.status = "covered";

@@ -158,6 +158,7 @@ struct SweepSettings {
   std::vector<std::string> objectives{"margin", "min_lci"};  ///< see sweep_objective_names()
   /// Grid spacing (mm) of the per-design collision fraction (see collision_fraction()), computed
   /// for covered designs when the design has `geometry:` and the station both mechanisms; 0: off.
+  /// Never finer than 1/24 of the ellipse's larger axis (sweep_collision_spacing()).
   double collision_spacing_mm = 2.0;
   /// Rules that need no design (names, ranges, counts); the design checks the station.
   void validate() const;

@@ -43,6 +43,13 @@ struct SweepRow {
   double score(const std::string& objective) const;
 };
 
+/// The collision fraction's grid has at most this many steps across the ellipse's larger axis
+/// (about 450 points, 200,000 pairs), so that no design of a sweep costs more than tens of ms.
+inline constexpr double kSweepCollisionStepsAcross = 24.0;
+/// Grid spacing of the collision fraction of a design whose target is `target`: the settings'
+/// collision_spacing_mm, coarsened to kSweepCollisionStepsAcross steps across a larger ellipse.
+double sweep_collision_spacing(const SweepSettings& settings, const Ellipse& target);
+
 /// Coverage sampling used by sweeps (coarser than the default).
 CoverageOptions sweep_coverage_options();
 /// Evaluates design `index` (no I/O).
