@@ -524,7 +524,17 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
     for (std::int64_t k = 0; k < count; ++k) {
       std::vector<double> values;
       to_values(s, u.data() + std::size_t(k) * dims, values, is_grid);
-      rows[std::size_t(k)] = evaluate_values(design, s, next + std::uint64_t(k), std::move(values), options.coverage);
+      // An exception must not leave an OpenMP region (std::terminate, no CSV): a design that
+      // throws becomes a row saying so, and the sweep goes on.
+      try {
+        rows[std::size_t(k)] = evaluate_values(design, s, next + std::uint64_t(k), std::move(values), options.coverage);
+      } catch (const std::exception& e) {
+        SweepRow& r = rows[std::size_t(k)];
+        r = SweepRow{};
+        r.index = next + std::uint64_t(k);
+        to_values(s, u.data() + std::size_t(k) * dims, r.values, is_grid);
+        r.status = std::string("error: ") + e.what();
+      }
     }
     for (const SweepRow& r : rows) {
       csv.stream() << sweep_csv_row(r) << '\n';
