@@ -191,6 +191,43 @@ TEST(CircleIntersection, TangencyWithinRoundingIsClampedNotNaN) {
   }
 }
 
+/// Against an independent reference in long double: the law of cosines for the foot and Heron's
+/// product K = (d+r1+r2)(-d+r1+r2)(d-r1+r2)(d+r1-r2) = (2 d h)^2 for the height. For exact inputs
+/// the intersection is a problem of conditioning 1/sin(gamma), gamma the angle at which the circles
+/// cross (sin gamma = d h / (r1 r2)), so the error may reach eps * scale * (1 + 1/sin gamma).
+TEST(CircleIntersection, AgreesWithLongDoubleHeronAtRadiusRatiosUpTo1e8) {
+  std::mt19937_64 rng(test_seed() + 3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  using LD = long double;
+  double worst = 0.0;
+  for (int k = 0; k < 200000; ++k) {
+    const double r1 = std::pow(10.0, 8 * u(rng) - 4), r2 = std::pow(10.0, 8 * u(rng) - 4);
+    const double d = std::fabs(r1 - r2) + 2 * std::min(r1, r2) * u(rng);
+    const double ang = 2 * kPi * u(rng);
+    const Vec2 c1(3 * r1 * (u(rng) - 0.5), 3 * r2 * (u(rng) - 0.5));
+    const Vec2 c2 = c1 + d * Vec2(std::cos(ang), std::sin(ang));
+    const int side = u(rng) < 0.5 ? 1 : -1;
+    const CircleIntersection x = intersect_circles(c1, r1, c2, r2, side);
+    // The centres actually posed, exactly.
+    const LD dx = LD(c2.x()) - LD(c1.x()), dy = LD(c2.y()) - LD(c1.y()), R1 = r1, R2 = r2;
+    const LD D = std::sqrt(dx * dx + dy * dy);
+    const LD K = (D + R1 + R2) * (-D + R1 + R2) * (D - R1 + R2) * (D + R1 - R2);
+    if (K < 0) {  // the rounding of c2 moved the circles apart: allowed either way, only by rounding
+      EXPECT_TRUE(x.status == Status::unreachable || x.h <= 1e-6 * std::max(r1, r2));
+      continue;
+    }
+    ASSERT_EQ(x.status, Status::ok) << r1 << " " << r2 << " " << d;
+    const LD h = std::sqrt(K) / (2 * D), a = (D * D + R1 * R1 - R2 * R2) / (2 * D);
+    const LD ox = (a * dx - side * h * dy) / D, oy = (a * dy + side * h * dx) / D;
+    const double sin_gamma = double(D * h / (R1 * R2));
+    const double scale = std::max({r1, r2, d, std::fabs(c1.x()), std::fabs(c1.y())});
+    const double err = double(std::hypot(LD(x.offset.x()) - ox, LD(x.offset.y()) - oy));
+    ASSERT_TRUE(std::isfinite(err));
+    worst = std::max(worst, err / (kEps * scale * (1.0 + 1.0 / std::max(sin_gamma, 1e-300))));
+  }
+  EXPECT_LE(worst, 4.0);
+}
+
 // --- regimes -----------------------------------------------------------------------------------
 
 struct Regime {

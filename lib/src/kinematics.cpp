@@ -46,15 +46,12 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
   }
   // Same expressions, in the same order, as the batch kernels (kinematics_batch.cpp).
   const double inv_d2 = 1.0 / d2;
-  const double inv_d = d * inv_d2;  // 1/d beside the square root, not after it
-  double a, h2;
-  if (!detail::chord(detail::CirclePair::make(r1, r2), d, inv_d2, a, h2)) return out;
-  const double h = std::sqrt(std::max(0.0, h2));
-  const double ux = dv.x() * inv_d, uy = dv.y() * inv_d;
+  double t, hd;
+  if (!detail::chord(detail::CirclePair::make(r1, r2), d2, inv_d2, t, hd)) return out;
   const double s = side >= 0 ? 1.0 : -1.0;
   out.status = Status::ok;
-  out.h = h;
-  out.offset = Vec2(a * ux - s * h * uy, a * uy + s * h * ux);
+  out.h = hd * d;
+  out.offset = Vec2(t * dv.x() - s * (hd * dv.y()), t * dv.y() + s * (hd * dv.x()));
   out.point = c1 + out.offset;
   return out;
 }

@@ -5,7 +5,9 @@
 //     -ffast-math (-fno-math-errno and -fno-trapping-math suffice);
 //   - fk_point / ik_angles, the scalar forms, over glibc's sin/cos/atan2 (< 1 ulp).
 // The arithmetic is the full scalar path's (kinematics.cpp), expression for expression, through
-// the shared detail::chord(); test_kinematics checks they agree.
+// the shared detail::chord(); test_kinematics checks they agree. Each circle intersection costs
+// one division and one square root: chord() works from the squared centre distance alone, so an
+// FK takes one square root and an IK two.
 //
 // ik_angles verifies the loop closure of the elbow configuration. The batch IK is not re-verified
 // per point:
@@ -61,19 +63,14 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
   const double dx = a2x - a1x, dy = a2y - a1y;
   const double d2 = dx * dx + dy * dy;
   const bool coincident = !(d2 > 0.0);
-  const double d2s = coincident ? 1.0 : d2;
-  // 1/d as d / d^2: the division runs beside the square root instead of after it.
-  const double d = std::sqrt(d2s);
-  const double inv_d2 = 1.0 / d2s;
-  const double inv_d = d * inv_d2;
-  double a, h2;
-  const bool reach = !coincident & detail::chord(g.distal, d, inv_d2, a, h2);
-  const double h = std::sqrt(std::max(0.0, h2));
-  const double ux = dx * inv_d, uy = dy * inv_d;
+  const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
+  double t, hd;  // P - A1 = t (dx, dy) + side hd (-dy, dx)
+  const bool reach = !coincident & detail::chord(g.distal, d2, inv_d2, t, hd);
+  const double tx = t * dx, ty = t * dy, hx = hd * dx, hy = hd * dy;
   double side = g.fixed_side;
   if constexpr (kAny) {
-    const double f1x_p = a * ux - h * uy, f1y_p = a * uy + h * ux;  // P - A1 on "+"
-    const double f1x_m = a * ux + h * uy, f1y_m = a * uy - h * ux;  // P - A1 on "-"
+    const double f1x_p = tx - hy, f1y_p = ty + hx;  // P - A1 on "+"
+    const double f1x_m = tx + hy, f1y_m = ty - hx;  // P - A1 on "-"
     const double p1 = cross(e1x, e1y, f1x_p, f1y_p) * g.w1;
     const double p2 = cross(e2x, e2y, f1x_p - dx, f1y_p - dy) * g.w2;
     const double m1 = cross(e1x, e1y, f1x_m, f1y_m) * g.w1;
@@ -81,12 +78,12 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
     // As fk(): "+" if it is in the working mode, else "-" if that is, else "+".
     side = (std::min(p1, p2) > 0.0) | !(std::min(m1, m2) > 0.0) ? 1.0 : -1.0;
   }
-  const double ox = a * ux - side * h * uy, oy = a * uy + side * h * ux;  // P - A1
+  const double ox = tx - side * hy, oy = ty + side * hx;  // P - A1
   const double pxk = a1x + ox, pyk = a1y + oy;
-  // |cross(P - A2, ...)| with P - A2 = (P - A1) - (A2 - A1); |cross(P - A1, P - A2)| = d h.
+  // |cross(P - A2, ...)| with P - A2 = (P - A1) - (A2 - A1); |cross(P - A1, P - A2)| = d h = d^2 hd.
   const bool sing1 = (std::fabs(cross(e1x, e1y, ox, oy)) < g.thr13) |
                      (std::fabs(cross(e2x, e2y, ox - dx, oy - dy)) < g.thr24);
-  const bool sing2 = d * h < g.thr34;
+  const bool sing2 = d2 * hd < g.thr34;
   px = reach ? pxk : 0.0;
   py = reach ? pyk : 0.0;
   status = detail::classify(reach, sing1, sing2);
@@ -113,17 +110,11 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, do
   const double dx = px - g.ox, dy = py - g.oy;
   const double d2 = dx * dx + dy * dy;
   const bool coincident = !(d2 > 0.0);
-  const double d2s = coincident ? 1.0 : d2;
-  // 1/d as d / d^2: the division runs beside the square root instead of after it.
-  const double d = std::sqrt(d2s);
-  const double inv_d2 = 1.0 / d2s;
-  const double inv_d = d * inv_d2;
-  double a, h2;
-  const bool reach = !coincident & detail::chord(g.circles, d, inv_d2, a, h2);
-  const double h = std::sqrt(std::max(0.0, h2));
-  const double ux = dx * inv_d, uy = dy * inv_d;
-  ex = reach ? a * ux - g.s * h * uy : 0.0;
-  ey = reach ? a * uy + g.s * h * ux : 0.0;
+  const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
+  double t, hd;  // A - O = t (dx, dy) + s hd (-dy, dx)
+  const bool reach = !coincident & detail::chord(g.circles, d2, inv_d2, t, hd);
+  ex = reach ? t * dx - g.s * (hd * dy) : 0.0;
+  ey = reach ? t * dy + g.s * (hd * dx) : 0.0;
   return reach;
 }
 

@@ -12,35 +12,36 @@ namespace fivebar::detail {
 inline double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
 inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-/// Tolerance on h^2 = (r1 - a)(r1 + a): its rounding error is a few eps * r1 * max(r1, |a|).
-inline double reach_tolerance(double r1, double a) {
-  return tol::kReachRel * r1 * std::max(r1, std::fabs(a));
-}
-
-/// Circle pair (c1, r1), (c2, r2) prepared for the intersection: the foot of the intersection
-/// chord is measured from the centre of the SMALLER circle, so that h^2 = (r - a)(r + a) keeps
-/// the digits of the small radius when the other is much larger (link ratios up to 1e4).
+/// Circle pair (c1, r1), (c2, r2) prepared for the intersection, in terms of the squared centre
+/// distance d^2 only: the circles meet iff (r1 - r2)^2 <= d^2 <= (r1 + r2)^2.
 struct CirclePair {
-  double rs;   ///< smaller radius
-  double hdd;  ///< (rs - rb)(rs + rb) / 2 <= 0
-  double w0;   ///< 0 when the small circle is c1, else 1
-  double sgn;  ///< +1 when the small circle is c1, else -1
+  double k;      ///< (r1 - r2)(r1 + r2) / 2: the chord foot is a = d/2 + k/d from c1
+  double dm;     ///< (r1 - r2)^2: inner tangency
+  double dp;     ///< (r1 + r2)^2: outer tangency
+  double dm_lo;  ///< dm (1 - kReachRel): below it the circles miss each other (one inside the other)
+  double dp_hi;  ///< dp (1 + kReachRel): above it they miss each other (apart)
   static CirclePair make(double r1, double r2) {
-    return r1 <= r2 ? CirclePair{r1, 0.5 * ((r1 - r2) * (r1 + r2)), 0.0, 1.0}
-                    : CirclePair{r2, 0.5 * ((r2 - r1) * (r2 + r1)), 1.0, -1.0};
+    const double dm = (r1 - r2) * (r1 - r2), dp = (r1 + r2) * (r1 + r2);
+    return {0.5 * ((r1 - r2) * (r1 + r2)), dm, dp, dm * (1.0 - tol::kReachRel), dp * (1.0 + tol::kReachRel)};
   }
 };
 
-/// Foot distance `a` from c1 along u = (c2 - c1)/d, and h^2; `reach` false when the circles miss
-/// each other by more than rounding. Shared verbatim by the scalar and batch paths. Takes 1/d^2
-/// rather than 1/d: as = d (1/2 + hdd/d^2) then waits for the square root d by one multiplication
-/// only (the division runs beside the square root), which shortens the dependency chain of a
-/// scalar FK or IK by about a tenth.
-inline bool chord(const CirclePair& c, double d, double inv_d2, double& a, double& h2) {
-  const double as = d * (0.5 + c.hdd * inv_d2);  // from the small circle's centre
-  h2 = (c.rs - as) * (c.rs + as);
-  a = c.w0 * d + c.sgn * as;
-  return h2 >= -reach_tolerance(c.rs, as);
+/// Intersection of a circle pair whose centres are (dx, dy) = c2 - c1 apart, d^2 = dx^2 + dy^2,
+/// as two ratios to d:  point - c1 = t (dx, dy) + side hd (-dy, dx),  t = a/d, hd = h/d.
+///   t  = 1/2 + k/d^2,
+///   hd = sqrt((d^2 - (r1 - r2)^2) ((r1 + r2)^2 - d^2)) / (2 d^2)   (Heron: 2 d h = that root),
+/// so no square root of d^2 is ever taken: one division (1/d^2, passed in) and one square root.
+/// Each factor under the root is a difference of squared lengths that vanishes at one tangency
+/// and carries an absolute error of a few eps d^2 there (the same as the foot form
+/// h^2 = (r - a)(r + a), whose a carries eps d); so h keeps its digits near both tangencies and at
+/// any link ratio. Within kReachRel (relative, in d^2) of a tangency the factor is clamped to 0.
+/// Shared verbatim by the scalar and batch paths; returns reachability.
+inline bool chord(const CirclePair& c, double d2, double inv_d2, double& t, double& hd) {
+  t = 0.5 + c.k * inv_d2;
+  const double g_in = std::max(0.0, d2 - c.dm) * inv_d2;   // 0 at inner tangency
+  const double g_out = std::max(0.0, c.dp - d2) * inv_d2;  // 0 at outer tangency
+  hd = 0.5 * std::sqrt(g_in * g_out);
+  return (d2 >= c.dm_lo) & (d2 <= c.dp_hi);
 }
 
 /// 1/cond of [[m00, m01], [m10, m11]] from the Frobenius norm and determinant:

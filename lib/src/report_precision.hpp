@@ -1,9 +1,11 @@
 #pragma once
 // FK and IK in a chosen floating-point type (float, double, long double) for the work-precision
 // study of `fivebar report accuracy` (private). The formulas are the library's stable ones
-// (STYLE.md; lib/src/kinematics_common.hpp): chord foot a measured from the smaller circle,
-// h = sqrt((r - a)(r + a)) clamped at rounding-level tangency, angles from atan2. Only the
-// arithmetic type changes, so the series show what precision alone buys.
+// (lib/src/kinematics_common.hpp, detail::chord): the intersection as ratios to the centre
+// distance d, computed from d^2 alone, t = a/d = 1/2 + (r1 - r2)(r1 + r2)/(2 d^2) and
+// h/d = sqrt((d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2)) / (2 d^2), each factor clamped at
+// rounding-level tangency; angles from atan2. Only the arithmetic type changes, so the series
+// show what precision alone buys.
 
 #include <algorithm>
 #include <cmath>
@@ -28,20 +30,16 @@ struct MechanismT {
 template <class T>
 inline bool chord_offset(T c1x, T c1y, T r1, T c2x, T c2y, T r2, T side, T& ox, T& oy) {
   const T dx = c2x - c1x, dy = c2y - c1y;
-  const T d = std::sqrt(dx * dx + dy * dy);
-  if (!(d > T(0))) return false;
-  const bool small1 = r1 <= r2;
-  const T rs = small1 ? r1 : r2, rb = small1 ? r2 : r1;
-  const T dd = (rs - rb) * (rs + rb);
-  const T as = T(0.5) * (d + dd / d);
-  const T h2 = (rs - as) * (rs + as);
-  const T tol = T(16) * std::numeric_limits<T>::epsilon() * rs * std::max(rs, std::fabs(as));
-  if (h2 < -tol) return false;
-  const T a = small1 ? as : d - as;
-  const T h = std::sqrt(std::max(T(0), h2));
-  const T ux = dx / d, uy = dy / d;
-  ox = a * ux - side * h * uy;
-  oy = a * uy + side * h * ux;
+  const T d2 = dx * dx + dy * dy;
+  if (!(d2 > T(0))) return false;
+  const T dm = (r1 - r2) * (r1 - r2), dp = (r1 + r2) * (r1 + r2);
+  const T rel = T(16) * std::numeric_limits<T>::epsilon();
+  if (d2 < dm * (T(1) - rel) || d2 > dp * (T(1) + rel)) return false;
+  const T inv_d2 = T(1) / d2;
+  const T t = T(0.5) + T(0.5) * ((r1 - r2) * (r1 + r2)) * inv_d2;  // a / d
+  const T hd = T(0.5) * std::sqrt((std::max(T(0), d2 - dm) * inv_d2) * (std::max(T(0), dp - d2) * inv_d2));  // h / d
+  ox = t * dx - side * (hd * dy);
+  oy = t * dy + side * (hd * dx);
   return true;
 }
 

@@ -6,13 +6,14 @@
 // link, eps = 2^-52):
 //
 //  * Circle centres, radii and distances. A_i = O_i + L_i (cos, sin) costs <= 3 roundings of
-//    quantities <= S per coordinate, d = |c2 - c1| and the chord foot
-//    a = (d + (r1 - r2)(r1 + r2)/d)/2 <= 5 more relative roundings of quantities <= 3S (|a| <= r
-//    when the circles meet). Every circle of an intersection is therefore displaced by at most
-//    e = 16 eps S along its normal.
+//    quantities <= S per coordinate, d^2 = |c2 - c1|^2 and the chord ratios t = a/d =
+//    1/2 + (r1 - r2)(r1 + r2)/(2 d^2) and h/d (detail::chord) <= 5 more relative roundings of
+//    quantities <= 3S (|a| <= r when the circles meet). Every circle of an intersection is
+//    therefore displaced by at most e = 16 eps S along its normal.
 //  * Intersection point (FK's tactor, IK's elbows). Two curves crossing at angle gamma, displaced
 //    by e1, e2 along their normals, cross within (e1 + e2)/|sin gamma| of the old point (first
-//    order). Near tangency that overestimates: with h^2 = (r - a)(r + a) perturbed by <= 2 r (2e),
+//    order). Near tangency that overestimates: h^2 = (d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2) / (4 d^2)
+//    moves by <= 2 r (2e) (r the smaller radius) when d moves by 2e, so
 //    h moves by <= 2 sqrt(2 r e), and the centre line (d apart) turns by <= 2e/d, moving the point
 //    by <= 2 e L / d. So |dP| <= 2e + min(2e/s, 2 sqrt(2 L e) + 2 e L / d), and never more than
 //    the circle's diameter 2L (+2e); s is the reference |sin| of the crossing angle: the tactor

@@ -10,9 +10,10 @@ namespace fivebar::tol {
 /// Machine epsilon of double.
 inline constexpr double kEps = std::numeric_limits<double>::epsilon();
 
-/// h^2 = (r1 - a)(r1 + a) of a circle-circle intersection is computed with an absolute error of
-/// a few eps * r1^2. Below -kReachRel * r1^2 the circles do not meet (unreachable); between that
-/// and 0 they are tangent within rounding and h is clamped to 0.
+/// Circles (c1, r1), (c2, r2) meet iff (r1 - r2)^2 <= d^2 <= (r1 + r2)^2, d = |c2 - c1|; the
+/// squared distance carries a relative rounding error of a few eps. A d^2 beyond a tangency value
+/// by more than kReachRel of it means the circles do not meet (unreachable); within that they are
+/// tangent within rounding and the chord height is clamped to 0.
 inline constexpr double kReachRel = 16.0 * kEps;
 
 /// |sin| of a joint angle (type I: between a proximal and its distal link; type II: between the
