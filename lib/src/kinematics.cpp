@@ -51,7 +51,8 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
   const double s = side >= 0 ? 1.0 : -1.0;
   out.status = Status::ok;
   out.h = hd * d;
-  out.offset = Vec2(t * dv.x() - s * (hd * dv.y()), t * dv.y() + s * (hd * dv.x()));
+  const double hs = s * hd;  // exact: s is +-1
+  out.offset = Vec2(t * dv.x() - hs * dv.y(), t * dv.y() + hs * dv.x());
   out.point = c1 + out.offset;
   return out;
 }

@@ -66,9 +66,10 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
   const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
   double t, hd;  // P - A1 = t (dx, dy) + side hd (-dy, dx)
   const bool reach = !coincident & detail::chord(g.distal, d2, inv_d2, t, hd);
-  const double tx = t * dx, ty = t * dy, hx = hd * dx, hy = hd * dy;
+  const double tx = t * dx, ty = t * dy;
   double side = g.fixed_side;
   if constexpr (kAny) {
+    const double hx = hd * dx, hy = hd * dy;
     const double f1x_p = tx - hy, f1y_p = ty + hx;  // P - A1 on "+"
     const double f1x_m = tx + hy, f1y_m = ty - hx;  // P - A1 on "-"
     const double p1 = cross(e1x, e1y, f1x_p, f1y_p) * g.w1;
@@ -78,7 +79,8 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
     // As fk(): "+" if it is in the working mode, else "-" if that is, else "+".
     side = (std::min(p1, p2) > 0.0) | !(std::min(m1, m2) > 0.0) ? 1.0 : -1.0;
   }
-  const double ox = tx - side * hy, oy = ty + side * hx;  // P - A1
+  const double hs = side * hd;  // exact: side is +-1
+  const double ox = tx - hs * dy, oy = ty + hs * dx;  // P - A1
   const double pxk = a1x + ox, pyk = a1y + oy;
   // |cross(P - A2, ...)| with P - A2 = (P - A1) - (A2 - A1); |cross(P - A1, P - A2)| = d h = d^2 hd.
   const bool sing1 = (std::fabs(cross(e1x, e1y, ox, oy)) < g.thr13) |
@@ -113,8 +115,9 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, do
   const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
   double t, hd;  // A - O = t (dx, dy) + s hd (-dy, dx)
   const bool reach = !coincident & detail::chord(g.circles, d2, inv_d2, t, hd);
-  ex = reach ? t * dx - g.s * (hd * dy) : 0.0;
-  ey = reach ? t * dy + g.s * (hd * dx) : 0.0;
+  const double hs = g.s * hd;  // exact: s is +-1
+  ex = reach ? t * dx - hs * dy : 0.0;
+  ey = reach ? t * dy + hs * dx : 0.0;
   return reach;
 }
 
@@ -136,14 +139,18 @@ inline Elbows elbows(const IkConst& g, double px, double py) {
 }
 
 template <class Trig>
-inline void ik_one(const IkConst& g, double px, double py, double& theta1, double& theta2, Status& status) {
-  const Elbows e = elbows(g, px, py);
+inline void ik_from_elbows(const IkConst& g, const Elbows& e, double& theta1, double& theta2, Status& status) {
   const bool sing1 = (std::fabs(cross(e.e1x, e.e1y, e.f1x, e.f1y)) < g.thr13) |
                      (std::fabs(cross(e.e2x, e.e2y, e.f2x, e.f2y)) < g.thr24);
   const bool sing2 = std::fabs(cross(e.f1x, e.f1y, e.f2x, e.f2y)) < g.thr34;
   theta1 = e.reach ? Trig::atan2(e.e1y, e.e1x) : 0.0;
   theta2 = e.reach ? Trig::atan2(e.e2y, e.e2x) : 0.0;
   status = detail::classify(e.reach, sing1, sing2);
+}
+
+template <class Trig>
+inline void ik_one(const IkConst& g, double px, double py, double& theta1, double& theta2, Status& status) {
+  ik_from_elbows<Trig>(g, elbows(g, px, py), theta1, theta2, status);
 }
 
 }  // namespace
@@ -168,7 +175,7 @@ AnglesResult ik_angles(const Mechanism& m, const Vec2& P) {
   AnglesResult r;
   const IkConst g(m);
   const Elbows e = elbows(g, P.x(), P.y());
-  ik_one<LibmTrig>(g, P.x(), P.y(), r.theta1, r.theta2, r.status);
+  ik_from_elbows<LibmTrig>(g, e, r.theta1, r.theta2, r.status);
   if (r.status == Status::unreachable) return r;
   // Loop closure of the configuration the angles describe: |A_i - O_i| = L_i, |P - A_i| = L_{i+2}
   // (first-order length residuals, no square roots). ik() additionally runs the angles forward
@@ -177,8 +184,12 @@ AnglesResult ik_angles(const Mechanism& m, const Vec2& P) {
   const auto residual = [](double x, double y, double l) { return std::fabs((x * x + y * y) - l * l) / (2.0 * l); };
   r.closure_error_mm = std::max({residual(e.e1x, e.e1y, m.L[0]), residual(e.e2x, e.e2y, m.L[1]),
                                  residual(e.f1x, e.f1y, m.L[2]), residual(e.f2x, e.f2y, m.L[3])});
-  if (!(r.closure_error_mm <= tol::kClosureRel * m.length_scale()) && r.status == Status::ok)
-    r.status = Status::singular_type1;  // only a numerically degenerate chord can get here
+  // kClosureRel * length_scale(); the links alone settle it unless the bases are further apart
+  // than the longest link, and only then is |O2 - O1| (a square root) needed.
+  const double longest_link = std::max({m.L[0], m.L[1], m.L[2], m.L[3]});
+  const bool closed = r.closure_error_mm <= tol::kClosureRel * longest_link ||
+                      r.closure_error_mm <= tol::kClosureRel * m.length_scale();
+  if (!closed && r.status == Status::ok) r.status = Status::singular_type1;  // only a numerically degenerate chord can get here
   return r;
 }
 

@@ -2,7 +2,9 @@
 // Small helpers shared by the scalar and batch kinematics (private).
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "fivebar/kinematics.hpp"
 #include "fivebar/tolerances.hpp"
@@ -14,15 +16,34 @@ inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y()
 
 /// Circle pair (c1, r1), (c2, r2) prepared for the intersection, in terms of the squared centre
 /// distance d^2 only: the circles meet iff (r1 - r2)^2 <= d^2 <= (r1 + r2)^2.
+/// Exact power-of-two scaling for a squared length x > 0: s = 2^-2m and u = 2^(m-1), where
+/// 2^2m <= x < 2^(2m+2). Scaling by a power of 4 commutes exactly with the square root, so
+/// sqrt(y s) u == sqrt(y) / 2 bit for bit whenever y itself neither over- nor underflows, and
+/// y s stays near 1 when y ~ x^2 even where y would. Integer operations only, no division.
+struct Pow4Scale {
+  double s, u;
+  static Pow4Scale of(double x) {
+    const auto bits = std::bit_cast<std::uint64_t>(x);
+    const int e = std::clamp(int((bits >> 52) & 0x7ff), 1, 2046) - 1023;  // unbiased exponent
+    const int m = e >> 1;                                                  // floor(e / 2)
+    return {std::bit_cast<double>(std::uint64_t(1023 - 2 * m) << 52),
+            std::bit_cast<double>(std::uint64_t(1022 + m) << 52)};
+  }
+};
+
+/// Circle pair (c1, r1), (c2, r2) prepared for the intersection, in terms of the squared centre
+/// distance d^2 only: the circles meet iff (r1 - r2)^2 <= d^2 <= (r1 + r2)^2.
 struct CirclePair {
-  double k;      ///< (r1 - r2)(r1 + r2) / 2: the chord foot is a = d/2 + k/d from c1
-  double dm;     ///< (r1 - r2)^2: inner tangency
-  double dp;     ///< (r1 + r2)^2: outer tangency
-  double dm_lo;  ///< dm (1 - kReachRel): below it the circles miss each other (one inside the other)
-  double dp_hi;  ///< dp (1 + kReachRel): above it they miss each other (apart)
+  double k;        ///< (r1 - r2)(r1 + r2) / 2: the chord foot is a = d/2 + k/d from c1
+  double dm;       ///< (r1 - r2)^2: inner tangency
+  double dp;       ///< (r1 + r2)^2: outer tangency
+  double dm_lo;    ///< dm (1 - kReachRel): below it the circles miss each other (one inside the other)
+  double dp_hi;    ///< dp (1 + kReachRel): above it they miss each other (apart)
+  Pow4Scale norm;  ///< of dp: keeps the fourth power under the root in range
   static CirclePair make(double r1, double r2) {
     const double dm = (r1 - r2) * (r1 - r2), dp = (r1 + r2) * (r1 + r2);
-    return {0.5 * ((r1 - r2) * (r1 + r2)), dm, dp, dm * (1.0 - tol::kReachRel), dp * (1.0 + tol::kReachRel)};
+    return {0.5 * ((r1 - r2) * (r1 + r2)), dm, dp, dm * (1.0 - tol::kReachRel), dp * (1.0 + tol::kReachRel),
+            Pow4Scale::of(dp)};
   }
 };
 
@@ -30,17 +51,19 @@ struct CirclePair {
 /// as two ratios to d:  point - c1 = t (dx, dy) + side hd (-dy, dx),  t = a/d, hd = h/d.
 ///   t  = 1/2 + k/d^2,
 ///   hd = sqrt((d^2 - (r1 - r2)^2) ((r1 + r2)^2 - d^2)) / (2 d^2)   (Heron: 2 d h = that root),
-/// so no square root of d^2 is ever taken: one division (1/d^2, passed in) and one square root.
+/// so no square root of d^2 is ever taken: one division (1/d^2, passed in) and one square root,
+/// and the root does not wait for the division (the two run side by side).
 /// Each factor under the root is a difference of squared lengths that vanishes at one tangency
 /// and carries an absolute error of a few eps d^2 there (the same as the foot form
 /// h^2 = (r - a)(r + a), whose a carries eps d); so h keeps its digits near both tangencies and at
 /// any link ratio. Within kReachRel (relative, in d^2) of a tangency the factor is clamped to 0.
-/// Shared verbatim by the scalar and batch paths; returns reachability.
+/// The product under the root is scaled by an exact power of 4 (Pow4Scale), so any lengths a
+/// double can hold work. Shared verbatim by the scalar and batch paths; returns reachability.
 inline bool chord(const CirclePair& c, double d2, double inv_d2, double& t, double& hd) {
   t = 0.5 + c.k * inv_d2;
-  const double g_in = std::max(0.0, d2 - c.dm) * inv_d2;   // 0 at inner tangency
-  const double g_out = std::max(0.0, c.dp - d2) * inv_d2;  // 0 at outer tangency
-  hd = 0.5 * std::sqrt(g_in * g_out);
+  const double g_in = std::max(0.0, d2 - c.dm);   // 0 at inner tangency
+  const double g_out = std::max(0.0, c.dp - d2);  // 0 at outer tangency
+  hd = std::sqrt(g_in * (g_out * c.norm.s)) * (c.norm.u * inv_d2);
   return (d2 >= c.dm_lo) & (d2 <= c.dp_hi);
 }
 

@@ -3,7 +3,7 @@
 // study of `fivebar report accuracy` (private). The formulas are the library's stable ones
 // (lib/src/kinematics_common.hpp, detail::chord): the intersection as ratios to the centre
 // distance d, computed from d^2 alone, t = a/d = 1/2 + (r1 - r2)(r1 + r2)/(2 d^2) and
-// h/d = sqrt((d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2)) / (2 d^2), each factor clamped at
+// h/d = sqrt((d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2)/(r1 + r2)^2) (r1 + r2) / (2 d^2), each factor clamped at
 // rounding-level tangency; angles from atan2. Only the arithmetic type changes, so the series
 // show what precision alone buys.
 
@@ -37,7 +37,7 @@ inline bool chord_offset(T c1x, T c1y, T r1, T c2x, T c2y, T r2, T side, T& ox, 
   if (d2 < dm * (T(1) - rel) || d2 > dp * (T(1) + rel)) return false;
   const T inv_d2 = T(1) / d2;
   const T t = T(0.5) + T(0.5) * ((r1 - r2) * (r1 + r2)) * inv_d2;  // a / d
-  const T hd = T(0.5) * std::sqrt((std::max(T(0), d2 - dm) * inv_d2) * (std::max(T(0), dp - d2) * inv_d2));  // h / d
+  const T hd = std::sqrt(std::max(T(0), d2 - dm) * (std::max(T(0), dp - d2) / dp)) * (T(0.5) * (r1 + r2) * inv_d2);  // h / d
   ox = t * dx - side * (hd * dy);
   oy = t * dy + side * (hd * dx);
   return true;
