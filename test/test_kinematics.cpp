@@ -228,6 +228,33 @@ TEST(CircleIntersection, AgreesWithLongDoubleHeronAtRadiusRatiosUpTo1e8) {
   EXPECT_LE(worst, 4.0);
 }
 
+/// Scaling every length by a power of two scales the intersection exactly (no rounding changes)
+/// as long as nothing over- or underflows: the chord's fourth-power product is rescaled by an exact
+/// power of 4, so lengths from 2^-480 to 2^480 (~1e-144 ... 1e144) give bit-for-bit the same point.
+TEST(CircleIntersection, ScalesExactlyByPowersOfTwoFrom1em144To1e144) {
+  std::mt19937_64 rng(test_seed() + 5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int checked = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const double r1 = 0.1 + 10 * u(rng), r2 = 0.1 + 10 * u(rng);
+    const Vec2 c1(20 * u(rng) - 10, 20 * u(rng) - 10);
+    const double d = std::fabs(r1 - r2) + 2 * std::min(r1, r2) * u(rng), ang = 2 * kPi * u(rng);
+    const Vec2 c2 = c1 + d * Vec2(std::cos(ang), std::sin(ang));
+    const CircleIntersection ref = intersect_circles(c1, r1, c2, r2, +1);
+    if (ref.status != Status::ok) continue;
+    ++checked;
+    for (int e : {-480, -200, -40, 40, 200, 480}) {
+      const double s = std::ldexp(1.0, e);
+      const CircleIntersection x = intersect_circles(s * c1, s * r1, s * c2, s * r2, +1);
+      ASSERT_EQ(x.status, Status::ok) << e;
+      EXPECT_EQ(x.offset.x(), s * ref.offset.x()) << e;
+      EXPECT_EQ(x.offset.y(), s * ref.offset.y()) << e;
+      EXPECT_EQ(x.h, s * ref.h) << e;
+    }
+  }
+  EXPECT_GT(checked, 1500);
+}
+
 // --- regimes -----------------------------------------------------------------------------------
 
 struct Regime {
