@@ -644,8 +644,12 @@ TEST(Extreme, CoincidentBaseJoints) {
 
 TEST(Extreme, NonFiniteAndHugeAnglesNeverProduceNaN) {
   const Mechanism m = paper("index", "lower");
-  std::vector<double> t1 = {1e7, -3e9, 1e300, std::nan(""), INFINITY, 0.5};
-  std::vector<double> t2 = {2.0, 2.0, 2.0, 2.0, 2.0, 2.0};
+  // Spread over several of fk_batch's blocks (256 points), and the last element, so that a flag
+  // lost between blocks would leave a fast-path result for one of them.
+  std::vector<double> t1(700, 0.5), t2(700, 2.0);
+  const double bad[] = {1e7, -3e9, 1e300, std::nan(""), INFINITY, -INFINITY};
+  const std::size_t where[] = {0, 255, 256, 400, 513, 699};
+  for (int i = 0; i < 6; ++i) t1[where[i]] = bad[i];
   std::vector<double> px(t1.size()), py(t1.size());
   std::vector<Status> st(t1.size());
   fk_batch(m, t1, t2, px, py, st);

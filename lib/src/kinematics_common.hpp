@@ -79,10 +79,14 @@ inline double lci2(double m00, double m01, double m10, double m11) {
 
 /// Worst status first: unreachable > singular_type1 > singular_type2 > ok. Written as selects on
 /// integers (no short-circuit) so that loops calling it stay vectorisable.
+template <class T>
+inline T classify_as(bool reachable, bool type1, bool type2) {
+  const T t2 = type2 ? T(Status::singular_type2) : T(Status::ok);
+  const T t1 = type1 ? T(Status::singular_type1) : t2;
+  return reachable ? t1 : T(Status::unreachable);
+}
 inline Status classify(bool reachable, bool type1, bool type2) {
-  const int t2 = type2 ? int(Status::singular_type2) : int(Status::ok);
-  const int t1 = type1 ? int(Status::singular_type1) : t2;
-  return static_cast<Status>(reachable ? t1 : int(Status::unreachable));
+  return static_cast<Status>(classify_as<int>(reachable, type1, type2));
 }
 
 /// Same, from the |sin| of the worst elbow angle and of the tactor angle.
