@@ -8,12 +8,16 @@
 
 #include <cmath>
 
-/// FIVEBAR_SIMD_CLONES on a function with a vectorisable loop: GCC compiles it twice, for
-/// baseline x86-64 (SSE2, two doubles per vector) and for AVX2 (four), and picks the clone at load
-/// time (ifunc). AVX2 without FMA: the same IEEE operations in the same order, so both clones
-/// give bit-identical results. Elsewhere (other compilers or targets) it expands to nothing.
+/// FIVEBAR_SIMD_CLONES on a function with a vectorisable loop: GCC compiles it three times, for
+/// baseline x86-64 (SSE2, two doubles per vector), AVX2 (four) and x86-64-v4 (AVX-512: eight, 32
+/// vector registers, mask registers), and picks the clone at load time (ifunc). Translation units
+/// that use it are compiled with -ffp-contract=off (lib/ and test/bench/ CMakeLists): AVX2 and
+/// AVX-512 machines have FMA, and contracting a*b+c into one rounding would change results. So
+/// every clone runs the same IEEE operations in the same order and gives bit-identical results
+/// (test `no_fused_multiply_add` checks the objects). Elsewhere (other compilers or targets) it
+/// expands to nothing.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define FIVEBAR_SIMD_CLONES __attribute__((target_clones("avx2", "default")))
+#define FIVEBAR_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
 #else
 #define FIVEBAR_SIMD_CLONES
 #endif
