@@ -181,20 +181,21 @@ AnglesResult ik_angles(const Mechanism& m, const Vec2& P) {
   AnglesResult r;
   const IkConst g(m);
   const Elbows e = elbows(g, P.x(), P.y());
-  ik_from_elbows<LibmTrig>(g, e, r.theta1, r.theta2, r.status);
-  if (r.status == Status::unreachable) return r;
+  if (!e.reach) return r;  // unreachable, angles 0
   // Loop closure of the configuration the angles describe: |A_i - O_i| = L_i, |P - A_i| = L_{i+2}
-  // (first-order length residuals, no square roots). ik() additionally runs the angles forward
-  // through sin/cos; here that would cost as much as the IK itself, and atan2 of the elbow offset
-  // is exact to < 1 ulp.
+  // (first-order length residuals, no square roots), taken before the atan2 calls while the
+  // elbows are still in registers. ik() additionally runs the angles forward through sin/cos;
+  // here that would cost as much as the IK itself, and atan2 of the elbow offset is exact to
+  // < 1 ulp.
   const auto residual = [](double x, double y, double l) { return std::fabs((x * x + y * y) - l * l) / (2.0 * l); };
-  r.closure_error_mm = std::max({residual(e.e1x, e.e1y, m.L[0]), residual(e.e2x, e.e2y, m.L[1]),
-                                 residual(e.f1x, e.f1y, m.L[2]), residual(e.f2x, e.f2y, m.L[3])});
+  const double closure = std::max({residual(e.e1x, e.e1y, m.L[0]), residual(e.e2x, e.e2y, m.L[1]),
+                                   residual(e.f1x, e.f1y, m.L[2]), residual(e.f2x, e.f2y, m.L[3])});
+  ik_from_elbows<LibmTrig>(g, e, r.theta1, r.theta2, r.status);
+  r.closure_error_mm = closure;
   // kClosureRel * length_scale(); the links alone settle it unless the bases are further apart
   // than the longest link, and only then is |O2 - O1| (a square root) needed.
   const double longest_link = std::max({m.L[0], m.L[1], m.L[2], m.L[3]});
-  const bool closed = r.closure_error_mm <= tol::kClosureRel * longest_link ||
-                      r.closure_error_mm <= tol::kClosureRel * m.length_scale();
+  const bool closed = closure <= tol::kClosureRel * longest_link || closure <= tol::kClosureRel * m.length_scale();
   if (!closed && r.status == Status::ok) r.status = Status::singular_type1;  // only a numerically degenerate chord can get here
   return r;
 }
