@@ -69,8 +69,12 @@ std::array<Pose, 4> ik_all(const Mechanism& m, const Vec2& P);
 /// 1 / condition number of a 2x2 matrix, in [0, 1], computed without inverting it.
 double lci(const Eigen::Matrix2d& J);
 
-/// Stable circle-circle intersection (STYLE.md): circles (c1, r1) and (c2, r2); `side` = +1 picks
-/// the point left of c1->c2 (cross(c2 - c1, p - c1) >= 0), -1 the other.
+/// Stable circle-circle intersection (no acos, STYLE.md): circles (c1, r1) and (c2, r2); `side` = +1
+/// picks the point left of c1->c2 (cross(c2 - c1, p - c1) >= 0), -1 the other. Computed from the
+/// squared centre distance d^2 alone: foot a/d = 1/2 + (r1^2 - r2^2)/(2 d^2) and height from
+/// Heron's factors (d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2) = (2 d h)^2, each vanishing at one
+/// tangency, so h keeps its digits there; one division and one square root. Within rounding of a
+/// tangency (tol::kReachRel) the height is clamped to 0.
 struct CircleIntersection {
   Status status = Status::unreachable;  ///< ok, unreachable, or singular_type1 for tangency
   Vec2 point{0.0, 0.0};
