@@ -2,12 +2,8 @@
 // code (DESIGN.md "Command line"). Expected values are derived here from the geometry of the
 // paper's device (Table 1), independently of the library.
 
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -24,9 +20,12 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
+#include "process.hpp"
 
 namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using ft::slurp;
 using nlohmann::json;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
@@ -57,65 +56,19 @@ double cross(const P2& o, const P2& a, const P2& b) {  // cross(a - o, b - o)
 }
 P2 xy(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>()}; }
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-/// A scratch directory per test.
+/// A scratch directory per test (test/process.hpp).
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("fivebar_test_cli_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
-  /// Runs the binary with `args`, feeding `input` on stdin, from `cwd` (default: the scratch dir).
-  Outcome run(const std::vector<std::string>& args, const std::string& input = "", fs::path cwd = {}) {
-    const fs::path in = dir_ / ".stdin", out = dir_ / ".stdout", err = dir_ / ".stderr";
+  /// Runs the binary with `args`, feeding `input` on stdin, from `cwd` (default: the scratch dir);
+  /// stdin, stdout and stderr pass through files in dir_ that are gone when it returns.
+  Outcome run(const std::vector<std::string>& args, const std::string& input = "", const fs::path& cwd = {}) {
+    const fs::path in = dir_ / ".stdin";
     std::ofstream(in, std::ios::binary) << input;
-    std::vector<std::string> argv_s{FIVEBAR_BINARY};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (cwd.empty()) cwd = dir_;
-
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, in.c_str(), O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addchdir_np(&actions, cwd.c_str());
-    pid_t pid = 0;
-    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    Outcome r;
-    if (rc != 0) {
-      ADD_FAILURE() << "cannot spawn " << argv[0] << ": " << std::strerror(rc);
-      return r;
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    fs::remove(in);
-    fs::remove(out);
-    fs::remove(err);
+    Outcome r = ft::run(FIVEBAR_BINARY, args, cwd.empty() ? dir_ : cwd, dir_, ft::child_timeout_s(600.0), in);
+    std::error_code ec;
+    fs::remove(in, ec);
+    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
+    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
     return r;
   }
 
@@ -145,7 +98,8 @@ class Cli : public ::testing::Test {
     return write(name, text);
   }
 
-  fs::path dir_;
+  ft::ScratchDir scratch_{"fivebar_test_cli"};
+  const fs::path dir_ = scratch_.path();
 };
 
 json parse_only_document(const Outcome& r) {

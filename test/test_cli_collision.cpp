@@ -3,12 +3,8 @@
 // derived here from the paper's geometry (Table 1) and the showcase's `geometry:` (pin bosses 5 mm,
 // min_clearance 0.3 mm), independently of the library.
 
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -24,11 +20,14 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
+#include "process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using ft::slurp;
 using nlohmann::json;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
@@ -38,59 +37,14 @@ const fs::path kSource = FIVEBAR_SOURCE_DIR;
 const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 class CliTactors : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("fivebar_test_cli_tactors_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
+  /// Runs the real binary in dir_; its stdout and stderr pass through files in dir_ that are gone
+  /// when it returns.
   Outcome run(const std::vector<std::string>& args) {
-    const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
-    std::vector<std::string> argv_s{FIVEBAR_BINARY};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addchdir_np(&actions, dir_.c_str());
-    pid_t pid = 0;
-    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    Outcome r;
-    if (rc != 0) {
-      ADD_FAILURE() << "cannot spawn " << argv[0] << ": " << std::strerror(rc);
-      return r;
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    fs::remove(out);
-    fs::remove(err);
+    Outcome r = ft::run(FIVEBAR_BINARY, args, dir_, dir_, ft::child_timeout_s(600.0));
+    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
+    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
     return r;
   }
 
@@ -117,7 +71,8 @@ class CliTactors : public ::testing::Test {
     return p;
   }
 
-  fs::path dir_;
+  ft::ScratchDir scratch_{"fivebar_test_cli_tactors"};
+  const fs::path dir_ = scratch_.path();
 };
 
 json parse(const Outcome& r) {

@@ -2,12 +2,8 @@
 // central differences; the work-precision series converge at the orders their methods have; the
 // stability catalogue passes on the paper's stations and on random geometries, with no NaN; the
 // output (JSON, text, plots), the `report` product and the CLI end to end.
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <Eigen/SVD>
 #include <nlohmann/json.hpp>
@@ -26,15 +22,17 @@
 #include "fivebar/report.hpp"
 #include "fivebar/scene.hpp"
 #include "fivebar/workspace.hpp"
+#include "process.hpp"
 #include "report_precision.hpp"
 #include "report_quad.hpp"
-
-extern char** environ;
 
 namespace fivebar {
 namespace {
 
 namespace fs = std::filesystem;
+namespace ft = ::fivebar::testing;
+using ft::Outcome;
+using ft::slurp;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
 using quadref::quad;
@@ -142,7 +140,7 @@ TEST(QuadReference, FkAgreesWithLongDoubleOnRegularPoses) {
     const auto angles = regular_angles(m, side, rng, 200);
     ASSERT_EQ(angles.size(), 200u);
     for (const auto& [t1, t2] : angles) {
-      SCOPED_TRACE(testing::Message() << station << "/" << which << " theta " << t1 << ", " << t2);
+      SCOPED_TRACE(::testing::Message() << station << "/" << which << " theta " << t1 << ", " << t2);
       const quadref::QPose q = quadref::fk(quadref::QMechanism(m), t1, t2, side);
       // Independent long double forms: the chord form and the acos form. |sin| >= 0.2 bounds
       // their rounding by ~5 * a few eps_ld * 30 mm; the quad value must sit within that.
@@ -171,7 +169,7 @@ TEST(QuadReference, IkAgreesWithLongDoubleAndFkOfItReturns) {
     const double px = double(f.P.x), py = double(f.P.y);
     const quadref::QPose q = quadref::ik(quadref::QMechanism(m), {px, py}, m.working_mode.sign1, m.working_mode.sign2);
     ASSERT_TRUE(q.reachable);
-    SCOPED_TRACE(testing::Message() << "P " << px << ", " << py);
+    SCOPED_TRACE(::testing::Message() << "P " << px << ", " << py);
     const double tol = 64 * double(std::numeric_limits<LD>::epsilon()) / 0.1;  // rad; elbow |sin| >= ~0.2
     LD a, b;
     ASSERT_TRUE(precision::ik(mt, LD(px), LD(py), a, b));
@@ -608,16 +606,8 @@ void expect_finite(const Json& j, const std::string& where) {
 
 class ScratchDir : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("fivebar_test_report_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path dir_;
+  ft::ScratchDir scratch_{"fivebar_test_report"};
+  const fs::path dir_ = scratch_.path();
 };
 
 using Output = ScratchDir;
@@ -698,46 +688,13 @@ TEST_F(Output, TheReportProductStatesTheAccuracyOfTheMainNumbers) {
 
 // --- CLI -------------------------------------------------------------------------------------------
 
-struct Outcome {
-  int code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 class ReportCli : public ScratchDir {
  protected:
+  /// Runs the real binary in dir_ (test/process.hpp).
   Outcome run(const std::vector<std::string>& args) {
-    const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
-    std::vector<std::string> argv_s{FIVEBAR_BINARY};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addchdir_np(&actions, dir_.c_str());
-    pid_t pid = 0;
-    const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    Outcome r;
-    if (rc != 0) {
-      ADD_FAILURE() << "cannot spawn: " << std::strerror(rc);
-      return r;
-    }
-    int status = 0;
-    waitpid(pid, &status, 0);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
+    Outcome r = ft::run(FIVEBAR_BINARY, args, dir_, dir_, ft::child_timeout_s(600.0));
+    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
+    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
     return r;
   }
 };
