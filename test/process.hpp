@@ -1,7 +1,7 @@
 #pragma once
 // Running the real `fivebar` binary from tests with a time bound: posix_spawn in its own process
 // group, stdin/stdout/stderr through files, polling wait, SIGKILL to the whole group when the
-// bound is exceeded. Header-only; used by test_hostile and test_output_hygiene.
+// bound is exceeded. Header-only; every test that runs the binary uses it.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -83,9 +84,11 @@ struct Outcome {
 };
 
 /// Starts `program args...` in `cwd` with `stdin_file` (may be empty: /dev/null) as stdin; stdout
-/// and stderr go to files in `io_dir`. The child leads its own process group.
+/// and stderr go to files in `io_dir`. The child leads its own process group. Its environment is
+/// this process's with `env` ("NAME=value" each) set on top, replacing a variable of that name.
 inline Child spawn(const std::string& program, const std::vector<std::string>& args, const fs::path& cwd,
-                   const fs::path& io_dir, const fs::path& stdin_file = {}) {
+                   const fs::path& io_dir, const fs::path& stdin_file = {},
+                   const std::vector<std::string>& env = {}) {
   Child c;
   static int counter = 0;
   const std::string tag = std::to_string(::getpid()) + "_" + std::to_string(++counter);
@@ -96,6 +99,19 @@ inline Child spawn(const std::string& program, const std::vector<std::string>& a
   std::vector<char*> argv;
   for (auto& a : argv_s) argv.push_back(a.data());
   argv.push_back(nullptr);
+  std::vector<std::string> env_s;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string var(*e);
+    const std::string name = var.substr(0, var.find('='));
+    const bool replaced = std::any_of(env.begin(), env.end(), [&](const std::string& x) {
+      return x.substr(0, x.find('=')) == name;
+    });
+    if (!replaced) env_s.push_back(var);
+  }
+  env_s.insert(env_s.end(), env.begin(), env.end());
+  std::vector<char*> envp;
+  for (auto& e : env_s) envp.push_back(e.data());
+  envp.push_back(nullptr);
 
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -114,7 +130,8 @@ inline Child spawn(const std::string& program, const std::vector<std::string>& a
   posix_spawnattr_setsigdefault(&attr, &all);  // default dispositions, whatever the test runner set
   posix_spawnattr_setsigmask(&attr, &none);
   c.started = std::chrono::steady_clock::now();
-  if (posix_spawn(&c.pid, argv[0], &actions, &attr, argv.data(), environ) != 0) c.pid = -1;
+  // posix_spawnp: a program name without '/' is looked up on PATH (mpirun); paths run as given.
+  if (posix_spawnp(&c.pid, argv[0], &actions, &attr, argv.data(), envp.data()) != 0) c.pid = -1;
   posix_spawnattr_destroy(&attr);
   posix_spawn_file_actions_destroy(&actions);
   return c;
@@ -155,8 +172,9 @@ inline Outcome wait(Child& c, double timeout_s) {
 
 /// spawn() + wait().
 inline Outcome run(const std::string& program, const std::vector<std::string>& args, const fs::path& cwd,
-                   const fs::path& io_dir, double timeout_s, const fs::path& stdin_file = {}) {
-  Child c = spawn(program, args, cwd, io_dir, stdin_file);
+                   const fs::path& io_dir, double timeout_s, const fs::path& stdin_file = {},
+                   const std::vector<std::string>& env = {}) {
+  Child c = spawn(program, args, cwd, io_dir, stdin_file, env);
   return wait(c, timeout_s);
 }
 

@@ -1,13 +1,9 @@
 // End-to-end tests of `fivebar sweep` on the real binary: JSON summary and files, bad input,
 // shards concatenating to the serial CSV, SIGINT leaving a valid CSV that --resume completes to
 // the uninterrupted result, and an MPI run (mpirun -n 2) equal to the serial one.
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -19,71 +15,37 @@
 #include <thread>
 
 #include "fivebar/sweep.hpp"
-
-extern char** environ;
+#include "process.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using ft::slurp;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
 const std::string kDesign = std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml";
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-struct Outcome {
-  int code = -1;
-  bool signaled = false;
-  std::string out, err;
-};
-
 class CliSweep : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("fivebar_test_cli_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
-    fs::create_directories(dir_);
+  /// Starts `program args...` (found on PATH unless it holds a '/') in dir_, stdout and stderr
+  /// through files there (test/process.hpp); wait_for() collects it.
+  ft::Child spawn(const std::string& program, const std::vector<std::string>& args) {
+    ft::Child c = ft::spawn(program, args, dir_, dir_);
+    if (c.pid <= 0) ADD_FAILURE() << "cannot spawn " << program;
+    return c;
   }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
-  /// Spawns argv[0] = program with args; returns the pid (stdout/stderr into dir_).
-  pid_t spawn(const std::string& program, const std::vector<std::string>& args) {
-    std::vector<std::string> argv_s{program};
-    argv_s.insert(argv_s.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : argv_s) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 1, (dir_ / ".stdout").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&actions, 2, (dir_ / ".stderr").c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = 0;
-    const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) ADD_FAILURE() << "cannot spawn " << program;
-    return rc == 0 ? pid : -1;
-  }
-  Outcome wait_for(pid_t pid) {
-    Outcome r;
-    int status = 0;
-    waitpid(pid, &status, 0);
-    r.signaled = WIFSIGNALED(status);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(dir_ / ".stdout");
-    r.err = slurp(dir_ / ".stderr");
+  Outcome wait_for(ft::Child& c) {
+    Outcome r = ft::wait(c, ft::child_timeout_s(600.0));
+    if (r.timed_out) ADD_FAILURE() << "timed out: " << r.err;
     return r;
   }
-  Outcome run(const std::vector<std::string>& args) { return wait_for(spawn(FIVEBAR_BINARY, args)); }
+  Outcome run(const std::vector<std::string>& args) {
+    ft::Child c = spawn(FIVEBAR_BINARY, args);
+    return wait_for(c);
+  }
 
   std::vector<std::string> sweep_args(const fs::path& out, const std::string& l3 = "L3=11:19:30",
                                       const std::string& l4 = "L4=11:19:30") {
@@ -91,7 +53,8 @@ class CliSweep : public ::testing::Test {
             out.string(), "--no-plots"};
   }
 
-  fs::path dir_;
+  ft::ScratchDir scratch_{"fivebar_test_cli_sweep"};
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(CliSweep, JsonSummaryAndFiles) {
@@ -189,14 +152,14 @@ TEST_F(CliSweep, InterruptLeavesAValidCsvAndResumeCompletesIt) {
   // grid must be long enough to interrupt, yet run twice more within the sanitizer build's timeout.
   auto args = sweep_args(dir_ / "cut", grid[0], grid[1]);
   args.insert(args.end(), {"--collision-spacing", "0", "--threads", "1"});
-  const pid_t pid = spawn(FIVEBAR_BINARY, args);
-  ASSERT_GT(pid, 0);
+  ft::Child child = spawn(FIVEBAR_BINARY, args);
+  ASSERT_GT(child.pid, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(150));
-  ::kill(pid, SIGINT);
-  const Outcome cut = wait_for(pid);
+  ::kill(child.pid, SIGINT);
+  const Outcome cut = wait_for(child);
   if (cut.code == 0) GTEST_SKIP() << "the sweep finished before the interrupt (a very fast machine)";
   ASSERT_EQ(cut.code, 130) << cut.err;
-  EXPECT_FALSE(cut.signaled);
+  EXPECT_EQ(cut.signal, 0);
   EXPECT_THAT(cut.err, HasSubstr("--resume"));
   // The CSV holds complete rows with contiguous indices, and no temporary file is left.
   const fivebar::Design design = [&] {
@@ -236,7 +199,8 @@ TEST_F(CliSweep, MpiRunEqualsTheSerialRun) {
   const auto sweep = sweep_args(dir_ / "mpi");
   args.insert(args.end(), sweep.begin(), sweep.end());
   args.push_back("--json");
-  const Outcome r = wait_for(spawn("mpirun", args));
+  ft::Child mpi = spawn("mpirun", args);
+  const Outcome r = wait_for(mpi);
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = json::parse(r.out);  // one document: only rank 0 prints
   EXPECT_TRUE(j["mpi"].get<bool>());

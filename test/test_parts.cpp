@@ -10,12 +10,8 @@
 // parses the STL files itself and measures volumes (divergence theorem), bounding boxes and hole
 // centres (centroid of the hole-wall vertices) on its own.
 
-#include <fcntl.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -38,10 +34,12 @@
 #include "fivebar/io.hpp"
 #include "fivebar/parts.hpp"
 #include "fivebar/scene.hpp"
-
-extern char** environ;
+#include "process.hpp"
 
 namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using ft::slurp;
 using namespace fivebar;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
@@ -59,13 +57,6 @@ constexpr double kHole = kPin + 2 * kClearance;     // 2.3
 constexpr double kShaftBore = kShaft + 2 * kClearance;  // 3.3
 constexpr double kThickness = 2.5, kBoss = 5.0, kWidth = 4.0, kTactorHeight = 6.0;
 constexpr int kFn = 24;
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 // --- An STL reader and measurements of the test's own ---------------------------------------------
 
@@ -162,16 +153,6 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& p) {
 
 class Parts : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("fivebar_test_parts_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
   fs::path write(const std::string& name, const std::string& text) {
     const fs::path p = dir_ / name;
     std::ofstream(p, std::ios::binary) << text;
@@ -221,7 +202,8 @@ class Parts : public ::testing::Test {
     return none;
   }
 
-  fs::path dir_;
+  ft::ScratchDir scratch_{"fivebar_test_parts"};
+  const fs::path dir_ = scratch_.path();
 };
 
 // --- Meshes and fits on synthetic data (no openscad) ------------------------------------------------
@@ -722,47 +704,12 @@ TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {
 
 // --- The command ------------------------------------------------------------------------------------
 
-struct Outcome {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-/// Runs the fivebar binary with extra environment variables, stdin and stdout/stderr to files.
+/// Runs the fivebar binary in `dir` with extra environment variables ("NAME=value"), through
+/// test/process.hpp.
 Outcome run_cli(const fs::path& dir, const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
-  const fs::path out = dir / ".stdout", err = dir / ".stderr";
-  std::vector<std::string> argv_s{FIVEBAR_BINARY};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  std::vector<std::string> env_s;
-  for (char** e = environ; *e != nullptr; ++e) env_s.emplace_back(*e);
-  env_s.insert(env_s.end(), env.begin(), env.end());
-  std::vector<char*> envp;
-  for (auto& e : env_s) envp.push_back(e.data());
-  envp.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addchdir_np(&actions, dir.c_str());
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&actions);
-  Outcome r;
-  if (rc != 0) {
-    ADD_FAILURE() << "cannot spawn " << argv[0] << ": " << std::strerror(rc);
-    return r;
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  fs::remove(out);
-  fs::remove(err);
+  Outcome r = ft::run(FIVEBAR_BINARY, args, dir, dir, ft::child_timeout_s(600.0), {}, env);
+  if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
+  if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
   return r;
 }
 
