@@ -24,6 +24,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/workspace_io.hpp"
 #include "fivebar/workspace_plot.hpp"
+#include "plot/cairo_bytes.hpp"
 
 namespace fivebar {
 
@@ -795,14 +796,9 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
           kTargetInk);
 }
 
-cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
+using plot_detail::append;
+using plot_detail::check;
 
-void check(cairo_status_t status, const char* what) {
-  if (status != CAIRO_STATUS_SUCCESS) throw std::runtime_error(std::string("cairo: ") + what + ": " + cairo_status_to_string(status));
-}
 
 }  // namespace
 

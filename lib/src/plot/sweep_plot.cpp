@@ -15,6 +15,7 @@
 
 #include "fivebar/io.hpp"
 #include "fivebar/sweep.hpp"
+#include "plot/cairo_bytes.hpp"
 
 namespace fivebar {
 
@@ -127,10 +128,7 @@ void colour(cairo_t* cr, double t) {
                        stops[i][2] + f * (stops[i + 1][2] - stops[i][2]));
 }
 
-cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
+using plot_detail::append;
 
 /// Draws with `draw` into an SVG and a PNG next to each other (atomically written).
 template <class Draw>

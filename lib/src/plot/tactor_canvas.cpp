@@ -1,6 +1,7 @@
 // Cairo canvas shared by the collision-map and pattern pictures (see tactor_canvas.hpp).
 
 #include "plot/tactor_canvas.hpp"
+#include "plot/cairo_bytes.hpp"
 
 #include <cairo-svg.h>
 
@@ -14,16 +15,9 @@ namespace fivebar::tactor_plot {
 
 namespace {
 
-cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
+using plot_detail::append;
+using plot_detail::check;
 
-void check(cairo_status_t status, const char* what) {
-  if (status != CAIRO_STATUS_SUCCESS) {
-    throw std::runtime_error(std::string("cairo: ") + what + ": " + cairo_status_to_string(status));
-  }
-}
 
 }  // namespace
 

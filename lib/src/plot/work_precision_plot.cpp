@@ -1,5 +1,6 @@
 // Work-precision plots with cairo (SVG and PNG surfaces, written to memory).
 #include "plot/work_precision_plot.hpp"
+#include "plot/cairo_bytes.hpp"
 
 #include <cairo-svg.h>
 #include <cairo.h>
@@ -254,10 +255,7 @@ void draw(cairo_t* cr, const PlotSpec& spec) {
   }
 }
 
-cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
+using plot_detail::append;
 
 }  // namespace
 
