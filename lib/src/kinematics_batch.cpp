@@ -277,16 +277,25 @@ FIVEBAR_SIMD_CLONES void lci_batch(const Mechanism& m, std::span<const double> p
   const std::size_t n = px.size();
   assert(py.size() == n && lci.size() == n && status.size() == n);
   const IkConst g(m);
-  for (std::size_t k = 0; k < n; ++k) {
-    const Elbows e = elbows(g, px[k], py[k]);
-    const double c1 = cross(e.e1x, e.e1y, e.f1x, e.f1y), c2 = cross(e.e2x, e.e2y, e.f2x, e.f2y);
-    const double cb = cross(e.f1x, e.f1y, e.f2x, e.f2y);
-    const Status st = detail::classify(e.reach, (std::fabs(c1) < g.thr13) | (std::fabs(c2) < g.thr24),
-                                       std::fabs(cb) < g.thr34);
-    // M = adj(B) C, cond(M) = cond(J) (see kinematics.cpp).
-    const double v = detail::lci2(e.f2y * c1, -e.f1y * c2, -e.f2x * c1, e.f1x * c2);
-    lci[k] = st == Status::ok ? v : 0.0;
-    status[k] = st;
+  alignas(64) Code code[kBlock];
+  for (std::size_t b = 0; b < n; b += kBlock) {
+    const std::size_t len = std::min(kBlock, n - b);
+    const double* __restrict x = px.data() + b;
+    const double* __restrict y = py.data() + b;
+    double* __restrict out = lci.data() + b;
+    for (std::size_t k = 0; k < len; ++k) {
+      const Elbows e = elbows(g, x[k], y[k]);
+      const double c1 = cross(e.e1x, e.e1y, e.f1x, e.f1y), c2 = cross(e.e2x, e.e2y, e.f2x, e.f2y);
+      const double cb = cross(e.f1x, e.f1y, e.f2x, e.f2y);
+      const Code c = detail::classify_as<Code>(e.reach, (std::fabs(c1) < g.thr13) | (std::fabs(c2) < g.thr24),
+                                               std::fabs(cb) < g.thr34);
+      // M = adj(B) C, cond(M) = cond(J) (see kinematics.cpp).
+      const double v = detail::lci2(e.f2y * c1, -e.f1y * c2, -e.f2x * c1, e.f1x * c2);
+      out[k] = c == Code(Status::ok) ? v : 0.0;
+      code[k] = c;
+    }
+    Status* __restrict st = status.data() + b;
+    for (std::size_t k = 0; k < len; ++k) st[k] = Status(code[k]);
   }
 }
 
