@@ -642,6 +642,29 @@ TEST(Extreme, CoincidentBaseJoints) {
   EXPECT_EQ(p.status, Status::singular_type2);
 }
 
+/// A tactor a subnormal distance from a base (d^2 below the smallest normal double, so 1/d^2 would
+/// overflow) with equal proximal and distal links (the IK circle passes through the base, so the
+/// inner tangency d^2 = 0 does not exclude it): every batch output stays finite.
+TEST(Extreme, SubnormalDistanceFromABaseNeverProducesNaN) {
+  Mechanism m = paper("index", "lower");
+  m.L = {9.0, 9.0, 9.0, 9.0};
+  const std::vector<double> px = {m.O1.x(), m.O1.x() + 1e-160, m.O1.x() + 3e-155, m.O2.x()};
+  const std::vector<double> py = {m.O1.y() + 1e-160, m.O1.y(), m.O1.y() + 1e-170, m.O2.y() + 1e-162};
+  const std::size_t n = px.size();
+  std::vector<double> t1(n), t2(n), l(n), f(n);
+  std::vector<Status> st(n), st2(n), st3(n);
+  std::vector<std::int8_t> as(n);
+  ik_batch(m, px, py, t1, t2, st);
+  lci_batch(m, px, py, l, st2);
+  conditioning_batch(m, px, py, l, f, as, st3);
+  for (std::size_t k = 0; k < n; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_TRUE(std::isfinite(t1[k]) && std::isfinite(t2[k]) && std::isfinite(l[k]) && std::isfinite(f[k]));
+    const AnglesResult a = ik_angles(m, {px[k], py[k]});
+    EXPECT_TRUE(std::isfinite(a.theta1) && std::isfinite(a.theta2) && std::isfinite(a.closure_error_mm));
+  }
+}
+
 TEST(Extreme, NonFiniteAndHugeAnglesNeverProduceNaN) {
   const Mechanism m = paper("index", "lower");
   // Spread over several of fk_batch's blocks (256 points), and the last element, so that a flag

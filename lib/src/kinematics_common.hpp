@@ -14,12 +14,11 @@ namespace fivebar::detail {
 inline double cross(double ax, double ay, double bx, double by) { return ax * by - ay * bx; }
 inline double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-/// Circle pair (c1, r1), (c2, r2) prepared for the intersection, in terms of the squared centre
-/// distance d^2 only: the circles meet iff (r1 - r2)^2 <= d^2 <= (r1 + r2)^2.
 /// Exact power-of-two scaling for a squared length x > 0: s = 2^-2m and u = 2^(m-1), where
 /// 2^2m <= x < 2^(2m+2). Scaling by a power of 4 commutes exactly with the square root, so
-/// sqrt(y s) u == sqrt(y) / 2 bit for bit whenever y itself neither over- nor underflows, and
-/// y s stays near 1 when y ~ x^2 even where y would. Integer operations only, no division.
+/// sqrt(y s) u == sqrt(y) / 2 bit for bit whenever neither y nor y s leaves the normal range, and
+/// y s stays within a few orders of x when y ~ x^2, even where y itself would overflow or
+/// underflow. Integer operations only, no division.
 struct Pow4Scale {
   double s, u;
   static Pow4Scale of(double x) {
