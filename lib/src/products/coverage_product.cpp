@@ -73,11 +73,7 @@ Product coverage_product() {
   Product p;
   p.name = "coverage";
   p.title = "Target coverage";
-  p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    for (const Station& s : d.stations)
-      if (!s.mechanisms().empty()) return std::nullopt;
-    return "no station has a mechanism";
-  };
+  p.unavailable = without_mechanisms;
   p.build = [](Context& ctx) {
     Built b;
     Json stations = Json::object();

@@ -225,12 +225,7 @@ Product kinematics_product() {
   Product p;
   p.name = "kinematics";
   p.title = "Kinematics at the target";
-  p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    for (const Station& s : d.stations) {
-      if (!s.mechanisms().empty()) return std::nullopt;
-    }
-    return "no station has a mechanism";
-  };
+  p.unavailable = without_mechanisms;
   p.build = [](Context& ctx) {
     Built b;
     json stations = json::array();

@@ -56,6 +56,13 @@ struct Product {
   std::function<Built(Context&)> build;
 };
 
+/// Product::unavailable for the products that need at least one station with a mechanism.
+inline std::optional<std::string> without_mechanisms(const Design& d) {
+  for (const Station& s : d.stations)
+    if (!s.mechanisms().empty()) return std::nullopt;
+  return "no station has a mechanism";
+}
+
 /// All implemented products; run_scene() follows known_products() for the order.
 const std::vector<Product>& registry();
 /// The entry named `name`, or nullptr when this build does not implement it.

@@ -93,11 +93,7 @@ Product report_product() {
   Product p;
   p.name = "report";
   p.title = "Accuracy and numerical stability";
-  p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    for (const Station& s : d.stations)
-      if (!s.mechanisms().empty()) return std::nullopt;
-    return "no station has a mechanism";
-  };
+  p.unavailable = without_mechanisms;
   p.build = [](Context& ctx) {
     Built b;
     AccuracyOptions ao;

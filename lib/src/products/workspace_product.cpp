@@ -62,11 +62,7 @@ Product workspace_product() {
   Product p;
   p.name = "workspace";
   p.title = "Reachable workspace";
-  p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    for (const Station& s : d.stations)
-      if (!s.mechanisms().empty()) return std::nullopt;
-    return "no station has a mechanism";
-  };
+  p.unavailable = without_mechanisms;
   p.build = [](Context& ctx) {
     Built b;
     Json stations = Json::array();
