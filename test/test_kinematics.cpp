@@ -662,7 +662,12 @@ TEST(Extreme, SubnormalDistanceFromABaseNeverProducesNaN) {
     EXPECT_TRUE(std::isfinite(t1[k]) && std::isfinite(t2[k]) && std::isfinite(l[k]) && std::isfinite(f[k]));
     const AnglesResult a = ik_angles(m, {px[k], py[k]});
     EXPECT_TRUE(std::isfinite(a.theta1) && std::isfinite(a.theta2) && std::isfinite(a.closure_error_mm));
+    EXPECT_TRUE(finite_pose(ik(m, {px[k], py[k]})));
   }
+  // The full path's intersection at that scale: circles of radius 1e-160 whose centres are 1e-160
+  // apart (d^2 subnormal) are treated as concentric, not divided through.
+  const CircleIntersection x = intersect_circles({0, 0}, 1e-160, {1e-160, 0}, 1e-160, +1);
+  EXPECT_TRUE(x.point.allFinite() && std::isfinite(x.h));
 }
 
 TEST(Extreme, NonFiniteAndHugeAnglesNeverProduceNaN) {

@@ -33,7 +33,8 @@ CircleIntersection intersect_circles(const Vec2& c1, double r1, const Vec2& c2, 
   const double d = std::sqrt(d2);
   out.d = d;
   const double scale = std::max({r1, r2, d});
-  if (d <= tol::kCoincidentRel * scale) {
+  // Coincident relative to the circles, or too close for 1/d^2 (detail::kMinD2).
+  if (d <= tol::kCoincidentRel * scale || !(d2 >= detail::kMinD2)) {
     // Concentric: no intersection, or (equal radii) every point of the circle. Report one point
     // (straight "up" from c1) and let the caller's singularity analysis classify it.
     if (std::fabs(r1 - r2) <= tol::kReachRel * scale) {

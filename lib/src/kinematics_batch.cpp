@@ -18,7 +18,6 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 
 #include "fivebar/detail/fastmath.hpp"
 #include "fivebar/kinematics.hpp"
@@ -38,12 +37,6 @@ struct LibmTrig {
   static void sincos(double x, double& s, double& c) { ::sincos(x, &s, &c); }  // glibc, one reduction
   static double atan2(double y, double x) { return std::atan2(y, x); }
 };
-
-/// Centres closer than sqrt(kMinD2) ~ 1.5e-154 (times the length unit) count as coincident: below
-/// the smallest normal d^2, 1/d^2 overflows and t = 1/2 + k/d^2 would be inf or NaN even where the
-/// circles meet (equal radii). From kMinD2 up, 1/d^2 is finite, and where the circles meet
-/// |k| <= |r1 - r2| (r1 + r2) / 2 <= d (r1 + r2) / 2 keeps t d finite.
-constexpr double kMinD2 = std::numeric_limits<double>::min();
 
 /// Loop-invariant constants of one mechanism.
 struct FkConst {
@@ -70,7 +63,7 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
   const double a1x = g.o1x + e1x, a1y = g.o1y + e1y, a2x = g.o2x + e2x, a2y = g.o2y + e2y;
   const double dx = a2x - a1x, dy = a2y - a1y;
   const double d2 = dx * dx + dy * dy;
-  const bool coincident = !(d2 >= kMinD2);
+  const bool coincident = !(d2 >= detail::kMinD2);
   const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
   double t, hd;  // P - A1 = t (dx, dy) + side hd (-dy, dx)
   const bool reach = !coincident & detail::chord(g.distal, d2, inv_d2, t, hd);
@@ -119,12 +112,12 @@ struct IkConst {
 inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, double& ey) {
   const double dx = px - g.ox, dy = py - g.oy;
   const double d2 = dx * dx + dy * dy;
-  const bool coincident = !(d2 >= kMinD2);
+  const bool coincident = !(d2 >= detail::kMinD2);
   const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
   double t, hd;  // A - O = t (dx, dy) + s hd (-dy, dx)
   const bool reach = !coincident & detail::chord(g.circles, d2, inv_d2, t, hd);
   const double hs = g.s * hd;  // exact: s is +-1
-  // Finite when the circles meet (see kMinD2); otherwise they may not be, and every caller selects
+  // Finite when the circles meet (see detail::kMinD2); otherwise they may not be, and every caller selects
   // its outputs on the reach flag, so the offsets themselves are not selected.
   ex = t * dx - hs * dy;
   ey = t * dy + hs * dx;

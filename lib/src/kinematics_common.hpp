@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "fivebar/kinematics.hpp"
 #include "fivebar/tolerances.hpp"
@@ -46,6 +47,13 @@ struct CirclePair {
   }
 };
 
+/// chord()'s precondition: d^2 >= kMinD2. Centres closer than sqrt(kMinD2) ~ 1.5e-154 (times the
+/// length unit) count as coincident: below the smallest normal d^2, 1/d^2 overflows and
+/// t = 1/2 + k/d^2 would be inf or NaN even where the circles meet (equal radii). From kMinD2 up,
+/// 1/d^2 is finite, and where the circles meet |k| <= |r1 - r2| (r1 + r2) / 2 <= d (r1 + r2) / 2
+/// keeps t d finite.
+inline constexpr double kMinD2 = std::numeric_limits<double>::min();
+
 /// Intersection of a circle pair whose centres are (dx, dy) = c2 - c1 apart, d^2 = dx^2 + dy^2,
 /// as two ratios to d:  point - c1 = t (dx, dy) + side hd (-dy, dx),  t = a/d, hd = h/d.
 ///   t  = 1/2 + k/d^2,
@@ -56,8 +64,9 @@ struct CirclePair {
 /// and carries an absolute error of a few eps d^2 there (the same as the foot form
 /// h^2 = (r - a)(r + a), whose a carries eps d); so h keeps its digits near both tangencies and at
 /// any link ratio. Within kReachRel (relative, in d^2) of a tangency the factor is clamped to 0.
-/// The product under the root is scaled by an exact power of 4 (Pow4Scale), so any lengths a
-/// double can hold work. Shared verbatim by the scalar and batch paths; returns reachability.
+/// The product under the root is scaled by an exact power of 4 (Pow4Scale), so it neither
+/// overflows nor underflows for any centre distance from sqrt(kMinD2) up. Shared verbatim by the
+/// scalar and batch paths; returns reachability.
 inline bool chord(const CirclePair& c, double d2, double inv_d2, double& t, double& hd) {
   t = 0.5 + c.k * inv_d2;
   const double g_in = std::max(0.0, d2 - c.dm);   // 0 at inner tangency
