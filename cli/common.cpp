@@ -341,6 +341,43 @@ void BatchSink::commit() {
   }
 }
 
+CLI::Option* add_batch_options(CLI::App& sub, const std::string& name, const std::string& columns, CLI::Option* single,
+                               std::string& file, std::string& output) {
+  auto* opt = sub.add_option("--" + name + "-file", file,
+                             "Batch: CSV with header columns " + columns +
+                                 " ('-' = stdin); writes one CSV row per input row")
+                  ->type_name("FILE");
+  sub.add_option("-o,--output", output, "Batch: write the CSV to this file (atomically) instead of stdout")
+      ->type_name("FILE");
+  single->excludes(opt);
+  return opt;
+}
+
+void require_single_or_batch(std::string_view command, const std::string& single, std::string_view single_usage,
+                             const std::string& file, std::string_view file_flag, const std::string& output) {
+  if (single.empty() == file.empty()) {
+    throw InputError(std::string(command) + " needs exactly one of " + std::string(single_usage) + " or " +
+                     std::string(file_flag) + " FILE");
+  }
+  if (!output.empty() && file.empty()) throw InputError("--output is for batch runs (" + std::string(file_flag) + ")");
+}
+
+BatchTally stream_batch(const std::string& file, std::vector<std::string> columns, const std::string& output,
+                        const std::function<bool(const std::vector<double>& row, std::ostream& out)>& solve) {
+  CsvReader reader(file, std::move(columns));
+  BatchSink sink(output);
+  std::ostream& out = sink.out();
+  out << kBatchHeader << "\n";
+  BatchTally tally;
+  std::vector<double> row;
+  while (reader.next(row)) {
+    ++tally.rows;
+    if (!solve(row, out)) ++tally.unsolved;
+  }
+  sink.commit();
+  return tally;
+}
+
 const char* const kBatchHeader = "x_mm,y_mm,theta1_deg,theta2_deg,status,lci,mode,assembly,within_joint_limits";
 
 void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Vec2>& point_mm,

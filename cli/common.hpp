@@ -122,6 +122,26 @@ class BatchSink {
   std::optional<AtomicFile> file_;
 };
 
+/// The batch form's options beside the single form `single`: `--<name>-file FILE` (a CSV with
+/// header columns `columns`, '-' = stdin) and -o/--output. Returns the file option, for excludes().
+CLI::Option* add_batch_options(CLI::App& sub, const std::string& name, const std::string& columns, CLI::Option* single,
+                               std::string& file, std::string& output);
+
+/// Exactly one of the single form (`single`, shown as `single_usage`) and the batch file
+/// (`file`, option `file_flag`), and --output only with the file; InputError otherwise.
+void require_single_or_batch(std::string_view command, const std::string& single, std::string_view single_usage,
+                             const std::string& file, std::string_view file_flag, const std::string& output);
+
+/// Streams the batch form: reads `file` row by row and writes kBatchHeader and one row per input
+/// row through `solve`, which writes its row and returns whether it has a solution. The output
+/// (stdout, or the --output file, atomically) is committed after the last row; a bad row throws
+/// before that. Returns how many rows were read and how many had no solution.
+struct BatchTally {
+  std::size_t rows = 0, unsolved = 0;
+};
+BatchTally stream_batch(const std::string& file, std::vector<std::string> columns, const std::string& output,
+                        const std::function<bool(const std::vector<double>& row, std::ostream& out)>& solve);
+
 /// Header and one row of batch output: x_mm,y_mm,theta1_deg,theta2_deg,status,lci,mode,assembly,
 /// within_joint_limits. For an unreachable row the known inputs are echoed and the rest left empty.
 extern const char* const kBatchHeader;

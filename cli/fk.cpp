@@ -40,31 +40,22 @@ Json context_json(const Design& design, const Selection& sel, const std::array<d
 }
 
 int run_batch(const FkOptions& opt, const Mechanism& m, AssemblyMode branch) {
-  CsvReader reader(opt.theta_file, {"theta1_deg", "theta2_deg"});
-  BatchSink sink(opt.output);
-  std::ostream& out = sink.out();
-  out << kBatchHeader << "\n";
-  std::vector<double> row;
-  std::size_t rows = 0, unsolved = 0;
-  while (reader.next(row)) {
-    const Pose pose = fk(m, row[0] * kDegToRad, row[1] * kDegToRad, branch);
-    write_batch_row(out, pose, std::nullopt, std::array<double, 2>{row[0], row[1]});
-    ++rows;
-    if (pose.status == Status::unreachable) ++unsolved;
-  }
-  sink.commit();
-  if (unsolved > 0) {
-    std::cerr << "fivebar fk: " << unsolved << " of " << rows << " rows have no configuration (status unreachable)\n";
+  const BatchTally tally = stream_batch(opt.theta_file, {"theta1_deg", "theta2_deg"}, opt.output,
+                                        [&](const std::vector<double>& row, std::ostream& out) {
+                                          const Pose pose = fk(m, row[0] * kDegToRad, row[1] * kDegToRad, branch);
+                                          write_batch_row(out, pose, std::nullopt, std::array<double, 2>{row[0], row[1]});
+                                          return pose.status != Status::unreachable;
+                                        });
+  if (tally.unsolved > 0) {
+    std::cerr << "fivebar fk: " << tally.unsolved << " of " << tally.rows
+              << " rows have no configuration (status unreachable)\n";
     return kCheckFailed;
   }
   return kOk;
 }
 
 int run_fk(const FkOptions& opt) {
-  if (opt.theta.empty() == opt.theta_file.empty()) {
-    throw InputError("fk needs exactly one of --theta T1,T2 or --theta-file FILE");
-  }
-  if (!opt.output.empty() && opt.theta_file.empty()) throw InputError("--output is for batch runs (--theta-file)");
+  require_single_or_batch("fk", opt.theta, "--theta T1,T2", opt.theta_file, "--theta-file", opt.output);
   const Design design = load(opt.target.design);
   const Selection sel = select(design, opt.target);
   const Mechanism& m = *sel.mechanism;
@@ -127,18 +118,13 @@ void setup_fk(CLI::App& app) {
   auto* theta = sub->add_option("-t,--theta", opt->theta,
                                 "Motor angles T1,T2 in degrees, counter-clockwise from +x (e.g. --theta 100,80)")
                     ->type_name("T1,T2");
-  auto* file = sub->add_option("--theta-file", opt->theta_file,
-                               "Batch: CSV with header columns theta1_deg,theta2_deg ('-' = stdin); "
-                               "writes one CSV row per input row")
-                   ->type_name("FILE");
-  sub->add_option("-o,--output", opt->output, "Batch: write the CSV to this file (atomically) instead of stdout")->type_name("FILE");
+  auto* file = add_batch_options(*sub, "theta", "theta1_deg,theta2_deg", theta, opt->theta_file, opt->output);
   auto* branch = sub->add_option("-b,--branch", opt->branch,
                                  "Assembly branch: + (tactor above the line A1A2), - (below) or any; default: the design's")
                      ->check(CLI::IsMember({"+", "-", "any"}))
                      ->type_name("SIGN");
   auto* all = sub->add_flag("-a,--all", opt->all, "Both assembly branches");
   auto* json = sub->add_flag("--json", opt->json, "Print one JSON document (mm, deg) on stdout and nothing else");
-  theta->excludes(file);
   all->excludes(branch);
   file->excludes(all)->excludes(json);
   sub->footer("Exit status: 0 a configuration exists, 1 none (status says why), 2 bad input, 3 internal error.");

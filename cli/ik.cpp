@@ -40,22 +40,15 @@ Json context_json(const Design& design, const Selection& sel, const Vec2& p) {
 }
 
 int run_batch(const IkOptions& opt, const Mechanism& m, WorkingMode mode) {
-  CsvReader reader(opt.point_file, {"x_mm", "y_mm"});
-  BatchSink sink(opt.output);
-  std::ostream& out = sink.out();
-  out << kBatchHeader << "\n";
-  std::vector<double> row;
-  std::size_t rows = 0, unsolved = 0;
-  while (reader.next(row)) {
-    const Vec2 p(row[0], row[1]);
-    const Pose pose = ik(m, p, mode);
-    write_batch_row(out, pose, p, std::nullopt);
-    ++rows;
-    if (!usable(pose)) ++unsolved;
-  }
-  sink.commit();
-  if (unsolved > 0) {
-    std::cerr << "fivebar ik: " << unsolved << " of " << rows
+  const BatchTally tally = stream_batch(opt.point_file, {"x_mm", "y_mm"}, opt.output,
+                                        [&](const std::vector<double>& row, std::ostream& out) {
+                                          const Vec2 p(row[0], row[1]);
+                                          const Pose pose = ik(m, p, mode);
+                                          write_batch_row(out, pose, p, std::nullopt);
+                                          return usable(pose);
+                                        });
+  if (tally.unsolved > 0) {
+    std::cerr << "fivebar ik: " << tally.unsolved << " of " << tally.rows
               << " rows have no usable solution (unreachable or outside the joint limits)\n";
     return kCheckFailed;
   }
@@ -88,10 +81,7 @@ void print_all(const Selection& sel, const Vec2& p, const std::array<Pose, 4>& p
 }
 
 int run_ik(const IkOptions& opt) {
-  if (opt.point.empty() == opt.point_file.empty()) {
-    throw InputError("ik needs exactly one of --point X,Y or --point-file FILE");
-  }
-  if (!opt.output.empty() && opt.point_file.empty()) throw InputError("--output is for batch runs (--point-file)");
+  require_single_or_batch("ik", opt.point, "--point X,Y", opt.point_file, "--point-file", opt.output);
   const Design design = load(opt.target.design);
   const Selection sel = select(design, opt.target);
   const Mechanism& m = *sel.mechanism;
@@ -154,18 +144,13 @@ void setup_ik(CLI::App& app) {
   add_target_options(*sub, opt->target);
   auto* point = sub->add_option("-p,--point", opt->point, "Tactor point X,Y in mm, station frame (e.g. --point 6.25,15.5)")
                     ->type_name("X,Y");
-  auto* file = sub->add_option("--point-file", opt->point_file,
-                               "Batch: CSV with header columns x_mm,y_mm ('-' = stdin); "
-                               "writes one CSV row per input row")
-                   ->type_name("FILE");
-  sub->add_option("-o,--output", opt->output, "Batch: write the CSV to this file (atomically) instead of stdout")->type_name("FILE");
+  auto* file = add_batch_options(*sub, "point", "x_mm,y_mm", point, opt->point_file, opt->output);
   auto* mode = sub->add_option("--mode", opt->mode,
                                "Working mode: signs of cross(A_i-O_i, P-A_i) for legs 1 and 2, e.g. -+ "
                                "(elbows out, lower) or +- (upper); default: the design's")
                    ->type_name("SIGNS");
   auto* all = sub->add_flag("-a,--all", opt->all, "All four working modes ++, +-, -+, --");
   auto* json = sub->add_flag("--json", opt->json, "Print one JSON document (mm, deg) on stdout and nothing else");
-  point->excludes(file);
   all->excludes(mode);
   file->excludes(all)->excludes(json);
   sub->footer(

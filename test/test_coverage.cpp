@@ -10,29 +10,15 @@
 #include <random>
 
 #include "fivebar/coverage.hpp"
+#include "paper.hpp"
 
 namespace fivebar {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-std::uint64_t test_seed() {
-  if (const char* s = std::getenv("FIVEBAR_TEST_SEED")) return std::strtoull(s, nullptr, 10);
-  return 20221023;
-}
-
-Mechanism paper(const std::string& station, const std::string& which) {
-  Mechanism m;
-  m.name = which;
-  const double dist = station == "index" ? 15.0 : 17.5;
-  const double y = which == "lower" ? 0.0 : (station == "index" ? 31.0 : 35.0);
-  m.O1 = {0.0, y};
-  m.O2 = {12.5, y};
-  m.L = {9.0, 9.0, dist, dist};
-  m.working_mode = which == "lower" ? WorkingMode{-1, +1} : WorkingMode{+1, -1};
-  m.assembly_mode = which == "lower" ? AssemblyMode::Plus : AssemblyMode::Minus;
-  return m;
-}
+using ::fivebar::testing::paper_mechanism;
+using ::fivebar::testing::test_seed;
 
 Ellipse ellipse(double cx, double cy, double ax, double ay, double angle_deg = 0.0) {
   Ellipse e;
@@ -113,7 +99,7 @@ TEST(Coverage, PaperStationsCoverTheirTargets) {
     const Ellipse target = std::string(s) == "index" ? ellipse(6.25, 15.5, 15, 12) : ellipse(6.25, 17.5, 15, 14);
     for (const char* w : {"lower", "upper"}) {
       SCOPED_TRACE(std::string(s) + " " + w);
-      const Mechanism m = paper(s, w);
+      const Mechanism m = paper_mechanism(s, w);
       const CoverageResult c = coverage(m, target);
       EXPECT_TRUE(c.covered) << c.reason;
       EXPECT_TRUE(c.inside);
@@ -127,7 +113,7 @@ TEST(Coverage, PaperStationsCoverTheirTargets) {
       for (int k = 0; k < 64; ++k) EXPECT_LE(c.min_lci, ik(m, on_ellipse(target, 1.0, 2 * kPi * k / 64)).lci + 1e-12);
     }
     const Station st{s, std::string(s) == "index" ? ellipse(6.25, 15.5, 15, 12) : ellipse(6.25, 17.5, 15, 14),
-                     paper(s, "lower"), paper(s, "upper")};
+                     paper_mechanism(s, "lower"), paper_mechanism(s, "upper")};
     const StationCoverage sc = station_coverage(st);
     ASSERT_TRUE(sc.shared.has_value());
     EXPECT_TRUE(sc.covered());
@@ -138,7 +124,7 @@ TEST(Coverage, PaperStationsCoverTheirTargets) {
 /// A circle inside the outer circle of leg 1 at distance delta from it (delta > 0 inside, < 0
 /// sticking out), away from every other constraint: margin = delta exactly.
 TEST(Coverage, TangentAndJustOutsideByTensOfMicrometres) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Vec2 dir = Vec2(0.3, 1.0).normalized();
   for (double delta : {50e-3, 20e-3, 1e-6, -1e-6, -20e-3, -50e-3}) {
     const double rho = 2.0;
@@ -153,7 +139,7 @@ TEST(Coverage, TangentAndJustOutsideByTensOfMicrometres) {
 }
 
 TEST(Coverage, RotatedEllipsesAgreeWithBruteForce) {
-  const Mechanism m = paper("thumb", "upper");
+  const Mechanism m = paper_mechanism("thumb", "upper");
   std::mt19937_64 rng(test_seed() + 3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   int inside = 0, outside = 0;
@@ -173,7 +159,7 @@ TEST(Coverage, RotatedEllipsesAgreeWithBruteForce) {
 
 TEST(Coverage, EllipseOverAHoleIsNotCovered) {
   // Index lower: the hole of radius 6 around O1 = (0, 0). An ellipse around (1, 2) holds it.
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Ellipse e = ellipse(1.0, 2.0, 15, 12);
   const CoverageResult r = coverage(m, e);
   EXPECT_FALSE(r.covered);
@@ -185,7 +171,7 @@ TEST(Coverage, EllipseOverAHoleIsNotCovered) {
 }
 
 TEST(Coverage, CoveredFractionMatchesSamplingWhenPartlyOutside) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Ellipse e = ellipse(6.25, 22.0, 15, 12);  // sticks out above the outer arcs
   const CoverageResult r = coverage(m, e);
   EXPECT_FALSE(r.inside);
@@ -203,7 +189,7 @@ TEST(Coverage, CoveredFractionMatchesSamplingWhenPartlyOutside) {
 }
 
 TEST(Coverage, JointLimitsCutTheEllipseAndTheVerdictFollowsIk) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   const Ellipse e = ellipse(6.25, 15.5, 15, 12);
   // Measure the joint ranges the ellipse needs, then set limits just wider / just narrower.
   double lo1 = INFINITY, hi1 = -INFINITY, lo2 = INFINITY, hi2 = -INFINITY;
@@ -235,18 +221,18 @@ TEST(Coverage, JointLimitsCutTheEllipseAndTheVerdictFollowsIk) {
 }
 
 TEST(Coverage, NearTangencyIsDecidedByTheExactTest) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Vec2 dir = Vec2(0.3, 1.0).normalized();
   const double rho = 2.0;
   const Vec2 c = m.O1 + (24.0 - rho - 1e-12) * dir;  // 1e-12 mm inside: within rounding
   const CoverageResult r = coverage(m, ellipse(c.x(), c.y(), 2 * rho, 2 * rho));
-  EXPECT_THAT(r.method, testing::HasSubstr("exact CGAL"));
+  EXPECT_THAT(r.method, ::testing::HasSubstr("exact CGAL"));
   // The circumscribed polygon sticks out by far more than 1e-12 mm: conservatively not inside.
   EXPECT_FALSE(r.inside);
 }
 
 TEST(Coverage, LciThresholdAndAssemblySideEnterTheVerdict) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   const Ellipse e = ellipse(6.25, 15.5, 15, 12);
   const CoverageResult base = coverage(m, e);
   ASSERT_TRUE(base.covered);
@@ -255,7 +241,7 @@ TEST(Coverage, LciThresholdAndAssemblySideEnterTheVerdict) {
   EXPECT_TRUE(strict.inside);
   EXPECT_FALSE(strict.lci_ok);
   EXPECT_FALSE(strict.covered);
-  EXPECT_THAT(strict.reason, testing::HasSubstr("LCI"));
+  EXPECT_THAT(strict.reason, ::testing::HasSubstr("LCI"));
   // Demanding the other assembly side fails over the whole ellipse.
   m.min_lci = 0.0;
   m.assembly_mode = AssemblyMode::Minus;

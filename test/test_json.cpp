@@ -9,22 +9,14 @@
 
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
+#include "paper.hpp"
 
 namespace fivebar {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Mechanism index_lower() {
-  Mechanism m;
-  m.name = "lower";
-  m.O1 = {0.0, 0.0};
-  m.O2 = {12.5, 0.0};
-  m.L = {9.0, 9.0, 15.0, 15.0};
-  m.working_mode = {-1, +1};
-  m.assembly_mode = AssemblyMode::Plus;
-  return m;
-}
+using ::fivebar::testing::paper_mechanism;
 
 TEST(AngleDeg, NormalisesToTheHalfOpenInterval) {
   EXPECT_EQ(angle_deg(0.0), 0.0);
@@ -61,7 +53,7 @@ TEST(ModeString, PrintsRealisedSignsWithZero) {
 }
 
 TEST(PoseJson, HasTheContractKeysInMillimetresAndDegrees) {
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   const Pose p = ik(m, Vec2(6.25, 15.5));
   ASSERT_EQ(p.status, Status::ok);
   const Json j = to_json(p);
@@ -87,7 +79,7 @@ TEST(PoseJson, HasTheContractKeysInMillimetresAndDegrees) {
 }
 
 TEST(PoseJson, JacobianIsNullWhenInvalid) {
-  Pose p = ik(index_lower(), Vec2(6.25, 15.5));
+  Pose p = ik(paper_mechanism("index", "lower"), Vec2(6.25, 15.5));
   p.jacobian_valid = false;
   EXPECT_TRUE(to_json(p)["jacobian"].is_null());
   p.mode = {0, +1};
@@ -97,7 +89,7 @@ TEST(PoseJson, JacobianIsNullWhenInvalid) {
 }
 
 TEST(PoseJson, UnreachablePoseHasNullGeometry) {
-  const Pose p = ik(index_lower(), Vec2(100.0, 100.0));
+  const Pose p = ik(paper_mechanism("index", "lower"), Vec2(100.0, 100.0));
   ASSERT_EQ(p.status, Status::unreachable);
   const Json j = to_json(p);
   EXPECT_EQ(j["status"], "unreachable");
@@ -109,7 +101,7 @@ TEST(PoseJson, UnreachablePoseHasNullGeometry) {
 }
 
 TEST(MechanismJson, LinksModesAndJointLimitsInDegrees) {
-  Mechanism m = index_lower();
+  Mechanism m = paper_mechanism("index", "lower");
   Json j = to_json(m);
   EXPECT_EQ(j["links_mm"], Json::array({9.0, 9.0, 15.0, 15.0}));
   EXPECT_EQ(j["bases_mm"][1], Json::array({12.5, 0.0}));

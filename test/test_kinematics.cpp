@@ -16,18 +16,16 @@
 #include "fivebar/detail/fastmath.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/tolerances.hpp"
+#include "paper.hpp"
 
 namespace fivebar {
 namespace {
 
+using ::fivebar::testing::paper_mechanism;
+using ::fivebar::testing::test_seed;
+
 constexpr double kPi = std::numbers::pi;
 constexpr double kEps = tol::kEps;
-
-/// Seed of every random test; FIVEBAR_TEST_SEED overrides it (never the clock).
-std::uint64_t test_seed() {
-  if (const char* s = std::getenv("FIVEBAR_TEST_SEED")) return std::strtoull(s, nullptr, 10);
-  return 20221023;
-}
 
 double deg(double d) { return d * kPi / 180.0; }
 
@@ -39,27 +37,6 @@ bool finite_pose(const Pose& p) {
   for (double v : p.transmission) ok = ok && std::isfinite(v);
   for (double v : p.type1_sin) ok = ok && std::isfinite(v);
   return ok;
-}
-
-/// Paper Table 1 (typed here, independent of the design loader).
-Mechanism paper(const std::string& station, const std::string& which) {
-  Mechanism m;
-  m.name = which;
-  const double dist = station == "index" ? 15.0 : 17.5;
-  const double upper_y = station == "index" ? 31.0 : 35.0;
-  m.L = {9.0, 9.0, dist, dist};
-  if (which == "lower") {
-    m.O1 = {0.0, 0.0};
-    m.O2 = {12.5, 0.0};
-    m.working_mode = {-1, +1};
-    m.assembly_mode = AssemblyMode::Plus;
-  } else {
-    m.O1 = {0.0, upper_y};
-    m.O2 = {12.5, upper_y};
-    m.working_mode = {+1, -1};
-    m.assembly_mode = AssemblyMode::Minus;
-  }
-  return m;
 }
 
 Mechanism random_mechanism(std::mt19937_64& rng, double scale = 10.0) {
@@ -269,7 +246,7 @@ struct Regime {
 std::vector<Regime> regimes() {
   std::vector<Regime> out;
   for (const char* s : {"index", "thumb"})
-    for (const char* w : {"lower", "upper"}) out.push_back({std::string(s) + "_" + w, paper(s, w)});
+    for (const char* w : {"lower", "upper"}) out.push_back({std::string(s) + "_" + w, paper_mechanism(s, w)});
   std::mt19937_64 rng(test_seed() + 7);
   for (int k = 0; k < 12; ++k) out.push_back({"random" + std::to_string(k), random_mechanism(rng)});
   return out;
@@ -296,7 +273,7 @@ TEST_P(KinematicsRegime, IkOfFkReturnsTheAnglesAndFkOfIkReturnsThePoint) {
   const auto poses = regular_poses(m, test_seed() + 11, 300);
   ASSERT_GT(poses.size(), 50u);
   for (const Pose& p : poses) {
-    SCOPED_TRACE(testing::Message() << "theta = " << p.theta1 << ", " << p.theta2 << " seed " << test_seed());
+    SCOPED_TRACE(::testing::Message() << "theta = " << p.theta1 << ", " << p.theta2 << " seed " << test_seed());
     const double s = min_sin(p);
     // Every FK point is exact to a few ulps of the scale divided by the conditioning (sin).
     const Vec2 ref = fk_paper_long(m, p.theta1, p.theta2, p.assembly);
@@ -397,7 +374,7 @@ TEST_P(KinematicsRegime, BatchAgreesWithScalar) {
   std::size_t ok = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const Pose p = fk(m, t1[k], t2[k]);
-    SCOPED_TRACE(testing::Message() << "theta " << t1[k] << ", " << t2[k]);
+    SCOPED_TRACE(::testing::Message() << "theta " << t1[k] << ", " << t2[k]);
     ASSERT_TRUE(std::isfinite(px[k]) && std::isfinite(py[k]));
     if (p.status == Status::ok && min_sin(p) > 1e-6) {
       ASSERT_EQ(st[k], Status::ok);
@@ -431,7 +408,7 @@ TEST_P(KinematicsRegime, BatchAgreesWithScalar) {
   for (std::size_t k = 0; k < n; ++k) {
     if (st[k] != Status::ok) continue;
     const Pose q = ik(m, {px[k], py[k]});
-    SCOPED_TRACE(testing::Message() << "P " << px[k] << ", " << py[k]);
+    SCOPED_TRACE(::testing::Message() << "P " << px[k] << ", " << py[k]);
     ASSERT_TRUE(std::isfinite(u1[k]) && std::isfinite(u2[k]) && std::isfinite(l[k]));
     if (q.status != Status::ok || min_sin(q) < 1e-6) continue;
     ASSERT_EQ(st2[k], Status::ok);
@@ -454,7 +431,7 @@ INSTANTIATE_TEST_SUITE_P(Regimes, KinematicsRegime, ::testing::ValuesIn(regimes(
 TEST(PaperStation, SymmetricPoseAtEllipseCentre) {
   // Index lower, P on the symmetry line x = 6.25 at y = 15.5: the two legs mirror each other,
   // so theta2 = pi - theta1 and the elbows point outward (A1.x < 0 < 12.5 < A2.x).
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Pose p = ik(m, {6.25, 15.5});
   ASSERT_EQ(p.status, Status::ok);
   EXPECT_NEAR(p.theta2, kPi - p.theta1, 1e-14);
@@ -471,7 +448,7 @@ TEST(PaperStation, SymmetricPoseAtEllipseCentre) {
 }
 
 TEST(PaperStation, IkAllGivesFourDistinctVerifiedBranches) {
-  const Mechanism m = paper("thumb", "upper");
+  const Mechanism m = paper_mechanism("thumb", "upper");
   const auto all = ik_all(m, {6.25, 17.5});
   for (std::size_t i = 0; i < 4; ++i) {
     EXPECT_EQ(all[i].status, Status::ok);
@@ -482,7 +459,7 @@ TEST(PaperStation, IkAllGivesFourDistinctVerifiedBranches) {
 }
 
 TEST(PaperStation, UnreachablePointIsAStatusNotAnException) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Pose p = ik(m, {6.25, 40.0});  // beyond L1 + L3 = 24 from both bases
   EXPECT_EQ(p.status, Status::unreachable);
   EXPECT_TRUE(finite_pose(p));
@@ -492,7 +469,7 @@ TEST(PaperStation, UnreachablePointIsAStatusNotAnException) {
 }
 
 TEST(PaperStation, FkAnyPicksTheWorkingModeBranch) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   const Pose ref = ik(m, {5.0, 14.0});
   m.assembly_mode = AssemblyMode::Any;
   const Pose p = fk(m, ref.theta1, ref.theta2);
@@ -505,7 +482,7 @@ TEST(PaperStation, FkAnyPicksTheWorkingModeBranch) {
 /// Type I: P on the line from O1 at distance D = (L1 + L3)(1 - delta) (stretched) or
 /// |L1 - L3|(1 + delta) (folded). Expected elbow |sin| from the law of cosines in long double.
 TEST(Extreme, TypeOneTangencyFromOneTenthToExact) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   m.L = {9.0, 9.0, 15.0, 15.0};
   const double dir = deg(70.0);
   for (bool stretched : {true, false}) {
@@ -514,7 +491,7 @@ TEST(Extreme, TypeOneTangencyFromOneTenthToExact) {
       const double D0 = stretched ? m.L[0] + m.L[2] : std::fabs(m.L[0] - m.L[2]);
       const double D = stretched ? D0 * (1 - delta) : D0 * (1 + delta);
       const Vec2 P = m.O1 + D * Vec2(std::cos(dir), std::sin(dir));
-      SCOPED_TRACE(testing::Message() << (stretched ? "stretched" : "folded") << " delta " << delta);
+      SCOPED_TRACE(::testing::Message() << (stretched ? "stretched" : "folded") << " delta " << delta);
       const Pose p = ik(m, P);
       ASSERT_TRUE(finite_pose(p));
       using LD = long double;
@@ -547,7 +524,7 @@ TEST(Extreme, TypeOneTangencyFromOneTenthToExact) {
 
 /// Type II: elbows placed so that |A2 - A1| = (L3 + L4)(1 - delta): distal links nearly collinear.
 TEST(Extreme, TypeTwoTangencyFromOneTenthToExact) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const double t1 = deg(150.0);
   using LD = long double;
   for (int k = 1; k <= 17; ++k) {
@@ -561,7 +538,7 @@ TEST(Extreme, TypeTwoTangencyFromOneTenthToExact) {
     const LD ux = -dx / d, uy = -dy / d;
     const LD ex = a * ux - h * uy, ey = a * uy + h * ux;
     const double t2 = double(std::atan2(ey, ex));
-    SCOPED_TRACE(testing::Message() << "delta " << delta << " theta2 " << t2);
+    SCOPED_TRACE(::testing::Message() << "delta " << delta << " theta2 " << t2);
     const Pose p = fk(m, t1, t2, AssemblyMode::Plus);
     ASSERT_TRUE(finite_pose(p));
     // The |sin| at the tactor for the angles actually posed, in long double.
@@ -609,7 +586,7 @@ TEST(Extreme, LinkRatiosFromTenThousandthToTenThousand) {
 }
 
 TEST(Extreme, EqualProximalAndDistalLinksIkCircleThroughTheBase) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   m.L = {9.0, 9.0, 9.0, 9.0};
   // At P = O1 leg 1 is folded onto itself: any theta1 closes the loop; the status says singular.
   const Pose at_base = ik(m, m.O1);
@@ -626,7 +603,7 @@ TEST(Extreme, EqualProximalAndDistalLinksIkCircleThroughTheBase) {
 }
 
 TEST(Extreme, CoincidentBaseJoints) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   m.O2 = m.O1;
   for (const Pose& p : regular_poses(m, test_seed() + 31, 50, 1e-3)) {
     const Pose q = ik(m, p.P, p.mode);
@@ -646,7 +623,7 @@ TEST(Extreme, CoincidentBaseJoints) {
 /// overflow) with equal proximal and distal links (the IK circle passes through the base, so the
 /// inner tangency d^2 = 0 does not exclude it): every batch output stays finite.
 TEST(Extreme, SubnormalDistanceFromABaseNeverProducesNaN) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   m.L = {9.0, 9.0, 9.0, 9.0};
   const std::vector<double> px = {m.O1.x(), m.O1.x() + 1e-160, m.O1.x() + 3e-155, m.O2.x()};
   const std::vector<double> py = {m.O1.y() + 1e-160, m.O1.y(), m.O1.y() + 1e-170, m.O2.y() + 1e-162};
@@ -671,7 +648,7 @@ TEST(Extreme, SubnormalDistanceFromABaseNeverProducesNaN) {
 }
 
 TEST(Extreme, NonFiniteAndHugeAnglesNeverProduceNaN) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   // Spread over several of fk_batch's blocks (256 points), and the last element, so that a flag
   // lost between blocks would leave a fast-path result for one of them.
   std::vector<double> t1(700, 0.5), t2(700, 2.0);

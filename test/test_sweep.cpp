@@ -15,14 +15,11 @@
 #include "fivebar/collision.hpp"
 #include "fivebar/coverage.hpp"
 #include "fivebar/sweep.hpp"
+#include "paper.hpp"
 
 namespace fivebar {
 namespace {
-
-std::uint64_t test_seed() {
-  if (const char* s = std::getenv("FIVEBAR_TEST_SEED")) return std::strtoull(s, nullptr, 10);
-  return 20221023;
-}
+using ::fivebar::testing::test_seed;
 
 Design paper_design() { return load_design(std::filesystem::path(FIVEBAR_SOURCE_DIR) / "designs/iros2022.yaml"); }
 
@@ -131,7 +128,7 @@ TEST(Evaluation, RowsAgreeWithSingleDesignCoverage) {
     EXPECT_EQ(st.lower->L[2], row.values[0]);
     EXPECT_EQ(st.upper->L[0], row.values[1]);
     const StationCoverage ref = station_coverage(st);
-    SCOPED_TRACE(testing::Message() << "design " << i << ": " << row.status);
+    SCOPED_TRACE(::testing::Message() << "design " << i << ": " << row.status);
     EXPECT_EQ(row.covered, ref.covered());
     EXPECT_NEAR(row.margin_lower_mm, ref.lower->margin_mm, 1e-12);
     if (row.covered) {
@@ -152,8 +149,8 @@ TEST(Evaluation, InvalidDesignsAreRowsNotErrors) {
   // L12 down to 2 mm is shorter than the geometry's 5 mm pin bosses.
   const Design d = with_sweep(grid({{"L12", 2, 9, 8}}));
   const SweepRow bad = evaluate_sweep_design(d, *d.sweep, 0);
-  EXPECT_THAT(bad.status, testing::StartsWith("invalid: "));
-  EXPECT_THAT(bad.status, testing::HasSubstr("boss_diameter"));
+  EXPECT_THAT(bad.status, ::testing::StartsWith("invalid: "));
+  EXPECT_THAT(bad.status, ::testing::HasSubstr("boss_diameter"));
   EXPECT_FALSE(bad.covered);
   EXPECT_TRUE(std::isnan(bad.margin_lower_mm));
 }
@@ -169,7 +166,7 @@ TEST(Evaluation, CollisionFractionOfCoveredDesignsOnly) {
   std::set<double> fractions;
   for (std::uint64_t i = 0; i < sweep_size(s); ++i) {
     const SweepRow row = evaluate_sweep_design(d, s, i);
-    SCOPED_TRACE(testing::Message() << "design " << i << ": " << row.status);
+    SCOPED_TRACE(::testing::Message() << "design " << i << ": " << row.status);
     if (!row.covered) {
       EXPECT_TRUE(std::isnan(row.collision_fraction));
       continue;
@@ -228,13 +225,13 @@ TEST(Evaluation, CollisionObjectiveNeedsGeometryAndBothMechanisms) {
   d.patterns.reset();
   d.sweep = s;
   EXPECT_THAT([&] { d.validate(); },
-              testing::ThrowsMessage<ValidationError>(testing::HasSubstr("needs the geometry: section")));
+              ::testing::ThrowsMessage<ValidationError>(::testing::HasSubstr("needs the geometry: section")));
   Design one = paper_design();
   one.stations[0].upper.reset();
   one.controller.reset();
   one.patterns.reset();
   one.sweep = s;
-  EXPECT_THAT([&] { one.validate(); }, testing::ThrowsMessage<ValidationError>(testing::HasSubstr("both a lower and an upper")));
+  EXPECT_THAT([&] { one.validate(); }, ::testing::ThrowsMessage<ValidationError>(::testing::HasSubstr("both a lower and an upper")));
 }
 
 TEST(Run, ShardsAndThreadsReproduceTheSerialRowsAndResumeContinuesExactly) {
@@ -293,7 +290,7 @@ TEST(Run, ResumeRefusesAnotherSweepsCsv) {
   o.plots = false;
   run_sweep(a, o);
   o.resume = true;
-  EXPECT_THAT([&] { run_sweep(b, o); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("not the same sweep")));
+  EXPECT_THAT([&] { run_sweep(b, o); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("not the same sweep")));
   std::filesystem::remove_all(o.out_dir);
 }
 
@@ -362,7 +359,7 @@ TEST(Shard, ParseRules) {
   EXPECT_EQ(parse_shard("0/4"), (std::pair<std::uint64_t, std::uint64_t>{0, 4}));
   EXPECT_EQ(parse_shard("3/4"), (std::pair<std::uint64_t, std::uint64_t>{3, 4}));
   for (const char* bad : {"4/4", "1", "/2", "a/b", "1/0", "-1/3", "1/2x"}) {
-    EXPECT_THAT([&] { parse_shard(bad); }, testing::ThrowsMessage<InputError>(testing::HasSubstr("--shard"))) << bad;
+    EXPECT_THAT([&] { parse_shard(bad); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("--shard"))) << bad;
   }
 }
 

@@ -9,29 +9,15 @@
 #include <random>
 
 #include "fivebar/workspace.hpp"
+#include "paper.hpp"
 
 namespace fivebar {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-std::uint64_t test_seed() {
-  if (const char* s = std::getenv("FIVEBAR_TEST_SEED")) return std::strtoull(s, nullptr, 10);
-  return 20221023;
-}
-
-Mechanism paper(const std::string& station, const std::string& which) {
-  Mechanism m;
-  m.name = which;
-  const double dist = station == "index" ? 15.0 : 17.5;
-  const double y = which == "lower" ? 0.0 : (station == "index" ? 31.0 : 35.0);
-  m.O1 = {0.0, y};
-  m.O2 = {12.5, y};
-  m.L = {9.0, 9.0, dist, dist};
-  m.working_mode = which == "lower" ? WorkingMode{-1, +1} : WorkingMode{+1, -1};
-  m.assembly_mode = which == "lower" ? AssemblyMode::Plus : AssemblyMode::Minus;
-  return m;
-}
+using ::fivebar::testing::paper_mechanism;
+using ::fivebar::testing::test_seed;
 
 /// Lens area of two disks (radii a, b, centre distance d), written out here independently.
 double lens(double a, double b, double d) {
@@ -51,12 +37,12 @@ double annuli_area_reference(const Mechanism& m) {
 }
 
 std::vector<Mechanism> geometries() {
-  std::vector<Mechanism> out = {paper("index", "lower"), paper("index", "upper"), paper("thumb", "lower"),
-                                paper("thumb", "upper")};
+  std::vector<Mechanism> out = {paper_mechanism("index", "lower"), paper_mechanism("index", "upper"), paper_mechanism("thumb", "lower"),
+                                paper_mechanism("thumb", "upper")};
   std::mt19937_64 rng(test_seed());
   std::uniform_real_distribution<double> len(2.0, 25.0), base(0.0, 20.0);
   while (out.size() < 16) {
-    Mechanism m = paper("index", "lower");
+    Mechanism m = paper_mechanism("index", "lower");
     m.O2 = {base(rng), 0.5 * base(rng)};
     m.L = {len(rng), len(rng), len(rng), len(rng)};
     if (annuli_area_reference(m) < 1.0) continue;
@@ -67,7 +53,7 @@ std::vector<Mechanism> geometries() {
 
 TEST(ExactRegion, AreaEqualsClosedFormOfIntersectingAnnuli) {
   for (const Mechanism& m : geometries()) {
-    SCOPED_TRACE(testing::Message() << "O2 " << m.O2.transpose() << " L " << m.L[0] << " " << m.L[1] << " "
+    SCOPED_TRACE(::testing::Message() << "O2 " << m.O2.transpose() << " L " << m.L[0] << " " << m.L[1] << " "
                                     << m.L[2] << " " << m.L[3]);
     const Region r = reachable_region(m);
     const double ref = annuli_area_reference(m);
@@ -78,7 +64,7 @@ TEST(ExactRegion, AreaEqualsClosedFormOfIntersectingAnnuli) {
 }
 
 TEST(ExactRegion, AreaScalesWithTheSquareOfTheScale) {
-  const Mechanism m = paper("thumb", "upper");
+  const Mechanism m = paper_mechanism("thumb", "upper");
   const double a1 = reachable_region(m).area_mm2();
   for (double s : {1e-3, 0.5, 3.0, 1e3}) {
     Mechanism ms = m;
@@ -92,7 +78,7 @@ TEST(ExactRegion, AreaScalesWithTheSquareOfTheScale) {
 TEST(ExactRegion, PaperIndexLowerHasOneComponentWithTwoHoles) {
   // Inner circles (radius |9 - 15| = 6) around O1 and O2 lie inside the other leg's annulus
   // (their points are 6.5 ... 18.5 mm from the other base, inside [6, 24]): two holes.
-  const Region r = reachable_region(paper("index", "lower"));
+  const Region r = reachable_region(paper_mechanism("index", "lower"));
   EXPECT_EQ(r.components(), 1);
   EXPECT_EQ(r.holes(), 2);
   // Perimeter: two full hole circles plus the outer boundary (two arcs of radius 24 meeting at
@@ -114,7 +100,7 @@ TEST(ExactRegion, JointLimitedLegAreaIsTwiceL1L3TimesTheSpan) {
         m.working_mode = {std::int8_t(sigma), 1};
         const double lo = lo_deg * kPi / 180, hi = (lo_deg + span_deg) * kPi / 180;
         m.joint_limits = std::array<JointRange, 2>{JointRange{lo, hi}, JointRange{-kPi, kPi}};
-        SCOPED_TRACE(testing::Message() << "sigma " << sigma << " lo " << lo_deg << " span " << span_deg);
+        SCOPED_TRACE(::testing::Message() << "sigma " << sigma << " lo " << lo_deg << " span " << span_deg);
         const Region r = reachable_region(m);
         EXPECT_NEAR(r.area_mm2(), 2 * 9.0 * 15.0 * (hi - lo), 1e-9 * 2 * 9 * 15 * (hi - lo));
         EXPECT_EQ(r.components(), 1);
@@ -126,7 +112,7 @@ TEST(ExactRegion, JointLimitedLegAreaIsTwiceL1L3TimesTheSpan) {
 TEST(ExactRegion, MembershipAgreesWithIkAndJointLimits) {
   std::mt19937_64 rng(test_seed() + 1);
   std::vector<Mechanism> ms = geometries();
-  Mechanism limited = paper("index", "lower");
+  Mechanism limited = paper_mechanism("index", "lower");
   limited.joint_limits = std::array<JointRange, 2>{JointRange{0.5, 2.9}, JointRange{-0.2, 2.0}};
   ms.push_back(limited);
   for (const Mechanism& m : ms) {
@@ -147,7 +133,7 @@ TEST(ExactRegion, MembershipAgreesWithIkAndJointLimits) {
 }
 
 TEST(ExactRegion, BoundaryDistanceOfAnnuliRegionIsTheActiveConstraint) {
-  const Mechanism m = paper("index", "lower");
+  const Mechanism m = paper_mechanism("index", "lower");
   const Region r = reachable_region(m);
   // On the symmetry line x = 6.25 both legs are alike: the boundary is the outer circle (24 mm)
   // or a hole (6 mm) around either base, whichever is nearer.
@@ -161,7 +147,7 @@ TEST(ExactRegion, BoundaryDistanceOfAnnuliRegionIsTheActiveConstraint) {
 }
 
 TEST(SampledArea, ReachConvergesToTheExactAreaAsTheGridIsRefined) {
-  Mechanism m = paper("index", "lower");
+  Mechanism m = paper_mechanism("index", "lower");
   m.joint_limits = std::array<JointRange, 2>{JointRange{0.3, 3.0}, JointRange{0.1, 2.8}};
   const Region r = reachable_region(m);
   double last_error = INFINITY;
@@ -178,7 +164,7 @@ TEST(SampledArea, ReachConvergesToTheExactAreaAsTheGridIsRefined) {
 }
 
 TEST(SampledArea, AssemblyAndLciRegionsAreNestedInsideReach) {
-  Mechanism m = paper("thumb", "lower");
+  Mechanism m = paper_mechanism("thumb", "lower");
   m.min_lci = 0.3;
   const Region r = reachable_region(m);
   const Grid g = Grid::covering(r.bounds(), 0.25, 0.5);
@@ -191,7 +177,7 @@ TEST(SampledArea, AssemblyAndLciRegionsAreNestedInsideReach) {
 }
 
 TEST(Field, SamplesMatchTheScalarKinematics) {
-  const Mechanism m = paper("index", "upper");
+  const Mechanism m = paper_mechanism("index", "upper");
   const Region r = reachable_region(m);
   const WorkspaceField f = sample_field(m, Grid::covering(r.bounds(), 1.0, 1.0));
   int reach = 0;

@@ -15,32 +15,22 @@
 
 #include "fivebar/detail/fastmath.hpp"
 #include "fivebar/kinematics.hpp"
+#include "paper.hpp"
 
 namespace {
 
 using fivebar::Mechanism;
+using fivebar::testing::paper_mechanism;
 using fivebar::Status;
 using fivebar::Vec2;
 
 constexpr std::size_t kN = 4096;
-
-Mechanism index_lower() {
-  Mechanism m;
-  m.name = "lower";
-  m.O1 = {0.0, 0.0};
-  m.O2 = {12.5, 0.0};
-  m.L = {9.0, 9.0, 15.0, 15.0};
-  m.working_mode = {-1, +1};
-  m.assembly_mode = fivebar::AssemblyMode::Plus;
-  return m;
-}
-
 /// Points uniformly in the index target ellipse (15 x 12 mm at (6.25, 15.5)) and their angles.
 struct Data {
   std::vector<double> px, py, t1, t2, ox, oy, o1, o2;
   std::vector<Status> st;
   Data() : px(kN), py(kN), t1(kN), t2(kN), ox(kN), oy(kN), o1(kN), o2(kN), st(kN) {
-    const Mechanism m = index_lower();
+    const Mechanism m = paper_mechanism("index", "lower");
     std::mt19937_64 rng(42);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     for (std::size_t k = 0; k < kN;) {
@@ -152,7 +142,7 @@ BENCHMARK(BM_fk_floor_scalar);
 
 void BM_fk_scalar(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   std::vector<double> ox(kN), oy(kN);
   for (auto _ : state) {
     for (std::size_t k = 0; k < kN; ++k) {
@@ -170,7 +160,7 @@ BENCHMARK(BM_fk_scalar);
 /// The full pose: point, Jacobian, LCI, transmission angles, singularity distances.
 void BM_fk_scalar_full_pose(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   double acc = 0.0;
   for (auto _ : state) {
     for (std::size_t k = 0; k < kN; ++k) acc += fivebar::fk(m, d.t1[k], d.t2[k]).lci;
@@ -196,7 +186,7 @@ BENCHMARK(BM_fk_floor16_batch);
 
 void BM_fk_batch(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   std::vector<double> ox(kN), oy(kN);
   std::vector<Status> st(kN);
   for (auto _ : state) {
@@ -230,7 +220,7 @@ BENCHMARK(BM_ik_floor_scalar);
 
 void BM_ik_scalar(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   std::vector<double> o1(kN), o2(kN);
   for (auto _ : state) {
     for (std::size_t k = 0; k < kN; ++k) {
@@ -247,7 +237,7 @@ BENCHMARK(BM_ik_scalar);
 
 void BM_ik_scalar_full_pose(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   double acc = 0.0;
   for (auto _ : state) {
     for (std::size_t k = 0; k < kN; ++k) acc += fivebar::ik(m, {d.px[k], d.py[k]}).lci;
@@ -273,7 +263,7 @@ BENCHMARK(BM_ik_floor16_batch);
 
 void BM_ik_batch(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   std::vector<double> o1(kN), o2(kN);
   std::vector<Status> st(kN);
   for (auto _ : state) {
@@ -288,7 +278,7 @@ BENCHMARK(BM_ik_batch);
 /// LCI from elbow positions only (square roots, no trigonometry): the workspace/coverage kernel.
 void BM_lci_batch(benchmark::State& state) {
   const Data& d = data();
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   std::vector<double> l(kN);
   std::vector<Status> st(kN);
   for (auto _ : state) {

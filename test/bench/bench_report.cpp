@@ -11,22 +11,12 @@
 #include "fivebar/report.hpp"
 #include "report_precision.hpp"
 #include "report_quad.hpp"
+#include "paper.hpp"
 
 namespace {
 
 using fivebar::Mechanism;
-
-Mechanism index_lower() {
-  Mechanism m;
-  m.name = "lower";
-  m.O1 = {0.0, 0.0};
-  m.O2 = {12.5, 0.0};
-  m.L = {9.0, 9.0, 15.0, 15.0};
-  m.working_mode = {-1, +1};
-  m.assembly_mode = fivebar::AssemblyMode::Plus;
-  return m;
-}
-
+using fivebar::testing::paper_mechanism;
 /// Joint angles around the symmetric pose of the target centre (all reachable).
 std::vector<std::array<double, 2>> angles() {
   std::mt19937_64 rng(7);
@@ -37,7 +27,7 @@ std::vector<std::array<double, 2>> angles() {
 }
 
 void report_quad_fk(benchmark::State& state) {
-  const fivebar::quadref::QMechanism m(index_lower());
+  const fivebar::quadref::QMechanism m(paper_mechanism("index", "lower"));
   const auto in = angles();
   std::size_t k = 0;
   for (auto _ : state) {
@@ -50,7 +40,7 @@ void report_quad_fk(benchmark::State& state) {
 BENCHMARK(report_quad_fk);
 
 void report_quad_ik(benchmark::State& state) {
-  const Mechanism mech = index_lower();
+  const Mechanism mech = paper_mechanism("index", "lower");
   const fivebar::quadref::QMechanism m(mech);
   std::vector<fivebar::quadref::QVec> pts;
   for (const auto& a : angles()) pts.push_back(fivebar::quadref::fk(m, a[0], a[1], 1).P);
@@ -66,7 +56,7 @@ BENCHMARK(report_quad_ik);
 
 template <class T>
 void report_precision_fk(benchmark::State& state) {
-  const fivebar::precision::MechanismT<T> m(index_lower());
+  const fivebar::precision::MechanismT<T> m(paper_mechanism("index", "lower"));
   const auto in = angles();
   std::size_t k = 0;
   for (auto _ : state) {
@@ -82,7 +72,7 @@ BENCHMARK_TEMPLATE(report_precision_fk, double);
 BENCHMARK_TEMPLATE(report_precision_fk, long double);
 
 void report_stability_catalogue(benchmark::State& state) {
-  const Mechanism m = index_lower();
+  const Mechanism m = paper_mechanism("index", "lower");
   fivebar::Ellipse e;
   e.center = {6.25, 15.5};
   e.axes = {15.0, 12.0};

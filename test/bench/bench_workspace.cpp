@@ -7,19 +7,15 @@
 
 #include "fivebar/coverage.hpp"
 #include "fivebar/workspace.hpp"
+#include "paper.hpp"
 
 namespace {
 
 using namespace fivebar;
 
+/// The paper's index lower mechanism, with joint limits if `limits`.
 Mechanism index_lower(bool limits) {
-  Mechanism m;
-  m.name = "lower";
-  m.O1 = {0.0, 0.0};
-  m.O2 = {12.5, 0.0};
-  m.L = {9.0, 9.0, 15.0, 15.0};
-  m.working_mode = {-1, +1};
-  m.assembly_mode = AssemblyMode::Plus;
+  Mechanism m = testing::paper_mechanism("index", "lower");
   if (limits) {
     constexpr double d = std::numbers::pi / 180.0;
     m.joint_limits = std::array<JointRange, 2>{JointRange{60 * d, 200 * d}, JointRange{-20 * d, 120 * d}};
