@@ -85,11 +85,7 @@ Selection select(const Design& design, const Target& target) {
     }
     sel.station = &design.stations.front();
   } else {
-    sel.station = design.station(target.station);
-    if (sel.station == nullptr) {
-      throw InputError("unknown station '" + target.station + "' in design '" + design.name +
-                       "' (it has: " + join(stations) + ")");
-    }
+    sel.station = &design.require_station(target.station);
   }
   std::vector<std::string> mechanisms;
   for (const Mechanism* m : sel.station->mechanisms()) mechanisms.push_back(m->name);
@@ -108,23 +104,6 @@ Selection select(const Design& design, const Target& target) {
     }
   }
   return sel;
-}
-
-std::vector<const Station*> select_stations(const Design& design, const std::string& station) {
-  std::vector<const Station*> out;
-  if (!station.empty()) {
-    const Station* s = design.station(station);
-    if (s == nullptr) {
-      std::vector<std::string> names;
-      for (const Station& st : design.stations) names.push_back(st.name);
-      throw InputError("unknown station '" + station + "' in design '" + design.name + "' (it has: " + join(names) + ")");
-    }
-    out.push_back(s);
-    return out;
-  }
-  for (const Station& s : design.stations)
-    if (!s.mechanisms().empty()) out.push_back(&s);
-  return out;
 }
 
 std::function<void(std::string_view)> terminal_progress(std::string_view command) {

@@ -58,10 +58,6 @@ struct Selection {
 /// for a name that is not there, InputError listing the choices.
 Selection select(const Design& design, const Target& target);
 
-/// The stations a whole-station command (workspace, coverage) works on: the one named by
-/// `station` (InputError listing the choices when absent), or every station with a mechanism.
-std::vector<const Station*> select_stations(const Design& design, const std::string& station);
-
 /// Progress lines on stderr, only when it is a terminal (DESIGN.md: long work shows progress).
 std::function<void(std::string_view)> terminal_progress(std::string_view command);
 

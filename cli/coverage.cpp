@@ -53,7 +53,7 @@ int run_coverage(const CoverageCliOptions& opt) {
   std::optional<Ellipse> override_target;
   if (opt.ellipse_given) override_target = parse_ellipse(opt.ellipse, "--ellipse");
   const Design design = load(opt.design);
-  const auto stations = select_stations(design, opt.station);
+  const auto stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
   // --mechanism: the station with the other mechanism removed, so only that one (and no shared
   // region) is judged. Checked for every station before any work, like workspace.

@@ -55,7 +55,7 @@ int run_workspace(const WorkspaceCliOptions& opt) {
   options.spacing_mm = opt.spacing_mm;
   options.mechanism = opt.mechanism;
   options.validate("--spacing");
-  const auto stations = select_stations(design, opt.station);
+  const auto stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
   const std::filesystem::path dir =
       opt.out.empty() ? resolve_output_dir("outputs", design.name) / "workspace" : std::filesystem::path(opt.out);

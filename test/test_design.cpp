@@ -426,6 +426,29 @@ TEST(DesignValidate, Stations) {
                  "stations.index.mechanisms.lower.links[2] = -3 mm: must be > 0");
 }
 
+TEST(Design, SelectsStationsByNameOrEveryOneWithAMechanism) {
+  Design d = valid_design();
+  Station thumb = valid_station();
+  thumb.name = "thumb";
+  Station bare = valid_station();  // a station without mechanisms: nothing to compute there
+  bare.name = "bare";
+  bare.lower.reset();
+  d.stations = {bare, valid_station(), thumb};
+
+  EXPECT_EQ(&d.require_station("thumb"), &d.stations[2]);
+  EXPECT_THAT([&] { d.require_station("pinky"); },
+              ThrowsMessage<InputError>(HasSubstr("unknown station 'pinky' in design 'd' (it has: bare, index, thumb)")));
+
+  const auto named = d.select_stations("bare");  // named explicitly: taken even without a mechanism
+  ASSERT_EQ(named.size(), 1u);
+  EXPECT_EQ(named[0], &d.stations[0]);
+  const auto all = d.select_stations("");
+  ASSERT_EQ(all.size(), 2u);  // file order, the bare station left out
+  EXPECT_EQ(all[0]->name, "index");
+  EXPECT_EQ(all[1]->name, "thumb");
+  EXPECT_THROW(d.select_stations("pinky"), InputError);
+}
+
 TEST(DesignValidate, Products) {
   const Design d = valid_design();
   expect_invalid(d, [](Design& x) { x.products = std::vector<std::string>{"kinematics", "nope"}; },

@@ -909,4 +909,20 @@ const Station* Design::station(std::string_view wanted) const {
   return nullptr;
 }
 
+const Station& Design::require_station(std::string_view wanted) const {
+  if (const Station* s = station(wanted)) return *s;
+  std::string names;
+  for (const Station& s : stations) names += (names.empty() ? "" : ", ") + s.name;
+  throw InputError("unknown station '" + std::string(wanted) + "' in design '" + name + "' (it has: " + names + ")");
+}
+
+std::vector<const Station*> Design::select_stations(std::string_view wanted) const {
+  if (!wanted.empty()) return {&require_station(wanted)};
+  std::vector<const Station*> out;
+  for (const Station& s : stations) {
+    if (!s.mechanisms().empty()) out.push_back(&s);
+  }
+  return out;
+}
+
 }  // namespace fivebar

@@ -89,13 +89,7 @@ std::optional<std::string> identifier_problem(std::string_view name) {
 
 std::vector<std::string> chosen_stations(const Design& d, const std::vector<std::string>& wanted) {
   std::vector<std::string> out;
-  std::string names;
-  for (const Station& s : d.stations) names += (names.empty() ? "" : ", ") + s.name;
-  for (const std::string& w : wanted) {
-    if (d.station(w) == nullptr) {
-      throw InputError("unknown station '" + w + "' in design '" + d.name + "' (it has: " + names + ")");
-    }
-  }
+  for (const std::string& w : wanted) d.require_station(w);  // throws for an unknown name
   for (const Station& s : d.stations) {
     if (wanted.empty() || std::find(wanted.begin(), wanted.end(), s.name) != wanted.end()) out.push_back(s.name);
   }

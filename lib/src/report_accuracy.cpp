@@ -710,19 +710,7 @@ AccuracyReport accuracy_report(const Design& design, const AccuracyOptions& o) {
   AccuracyReport report;
   report.design = design.name;
   report.quick = o.quick;
-  std::vector<const Station*> stations;
-  if (!o.station.empty()) {
-    const Station* s = design.station(o.station);
-    if (!s) {
-      std::string names;
-      for (const Station& st : design.stations) names += (names.empty() ? "" : ", ") + st.name;
-      throw InputError("--station " + o.station + ": no such station in design " + design.name + " (stations: " +
-                       names + ")");
-    }
-    stations.push_back(s);
-  } else {
-    for (const Station& s : design.stations) stations.push_back(&s);
-  }
+  const std::vector<const Station*> stations = design.select_stations(o.station);
   std::vector<const Mechanism*> all;
   for (const Station* s : stations) {
     for (const Mechanism* m : s->mechanisms()) {

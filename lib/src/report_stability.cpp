@@ -817,19 +817,7 @@ StabilityReport stability_catalogue(const Mechanism& m, const Ellipse& target, c
 StabilityReport stability_report(const Design& design, const StabilityOptions& o) {
   StabilityReport report;
   report.design = design.name;
-  std::vector<const Station*> stations;
-  if (!o.station.empty()) {
-    const Station* s = design.station(o.station);
-    if (!s) {
-      std::string names;
-      for (const Station& st : design.stations) names += (names.empty() ? "" : ", ") + st.name;
-      throw InputError("--station " + o.station + ": no such station in design " + design.name + " (stations: " +
-                       names + ")");
-    }
-    stations.push_back(s);
-  } else {
-    for (const Station& s : design.stations) stations.push_back(&s);
-  }
+  const std::vector<const Station*> stations = design.select_stations(o.station);
   for (const Station* s : stations) {
     for (const Mechanism* m : s->mechanisms()) {
       if (o.progress) o.progress("stability: " + label_of(*s, *m));

@@ -306,7 +306,14 @@ struct Design {
   std::optional<ControllerSettings> controller;  ///< `controller:`; absent: nothing to export
 
   void validate() const;
+  /// The station named `name`, or nullptr.
   const Station* station(std::string_view name) const;
+  /// The station named `name`; InputError "unknown station 'NAME' in design 'D' (it has: ...)"
+  /// listing the design's stations when there is none.
+  const Station& require_station(std::string_view name) const;
+  /// The stations a whole-station command works on: the one named `name` (as require_station()),
+  /// or, for an empty name, every station with a mechanism, in file order.
+  std::vector<const Station*> select_stations(std::string_view name) const;
 };
 
 /// True when `name` can serve as a design or station name and hence as one path component under
