@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "process.hpp"
+#include "cli_test.hpp"
 
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
@@ -34,8 +34,6 @@ using ::testing::MatchesRegex;
 
 namespace {
 
-const fs::path kSource = FIVEBAR_SOURCE_DIR;
-const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 // Paper Table 1, index station, lower mechanism: O1 (0,0), O2 (12.5,0), L1=L2=9, L3=L4=15.
@@ -56,57 +54,11 @@ double cross(const P2& o, const P2& a, const P2& b) {  // cross(a - o, b - o)
 }
 P2 xy(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>()}; }
 
-/// A scratch directory per test (test/process.hpp).
-class Cli : public ::testing::Test {
+/// The paper's design and a scratch directory per test (test/cli_test.hpp).
+class Cli : public ft::CliTest {
  protected:
-  /// Runs the binary with `args`, feeding `input` on stdin, from `cwd` (default: the scratch dir);
-  /// stdin, stdout and stderr pass through files in dir_ that are gone when it returns.
-  Outcome run(const std::vector<std::string>& args, const std::string& input = "", const fs::path& cwd = {}) {
-    const fs::path in = dir_ / ".stdin";
-    std::ofstream(in, std::ios::binary) << input;
-    Outcome r = ft::run(FIVEBAR_BINARY, args, cwd.empty() ? dir_ : cwd, dir_, ft::child_timeout_s(600.0), in);
-    std::error_code ec;
-    fs::remove(in, ec);
-    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
-    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
-    return r;
-  }
-
-  /// Files and directories under `root`, relative, sorted.
-  static std::vector<std::string> tree(const fs::path& root) {
-    std::vector<std::string> out;
-    if (!fs::exists(root)) return out;
-    for (const auto& e : fs::recursive_directory_iterator(root)) {
-      out.push_back(fs::relative(e.path(), root).generic_string());
-    }
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
-  fs::path write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
-  }
-
-  /// The paper design with `from` replaced by `to` (first occurrence).
-  fs::path design_with(const std::string& name, const std::string& from, const std::string& to) {
-    std::string text = slurp(kDesign);
-    const auto pos = text.find(from);
-    EXPECT_NE(pos, std::string::npos) << from;
-    if (pos != std::string::npos) text.replace(pos, from.size(), to);
-    return write(name, text);
-  }
-
-  ft::ScratchDir scratch_{"fivebar_test_cli"};
-  const fs::path dir_ = scratch_.path();
+  Cli() : CliTest("fivebar_test_cli") {}
 };
-
-json parse_only_document(const Outcome& r) {
-  json j;
-  EXPECT_NO_THROW(j = json::parse(r.out)) << "stdout is not exactly one JSON document:\n" << r.out;
-  return j;
-}
 
 std::vector<std::vector<std::string>> parse_csv(const std::string& text) {
   std::vector<std::vector<std::string>> rows;
@@ -187,7 +139,7 @@ TEST_F(Cli, FkJsonMatchesTheGeometryAndHasTheContractKeys) {
   const Outcome r = run(args({"fk", kDesign}, kIndexLowerArgs, {"--theta", "100,80", "--json"}));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.err, IsEmpty());
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   for (const char* key : {"status", "point_mm", "theta_deg", "elbows_mm", "mode", "assembly", "jacobian", "lci",
                           "force_capability", "transmission_deg", "singularity", "closure_error_mm",
                           "within_joint_limits"}) {
@@ -256,7 +208,7 @@ TEST_F(Cli, FkBranchesAndNegativeAngles) {
   // Upper mechanism, angles below its base line: negative values right after the option.
   const Outcome r = run({"fk", kDesign, "-s", "index", "-m", "upper", "--theta", "-100,-80", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   const P2 A1 = elbow(kIndexUpper.O1, 9.0, -100.0);
   const P2 A2 = elbow(kIndexUpper.O2, 9.0, -80.0);
   const P2 P = xy(j["point_mm"]);
@@ -266,7 +218,7 @@ TEST_F(Cli, FkBranchesAndNegativeAngles) {
 
   const Outcome all = run({"fk", kDesign, "-s", "index", "-m", "upper", "--theta", "-100,-80", "--all", "--json"});
   ASSERT_EQ(all.code, 0) << all.err;
-  const json b = parse_only_document(all);
+  const json b = parse(all);
   ASSERT_EQ(b["branches"].size(), 2u);
   EXPECT_EQ(b["branches"][0]["assembly"], "+");
   EXPECT_EQ(b["branches"][1]["assembly"], "-");
@@ -281,7 +233,7 @@ TEST_F(Cli, FkWithoutConfigurationExitsOne) {
   // theta = (180, 0) puts the elbows 30.5 mm apart: more than L3 + L4 = 30.
   const Outcome r = run(args({"fk", kDesign}, kIndexLowerArgs, {"--theta", "180,0", "--json"}));
   EXPECT_EQ(r.code, 1);
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   EXPECT_EQ(j["status"], "unreachable");
   EXPECT_TRUE(j["point_mm"].is_null());
   EXPECT_FALSE(r.err.empty());
@@ -341,7 +293,7 @@ TEST_F(Cli, IkAnglesPlaceTheElbowsAtTheDistalLengths) {
     SCOPED_TRACE(point);
     const Outcome r = run(args({"ik", kDesign}, kIndexLowerArgs, {"--point", point, "--json"}));
     ASSERT_EQ(r.code, 0) << r.err;
-    const json j = parse_only_document(r);
+    const json j = parse(r);
     EXPECT_EQ(j["status"], "ok");
     const P2 P{x, y};
     const P2 A1 = elbow(kIndexLower.O1, 9.0, j["theta_deg"][0].get<double>());
@@ -360,7 +312,7 @@ TEST_F(Cli, IkAnglesPlaceTheElbowsAtTheDistalLengths) {
 TEST_F(Cli, IkAllGivesFourBranchesConsistentWithSingleIk) {
   const Outcome all = run(args({"ik", kDesign}, kIndexLowerArgs, {"--point", "6.25,15.5", "--all", "--json"}));
   ASSERT_EQ(all.code, 0) << all.err;
-  const json j = parse_only_document(all);
+  const json j = parse(all);
   ASSERT_EQ(j["branches"].size(), 4u);
   const std::array<std::string, 4> modes{"++", "+-", "-+", "--"};
   const P2 P{6.25, 15.5};
@@ -391,7 +343,7 @@ TEST_F(Cli, IkUnreachablePointExitsOne) {
   // |P - O1| = sqrt(2) * 100 mm, far beyond L1 + L3 = 24 mm.
   const Outcome r = run(args({"ik", kDesign}, kIndexLowerArgs, {"--point", "100,100", "--json"}));
   EXPECT_EQ(r.code, 1);
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   EXPECT_EQ(j["status"], "unreachable");
   EXPECT_EQ(j["target_mm"], json::array({100.0, 100.0}));
   EXPECT_TRUE(j["theta_deg"].is_null());
@@ -545,7 +497,7 @@ TEST_F(Cli, RunJsonAndDefaultOutputRoot) {
   const Outcome r = run({"run", kDesign, "--json", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.err, IsEmpty());
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   EXPECT_EQ(j["built"][0]["name"], "kinematics");
   EXPECT_EQ(j["summary_md"], "outputs/iros2022/summary.md");
   EXPECT_TRUE(fs::exists(dir_ / "outputs" / "iros2022" / "summary.json"));
@@ -560,7 +512,7 @@ TEST_F(Cli, RunProductsOptionAndSceneList) {
 
   const Outcome listed = run({"run", kDesign, "--out", out.string(), "--products", "kinematics", "--json"});
   ASSERT_EQ(listed.code, 0) << listed.err;
-  const json j = parse_only_document(listed);
+  const json j = parse(listed);
   EXPECT_TRUE(j["products_listed"].get<bool>());
   EXPECT_TRUE(j["built"][0]["requested"].get<bool>());
 

@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "process.hpp"
+#include "cli_test.hpp"
 
 namespace {
 
@@ -33,53 +33,13 @@ using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
 
-const fs::path kSource = FIVEBAR_SOURCE_DIR;
-const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
 constexpr double kDeg = std::numbers::pi / 180.0;
 
-class CliTactors : public ::testing::Test {
+/// The paper's design and a scratch directory per test (test/cli_test.hpp).
+class CliTactors : public ft::CliTest {
  protected:
-  /// Runs the real binary in dir_; its stdout and stderr pass through files in dir_ that are gone
-  /// when it returns.
-  Outcome run(const std::vector<std::string>& args) {
-    Outcome r = ft::run(FIVEBAR_BINARY, args, dir_, dir_, ft::child_timeout_s(600.0));
-    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
-    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
-    return r;
-  }
-
-  /// The paper design with `from` replaced by `to`.
-  fs::path design_with(const std::string& name, const std::string& from, const std::string& to) {
-    std::string text = slurp(kDesign);
-    const auto pos = text.find(from);
-    EXPECT_NE(pos, std::string::npos) << from;
-    if (pos != std::string::npos) text.replace(pos, from.size(), to);
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
-  }
-
-  /// The paper design with the block from `start` up to (not including) `end` removed.
-  fs::path design_without(const std::string& name, const std::string& start, const std::string& end) {
-    std::string text = slurp(kDesign);
-    const auto a = text.find(start);
-    const auto b = text.find(end, a);
-    EXPECT_TRUE(a != std::string::npos && b != std::string::npos) << start;
-    if (a != std::string::npos && b != std::string::npos) text.erase(a, b - a);
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
-  }
-
-  ft::ScratchDir scratch_{"fivebar_test_cli_tactors"};
-  const fs::path dir_ = scratch_.path();
+  CliTactors() : CliTest("fivebar_test_cli_tactors") {}
 };
-
-json parse(const Outcome& r) {
-  json j;
-  EXPECT_NO_THROW(j = json::parse(r.out)) << "stdout is not exactly one JSON document:\n" << r.out;
-  return j;
-}
 
 std::array<double, 2> xy(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>()}; }
 

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "process.hpp"
+#include "cli_test.hpp"
 
 namespace {
 
@@ -30,9 +30,6 @@ using ::testing::HasSubstr;
 using ::testing::IsEmpty;
 using ::testing::Not;
 
-const fs::path kSource = FIVEBAR_SOURCE_DIR;
-const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
-
 std::vector<std::string> listing(const fs::path& dir) {
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
@@ -40,37 +37,12 @@ std::vector<std::string> listing(const fs::path& dir) {
   return names;
 }
 
-class CliExport : public ::testing::Test {
+/// The paper's design and a scratch directory per test, the binary's working directory so that a
+/// default outputs/ would land there (test/cli_test.hpp).
+class CliExport : public ft::CliTest {
  protected:
-  /// Runs the real binary in dir_ (so that a default outputs/ would land there); its stdout and
-  /// stderr pass through files in dir_ that are gone when it returns.
-  Outcome run(const std::vector<std::string>& args) {
-    Outcome r = ft::run(FIVEBAR_BINARY, args, dir_, dir_, ft::child_timeout_s(600.0));
-    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
-    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
-    return r;
-  }
-
-  /// The paper design with `from` replaced by `to`, saved under dir_.
-  fs::path design_with(const std::string& name, const std::string& from, const std::string& to) {
-    std::string text = slurp(kDesign);
-    const auto pos = text.find(from);
-    EXPECT_NE(pos, std::string::npos) << from;
-    if (pos != std::string::npos) text.replace(pos, from.size(), to);
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
-  }
-
-  ft::ScratchDir scratch_{"fivebar_test_cli_export"};
-  const fs::path dir_ = scratch_.path();
+  CliExport() : CliTest("fivebar_test_cli_export") {}
 };
-
-json parse(const Outcome& r) {
-  json j;
-  EXPECT_NO_THROW(j = json::parse(r.out)) << "stdout is not exactly one JSON document:\n" << r.out;
-  return j;
-}
 
 TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   const Outcome r = run({"export", kDesign, "--out", "ctl"});

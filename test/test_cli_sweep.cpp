@@ -14,8 +14,8 @@
 #include <sstream>
 #include <thread>
 
+#include "cli_test.hpp"
 #include "fivebar/sweep.hpp"
-#include "process.hpp"
 
 namespace {
 
@@ -26,10 +26,12 @@ using ft::slurp;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
-const std::string kDesign = std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml";
-
-class CliSweep : public ::testing::Test {
+/// The paper's design and a scratch directory per test (test/cli_test.hpp); spawn() and wait_for()
+/// for the runs that are interrupted or go through mpirun.
+class CliSweep : public ft::CliTest {
  protected:
+  CliSweep() : CliTest("fivebar_test_cli_sweep") {}
+
   /// Starts `program args...` (found on PATH unless it holds a '/') in dir_, stdout and stderr
   /// through files there (test/process.hpp); wait_for() collects it.
   ft::Child spawn(const std::string& program, const std::vector<std::string>& args) {
@@ -42,19 +44,12 @@ class CliSweep : public ::testing::Test {
     if (r.timed_out) ADD_FAILURE() << "timed out: " << r.err;
     return r;
   }
-  Outcome run(const std::vector<std::string>& args) {
-    ft::Child c = spawn(FIVEBAR_BINARY, args);
-    return wait_for(c);
-  }
 
   std::vector<std::string> sweep_args(const fs::path& out, const std::string& l3 = "L3=11:19:30",
                                       const std::string& l4 = "L4=11:19:30") {
     return {"sweep", kDesign, "--station", "index", "--mechanism", "lower", "--vary", l3, "--vary", l4, "--out",
             out.string(), "--no-plots"};
   }
-
-  ft::ScratchDir scratch_{"fivebar_test_cli_sweep"};
-  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(CliSweep, JsonSummaryAndFiles) {

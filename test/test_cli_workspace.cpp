@@ -20,7 +20,7 @@
 #include <string>
 #include <vector>
 
-#include "process.hpp"
+#include "cli_test.hpp"
 
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
@@ -34,8 +34,6 @@ using ::testing::Not;
 
 namespace {
 
-const fs::path kSource = FIVEBAR_SOURCE_DIR;
-const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
 constexpr double kPi = std::numbers::pi;
 
 // --- geometry of the paper's device, by hand ---------------------------------------------------
@@ -68,48 +66,12 @@ double annuli_margin(double r, double R, double ox1, double ox2, double oy, doub
   return margin;
 }
 
-// --- running the binary (test/process.hpp) -------------------------------------------------------
+// --- running the binary (test/cli_test.hpp) ---------------------------------------------------------
 
-class CliWorkspace : public ::testing::Test {
+class CliWorkspace : public ft::CliTest {
  protected:
-  /// Runs the real binary in dir_; its stdout and stderr pass through files in dir_ that are gone
-  /// when it returns.
-  Outcome run(const std::vector<std::string>& args) {
-    Outcome r = ft::run(FIVEBAR_BINARY, args, dir_, dir_, ft::child_timeout_s(600.0));
-    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
-    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
-    return r;
-  }
-
-  /// Files and directories under `root`, relative, sorted.
-  static std::vector<std::string> tree(const fs::path& root) {
-    std::vector<std::string> out;
-    if (!fs::exists(root)) return out;
-    for (const auto& e : fs::recursive_directory_iterator(root)) out.push_back(fs::relative(e.path(), root).generic_string());
-    std::sort(out.begin(), out.end());
-    return out;
-  }
-
-  /// The paper design with `from` replaced by `to` (first occurrence), written to the scratch dir.
-  fs::path design_with(const std::string& name, const std::string& from, const std::string& to) {
-    std::string text = slurp(kDesign);
-    const auto pos = text.find(from);
-    EXPECT_NE(pos, std::string::npos) << from;
-    if (pos != std::string::npos) text.replace(pos, from.size(), to);
-    const fs::path p = dir_ / name;
-    std::ofstream(p) << text;
-    return p;
-  }
-
-  ft::ScratchDir scratch_{"fivebar_test_cli_ws"};
-  const fs::path dir_ = scratch_.path();
+  CliWorkspace() : CliTest("fivebar_test_cli_ws") {}
 };
-
-json parse_only_document(const Outcome& r) {
-  json j;
-  EXPECT_NO_THROW(j = json::parse(r.out)) << "stdout is not exactly one JSON document:\n" << r.out;
-  return j;
-}
 
 // --- workspace --------------------------------------------------------------------------------
 
@@ -117,7 +79,7 @@ TEST_F(CliWorkspace, WorkspaceJsonAreasMatchTheAnnuliOfTableOne) {
   const fs::path out = dir_ / "ws";
   const Outcome r = run({"workspace", kDesign, "--out", out.string(), "--spacing", "0.5", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   EXPECT_EQ(j["command"], "workspace");
   EXPECT_EQ(j["design"], "iros2022");
   EXPECT_EQ(j["spacing_mm"], 0.5);
@@ -270,7 +232,7 @@ TEST_F(CliWorkspace, CoverageEllipseOverrideOutsideIsExitOneWithNegativeMargin) 
   // 40 mm wide at the index centre: x reaches -13.75 where |P - O2| = 26.25 > 24.
   const Outcome r = run({"coverage", kDesign, "--station", "index", "--ellipse", "6.25,15.5,40,12,0", "--json"});
   EXPECT_EQ(r.code, 1) << r.err;
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   EXPECT_EQ(keys(j["stations"]), std::vector<std::string>{"index"});
   for (const char* part : {"lower", "upper", "shared"}) {
     const json& c = j["stations"]["index"][part];
@@ -300,7 +262,7 @@ TEST_F(CliWorkspace, CoverageFailsOnTheDesignsLciThreshold) {
       design_with("strict.yaml", "assembly_mode: \"+\"", "assembly_mode: \"+\"\n        min_lci: 0.9");
   const Outcome r = run({"coverage", design.string(), "--json"});
   EXPECT_EQ(r.code, 1) << r.err;
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   const json& lower = j["stations"]["index"]["lower"];
   EXPECT_TRUE(lower["inside"].get<bool>());
   EXPECT_FALSE(lower["lci_ok"].get<bool>());
@@ -321,7 +283,7 @@ TEST_F(CliWorkspace, CoverageOfOneMechanismJudgesItAloneWithoutTheSharedRegion) 
   EXPECT_EQ(both.code, 1) << both.err;
   EXPECT_EQ(upper.code, 0) << upper.err;
   EXPECT_EQ(lower.code, 1) << lower.err;
-  const json jb = parse_only_document(both), ju = parse_only_document(upper), jl = parse_only_document(lower);
+  const json jb = parse(both), ju = parse(upper), jl = parse(lower);
   // Only the chosen mechanism, no shared region, and the same numbers as the full run.
   EXPECT_FALSE(ju["stations"]["index"].contains("lower"));
   EXPECT_FALSE(ju["stations"]["index"].contains("shared"));
@@ -397,7 +359,7 @@ TEST_F(CliWorkspace, RunCoverageFailsForAStationThatIsNotCoveredAndOnlyScansTheS
   const fs::path out = dir_ / "out";
   const Outcome r = run({"run", design.string(), "--out", out.string(), "--products", "coverage", "--json", "--quiet"});
   EXPECT_EQ(r.code, 1) << r.err;
-  const json j = parse_only_document(r);
+  const json j = parse(r);
   ASSERT_EQ(j["built"].size(), 1u);
   EXPECT_FALSE(j["built"][0]["passed"].get<bool>());
   EXPECT_EQ(keys(j["results"]["coverage"]["stations"]), std::vector<std::string>{"index"});

@@ -29,12 +29,12 @@
 #include <string>
 #include <vector>
 
+#include "cli_test.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/parts.hpp"
 #include "fivebar/scene.hpp"
-#include "process.hpp"
 
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
@@ -46,9 +46,6 @@ using ::testing::HasSubstr;
 using ::testing::Not;
 
 namespace {
-
-const fs::path kSource = FIVEBAR_SOURCE_DIR;
-const fs::path kDesign = kSource / "designs" / "iros2022.yaml";
 
 // Paper Table 1 and designs/iros2022.yaml's geometry/print sections, restated.
 constexpr double kL1 = 9.0, kL3Index = 15.0, kL3Thumb = 17.5;
@@ -151,23 +148,18 @@ std::vector<std::map<std::string, std::string>> read_csv(const fs::path& p) {
 
 // --- Fixture ------------------------------------------------------------------------------------
 
-class Parts : public ::testing::Test {
+/// A scratch directory per test and the binary (test/cli_test.hpp), with the design at $fn 24.
+class Parts : public ft::CliTest {
  protected:
-  fs::path write(const std::string& name, const std::string& text) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
+  Parts() : CliTest("fivebar_test_parts") {}
+
+  /// The paper's design file as a path: messages are checked against kDesign.string().
+  static inline const fs::path kDesign = CliTest::kDesign;
+
   /// The paper's design file with `from` replaced by `to` (each must occur), $fn lowered to 24.
-  fs::path design_with(const std::string& name, std::vector<std::pair<std::string, std::string>> edits = {}) {
-    std::string text = slurp(kDesign);
+  fs::path design_with(const std::string& name, std::vector<ft::Edit> edits = {}) {
     edits.emplace_back("fn: 96", "fn: " + std::to_string(kFn));
-    for (const auto& [from, to] : edits) {
-      const auto pos = text.find(from);
-      EXPECT_NE(pos, std::string::npos) << from;
-      if (pos != std::string::npos) text.replace(pos, from.size(), to);
-    }
-    return write(name, text);
+    return CliTest::design_with(name, edits);
   }
   /// 1-based line of the first line of `file` containing `needle`.
   static int line_of(const fs::path& file, const std::string& needle) {
@@ -201,9 +193,6 @@ class Parts : public ::testing::Test {
     static const PartResult none;
     return none;
   }
-
-  ft::ScratchDir scratch_{"fivebar_test_parts"};
-  const fs::path dir_ = scratch_.path();
 };
 
 // --- Meshes and fits on synthetic data (no openscad) ------------------------------------------------
@@ -704,28 +693,19 @@ TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {
 
 // --- The command ------------------------------------------------------------------------------------
 
-/// Runs the fivebar binary in `dir` with extra environment variables ("NAME=value"), through
-/// test/process.hpp.
-Outcome run_cli(const fs::path& dir, const std::vector<std::string>& args, const std::vector<std::string>& env = {}) {
-  Outcome r = ft::run(FIVEBAR_BINARY, args, dir, dir, ft::child_timeout_s(600.0), {}, env);
-  if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
-  if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
-  return r;
-}
-
 TEST_F(Parts, CliSourcesOnlyMissingOpenscadAndBadInput) {
   const std::string file = design_with("d.yaml").string();
   const std::string out = (dir_ / "out").string();
 
   // openscad missing: a clear message, exit 1, nothing written.
-  const Outcome missing = run_cli(dir_, {"parts", file, "--out", out}, {"FIVEBAR_OPENSCAD=/nonexistent/openscad"});
+  const Outcome missing = run_with_env({"parts", file, "--out", out}, {"FIVEBAR_OPENSCAD=/nonexistent/openscad"});
   EXPECT_EQ(missing.code, 1);
   EXPECT_THAT(missing.err, AllOf(HasSubstr("openscad"), HasSubstr("not found"), HasSubstr("--no-render")));
   EXPECT_FALSE(fs::exists(out));
 
   // --no-render still writes the sources: both stations, 10 parts.
-  const Outcome sources = run_cli(dir_, {"parts", file, "--out", out, "--no-render", "--json"},
-                                  {"FIVEBAR_OPENSCAD=/nonexistent/openscad"});
+  const Outcome sources = run_with_env({"parts", file, "--out", out, "--no-render", "--json"},
+                                       {"FIVEBAR_OPENSCAD=/nonexistent/openscad"});
   ASSERT_EQ(sources.code, 0) << sources.err;
   const auto j = nlohmann::json::parse(sources.out);
   EXPECT_EQ(j["command"], "parts");
@@ -736,12 +716,12 @@ TEST_F(Parts, CliSourcesOnlyMissingOpenscadAndBadInput) {
 
   // Bad input: exit 2 with file, line and key; an unknown station.
   const fs::path bad = design_with("bad.yaml", {{"links: [9, 9, 17.5, 17.5]", "links: [9, 4, 17.5, 17.5]"}});
-  const Outcome refused = run_cli(dir_, {"parts", bad.string(), "--out", (dir_ / "bad").string()});
+  const Outcome refused = run({"parts", bad.string(), "--out", (dir_ / "bad").string()});
   EXPECT_EQ(refused.code, 2);
   EXPECT_THAT(refused.err, HasSubstr(bad.string() + ":" + std::to_string(line_of(bad, "links: [9, 4")) +
                                      ": stations.thumb.mechanisms.lower.links[1] = 4 mm"));
   EXPECT_FALSE(fs::exists(dir_ / "bad"));
-  const Outcome station = run_cli(dir_, {"parts", file, "--station", "pinky", "--out", out});
+  const Outcome station = run({"parts", file, "--station", "pinky", "--out", out});
   EXPECT_EQ(station.code, 2);
   EXPECT_THAT(station.err, HasSubstr("no station 'pinky'"));
 }
@@ -749,7 +729,7 @@ TEST_F(Parts, CliSourcesOnlyMissingOpenscadAndBadInput) {
 TEST_F(Parts, CliRendersChecksAndFailsWhenAMeshMissesTheDesign) {
   const std::string file = design_with("d.yaml").string();
   const std::string out = (dir_ / "out").string();
-  const Outcome ok = run_cli(dir_, {"parts", file, "--station", "index", "--out", out});
+  const Outcome ok = run({"parts", file, "--station", "index", "--out", out});
   ASSERT_EQ(ok.code, 0) << ok.err;
   EXPECT_THAT(ok.out, AllOf(HasSubstr("proximal_link_9mm"), HasSubstr("9.0000"), HasSubstr("15.0000"),
                             HasSubstr("5 rendered, 0 up to date, 0 failed"), HasSubstr("bom.csv")));
@@ -764,8 +744,8 @@ TEST_F(Parts, CliRendersChecksAndFailsWhenAMeshMissesTheDesign) {
   ASSERT_NE(text.find(from), std::string::npos);
   text.replace(text.find(from), from.size(), "translate([length + 0.05, 0, -1]) linear_extrude(height = top + 2)");
   std::ofstream(lib / "fivebar.scad") << text;
-  const Outcome off = run_cli(dir_, {"parts", file, "--station", "index", "--out", out, "--json"},
-                              {"FIVEBAR_SCAD_DIR=" + lib.string()});
+  const Outcome off = run_with_env({"parts", file, "--station", "index", "--out", out, "--json"},
+                                   {"FIVEBAR_SCAD_DIR=" + lib.string()});
   EXPECT_EQ(off.code, 1);
   const auto j = nlohmann::json::parse(off.out);
   EXPECT_FALSE(j["passed"].get<bool>());

@@ -18,11 +18,11 @@
 #include <random>
 #include <sstream>
 
+#include "cli_test.hpp"
 #include "fivebar/coverage.hpp"
 #include "fivebar/report.hpp"
 #include "fivebar/scene.hpp"
 #include "fivebar/workspace.hpp"
-#include "process.hpp"
 #include "report_precision.hpp"
 #include "report_quad.hpp"
 
@@ -40,8 +40,6 @@ using LD = long double;
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kEps = std::numeric_limits<double>::epsilon();
-const fs::path kSource = FIVEBAR_SOURCE_DIR;
-const std::string kDesign = (kSource / "designs" / "iros2022.yaml").string();
 
 std::uint64_t test_seed() {
   if (const char* s = std::getenv("FIVEBAR_TEST_SEED")) return std::strtoull(s, nullptr, 10);
@@ -476,7 +474,7 @@ const StabilityCase* find_case(const StabilityReport& r, const std::string& grou
 }
 
 TEST(Stability, EveryCasePassesOnThePaperStations) {
-  const StabilityReport r = stability_report(load_design(kDesign));
+  const StabilityReport r = stability_report(load_design(ft::CliTest::kDesign));
   expect_all_pass(r);
   // Every group of the catalogue is there, for every mechanism.
   for (const char* mech : {"index/lower", "index/upper", "thumb/lower", "thumb/upper"}) {
@@ -604,13 +602,13 @@ void expect_finite(const Json& j, const std::string& where) {
   }
 }
 
-class ScratchDir : public ::testing::Test {
+/// The paper's design and a scratch directory per test; ReportCli also runs the binary in it (test/cli_test.hpp).
+class ReportTest : public ft::CliTest {
  protected:
-  ft::ScratchDir scratch_{"fivebar_test_report"};
-  const fs::path dir_ = scratch_.path();
+  ReportTest() : CliTest("fivebar_test_report") {}
 };
 
-using Output = ScratchDir;
+using Output = ReportTest;
 
 TEST_F(Output, JsonTextAndPlotsOfTheAccuracyReport) {
   AccuracyReport r;
@@ -688,16 +686,7 @@ TEST_F(Output, TheReportProductStatesTheAccuracyOfTheMainNumbers) {
 
 // --- CLI -------------------------------------------------------------------------------------------
 
-class ReportCli : public ScratchDir {
- protected:
-  /// Runs the real binary in dir_ (test/process.hpp).
-  Outcome run(const std::vector<std::string>& args) {
-    Outcome r = ft::run(FIVEBAR_BINARY, args, dir_, dir_, ft::child_timeout_s(600.0));
-    if (!r.spawned) ADD_FAILURE() << "cannot spawn " << FIVEBAR_BINARY;
-    if (r.timed_out) ADD_FAILURE() << "fivebar timed out: " << r.err;
-    return r;
-  }
-};
+using ReportCli = ReportTest;
 
 TEST_F(ReportCli, StabilityJsonAndExitCode) {
   const Outcome r = run({"report", "stability", kDesign, "--station", "index", "--json"});
