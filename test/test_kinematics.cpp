@@ -137,6 +137,39 @@ TEST(FastMath, Atan2WithinThreeUlpInEveryOctant) {
   EXPECT_EQ(detail::fast_atan2(0.0, 0.0), 0.0);
 }
 
+TEST(FastMath, AngleOfAVectorOfKnownLengthWithinThreeUlp) {
+  // Vectors r (cos a, sin a) rounded from long double, so sqrt(x^2 + y^2) = r to within an ulp; the
+  // reference is the long-double atan2 of the rounded components. Every octant, lengths 1e-6 to
+  // 1e6, and the octant boundaries (|x| = |y|, an axis) where the fold changes branch.
+  std::mt19937_64 rng(test_seed() + 2);
+  std::uniform_real_distribution<long double> angle(-kPi, kPi);
+  std::uniform_real_distribution<double> e(-6.0, 6.0);
+  double worst = 0.0;
+  const auto check = [&](long double a, double r) {
+    const double x = double(r * std::cos(a)), y = double(r * std::sin(a));
+    const long double t = std::atan2((long double)y, (long double)x);
+    worst = std::max(worst, double(std::fabs(detail::fast_angle(y, x, r) - t) / ulp_of(t)));
+  };
+  for (int k = 0; k < 400000; ++k) check(angle(rng), std::pow(10.0, e(rng)));
+  for (int q = -8; q <= 8; ++q) {
+    for (long double da : {-1e-12L, 0.0L, 1e-12L}) check(q * (long double)kPi / 4 + da, 9.0);
+  }
+  EXPECT_LE(worst, 3.0);
+  EXPECT_EQ(detail::fast_angle(0.0, 9.0, 9.0), 0.0);
+  EXPECT_DOUBLE_EQ(detail::fast_angle(0.0, -9.0, 9.0), kPi);
+  EXPECT_DOUBLE_EQ(detail::fast_angle(9.0, 0.0, 9.0), kPi / 2);
+  EXPECT_DOUBLE_EQ(detail::fast_angle(-9.0, 0.0, 9.0), -kPi / 2);
+  // A length off by delta (relative) moves the angle by at most 0.42 delta rad: the bound the
+  // batch IK relies on when the elbow offset's length is the link's only to the reach slack.
+  for (double delta : {1e-12, -1e-12, 16 * kEps}) {
+    for (int k = 0; k < 64; ++k) {
+      const double a = -kPi + 2 * kPi * (k + 0.5) / 64, x = 9.0 * std::cos(a), y = 9.0 * std::sin(a);
+      EXPECT_NEAR(detail::fast_angle(y, x, 9.0 * (1 + delta)), std::atan2(y, x), 0.42 * std::fabs(delta) + 4 * kEps)
+          << a;
+    }
+  }
+}
+
 // --- circle intersection -----------------------------------------------------------------------
 
 TEST(CircleIntersection, HandWorkedCases) {

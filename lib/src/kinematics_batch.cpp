@@ -1,6 +1,6 @@
 // Lean kinematics: FK to the tactor point and IK to the joint angles with a status, nothing else.
 // One per-element kernel serves two entry points:
-//   - the batch (structure-of-arrays) loops, over fastmath.hpp's vectorisable sin/cos/atan2:
+//   - the batch (structure-of-arrays) loops, over fastmath.hpp's vectorisable sin/cos and angle:
 //     the bodies are branch-free (selects only), so GCC vectorises them at -O3 without
 //     -ffast-math (-fno-math-errno and -fno-trapping-math suffice);
 //   - fk_point / ik_angles, the scalar forms, over glibc's sin/cos/atan2 (< 1 ulp).
@@ -10,10 +10,10 @@
 // FK takes one square root and an IK two.
 //
 // ik_angles verifies the loop closure of the elbow configuration. The batch IK is not re-verified
-// per point:
-// the elbows are the exact circle intersection and the angles are atan2 of the elbow offsets, so
-// closure holds by construction up to the atan2 error (< 3 ulp); test_kinematics verifies batch
-// IK by FK on every regime.
+// per point: the elbows are the exact circle intersection and the angles are those of the elbow
+// offsets, so closure holds by construction up to the angle's error (< 3 ulp); test_kinematics
+// verifies batch IK by FK on every regime. The batch angle is fast_angle, which knows the offset's
+// length (the proximal link) and so needs one division where a general atan2 needs two.
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -31,11 +31,12 @@ using detail::cross;
 
 struct FastTrig {
   static void sincos(double x, double& s, double& c) { detail::fast_sincos(x, s, c); }
-  static double atan2(double y, double x) { return detail::fast_atan2(y, x); }
+  /// The angle of an elbow offset (y, x) of known length r: one division (detail::fast_angle).
+  static double angle(double y, double x, double r) { return detail::fast_angle(y, x, r); }
 };
 struct LibmTrig {
   static void sincos(double x, double& s, double& c) { ::sincos(x, &s, &c); }  // glibc, one reduction
-  static double atan2(double y, double x) { return std::atan2(y, x); }
+  static double angle(double y, double x, double /*r*/) { return std::atan2(y, x); }  // < 1 ulp
 };
 
 /// Loop-invariant constants of one mechanism.
@@ -94,6 +95,7 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
 
 struct LegConst {
   double ox, oy;
+  double r;                    // proximal link length |A - O|
   detail::CirclePair circles;  // (O, L_i) and (P, L_{i+2})
   double s;                    // chord side: -sigma of the working mode
 };
@@ -102,8 +104,8 @@ struct IkConst {
   LegConst g1, g2;
   double thr13, thr24, thr34;  // kSingularSin * L_I * L_J
   explicit IkConst(const Mechanism& m)
-      : g1{m.O1.x(), m.O1.y(), detail::CirclePair::make(m.L[0], m.L[2]), -double(m.working_mode.sign1)},
-        g2{m.O2.x(), m.O2.y(), detail::CirclePair::make(m.L[1], m.L[3]), -double(m.working_mode.sign2)},
+      : g1{m.O1.x(), m.O1.y(), m.L[0], detail::CirclePair::make(m.L[0], m.L[2]), -double(m.working_mode.sign1)},
+        g2{m.O2.x(), m.O2.y(), m.L[1], detail::CirclePair::make(m.L[1], m.L[3]), -double(m.working_mode.sign2)},
         thr13(tol::kSingularSin * m.L[0] * m.L[2]), thr24(tol::kSingularSin * m.L[1] * m.L[3]),
         thr34(tol::kSingularSin * m.L[2] * m.L[3]) {}
 };
@@ -146,8 +148,8 @@ inline void ik_from_elbows(const IkConst& g, const Elbows& e, double& theta1, do
   const bool sing1 = (std::fabs(cross(e.e1x, e.e1y, e.f1x, e.f1y)) < g.thr13) |
                      (std::fabs(cross(e.e2x, e.e2y, e.f2x, e.f2y)) < g.thr24);
   const bool sing2 = std::fabs(cross(e.f1x, e.f1y, e.f2x, e.f2y)) < g.thr34;
-  theta1 = e.reach ? Trig::atan2(e.e1y, e.e1x) : 0.0;
-  theta2 = e.reach ? Trig::atan2(e.e2y, e.e2x) : 0.0;
+  theta1 = e.reach ? Trig::angle(e.e1y, e.e1x, g.g1.r) : 0.0;
+  theta2 = e.reach ? Trig::angle(e.e2y, e.e2x, g.g2.r) : 0.0;
   status = detail::classify_as<S>(e.reach, sing1, sing2);
 }
 

@@ -91,4 +91,35 @@ inline double fast_atan2(double y, double x) {
   return std::copysign(a2, y);
 }
 
+/// The angle of (x, y) when its length r > 0 is known: atan2(y, x) in [-pi, pi] with one division
+/// instead of fast_atan2's two and no reduction step. Folded into the first octant
+/// (lo = min(|x|, |y|), hi = max), phi = atan2(lo, hi) <= pi/4 is twice the angle whose tangent is
+/// tan(phi/2) = lo / (r + hi) <= tan(pi/8): the range of the atan polynomial as it stands. Both
+/// terms of r + hi are positive, so the sum and the quotient are correctly rounded; a relative error
+/// delta in r against sqrt(x^2 + y^2) moves the result by at most 0.42 delta (rad). For an elbow
+/// offset of an IK, whose length is the proximal link's to within the reach slack (16 eps).
+inline double fast_angle(double y, double x, double r) {
+  constexpr double kPio2Hi = 1.57079632679489655800e+00, kPio2Lo = 6.12323399573676603587e-17;
+  constexpr double kPiHi = 3.14159265358979311600e+00, kPiLo = 1.22464679914735317720e-16;
+  constexpr double aT0 = 3.33333333333329318027e-01, aT1 = -1.99999999998764832476e-01,
+                   aT2 = 1.42857142725034663711e-01, aT3 = -1.11111104054623557880e-01,
+                   aT4 = 9.09088713343650656196e-02, aT5 = -7.69187620504482999495e-02,
+                   aT6 = 6.66107313738753120669e-02, aT7 = -5.83357013379057348645e-02,
+                   aT8 = 4.97687799461593236017e-02, aT9 = -3.65315727442169155270e-02,
+                   aT10 = 1.62858201153657823623e-02;
+  const double ax = std::fabs(x);
+  const double ay = std::fabs(y);
+  const double hi = ax > ay ? ax : ay;
+  const double lo = ax > ay ? ay : ax;
+  const double t = lo / (r + hi);  // tan(phi / 2) in [0, tan(pi/8)]
+  const double z = t * t;
+  const double w = z * z;
+  const double s1 = z * (aT0 + w * (aT2 + w * (aT4 + w * (aT6 + w * (aT8 + w * aT10)))));
+  const double s2 = w * (aT1 + w * (aT3 + w * (aT5 + w * (aT7 + w * aT9))));
+  const double a0 = 2.0 * (t - t * (s1 + s2));  // exact doubling
+  const double a1 = ay > ax ? (kPio2Hi - a0) + kPio2Lo : a0;
+  const double a2 = x < 0.0 ? (kPiHi - a1) + kPiLo : a1;
+  return std::copysign(a2, y);
+}
+
 }  // namespace fivebar::detail
