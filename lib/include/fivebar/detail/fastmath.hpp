@@ -62,18 +62,35 @@ inline void fast_sincos(double x, double& s_out, double& c_out) {
   c_out = (q == 1.0 || std::fabs(q) == 2.0) ? -c : c;
 }
 
-/// atan2(y, x) in [-pi, pi]; atan2(0, 0) = 0. Finite inputs only.
-inline double fast_atan2(double y, double x) {
-  constexpr double kTanPi8 = 0.41421356237309504880;
-  constexpr double kPio4Hi = 7.85398163397448278999e-01, kPio4Lo = 3.06161699786838301793e-17;
-  constexpr double kPio2Hi = 1.57079632679489655800e+00, kPio2Lo = 6.12323399573676603587e-17;
-  constexpr double kPiHi = 3.14159265358979311600e+00, kPiLo = 1.22464679914735317720e-16;
+/// fdlibm's atan kernel: t (s1 + s2) with atan(t) = t - that, for |t| <= 7/16.
+inline double atan_tail(double t) {
   constexpr double aT0 = 3.33333333333329318027e-01, aT1 = -1.99999999998764832476e-01,
                    aT2 = 1.42857142725034663711e-01, aT3 = -1.11111104054623557880e-01,
                    aT4 = 9.09088713343650656196e-02, aT5 = -7.69187620504482999495e-02,
                    aT6 = 6.66107313738753120669e-02, aT7 = -5.83357013379057348645e-02,
                    aT8 = 4.97687799461593236017e-02, aT9 = -3.65315727442169155270e-02,
                    aT10 = 1.62858201153657823623e-02;
+  const double z = t * t;
+  const double w = z * z;
+  const double s1 = z * (aT0 + w * (aT2 + w * (aT4 + w * (aT6 + w * (aT8 + w * aT10)))));
+  const double s2 = w * (aT1 + w * (aT3 + w * (aT5 + w * (aT7 + w * aT9))));
+  return t * (s1 + s2);
+}
+
+/// From a0 = atan2(min(|x|, |y|), max(|x|, |y|)) in [0, pi/4] to atan2(y, x) in [-pi, pi], with pi/2
+/// and pi in two parts so that the subtractions keep a0's digits.
+inline double atan_unfold(double a0, double x, double y) {
+  constexpr double kPio2Hi = 1.57079632679489655800e+00, kPio2Lo = 6.12323399573676603587e-17;
+  constexpr double kPiHi = 3.14159265358979311600e+00, kPiLo = 1.22464679914735317720e-16;
+  const double a1 = std::fabs(y) > std::fabs(x) ? (kPio2Hi - a0) + kPio2Lo : a0;
+  const double a2 = x < 0.0 ? (kPiHi - a1) + kPiLo : a1;
+  return std::copysign(a2, y);
+}
+
+/// atan2(y, x) in [-pi, pi]; atan2(0, 0) = 0. Finite inputs only.
+inline double fast_atan2(double y, double x) {
+  constexpr double kTanPi8 = 0.41421356237309504880;
+  constexpr double kPio4Hi = 7.85398163397448278999e-01, kPio4Lo = 3.06161699786838301793e-17;
   const double ax = std::fabs(x);
   const double ay = std::fabs(y);
   const double hi = ax > ay ? ax : ay;
@@ -81,45 +98,24 @@ inline double fast_atan2(double y, double x) {
   const double q = lo / (hi > 0.0 ? hi : 1.0);  // in [0, 1]
   const bool reduce = q > kTanPi8;
   const double t = reduce ? (q - 1.0) / (q + 1.0) : q;
-  const double z = t * t;
-  const double w = z * z;
-  const double s1 = z * (aT0 + w * (aT2 + w * (aT4 + w * (aT6 + w * (aT8 + w * aT10)))));
-  const double s2 = w * (aT1 + w * (aT3 + w * (aT5 + w * (aT7 + w * aT9))));
-  const double a0 = reduce ? kPio4Hi - ((t * (s1 + s2) - kPio4Lo) - t) : t - t * (s1 + s2);
-  const double a1 = ay > ax ? (kPio2Hi - a0) + kPio2Lo : a0;
-  const double a2 = x < 0.0 ? (kPiHi - a1) + kPiLo : a1;
-  return std::copysign(a2, y);
+  const double tail = atan_tail(t);
+  return atan_unfold(reduce ? kPio4Hi - ((tail - kPio4Lo) - t) : t - tail, x, y);
 }
 
 /// The angle of (x, y) when its length r > 0 is known: atan2(y, x) in [-pi, pi] with one division
 /// instead of fast_atan2's two and no reduction step. Folded into the first octant
 /// (lo = min(|x|, |y|), hi = max), phi = atan2(lo, hi) <= pi/4 is twice the angle whose tangent is
-/// tan(phi/2) = lo / (r + hi) <= tan(pi/8): the range of the atan polynomial as it stands. Both
-/// terms of r + hi are positive, so the sum and the quotient are correctly rounded; a relative error
+/// tan(phi/2) = lo / (r + hi) <= tan(pi/8): the range of the atan kernel as it stands. Both terms
+/// of r + hi are positive, so the sum and the quotient are correctly rounded; a relative error
 /// delta in r against sqrt(x^2 + y^2) moves the result by at most 0.42 delta (rad). For an elbow
 /// offset of an IK, whose length is the proximal link's to within the reach slack (16 eps).
 inline double fast_angle(double y, double x, double r) {
-  constexpr double kPio2Hi = 1.57079632679489655800e+00, kPio2Lo = 6.12323399573676603587e-17;
-  constexpr double kPiHi = 3.14159265358979311600e+00, kPiLo = 1.22464679914735317720e-16;
-  constexpr double aT0 = 3.33333333333329318027e-01, aT1 = -1.99999999998764832476e-01,
-                   aT2 = 1.42857142725034663711e-01, aT3 = -1.11111104054623557880e-01,
-                   aT4 = 9.09088713343650656196e-02, aT5 = -7.69187620504482999495e-02,
-                   aT6 = 6.66107313738753120669e-02, aT7 = -5.83357013379057348645e-02,
-                   aT8 = 4.97687799461593236017e-02, aT9 = -3.65315727442169155270e-02,
-                   aT10 = 1.62858201153657823623e-02;
   const double ax = std::fabs(x);
   const double ay = std::fabs(y);
   const double hi = ax > ay ? ax : ay;
   const double lo = ax > ay ? ay : ax;
-  const double t = lo / (r + hi);  // tan(phi / 2) in [0, tan(pi/8)]
-  const double z = t * t;
-  const double w = z * z;
-  const double s1 = z * (aT0 + w * (aT2 + w * (aT4 + w * (aT6 + w * (aT8 + w * aT10)))));
-  const double s2 = w * (aT1 + w * (aT3 + w * (aT5 + w * (aT7 + w * aT9))));
-  const double a0 = 2.0 * (t - t * (s1 + s2));  // exact doubling
-  const double a1 = ay > ax ? (kPio2Hi - a0) + kPio2Lo : a0;
-  const double a2 = x < 0.0 ? (kPiHi - a1) + kPiLo : a1;
-  return std::copysign(a2, y);
+  const double t = lo / (r + hi);                           // tan(phi / 2) in [0, tan(pi/8)]
+  return atan_unfold(2.0 * (t - atan_tail(t)), x, y);  // exact doubling
 }
 
 }  // namespace fivebar::detail
