@@ -736,7 +736,8 @@ TEST(DesignLimits, NamesFromAFileCannotInjectLinesOrTerminalEscapes) {
 namespace fivebar {
 namespace {
 
-const std::string kPatternStations = R"(stations:
+/// The paper's two stations as a `stations:` block, for sections that name them (patterns, controller).
+const std::string kPaperStations = R"(stations:
   index:
     target: {center: [6.25, 15.5], axes: [15, 12]}
     mechanisms:
@@ -750,7 +751,7 @@ const std::string kPatternStations = R"(stations:
 
 TEST(Loader, PatternsSectionDefaultsUnitsAndPerStationEntries) {
   // A bare section: the four kinds with their defaults, at 100 Hz, 360 deg/s.
-  const Design bare = load_design_from_string("name: p\npatterns:\n" + kPatternStations, "<test>");
+  const Design bare = load_design_from_string("name: p\npatterns:\n" + kPaperStations, "<test>");
   ASSERT_TRUE(bare.patterns.has_value());
   EXPECT_EQ(bare.patterns->rate_hz, 100.0);
   EXPECT_DOUBLE_EQ(bare.patterns->max_joint_speed, 2.0 * kPi);
@@ -769,7 +770,7 @@ patterns:
     thumb:
       stretch: {duration_s: 0.5}
       twist: {amplitude_mm: 5}
-)" + kPatternStations,
+)" + kPaperStations,
                                            "<test>");
   const PatternSettings& p = *d.patterns;
   EXPECT_EQ(p.rate_hz, 50.0);
@@ -801,7 +802,7 @@ patterns:
   EXPECT_EQ(thumb[2].kind, PatternKind::pivot);
   EXPECT_TRUE(p.for_station("nowhere").size() == 2u);  // the top-level kinds apply to any station
 
-  const Design none = load_design_from_string("name: p\n" + kPatternStations, "<test>");
+  const Design none = load_design_from_string("name: p\n" + kPaperStations, "<test>");
   EXPECT_FALSE(none.patterns.has_value());
 }
 
@@ -876,20 +877,8 @@ TEST(DesignValidate, PatternStationsMustExist) {
 namespace fivebar {
 namespace {
 
-const std::string kControllerStations = R"(stations:
-  index:
-    target: {center: [6.25, 15.5], axes: [15, 12]}
-    mechanisms:
-      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 15, 15], working_mode: "-+"}
-      upper: {bases: [[0, 31], [12.5, 31]], links: [9, 9, 15, 15], working_mode: "+-"}
-  thumb:
-    target: {center: [6.25, 17.5], axes: [15, 14]}
-    mechanisms:
-      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 17.5, 17.5], working_mode: "-+"}
-)";
-
 TEST(Loader, ControllerSectionAloneTakesEveryDefault) {
-  const Design d = load_design_from_string("name: c\ncontroller:\n" + kControllerStations, "<test>");
+  const Design d = load_design_from_string("name: c\ncontroller:\n" + kPaperStations, "<test>");
   ASSERT_TRUE(d.controller.has_value());
   const ControllerSettings& c = *d.controller;
   EXPECT_EQ(c.node, "fivebar_controller");
@@ -902,7 +891,7 @@ TEST(Loader, ControllerSectionAloneTakesEveryDefault) {
   EXPECT_TRUE(c.overrides.empty());
   // 5 V over 300 deg of travel: 60 deg per volt.
   EXPECT_DOUBLE_EQ(c.potentiometer.rad_per_volt, deg(60));
-  const Design none = load_design_from_string("name: c\n" + kControllerStations, "<test>");
+  const Design none = load_design_from_string("name: c\n" + kPaperStations, "<test>");
   EXPECT_FALSE(none.controller.has_value());
 }
 
@@ -925,7 +914,7 @@ controller:
         theta2:
           pid: {kp: 2}
           potentiometer: {volts_at_zero: 1.25, rad_per_volt: -4}
-)" + kControllerStations,
+)" + kPaperStations,
                                            "<test>");
   const ControllerSettings& c = *d.controller;
   EXPECT_EQ(c.node, "haptics_node");
@@ -971,7 +960,7 @@ controller:
     upper: {pid: {ki: 0.5}}
   stations:
     index: {pid: {kp: 4}}
-)" + kControllerStations,
+)" + kPaperStations,
                                            "<test>");
   const ControllerSettings& c = *d.controller;
   // A scope naming a station beats every station-less one, however narrow.
@@ -998,7 +987,7 @@ patterns:
 controller:
   loop_rate_hz: 200
   max_velocity_deg_s: 90
-)" + kControllerStations,
+)" + kPaperStations,
                                            "<test>");
   ASSERT_TRUE(d.patterns.has_value());
   EXPECT_EQ(d.patterns->rate_hz, 200.0);
@@ -1115,7 +1104,7 @@ TEST(DesignWriter, ShowcaseRoundTripsWithPatternsAndController) {
 }
 
 TEST(DesignWriter, PatternsWithoutControllerKeepTheirSpeedAndPivotContactPoints) {
-  Design d = load_design_from_string("name: w\n" + kControllerStations, "<test>");
+  Design d = load_design_from_string("name: w\n" + kPaperStations, "<test>");
   PatternSettings ps;
   ps.rate_hz = 50.0;
   ps.max_joint_speed = deg(123.5);
