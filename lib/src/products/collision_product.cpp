@@ -14,8 +14,6 @@ namespace fivebar::products {
 
 namespace {
 
-bool has_pair(const Station& s) { return s.lower.has_value() && s.upper.has_value(); }
-
 constexpr const char* kPreamble =
     "Both tactors of a station share the fingertip. Every pair of tactor positions on a grid over the "
     "target ellipse (upper anywhere, lower anywhere) is checked for interference of the two mechanisms' "
@@ -32,13 +30,7 @@ Product collision_product() {
   Product p;
   p.name = "collision";
   p.title = "Collision of the two tactors";
-  p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    if (!d.geometry) return "the design has no `geometry:` section (link widths and planes are needed)";
-    if (std::none_of(d.stations.begin(), d.stations.end(), has_pair)) {
-      return "no station has both a lower and an upper mechanism";
-    }
-    return std::nullopt;
-  };
+  p.unavailable = [](const Design& d) { return without_pairs(d, "link widths and planes are needed"); };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
     const Geometry& g = *d.geometry;

@@ -19,8 +19,6 @@ namespace {
 
 constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
-bool has_pair(const Station& s) { return s.lower.has_value() && s.upper.has_value(); }
-
 constexpr const char* kPreamble =
     "The skin-deformation patterns of the paper (Fig. 6: stretching, slipping, twisting) and pivoting "
     "(the tactors track two points of the rotating object), sampled at the controller rate. Every sample "
@@ -37,12 +35,8 @@ Product pattern_product() {
   p.name = "pattern";
   p.title = "Skin-deformation patterns";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    if (!d.geometry) return "the design has no `geometry:` section (collision checks need the link outlines)";
     if (!d.patterns) return "the design has no `patterns:` section";
-    if (std::none_of(d.stations.begin(), d.stations.end(), has_pair)) {
-      return "no station has both a lower and an upper mechanism";
-    }
-    return std::nullopt;
+    return without_pairs(d, "collision checks need the link outlines");
   };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;

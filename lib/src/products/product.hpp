@@ -63,6 +63,18 @@ inline std::optional<std::string> without_mechanisms(const Design& d) {
   return "no station has a mechanism";
 }
 
+/// True when both tactors of `s` are there (the products on a pair: collision, pattern).
+inline bool has_pair(const Station& s) { return s.lower.has_value() && s.upper.has_value(); }
+
+/// Product::unavailable for the products on a station's two tactors: they need the design's
+/// `geometry:` (`geometry_for` says what for) and a station with both mechanisms.
+inline std::optional<std::string> without_pairs(const Design& d, std::string_view geometry_for) {
+  if (!d.geometry) return "the design has no `geometry:` section (" + std::string(geometry_for) + ")";
+  for (const Station& s : d.stations)
+    if (has_pair(s)) return std::nullopt;
+  return "no station has both a lower and an upper mechanism";
+}
+
 /// All implemented products; run_scene() follows known_products() for the order.
 const std::vector<Product>& registry();
 /// The entry named `name`, or nullptr when this build does not implement it.
