@@ -96,16 +96,15 @@ inline void fk_one(const FkConst& g, double theta1, double theta2, double& px, d
 struct LegConst {
   double ox, oy;
   double r;                    // proximal link length |A - O|
-  detail::CirclePair circles;  // (O, L_i) and (P, L_{i+2})
-  double s;                    // chord side: -sigma of the working mode
+  detail::CirclePair circles;  // (O, L_i) and (P, L_{i+2}), on the chord side -sigma of the working mode
 };
 
 struct IkConst {
   LegConst g1, g2;
   double thr13, thr24, thr34;  // kSingularSin * L_I * L_J
   explicit IkConst(const Mechanism& m)
-      : g1{m.O1.x(), m.O1.y(), m.L[0], detail::CirclePair::make(m.L[0], m.L[2]), -double(m.working_mode.sign1)},
-        g2{m.O2.x(), m.O2.y(), m.L[1], detail::CirclePair::make(m.L[1], m.L[3]), -double(m.working_mode.sign2)},
+      : g1{m.O1.x(), m.O1.y(), m.L[0], detail::CirclePair::make(m.L[0], m.L[2]).on_side(-m.working_mode.sign1)},
+        g2{m.O2.x(), m.O2.y(), m.L[1], detail::CirclePair::make(m.L[1], m.L[3]).on_side(-m.working_mode.sign2)},
         thr13(tol::kSingularSin * m.L[0] * m.L[2]), thr24(tol::kSingularSin * m.L[1] * m.L[3]),
         thr34(tol::kSingularSin * m.L[2] * m.L[3]) {}
 };
@@ -116,9 +115,8 @@ inline bool elbow_offset(const LegConst& g, double px, double py, double& ex, do
   const double d2 = dx * dx + dy * dy;
   const bool coincident = !(d2 >= detail::kMinD2);
   const double inv_d2 = 1.0 / (coincident ? 1.0 : d2);
-  double t, hd;  // A - O = t (dx, dy) + s hd (-dy, dx)
-  const bool reach = !coincident & detail::chord(g.circles, d2, inv_d2, t, hd);
-  const double hs = g.s * hd;  // exact: s is +-1
+  double t, hs;  // A - O = t (dx, dy) + hs (-dy, dx), hs = s hd signed by the chord side s
+  const bool reach = !coincident & detail::chord(g.circles, d2, inv_d2, t, hs);
   // Finite when the circles meet (see detail::kMinD2); otherwise they may not be, and every caller selects
   // its outputs on the reach flag, so the offsets themselves are not selected.
   ex = t * dx - hs * dy;

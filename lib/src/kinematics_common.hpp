@@ -45,6 +45,13 @@ struct CirclePair {
     return {0.5 * ((r1 - r2) * (r1 + r2)), dm, dp, dm * (1.0 - tol::kReachRel), dp * (1.0 + tol::kReachRel),
             Pow4Scale::of(dp)};
   }
+  /// The same pair, with chord() returning side hd instead of hd (side = +-1, folded into the
+  /// exact power-of-two factor: bit for bit side times the unsigned result, one multiply fewer).
+  CirclePair on_side(double side) const {
+    CirclePair c = *this;
+    c.norm.u *= side;
+    return c;
+  }
 };
 
 /// chord()'s precondition: d^2 >= kMinD2. Centres closer than sqrt(kMinD2) ~ 1.5e-154 (times the
