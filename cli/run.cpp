@@ -55,9 +55,7 @@ int run_run(const RunOptions& opt) {
   SceneOptions options;
   options.out_root = opt.out;
   if (!opt.products.empty()) options.products = opt.products;
-  if (!opt.quiet) {
-    options.progress = [](std::string_view message) { std::cerr << "fivebar: " << message << "\n"; };
-  }
+  if (!opt.quiet) options.progress = terminal_progress("run");  // only for a person watching
   const SceneReport report = run_scene(design, options);
   if (opt.json) {
     Json doc = report.to_json();

@@ -512,6 +512,7 @@ TEST_F(Cli, RunProductsOptionAndSceneList) {
 
   const Outcome listed = run({"run", kDesign, "--out", out.string(), "--products", "kinematics", "--json"});
   ASSERT_EQ(listed.code, 0) << listed.err;
+  EXPECT_THAT(listed.err, IsEmpty());  // stderr is a file, not a terminal: no progress lines even without --quiet
   const json j = parse(listed);
   EXPECT_TRUE(j["products_listed"].get<bool>());
   EXPECT_TRUE(j["built"][0]["requested"].get<bool>());
