@@ -1,8 +1,6 @@
 // fivebar parts: OpenSCAD sources, STL renders, mesh and fit checks and the bill of materials of
 // a design's printed parts, into OUT/<name>/parts/.
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -63,9 +61,7 @@ int run_parts(const PartsCliOptions& opt) {
   if (!opt.station.empty()) options.station = opt.station;
   options.render = !opt.no_render;
   options.jobs = opt.jobs;
-  if (::isatty(STDERR_FILENO) != 0) {
-    options.progress = [](std::string_view line) { std::cerr << "fivebar: " << line << "\n"; };
-  }
+  options.progress = terminal_progress("parts");
   PartsReport report;
   try {
     report = build_parts(design, options);

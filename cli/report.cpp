@@ -1,8 +1,6 @@
 // fivebar report accuracy | stability: work-precision of every approximate answer, and the
 // catalogue of extreme cases against a __float128 reference.
 
-#include <unistd.h>
-
 #include <iostream>
 #include <memory>
 
@@ -24,8 +22,8 @@ struct ReportOptions {
 };
 
 std::function<void(std::string_view)> progress_sink(bool quiet) {
-  if (quiet || !::isatty(STDERR_FILENO)) return {};
-  return [](std::string_view message) { std::cerr << "fivebar: " << message << "\n"; };
+  if (quiet) return {};
+  return terminal_progress("report");
 }
 
 int run_accuracy(const ReportOptions& opt) {
