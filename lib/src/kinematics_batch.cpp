@@ -159,6 +159,29 @@ using Code = std::int16_t;
 constexpr std::size_t kBlock = 256;
 constexpr Code kOutsideBit = 4;  // fk_batch: an angle beyond the fast reduction's range
 
+/// The blocking of the batch loops: `body(b, len, code)` fills code[0, len) for the points
+/// [b, b + len), and each block's codes are then narrowed into `status`, with the `flags` bits
+/// masked off; returns the OR of those bits over all points. Inlined into each SIMD clone, and so
+/// must the body be (its lambda carries always_inline): a body left out of line is compiled once,
+/// for baseline x86-64, and the FK batch ran 3x slower so. ctest batch_kernels_inlined checks it.
+template <class Body>
+[[gnu::always_inline]] inline Code for_blocks(std::span<Status> status, Code flags, Body&& body) {
+  alignas(64) Code code[kBlock];
+  Code seen = 0;
+  for (std::size_t b = 0; b < status.size(); b += kBlock) {
+    const std::size_t len = std::min(kBlock, status.size() - b);
+    body(b, len, code);
+    Status* __restrict st = status.data() + b;
+    Code block_seen = 0;
+    for (std::size_t k = 0; k < len; ++k) {
+      st[k] = Status(code[k] & ~flags);
+      block_seen |= code[k] & flags;
+    }
+    seen |= block_seen;
+  }
+  return seen;
+}
+
 }  // namespace
 
 // --- scalar lean forms ---------------------------------------------------------------------------
@@ -214,10 +237,7 @@ FIVEBAR_SIMD_CLONES void fk_batch(const Mechanism& m, std::span<const double> th
     return (std::fabs(t1) <= detail::kFastTrigMax) & (std::fabs(t2) <= detail::kFastTrigMax) ? c : Code(c | kOutsideBit);
   };
   const bool any = m.assembly_mode == AssemblyMode::Any;
-  int any_outside = 0;
-  alignas(64) Code code[kBlock];
-  for (std::size_t b = 0; b < n; b += kBlock) {
-    const std::size_t len = std::min(kBlock, n - b);
+  const Code outside = for_blocks(status, kOutsideBit, [&](std::size_t b, std::size_t len, Code* __restrict code) __attribute__((always_inline)) {
     const double* __restrict t1 = theta1.data() + b;
     const double* __restrict t2 = theta2.data() + b;
     double* __restrict x = px.data() + b;
@@ -235,15 +255,8 @@ FIVEBAR_SIMD_CLONES void fk_batch(const Mechanism& m, std::span<const double> th
         code[k] = mark(t1[k], t2[k], c);
       }
     }
-    Status* __restrict st = status.data() + b;
-    int outside = 0;
-    for (std::size_t k = 0; k < len; ++k) {
-      st[k] = Status(code[k] & ~kOutsideBit);
-      outside |= code[k] & kOutsideBit;
-    }
-    any_outside |= outside;
-  }
-  if (!any_outside) return;
+  });
+  if (!outside) return;
   for (std::size_t k = 0; k < n; ++k) {
     if (!(std::fabs(theta1[k]) <= detail::kFastTrigMax && std::fabs(theta2[k]) <= detail::kFastTrigMax)) {
       const PointResult p = fk_point(m, theta1[k], theta2[k]);
@@ -256,30 +269,23 @@ FIVEBAR_SIMD_CLONES void fk_batch(const Mechanism& m, std::span<const double> th
 
 FIVEBAR_SIMD_CLONES void ik_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
               std::span<double> theta1, std::span<double> theta2, std::span<Status> status) {
-  const std::size_t n = px.size();
-  assert(py.size() == n && theta1.size() == n && theta2.size() == n && status.size() == n);
+  assert(py.size() == px.size() && theta1.size() == px.size() && theta2.size() == px.size() &&
+         status.size() == px.size());
   const IkConst g(m);
-  alignas(64) Code code[kBlock];
-  for (std::size_t b = 0; b < n; b += kBlock) {
-    const std::size_t len = std::min(kBlock, n - b);
+  for_blocks(status, 0, [&](std::size_t b, std::size_t len, Code* __restrict code) __attribute__((always_inline)) {
     const double* __restrict x = px.data() + b;
     const double* __restrict y = py.data() + b;
     double* __restrict t1 = theta1.data() + b;
     double* __restrict t2 = theta2.data() + b;
     for (std::size_t k = 0; k < len; ++k) ik_from_elbows<FastTrig>(g, elbows(g, x[k], y[k]), t1[k], t2[k], code[k]);
-    Status* __restrict st = status.data() + b;
-    for (std::size_t k = 0; k < len; ++k) st[k] = Status(code[k]);
-  }
+  });
 }
 
 FIVEBAR_SIMD_CLONES void lci_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
                std::span<double> lci, std::span<Status> status) {
-  const std::size_t n = px.size();
-  assert(py.size() == n && lci.size() == n && status.size() == n);
+  assert(py.size() == px.size() && lci.size() == px.size() && status.size() == px.size());
   const IkConst g(m);
-  alignas(64) Code code[kBlock];
-  for (std::size_t b = 0; b < n; b += kBlock) {
-    const std::size_t len = std::min(kBlock, n - b);
+  for_blocks(status, 0, [&](std::size_t b, std::size_t len, Code* __restrict code) __attribute__((always_inline)) {
     const double* __restrict x = px.data() + b;
     const double* __restrict y = py.data() + b;
     double* __restrict out = lci.data() + b;
@@ -294,9 +300,7 @@ FIVEBAR_SIMD_CLONES void lci_batch(const Mechanism& m, std::span<const double> p
       out[k] = c == Code(Status::ok) ? v : 0.0;
       code[k] = c;
     }
-    Status* __restrict st = status.data() + b;
-    for (std::size_t k = 0; k < len; ++k) st[k] = Status(code[k]);
-  }
+  });
 }
 
 FIVEBAR_SIMD_CLONES void conditioning_batch(const Mechanism& m, std::span<const double> px, std::span<const double> py,
