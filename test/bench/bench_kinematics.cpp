@@ -30,6 +30,7 @@ using fivebar::Status;
 using fivebar::Vec2;
 
 constexpr std::size_t kN = 4096;
+
 /// Points uniformly in the index target ellipse (15 x 12 mm at (6.25, 15.5)) and their angles.
 struct Data {
   std::vector<double> px, py, t1, t2, ox, oy, o1, o2;

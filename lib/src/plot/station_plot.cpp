@@ -799,7 +799,6 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
 using plot_detail::append;
 using plot_detail::check;
 
-
 }  // namespace
 
 void PlotOptions::validate() const {

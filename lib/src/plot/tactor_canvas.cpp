@@ -18,7 +18,6 @@ namespace {
 using plot_detail::append;
 using plot_detail::check;
 
-
 }  // namespace
 
 Canvas::Canvas(double width_px, double height_px) : width_(width_px), height_(height_px) {
