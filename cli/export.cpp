@@ -109,13 +109,13 @@ int run_export(const ExportCliOptions& opt) {
     for (const auto& f : r.files) files.push_back(f.generic_string());
     print_json({{"command", "export"},
                 {"design", design.name},
-                {"node", design.controller->node},
+                {"node", design.get<ControllerSettings>()->node},
                 {"design_hash", r.hash},
                 {"exported", r.gate.passed()},
                 {"files", files},
                 {"gate", to_json(r.gate)}});
   } else {
-    std::cout << "export of design " << design.name << " for node " << design.controller->node << ", stations ";
+    std::cout << "export of design " << design.name << " for node " << design.get<ControllerSettings>()->node << ", stations ";
     for (std::size_t i = 0; i < r.gate.stations.size(); ++i) std::cout << (i ? ", " : "") << r.gate.stations[i];
     std::cout << "\n";
     print_gate(r.gate);

@@ -43,9 +43,9 @@ PatternSpec spec_for(const PatternOptions& opt, const Design& design, const Stat
   PatternSpec spec;
   spec.kind = kind;
   if (kind == PatternKind::pivot) spec.duration_s = 2.0;
-  if (design.patterns) {
-    spec.rate_hz = design.patterns->rate_hz;
-    for (const PatternSpec& p : design.patterns->for_station(s.name)) {
+  if (design.get<PatternSettings>()) {
+    spec.rate_hz = design.get<PatternSettings>()->rate_hz;
+    for (const PatternSpec& p : design.get<PatternSettings>()->for_station(s.name)) {
       if (p.kind == kind) spec = p;
     }
   }
@@ -131,7 +131,7 @@ int run_pattern(const PatternOptions& opt) {
   const Geometry& g = require_geometry(design);
   const PatternSpec spec = spec_for(opt, design, s, *kind);
   double max_speed = PatternSettings{}.max_joint_speed;
-  if (design.patterns) max_speed = design.patterns->max_joint_speed;
+  if (design.get<PatternSettings>()) max_speed = design.get<PatternSettings>()->max_joint_speed;
   if (opt.max_speed_deg_s) max_speed = *opt.max_speed_deg_s / kDegPerRad;
 
   const PatternResult r = check_pattern(s, g, spec, max_speed);

@@ -72,7 +72,8 @@ SweepVariable parse_vary(const std::string& text) {
 
 /// The sweep settings: the design's `sweep:` section with the command line's values on top.
 SweepSettings settings_of(const Design& design, const SweepCliOptions& o) {
-  SweepSettings s = design.sweep.value_or(SweepSettings{});
+  const SweepSettings* given = design.get<SweepSettings>();
+  SweepSettings s = given ? *given : SweepSettings{};
   if (!o.station.empty()) s.station = o.station;
   if (s.station.empty() && design.stations.size() == 1) s.station = design.stations[0].name;
   if (!o.mechanism.empty()) s.mechanism = o.mechanism;
@@ -129,12 +130,12 @@ int run_sweep_cmd(const SweepCliOptions& o) {
   SweepSettings settings = settings_of(design, o);
   try {
     Design check = design;
-    check.sweep = settings;
+    check.set<SweepSettings>(settings);
     check.validate();
   } catch (const ValidationError& e) {
     throw InputError(o.design + ": sweep (file and command line): " + e.what());
   }
-  design.sweep = settings;
+  design.set<SweepSettings>(settings);
   SweepOptions options;
   options.out_dir = o.out.empty() ? std::filesystem::path("outputs") / design.name / "sweep" : std::filesystem::path(o.out);
   if (!o.shard.empty()) std::tie(options.shard, options.shards) = parse_shard(o.shard);

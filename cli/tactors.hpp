@@ -37,11 +37,11 @@ inline const Station& select_pair_station(const Design& design, const std::strin
 
 /// The design's geometry; InputError when the design has none.
 inline const Geometry& require_geometry(const Design& design) {
-  if (!design.geometry) {
+  if (!design.get<Geometry>()) {
     throw InputError("design '" + design.name + "' has no geometry: section: link widths, pins and planes are "
                      "needed to check collisions (see designs/iros2022.yaml)");
   }
-  return *design.geometry;
+  return *design.get<Geometry>();
 }
 
 /// --out, or outputs/<design name>/<sub> by default; created.

@@ -159,14 +159,14 @@ TEST_F(CliSweep, InterruptLeavesAValidCsvAndResumeCompletesIt) {
   // The CSV holds complete rows with contiguous indices, and no temporary file is left.
   const fivebar::Design design = [&] {
     fivebar::Design d = fivebar::load_design(kDesign);
-    d.sweep = fivebar::SweepSettings{};
-    d.sweep->station = "index";
-    d.sweep->mechanism = "lower";
-    d.sweep->vary = {{"L3", 11, 19, 400}, {"L4", 11, 19, 400}};
+    d.set(fivebar::SweepSettings{});
+    d.get<fivebar::SweepSettings>()->station = "index";
+    d.get<fivebar::SweepSettings>()->mechanism = "lower";
+    d.get<fivebar::SweepSettings>()->vary = {{"L3", 11, 19, 400}, {"L4", 11, 19, 400}};
     return d;
   }();
   std::uint64_t rows = 0;
-  fivebar::read_sweep_csv(dir_ / "cut" / "sweep.csv", *design.sweep, [&](const fivebar::SweepRow& r, const std::string&) {
+  fivebar::read_sweep_csv(dir_ / "cut" / "sweep.csv", *design.get<fivebar::SweepSettings>(), [&](const fivebar::SweepRow& r, const std::string&) {
     EXPECT_EQ(r.index, rows);
     ++rows;
   });

@@ -18,6 +18,7 @@
 
 #include <Eigen/Geometry>
 
+#include "fivebar/sections/geometry.hpp"
 #include "fivebar/collision.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/kinematics.hpp"
@@ -366,7 +367,7 @@ TEST(Interference, CrossingDistalLinksInTheSamePlaneCollide) {
 TEST(Interference, SymmetricInTheTwoMechanismsAndInvariantUnderRigidMotion) {
   const Design d = load_design(kDesign);
   const Station& s = *d.station("index");
-  const Geometry& g = *d.geometry;
+  const Geometry& g = *d.get<Geometry>();
   std::mt19937_64 rng(seed());
   std::uniform_real_distribution<double> ux(-1.25, 13.75), uy(9.5, 21.5), angle(-3.0, 3.0), shift(-50.0, 50.0);
   for (int i = 0; i < 200; ++i) {
@@ -408,14 +409,14 @@ TEST(Interference, PaperStationTactorsStackedVertically) {
     const Vec2 c = s.target.center;
     const Pose up = ik(*s.upper, c + Vec2(0, 0.5 * sep));
     const Pose low = ik(*s.lower, c - Vec2(0, 0.5 * sep));
-    const Interference in = interference(*s.upper, up, *s.lower, low, *d.geometry);
+    const Interference in = interference(*s.upper, up, *s.lower, low, *d.get<Geometry>());
     EXPECT_NEAR(in.min_clearance_mm, sep - 5.0, 1e-12);
     EXPECT_EQ(in.closest.plane, 1);
-    EXPECT_EQ(in.collides, sep - 5.0 < d.geometry->min_clearance);
+    EXPECT_EQ(in.collides, sep - 5.0 < d.get<Geometry>()->min_clearance);
   }
   // Both at the centre: the P bosses coincide (-5), the tactor disks too (-4).
   const Interference same =
-      interference(*s.upper, ik(*s.upper, s.target.center), *s.lower, ik(*s.lower, s.target.center), *d.geometry);
+      interference(*s.upper, ik(*s.upper, s.target.center), *s.lower, ik(*s.lower, s.target.center), *d.get<Geometry>());
   EXPECT_DOUBLE_EQ(same.min_clearance_mm, -5.0);
   const auto tactors = std::find_if(same.colliding.begin(), same.colliding.end(),
                                     [](const PairClearance& p) { return p.name() == "upper.tactor vs lower.tactor"; });
@@ -457,7 +458,7 @@ class PriorityRule : public ::testing::Test {
  protected:
   void SetUp() override {
     design_ = load_design(kDesign);
-    g_ = *design_.geometry;
+    g_ = *design_.get<Geometry>();
   }
   Design design_;
   Geometry g_;
@@ -562,7 +563,7 @@ TEST_F(PriorityRule, BadSearchOptionsAreInputErrors) {
 
 TEST(CollisionMap, PaperStations) {
   const Design d = load_design(kDesign);
-  const Geometry& g = *d.geometry;
+  const Geometry& g = *d.get<Geometry>();
   for (const Station& s : d.stations) {
     SCOPED_TRACE(s.name);
     const CollisionMap map = collision_map(s, g);
@@ -602,12 +603,12 @@ TEST(CollisionMap, NeedsBothMechanismsAndASensibleSpacing) {
   const Design d = load_design(kDesign);
   Station one = *d.station("index");
   one.upper.reset();
-  EXPECT_THAT([&] { collision_map(one, *d.geometry); }, ThrowsMessage<InputError>(HasSubstr("both")));
+  EXPECT_THAT([&] { collision_map(one, *d.get<Geometry>()); }, ThrowsMessage<InputError>(HasSubstr("both")));
   CollisionMapOptions o;
   o.spacing_mm = 0.0;
-  EXPECT_THROW(collision_map(*d.station("index"), *d.geometry, o), InputError);
+  EXPECT_THROW(collision_map(*d.station("index"), *d.get<Geometry>(), o), InputError);
   o.spacing_mm = 1e-4;
-  EXPECT_THROW(collision_map(*d.station("index"), *d.geometry, o), InputError);
+  EXPECT_THROW(collision_map(*d.station("index"), *d.get<Geometry>(), o), InputError);
 }
 
 TEST(CollisionMap, PictureAndJson) {
@@ -615,8 +616,8 @@ TEST(CollisionMap, PictureAndJson) {
   const Station& s = *d.station("index");
   CollisionMapOptions o;
   o.spacing_mm = 1.5;
-  const CollisionMap map = collision_map(s, *d.geometry, o);
-  const RenderedPlot pic = plot_collision_map(s, *d.geometry, map);
+  const CollisionMap map = collision_map(s, *d.get<Geometry>(), o);
+  const RenderedPlot pic = plot_collision_map(s, *d.get<Geometry>(), map);
   ASSERT_GT(pic.png.size(), 8u);
   EXPECT_EQ(pic.png.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8));
   EXPECT_THAT(pic.svg, HasSubstr("<svg"));
@@ -632,7 +633,7 @@ TEST(CollisionMap, PictureAndJson) {
 
 TEST(OutlinesCollide, SameVerdictAsTheUnprunedMinimumOnRandomPosePairs) {
   const Design d = load_design(kDesign);
-  const Geometry& g = *d.geometry;
+  const Geometry& g = *d.get<Geometry>();
   const Station& s = *d.station("index");
   std::mt19937_64 rng(seed());
   std::uniform_real_distribution<double> ux(-7.5, 7.5), uy(-6.0, 6.0);
@@ -656,7 +657,7 @@ TEST(OutlinesCollide, SameVerdictAsTheUnprunedMinimumOnRandomPosePairs) {
 
 TEST(CollisionFraction, CountsEveryUsablePairLikeAnUnprunedInterferenceCheck) {
   const Design d = load_design(kDesign);
-  const Geometry& g = *d.geometry;
+  const Geometry& g = *d.get<Geometry>();
   for (const Station& s : d.stations) {
     SCOPED_TRACE(s.name);
     const double spacing = 2.0;
@@ -701,7 +702,7 @@ TEST(CollisionFraction, CountsEveryUsablePairLikeAnUnprunedInterferenceCheck) {
 TEST(CollisionFraction, GrowsWithTheRequiredClearance) {
   const Design d = load_design(kDesign);
   const Station& s = *d.station("thumb");
-  Geometry g = *d.geometry;
+  Geometry g = *d.get<Geometry>();
   double last = -1.0;
   for (double clearance : {0.0, 0.5, 1.0, 2.0, 4.0}) {
     g.min_clearance = clearance;
@@ -719,7 +720,7 @@ TEST(CollisionFraction, GrowsWithTheRequiredClearance) {
 TEST(CollisionJson, InterferenceAndRule) {
   const Design d = load_design(kDesign);
   const Station& s = *d.station("index");
-  const PriorityResult r = apply_priority(*s.upper, *s.lower, *d.geometry, s.target.center, s.target.center);
+  const PriorityResult r = apply_priority(*s.upper, *s.lower, *d.get<Geometry>(), s.target.center, s.target.center);
   const Json j = to_json(r);
   EXPECT_EQ(j["status"], "moved");
   EXPECT_TRUE(j["before"]["collides"].get<bool>());

@@ -16,6 +16,11 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
+#include "fivebar/sections/print.hpp"
+#include "fivebar/sections/sweep.hpp"
 
 namespace fivebar {
 namespace {
@@ -554,22 +559,22 @@ TEST(Loader, GeometryAndPrintSectionsWithDefaults) {
 )";
   // A bare section takes every default; a scalar width applies to all four links.
   const Design bare = load_design_from_string("name: g\ngeometry:\nprint:\n" + stations, "<test>");
-  ASSERT_TRUE(bare.geometry && bare.print);
-  EXPECT_EQ(bare.geometry->link_width, (std::array<double, 4>{4.0, 4.0, 4.0, 4.0}));
-  EXPECT_EQ(bare.print->pin_clearance, 0.15);
+  ASSERT_TRUE(bare.get<Geometry>() && bare.get<PrintSettings>());
+  EXPECT_EQ(bare.get<Geometry>()->link_width, (std::array<double, 4>{4.0, 4.0, 4.0, 4.0}));
+  EXPECT_EQ(bare.get<PrintSettings>()->pin_clearance, 0.15);
   const Design set = load_design_from_string(
       "name: g\ngeometry: {link_width: 3.5, layers: [0, 1, 2, 3], pin_diameter: 1.5}\n"
       "print: {fn: 64, material: Grey V4, pin_clearance: 0.2}\n" + stations,
       "<test>");
-  EXPECT_EQ(set.geometry->link_width, (std::array<double, 4>{3.5, 3.5, 3.5, 3.5}));
-  EXPECT_EQ(set.geometry->layers, (std::array<int, 4>{0, 1, 2, 3}));
-  EXPECT_EQ(set.geometry->pin_diameter, 1.5);
-  EXPECT_EQ(set.print->fn, 64);
-  EXPECT_EQ(set.print->material, "Grey V4");
-  EXPECT_EQ(set.print->pin_clearance, 0.2);
+  EXPECT_EQ(set.get<Geometry>()->link_width, (std::array<double, 4>{3.5, 3.5, 3.5, 3.5}));
+  EXPECT_EQ(set.get<Geometry>()->layers, (std::array<int, 4>{0, 1, 2, 3}));
+  EXPECT_EQ(set.get<Geometry>()->pin_diameter, 1.5);
+  EXPECT_EQ(set.get<PrintSettings>()->fn, 64);
+  EXPECT_EQ(set.get<PrintSettings>()->material, "Grey V4");
+  EXPECT_EQ(set.get<PrintSettings>()->pin_clearance, 0.2);
   const Design none = load_design_from_string("name: g\n" + stations, "<test>");
-  EXPECT_FALSE(none.geometry.has_value());
-  EXPECT_FALSE(none.print.has_value());
+  EXPECT_FALSE(none.has<Geometry>());
+  EXPECT_FALSE(none.has<PrintSettings>());
 }
 
 TEST(GeometryValidate, Rules) {
@@ -644,9 +649,9 @@ TEST(DesignLimits, BracketsOutsideFlowCollectionsAreNotNesting) {
   EXPECT_EQ(message_of(block), "");
   const std::string quoted = kMinimal + "print:\n  material: \"a " + many + "\n    continued \\\" [[[ \"\n";
   EXPECT_EQ(message_of(quoted), "");
-  EXPECT_EQ(load_design_from_string(quoted, "q.yaml").print->material.substr(0, 4), "a [{");
+  EXPECT_EQ(load_design_from_string(quoted, "q.yaml").get<PrintSettings>()->material.substr(0, 4), "a [{");
   const std::string single = kMinimal + "print:\n  material: 'it''s [[[ {{{'\n";
-  EXPECT_EQ(load_design_from_string(single, "s.yaml").print->material, "it's [[[ {{{");
+  EXPECT_EQ(load_design_from_string(single, "s.yaml").get<PrintSettings>()->material, "it's [[[ {{{");
 }
 
 TEST(DesignLimits, UnclosedQuoteIsNamedWhereItOpens) {
@@ -752,13 +757,13 @@ const std::string kPaperStations = R"(stations:
 TEST(Loader, PatternsSectionDefaultsUnitsAndPerStationEntries) {
   // A bare section: the four kinds with their defaults, at 100 Hz, 360 deg/s.
   const Design bare = load_design_from_string("name: p\npatterns:\n" + kPaperStations, "<test>");
-  ASSERT_TRUE(bare.patterns.has_value());
-  EXPECT_EQ(bare.patterns->rate_hz, 100.0);
-  EXPECT_DOUBLE_EQ(bare.patterns->max_joint_speed, 2.0 * kPi);
-  ASSERT_EQ(bare.patterns->global.size(), 4u);
-  EXPECT_EQ(bare.patterns->global[3].kind, PatternKind::pivot);
-  EXPECT_EQ(bare.patterns->global[3].duration_s, 2.0);
-  EXPECT_DOUBLE_EQ(bare.patterns->global[3].pivot_amplitude, deg(20));
+  ASSERT_TRUE(bare.has<PatternSettings>());
+  EXPECT_EQ(bare.get<PatternSettings>()->rate_hz, 100.0);
+  EXPECT_DOUBLE_EQ(bare.get<PatternSettings>()->max_joint_speed, 2.0 * kPi);
+  ASSERT_EQ(bare.get<PatternSettings>()->global.size(), 4u);
+  EXPECT_EQ(bare.get<PatternSettings>()->global[3].kind, PatternKind::pivot);
+  EXPECT_EQ(bare.get<PatternSettings>()->global[3].duration_s, 2.0);
+  EXPECT_DOUBLE_EQ(bare.get<PatternSettings>()->global[3].pivot_amplitude, deg(20));
 
   const Design d = load_design_from_string(R"(name: p
 patterns:
@@ -772,7 +777,7 @@ patterns:
       twist: {amplitude_mm: 5}
 )" + kPaperStations,
                                            "<test>");
-  const PatternSettings& p = *d.patterns;
+  const PatternSettings& p = *d.get<PatternSettings>();
   EXPECT_EQ(p.rate_hz, 50.0);
   EXPECT_DOUBLE_EQ(p.max_joint_speed, deg(90));
   // The index has the two top-level kinds; the section's rate is their default.
@@ -803,19 +808,19 @@ patterns:
   EXPECT_TRUE(p.for_station("nowhere").size() == 2u);  // the top-level kinds apply to any station
 
   const Design none = load_design_from_string("name: p\n" + kPaperStations, "<test>");
-  EXPECT_FALSE(none.patterns.has_value());
+  EXPECT_FALSE(none.has<PatternSettings>());
 }
 
 TEST(Loader, ShowcasePatternsCoverTheFourKindsOnBothStations) {
   const Design d = load_design(kSourceDir / "designs/iros2022.yaml");
-  ASSERT_TRUE(d.patterns.has_value());
+  ASSERT_TRUE(d.has<PatternSettings>());
   for (const char* station : {"index", "thumb"}) {
-    const auto specs = d.patterns->for_station(station);
+    const auto specs = d.get<PatternSettings>()->for_station(station);
     ASSERT_EQ(specs.size(), 4u) << station;
     for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(specs[i].kind, all_pattern_kinds()[i]) << station;
   }
-  EXPECT_EQ(d.patterns->for_station("thumb")[2].amplitude_mm, 5.5);
-  EXPECT_EQ(d.patterns->for_station("index")[2].amplitude_mm, 4.0);
+  EXPECT_EQ(d.get<PatternSettings>()->for_station("thumb")[2].amplitude_mm, 5.5);
+  EXPECT_EQ(d.get<PatternSettings>()->for_station("index")[2].amplitude_mm, 4.0);
 }
 
 TEST(PatternValidate, Rules) {
@@ -859,12 +864,12 @@ TEST(PatternKinds, RoundTrip) {
 
 TEST(DesignValidate, PatternStationsMustExist) {
   Design d = valid_design();
-  d.patterns = PatternSettings{};
+  d.set<PatternSettings>(PatternSettings{});
   PatternSpec spec;
-  d.patterns->per_station.emplace_back("middle", spec);
+  d.get<PatternSettings>()->per_station.emplace_back("middle", spec);
   EXPECT_THAT([&] { d.validate(); },
               ThrowsMessage<InputError>(HasSubstr("patterns.stations.middle: no such station in this design (stations: index)")));
-  d.patterns->per_station.front().first = "index";
+  d.get<PatternSettings>()->per_station.front().first = "index";
   EXPECT_NO_THROW(d.validate());
 }
 
@@ -879,8 +884,8 @@ namespace {
 
 TEST(Loader, ControllerSectionAloneTakesEveryDefault) {
   const Design d = load_design_from_string("name: c\ncontroller:\n" + kPaperStations, "<test>");
-  ASSERT_TRUE(d.controller.has_value());
-  const ControllerSettings& c = *d.controller;
+  ASSERT_TRUE(d.has<ControllerSettings>());
+  const ControllerSettings& c = *d.get<ControllerSettings>();
   EXPECT_EQ(c.node, "fivebar_controller");
   EXPECT_EQ(c.loop_rate_hz, 100.0);  // paper: PID at 100 Hz
   EXPECT_EQ(c.pwm_hz, 1000.0);       // paper: 1 kHz PWM
@@ -892,7 +897,7 @@ TEST(Loader, ControllerSectionAloneTakesEveryDefault) {
   // 5 V over 300 deg of travel: 60 deg per volt.
   EXPECT_DOUBLE_EQ(c.potentiometer.rad_per_volt, deg(60));
   const Design none = load_design_from_string("name: c\n" + kPaperStations, "<test>");
-  EXPECT_FALSE(none.controller.has_value());
+  EXPECT_FALSE(none.has<ControllerSettings>());
 }
 
 TEST(Loader, ControllerUnitsAndOverridesFromTheWidestScopeToTheJoint) {
@@ -916,7 +921,7 @@ controller:
           potentiometer: {volts_at_zero: 1.25, rad_per_volt: -4}
 )" + kPaperStations,
                                            "<test>");
-  const ControllerSettings& c = *d.controller;
+  const ControllerSettings& c = *d.get<ControllerSettings>();
   EXPECT_EQ(c.node, "haptics_node");
   EXPECT_EQ(c.loop_rate_hz, 250.0);
   EXPECT_EQ(c.pwm_hz, 20000.0);
@@ -962,7 +967,7 @@ controller:
     index: {pid: {kp: 4}}
 )" + kPaperStations,
                                            "<test>");
-  const ControllerSettings& c = *d.controller;
+  const ControllerSettings& c = *d.get<ControllerSettings>();
   // A scope naming a station beats every station-less one, however narrow.
   EXPECT_EQ(c.joint("index", "lower", 1).pid.kp, 4.0);
   EXPECT_EQ(c.joint("index", "lower", 1).pid.kd, 0.01);  // not given by the station: the mechanisms'
@@ -975,8 +980,8 @@ controller:
   // The thumb has no upper mechanism: a rule for every upper mechanism is simply unused there.
   const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
   EXPECT_EQ(to_yaml(back), to_yaml(d));
-  EXPECT_EQ(back.controller->joint("thumb", "lower", 1).pid.kp, 2.5);
-  EXPECT_EQ(back.controller->joint("index", "lower", 1).pid.kp, 4.0);
+  EXPECT_EQ(back.get<ControllerSettings>()->joint("thumb", "lower", 1).pid.kp, 2.5);
+  EXPECT_EQ(back.get<ControllerSettings>()->joint("index", "lower", 1).pid.kp, 4.0);
 }
 
 TEST(Loader, PatternsTakeTheControllersRateAndTheOneSpeedLimit) {
@@ -989,11 +994,11 @@ controller:
   max_velocity_deg_s: 90
 )" + kPaperStations,
                                            "<test>");
-  ASSERT_TRUE(d.patterns.has_value());
-  EXPECT_EQ(d.patterns->rate_hz, 200.0);
-  EXPECT_DOUBLE_EQ(d.patterns->max_joint_speed, kPi / 2);
-  EXPECT_EQ(d.patterns->max_joint_speed, d.controller->max_velocity);
-  const auto specs = d.patterns->for_station("index");
+  ASSERT_TRUE(d.has<PatternSettings>());
+  EXPECT_EQ(d.get<PatternSettings>()->rate_hz, 200.0);
+  EXPECT_DOUBLE_EQ(d.get<PatternSettings>()->max_joint_speed, kPi / 2);
+  EXPECT_EQ(d.get<PatternSettings>()->max_joint_speed, d.get<ControllerSettings>()->max_velocity);
+  const auto specs = d.get<PatternSettings>()->for_station("index");
   ASSERT_EQ(specs.size(), 2u);
   EXPECT_EQ(specs[0].rate_hz, 200.0);  // the loop rate, unless the pattern says otherwise
   EXPECT_EQ(specs[1].rate_hz, 50.0);
@@ -1043,18 +1048,18 @@ TEST(ControllerValidate, Rules) {
 
 TEST(DesignValidate, OneJointSpeedLimitWithAController) {
   Design d = valid_design();
-  d.controller = ControllerSettings{};
-  d.patterns = PatternSettings{};
+  d.set<ControllerSettings>(ControllerSettings{});
+  d.set<PatternSettings>(PatternSettings{});
   EXPECT_NO_THROW(d.validate());  // both 360 deg/s by default
-  d.patterns->max_joint_speed = deg(180);
+  d.get<PatternSettings>()->max_joint_speed = deg(180);
   EXPECT_THAT([&] { d.validate(); },
               ThrowsMessage<InputError>(HasSubstr("patterns.max_joint_speed_deg_s = 180 deg/s: differs from "
                                                   "controller.max_velocity_deg_s (360 deg/s)")));
-  d.controller->max_velocity = deg(180);
+  d.get<ControllerSettings>()->max_velocity = deg(180);
   EXPECT_NO_THROW(d.validate());
   ControlOverride o;
   o.station = "index", o.mechanism = "upper";  // valid_design() has only the lower mechanism
-  d.controller->overrides.push_back(o);
+  d.get<ControllerSettings>()->overrides.push_back(o);
   EXPECT_THAT([&] { d.validate(); }, ThrowsMessage<InputError>(HasSubstr("controller.stations.index.upper: station "
                                                                            "'index' has no upper mechanism")));
 }
@@ -1063,17 +1068,17 @@ TEST(DesignValidate, OneJointSpeedLimitWithAController) {
 // means equal values), and the values that matter are checked one by one as well.
 TEST(DesignWriter, ShowcaseRoundTripsWithPatternsAndController) {
   const Design d = load_design(kSourceDir / "designs/iros2022.yaml");
-  ASSERT_TRUE(d.patterns && d.controller);
+  ASSERT_TRUE(d.get<PatternSettings>() && d.get<ControllerSettings>());
   const std::string text = to_yaml(d);
   EXPECT_THAT(text, HasSubstr("patterns:"));
   EXPECT_THAT(text, HasSubstr("controller:"));
   EXPECT_THAT(text, ::testing::Not(HasSubstr("max_joint_speed_deg_s")));  // the controller owns the limit
   const Design back = load_design_from_string(text, "<to_yaml>");
   EXPECT_EQ(to_yaml(back), text);
-  ASSERT_TRUE(back.patterns && back.controller);
-  EXPECT_EQ(back.patterns->max_joint_speed, d.patterns->max_joint_speed);
+  ASSERT_TRUE(back.get<PatternSettings>() && back.get<ControllerSettings>());
+  EXPECT_EQ(back.get<PatternSettings>()->max_joint_speed, d.get<PatternSettings>()->max_joint_speed);
   for (const char* station : {"index", "thumb"}) {
-    const auto a = d.patterns->for_station(station), b = back.patterns->for_station(station);
+    const auto a = d.get<PatternSettings>()->for_station(station), b = back.get<PatternSettings>()->for_station(station);
     ASSERT_EQ(a.size(), b.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
       EXPECT_EQ(a[i].kind, b[i].kind);
@@ -1086,7 +1091,7 @@ TEST(DesignWriter, ShowcaseRoundTripsWithPatternsAndController) {
     }
     for (const char* m : {"lower", "upper"}) {
       for (int j = 1; j <= 2; ++j) {
-        const JointControl x = d.controller->joint(station, m, j), y = back.controller->joint(station, m, j);
+        const JointControl x = d.get<ControllerSettings>()->joint(station, m, j), y = back.get<ControllerSettings>()->joint(station, m, j);
         EXPECT_EQ(x.pid.kp, y.pid.kp);
         EXPECT_EQ(x.pid.ki, y.pid.ki);
         EXPECT_EQ(x.pid.kd, y.pid.kd);
@@ -1096,11 +1101,11 @@ TEST(DesignWriter, ShowcaseRoundTripsWithPatternsAndController) {
       }
     }
   }
-  EXPECT_EQ(back.patterns->for_station("thumb")[2].amplitude_mm, 5.5);  // the thumb's own twist
-  EXPECT_EQ(back.controller->node, d.controller->node);
-  EXPECT_EQ(back.controller->max_velocity, d.controller->max_velocity);
-  EXPECT_EQ(back.controller->adc_range_v, d.controller->adc_range_v);
-  EXPECT_EQ(back.controller->joint("index", "upper", 1).potentiometer.volts_at_zero, 4.75);
+  EXPECT_EQ(back.get<PatternSettings>()->for_station("thumb")[2].amplitude_mm, 5.5);  // the thumb's own twist
+  EXPECT_EQ(back.get<ControllerSettings>()->node, d.get<ControllerSettings>()->node);
+  EXPECT_EQ(back.get<ControllerSettings>()->max_velocity, d.get<ControllerSettings>()->max_velocity);
+  EXPECT_EQ(back.get<ControllerSettings>()->adc_range_v, d.get<ControllerSettings>()->adc_range_v);
+  EXPECT_EQ(back.get<ControllerSettings>()->joint("index", "upper", 1).potentiometer.volts_at_zero, 4.75);
 }
 
 TEST(DesignWriter, PatternsWithoutControllerKeepTheirSpeedAndPivotContactPoints) {
@@ -1119,19 +1124,19 @@ TEST(DesignWriter, PatternsWithoutControllerKeepTheirSpeedAndPivotContactPoints)
   slip.kind = PatternKind::slip;
   slip.amplitude_mm = 0.1 + 0.2;  // not a short decimal: must still come back bit for bit
   ps.per_station.emplace_back("thumb", slip);
-  d.patterns = ps;
+  d.set<PatternSettings>(ps);
   d.validate();
   const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
-  ASSERT_TRUE(back.patterns.has_value());
-  EXPECT_EQ(back.patterns->rate_hz, 50.0);
-  EXPECT_EQ(back.patterns->max_joint_speed, deg(123.5));
-  ASSERT_EQ(back.patterns->global.size(), 1u);
-  const PatternSpec& p = back.patterns->global[0];
+  ASSERT_TRUE(back.has<PatternSettings>());
+  EXPECT_EQ(back.get<PatternSettings>()->rate_hz, 50.0);
+  EXPECT_EQ(back.get<PatternSettings>()->max_joint_speed, deg(123.5));
+  ASSERT_EQ(back.get<PatternSettings>()->global.size(), 1u);
+  const PatternSpec& p = back.get<PatternSettings>()->global[0];
   EXPECT_EQ(p.pivot_amplitude, deg(12.5));
   ASSERT_TRUE(p.contact_points.has_value());
   EXPECT_EQ((*p.contact_points)[1], Vec2(-0.7, -2.9));
   EXPECT_EQ(p.centre, Vec2(6.0, 15.0));
-  const auto thumb = back.patterns->for_station("thumb");
+  const auto thumb = back.get<PatternSettings>()->for_station("thumb");
   ASSERT_EQ(thumb.size(), 2u);
   EXPECT_EQ(thumb[0].kind, PatternKind::slip);
   EXPECT_EQ(thumb[0].amplitude_mm, 0.1 + 0.2);

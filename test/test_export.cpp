@@ -23,6 +23,11 @@
 #include <thread>
 #include <vector>
 
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
+#include "fivebar/sections/print.hpp"
+#include "fivebar/sections/sweep.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export.hpp"
 #include "fivebar/io.hpp"
@@ -116,13 +121,13 @@ TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
     edit(e);
     return design_hash(e, {});
   };
-  EXPECT_NE(changed([](Design& e) { e.controller->pid.kp = 5.5; }), h);
+  EXPECT_NE(changed([](Design& e) { e.get<ControllerSettings>()->pid.kp = 5.5; }), h);
   EXPECT_NE(changed([](Design& e) { e.stations[0].lower->L[2] = 15.25; }), h);
-  EXPECT_NE(changed([](Design& e) { e.patterns->global[0].amplitude_mm = 2.5; }), h);
-  EXPECT_NE(changed([](Design& e) { e.geometry->min_clearance = 0.25; }), h);
+  EXPECT_NE(changed([](Design& e) { e.get<PatternSettings>()->global[0].amplitude_mm = 2.5; }), h);
+  EXPECT_NE(changed([](Design& e) { e.get<Geometry>()->min_clearance = 0.25; }), h);
   // Printing, sweeping and the product list do not make a controller file stale.
-  EXPECT_EQ(changed([](Design& e) { e.print->fn = 24; }), h);
-  EXPECT_EQ(changed([](Design& e) { e.sweep.reset(); }), h);
+  EXPECT_EQ(changed([](Design& e) { e.get<PrintSettings>()->fn = 24; }), h);
+  EXPECT_EQ(changed([](Design& e) { e.reset<SweepSettings>(); }), h);
   EXPECT_EQ(changed([](Design& e) { e.products = std::vector<std::string>{"export"}; }), h);
   // A one-station export hashes its station only: the thumb's gains do not touch it.
   const std::string index_only = design_hash(d, {"index"});
@@ -130,7 +135,7 @@ TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
   Design e = paper();
   ControlOverride o;
   o.station = "thumb", o.kp = 9.0;
-  e.controller->overrides.push_back(o);
+  e.get<ControllerSettings>()->overrides.push_back(o);
   EXPECT_EQ(design_hash(e, {"index"}), index_only);
   EXPECT_NE(design_hash(e, {}), h);
 }
@@ -395,13 +400,13 @@ TEST(Gate, SingularityThresholdAgainstTheLciAtTheEllipsesBottom) {
   const Station& s = d.stations[0];
   const Pose bottom = ik(*s.lower, s.target.center - Vec2(0.0, s.target.axes.y() / 2));
   ASSERT_EQ(bottom.status, Status::ok);
-  d.controller->min_lci = std::min(1.0, bottom.lci + 0.01);
+  d.get<ControllerSettings>()->min_lci = std::min(1.0, bottom.lci + 0.01);
   const ExportGate g = export_gate(d, {.stations = {"index"}});
   EXPECT_FALSE(g.passed());
   EXPECT_THAT(failed_kinds(g), Contains(std::string("index/lower singularity")));
   EXPECT_THAT(g.reasons(), Contains(AllOf(StartsWith("index/lower singularity: min LCI over the ellipse"),
                                           HasSubstr("below"))));
-  d.controller->min_lci = 0.0;
+  d.get<ControllerSettings>()->min_lci = 0.0;
   d.stations[0].lower->min_lci = 0.3;  // a mechanism's own threshold counts too (0.362 > 0.3)
   EXPECT_TRUE(export_gate(d, {.stations = {"index"}}).passed());
 }
@@ -426,10 +431,10 @@ TEST(Gate, EveryFailureIsListedAtOnce) {
   d.stations[1].target.axes = Vec2(40.0, 40.0);  // the thumb cannot cover this
   ControlOverride o;
   o.station = "index", o.mechanism = "lower", o.joint = 1, o.volts_at_zero = 9.0;  // 180 deg reads 12 V
-  d.controller->overrides.push_back(o);
+  d.get<ControllerSettings>()->overrides.push_back(o);
   PatternSpec twist;  // index twist beyond the ~5.3 mm where L3 meets the upper's tactor joint
   twist.kind = PatternKind::twist, twist.amplitude_mm = 7.0, twist.separation_mm = 8.0;
-  d.patterns->per_station.emplace_back("index", twist);
+  d.get<PatternSettings>()->per_station.emplace_back("index", twist);
   d.validate();
   const ExportGate g = export_gate(d);
   const auto failed = failed_kinds(g);
@@ -446,12 +451,12 @@ TEST(Gate, EveryFailureIsListedAtOnce) {
 TEST(Gate, NamesMustBeIdentifiersInEveryFormat) {
   Design d = paper();
   d.stations[0].name = "int";
-  d.sweep.reset();
-  d.controller->node = "linux";
-  for (auto& o : d.controller->overrides) {
+  d.reset<SweepSettings>();
+  d.get<ControllerSettings>()->node = "linux";
+  for (auto& o : d.get<ControllerSettings>()->overrides) {
     if (o.station == "index") o.station = "int";
   }
-  for (auto& e : d.patterns->per_station) {
+  for (auto& e : d.get<PatternSettings>()->per_station) {
     if (e.first == "index") e.first = "int";
   }
   d.validate();
@@ -464,12 +469,12 @@ TEST(Gate, NamesMustBeIdentifiersInEveryFormat) {
 
 TEST(Gate, NeedsTheControllerSectionAndGeometry) {
   Design d = paper();
-  d.controller.reset();
+  d.reset<ControllerSettings>();
   EXPECT_THAT([&] { export_gate(d); }, ThrowsMessage<InputError>(HasSubstr("has no controller: section")));
   d = paper();
   EXPECT_THAT([&] { export_gate(d, {.stations = {"pinky"}}); },
               ThrowsMessage<InputError>(HasSubstr("unknown station 'pinky'")));
-  d.geometry.reset();
+  d.reset<Geometry>();
   const ExportGate g = export_gate(d);
   EXPECT_THAT(failed_kinds(g), Contains(std::string("design geometry")));
   EXPECT_THAT(failed_kinds(g), Contains(std::string("index stretch pattern")));
@@ -493,7 +498,7 @@ class ExportFiles : public ::testing::Test {
 
 Design failing() {
   Design d = paper();
-  d.controller->min_lci = 0.99;  // no five-bar is that well conditioned over a 15 mm ellipse
+  d.get<ControllerSettings>()->min_lci = 0.99;  // no five-bar is that well conditioned over a 15 mm ellipse
   return d;
 }
 
@@ -601,7 +606,7 @@ TEST(Check, AnIntegerWhereADoubleIsDeclaredIsADifference) {
 TEST(Check, AStaleFileIsReportedByHashAndValue) {
   const std::string yaml = render_ros2_yaml(controller_parameters(paper(), {}));
   Design changed = paper();
-  changed.controller->pid.kd = 0.06;
+  changed.get<ControllerSettings>()->pid.kd = 0.06;
   const ExportCheck c = check_export(yaml, ExportFormat::ros2, changed, "f.yaml");
   EXPECT_FALSE(c.hash_matches());
   EXPECT_FALSE(c.matches());

@@ -10,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
 #include "fivebar/export.hpp"
 #include "fivebar/version.hpp"
 #include "header_values.hpp"
@@ -22,7 +24,7 @@ const fs::path kSource = FIVEBAR_SOURCE_DIR;
 
 TEST(ExportedHeader, EveryCompiledValueEqualsTheDesign) {
   const Design d = load_design(kSource / "designs" / "iros2022.yaml");
-  const ControllerSettings& c = *d.controller;
+  const ControllerSettings& c = *d.get<ControllerSettings>();
   const fivebar_test::HeaderValues v = fivebar_test::header_values();
   EXPECT_EQ(v.design, d.name);
   EXPECT_EQ(v.design_hash, design_hash(d, {}));
@@ -83,10 +85,10 @@ TEST(ExportedHeader, EveryCompiledValueEqualsTheDesign) {
     EXPECT_EQ(hj.max_velocity, c.max_velocity);
   }
   EXPECT_EQ(v.collision_priority, "upper");
-  EXPECT_EQ(v.min_clearance, d.geometry->min_clearance / 1000);
+  EXPECT_EQ(v.min_clearance, d.get<Geometry>()->min_clearance / 1000);
   for (int k = 0; k < 4; ++k) {
-    EXPECT_EQ(v.link_widths[k], d.geometry->link_width[k] / 1000);
-    EXPECT_EQ(v.layers[k], d.geometry->layers[k]);
+    EXPECT_EQ(v.link_widths[k], d.get<Geometry>()->link_width[k] / 1000);
+    EXPECT_EQ(v.layers[k], d.get<Geometry>()->layers[k]);
   }
 }
 

@@ -30,6 +30,9 @@
 #include <vector>
 
 #include "cli_test.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
+#include "fivebar/sections/print.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
@@ -174,7 +177,7 @@ class Parts : public ft::CliTest {
   /// The paper's device at $fn 24, tip sizes pinned so that the expected post height is known here.
   Design paper() {
     Design d = load_design(kDesign);
-    d.print->fn = kFn;
+    d.get<PrintSettings>()->fn = kFn;
     return d;
   }
   PartsOptions options(const fs::path& out, std::optional<std::string> station = "index") {
@@ -370,7 +373,7 @@ TEST_F(Parts, PlanOfThePaperIndexStation) {
 
 TEST_F(Parts, LayersChooseWhichDistalLinkCarriesTheTactor) {
   Design d = paper();
-  d.geometry->layers = {0, 0, 1, 2};  // L4 above L3: the post must not pass through L3
+  d.get<Geometry>()->layers = {0, 0, 1, 2};  // L4 above L3: the post must not pass through L3
   const auto plan = plan_parts(d, options(dir_ / "out"));
   for (const auto& p : plan) {
     if (p.name.starts_with("distal_link_tactor")) {
@@ -435,7 +438,7 @@ TEST_F(Parts, OtherUnprintableNumbersNameTheirKey) {
                             "stations.index.mechanisms.lower.bases[0]")));
   // No geometry section, an unknown station.
   Design bare = paper();
-  bare.geometry.reset();
+  bare.reset<Geometry>();
   EXPECT_THAT([&] { (void)build_parts(bare, options(out)); },
               ::testing::ThrowsMessage<InputError>(HasSubstr("no geometry: section")));
   EXPECT_THAT([&] { (void)build_parts(paper(), options(out, "pinky")); },
@@ -652,8 +655,8 @@ TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {
 
   Design d = paper();
   d.stations.pop_back();  // the scene has the index station only
-  if (d.patterns) {       // and so no per-station pattern settings for the thumb
-    std::erase_if(d.patterns->per_station, [](const auto& entry) { return entry.first == "thumb"; });
+  if (d.get<PatternSettings>()) {       // and so no per-station pattern settings for the thumb
+    std::erase_if(d.get<PatternSettings>()->per_station, [](const auto& entry) { return entry.first == "thumb"; });
   }
   SceneOptions so;
   so.out_root = dir_ / "scene";
@@ -675,7 +678,7 @@ TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {
 
   // Left out, with the reason: no geometry; openscad not installed.
   Design bare = paper();
-  bare.geometry.reset();
+  bare.reset<Geometry>();
   so.products.reset();
   for (const auto& p : run_scene(bare, so).products) {
     if (p.name == "parts") EXPECT_THAT(p.reason, HasSubstr("geometry"));

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/pattern.hpp"
@@ -153,15 +155,15 @@ class PaperPatterns : public ::testing::Test {
  protected:
   void SetUp() override { design_ = load_design(kDesign); }
   const Station& station(const char* name) const { return *design_.station(name); }
-  const Geometry& geometry() const { return *design_.geometry; }
-  double max_speed() const { return design_.patterns->max_joint_speed; }
+  const Geometry& geometry() const { return *design_.get<Geometry>(); }
+  double max_speed() const { return design_.get<PatternSettings>()->max_joint_speed; }
   Design design_;
 };
 
 TEST_F(PaperPatterns, TheShowcasePatternsAllRender) {
-  ASSERT_TRUE(design_.patterns.has_value());
+  ASSERT_TRUE(design_.has<PatternSettings>());
   for (const Station& s : design_.stations) {
-    const auto specs = design_.patterns->for_station(s.name);
+    const auto specs = design_.get<PatternSettings>()->for_station(s.name);
     ASSERT_EQ(specs.size(), 4u) << s.name;
     for (const PatternSpec& sp : specs) {
       SCOPED_TRACE(s.name + " " + std::string(to_string(sp.kind)));

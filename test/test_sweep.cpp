@@ -12,6 +12,11 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
+#include "fivebar/sections/print.hpp"
+#include "fivebar/sections/sweep.hpp"
 #include "fivebar/collision.hpp"
 #include "fivebar/coverage.hpp"
 #include "fivebar/sweep.hpp"
@@ -25,7 +30,7 @@ Design paper_design() { return load_design(std::filesystem::path(FIVEBAR_SOURCE_
 
 Design with_sweep(SweepSettings s) {
   Design d = paper_design();
-  d.sweep = std::move(s);
+  d.set<SweepSettings>(std::move(s));
   d.validate();
   return d;
 }
@@ -119,12 +124,12 @@ TEST(Enumeration, SobolIsMoreUniformThanRandom) {
 TEST(Evaluation, RowsAgreeWithSingleDesignCoverage) {
   const Design d = with_sweep(grid({{"L34", 11, 19, 25}, {"L12", 6, 12, 25}}));
   std::mt19937_64 rng(test_seed());
-  std::uniform_int_distribution<std::uint64_t> pick(0, sweep_size(*d.sweep) - 1);
+  std::uniform_int_distribution<std::uint64_t> pick(0, sweep_size(*d.get<SweepSettings>()) - 1);
   int covered = 0, not_covered = 0;
   for (int trial = 0; trial < 40; ++trial) {
     const std::uint64_t i = pick(rng);
-    const SweepRow row = evaluate_sweep_design(d, *d.sweep, i);
-    const Station st = apply_sweep(d, *d.sweep, row.values);
+    const SweepRow row = evaluate_sweep_design(d, *d.get<SweepSettings>(), i);
+    const Station st = apply_sweep(d, *d.get<SweepSettings>(), row.values);
     EXPECT_EQ(st.lower->L[2], row.values[0]);
     EXPECT_EQ(st.upper->L[0], row.values[1]);
     const StationCoverage ref = station_coverage(st);
@@ -148,7 +153,7 @@ TEST(Evaluation, RowsAgreeWithSingleDesignCoverage) {
 TEST(Evaluation, InvalidDesignsAreRowsNotErrors) {
   // L12 down to 2 mm is shorter than the geometry's 5 mm pin bosses.
   const Design d = with_sweep(grid({{"L12", 2, 9, 8}}));
-  const SweepRow bad = evaluate_sweep_design(d, *d.sweep, 0);
+  const SweepRow bad = evaluate_sweep_design(d, *d.get<SweepSettings>(), 0);
   EXPECT_THAT(bad.status, ::testing::StartsWith("invalid: "));
   EXPECT_THAT(bad.status, ::testing::HasSubstr("boss_diameter"));
   EXPECT_FALSE(bad.covered);
@@ -173,7 +178,7 @@ TEST(Evaluation, CollisionFractionOfCoveredDesignsOnly) {
     }
     ++covered;
     const Station st = apply_sweep(d, s, row.values);
-    const CollisionFraction ref = collision_fraction(st, *d.geometry, 2.5);
+    const CollisionFraction ref = collision_fraction(st, *d.get<Geometry>(), 2.5);
     EXPECT_EQ(row.collision_fraction, ref.fraction);
     EXPECT_GT(row.collision_fraction, 0.0);
     EXPECT_LT(row.collision_fraction, 1.0);
@@ -187,15 +192,15 @@ TEST(Evaluation, CollisionFractionOfCoveredDesignsOnly) {
   s.objectives = {"margin"};
   const Design off = with_sweep(s);
   Design bare = paper_design();
-  bare.geometry.reset();
-  bare.print.reset();
-  bare.controller.reset();
-  bare.patterns.reset();
-  bare.sweep = grid({{"L34", 11, 19, 9}});
+  bare.reset<Geometry>();
+  bare.reset<PrintSettings>();
+  bare.reset<ControllerSettings>();
+  bare.reset<PatternSettings>();
+  bare.set<SweepSettings>(grid({{"L34", 11, 19, 9}}));
   bare.validate();
   for (std::uint64_t i = 0; i < sweep_size(s); ++i) {
-    EXPECT_TRUE(std::isnan(evaluate_sweep_design(off, *off.sweep, i).collision_fraction));
-    EXPECT_TRUE(std::isnan(evaluate_sweep_design(bare, *bare.sweep, i).collision_fraction));
+    EXPECT_TRUE(std::isnan(evaluate_sweep_design(off, *off.get<SweepSettings>(), i).collision_fraction));
+    EXPECT_TRUE(std::isnan(evaluate_sweep_design(bare, *bare.get<SweepSettings>(), i).collision_fraction));
   }
 }
 
@@ -209,7 +214,7 @@ TEST(Evaluation, CollisionGridIsNeverFinerThanTwentyFourStepsAcross) {
   EXPECT_DOUBLE_EQ(sweep_collision_spacing(s, st.target), 15.0 / 24.0);
   const SweepRow row = evaluate_sweep_design(d, s, 0);
   ASSERT_TRUE(row.covered) << row.status;
-  EXPECT_EQ(row.collision_fraction, collision_fraction(st, *d.geometry, 15.0 / 24.0).fraction);
+  EXPECT_EQ(row.collision_fraction, collision_fraction(st, *d.get<Geometry>(), 15.0 / 24.0).fraction);
   // A spacing coarser than that is kept as it is.
   s.collision_spacing_mm = 3.0;
   EXPECT_EQ(sweep_collision_spacing(s, st.target), 3.0);
@@ -219,18 +224,18 @@ TEST(Evaluation, CollisionObjectiveNeedsGeometryAndBothMechanisms) {
   SweepSettings s = grid({{"L34", 11, 19, 3}});
   s.objectives = {"collision"};
   Design d = paper_design();
-  d.geometry.reset();
-  d.print.reset();
-  d.controller.reset();
-  d.patterns.reset();
-  d.sweep = s;
+  d.reset<Geometry>();
+  d.reset<PrintSettings>();
+  d.reset<ControllerSettings>();
+  d.reset<PatternSettings>();
+  d.set<SweepSettings>(s);
   EXPECT_THAT([&] { d.validate(); },
               ::testing::ThrowsMessage<ValidationError>(::testing::HasSubstr("needs the geometry: section")));
   Design one = paper_design();
   one.stations[0].upper.reset();
-  one.controller.reset();
-  one.patterns.reset();
-  one.sweep = s;
+  one.reset<ControllerSettings>();
+  one.reset<PatternSettings>();
+  one.set<SweepSettings>(s);
   EXPECT_THAT([&] { one.validate(); }, ::testing::ThrowsMessage<ValidationError>(::testing::HasSubstr("both a lower and an upper")));
 }
 
@@ -251,7 +256,7 @@ TEST(Run, ShardsAndThreadsReproduceTheSerialRowsAndResumeContinuesExactly) {
   two.out_dir = temp_dir("threads");
   EXPECT_EQ(slurp(run_sweep(d, two).csv), rows);
 
-  std::string joined = sweep_csv_header(*d.sweep) + "\n";
+  std::string joined = sweep_csv_header(*d.get<SweepSettings>()) + "\n";
   for (std::uint64_t k = 0; k < 3; ++k) {
     SweepOptions shard = o;
     shard.out_dir = temp_dir("shards");
@@ -332,7 +337,7 @@ TEST(Run, ParetoSetIsExactlyTheBruteForceNonDominatedSet) {
   EXPECT_EQ(best.name, "iros2022-best");  // its outputs do not overwrite the swept design's
   EXPECT_EQ(best.station("index")->lower->L[2], r.best->values[0]);
   EXPECT_EQ(best.station("index")->upper->L[0], r.best->values[1]);
-  EXPECT_FALSE(best.sweep.has_value());
+  EXPECT_FALSE(best.has<SweepSettings>());
   std::filesystem::remove_all(o.out_dir);
 }
 
@@ -341,7 +346,7 @@ TEST(DesignFile, ToYamlRoundTrips) {
   d.stations[0].lower->joint_limits = std::array<JointRange, 2>{JointRange{0.1, 3.0}, JointRange{-0.5, 2.0}};
   d.stations[0].lower->min_lci = 0.125;
   d.stations[1].target.angle = 0.3;
-  d.sweep = grid({{"L34", 12, 18, 13}});
+  d.set<SweepSettings>(grid({{"L34", 12, 18, 13}}));
   d.products = std::vector<std::string>{"kinematics"};
   const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");
   EXPECT_EQ(to_yaml(back), to_yaml(d));
@@ -351,8 +356,8 @@ TEST(DesignFile, ToYamlRoundTrips) {
   EXPECT_NEAR(m.joint_limits->at(1).span(), 2.5, 1e-12);
   EXPECT_EQ(m.min_lci, 0.125);
   EXPECT_NEAR(back.stations[1].target.angle, 0.3, 1e-12);
-  EXPECT_EQ(back.geometry->link_width, d.geometry->link_width);
-  EXPECT_EQ(back.print->material, d.print->material);
+  EXPECT_EQ(back.get<Geometry>()->link_width, d.get<Geometry>()->link_width);
+  EXPECT_EQ(back.get<PrintSettings>()->material, d.get<PrintSettings>()->material);
 }
 
 TEST(Shard, ParseRules) {

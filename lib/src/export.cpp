@@ -97,12 +97,12 @@ std::vector<std::string> chosen_stations(const Design& d, const std::vector<std:
 }
 
 const ControllerSettings& require_controller(const Design& d) {
-  if (!d.controller) {
+  if (!d.get<ControllerSettings>()) {
     throw InputError("design '" + d.name +
                      "' has no controller: section (loop rate, PWM, PID gains, potentiometer calibration): "
                      "nothing to export; see designs/iros2022.yaml");
   }
-  return *d.controller;
+  return *d.get<ControllerSettings>();
 }
 
 /// The branch a joint's angles are written on, one for the gate, the limits and the potentiometer
@@ -276,8 +276,8 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
     pairs = pairs || (s.lower && s.upper);
   }
   if (pairs) {
-    add("geometry", "design", d.geometry.has_value(),
-        d.geometry ? "link outlines for the controller's collision check: geometry: section"
+    add("geometry", "design", d.has<Geometry>(),
+        d.get<Geometry>() ? "link outlines for the controller's collision check: geometry: section"
                    : "no geometry: section: the controller's collision check (FK of the measured joints, "
                      "upper priority) needs the link widths, pins and planes");
   }
@@ -366,21 +366,21 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
   }
 
   // Patterns declared for the exported stations.
-  if (!d.patterns) {
+  if (!d.get<PatternSettings>()) {
     add("pattern", "design", true, "no patterns: section: nothing to check");
   } else {
     for (const std::string& name : gate.stations) {
       const Station& s = *d.station(name);
-      const std::vector<PatternSpec> specs = d.patterns->for_station(name);
+      const std::vector<PatternSpec> specs = d.get<PatternSettings>()->for_station(name);
       if (specs.empty() || !(s.lower && s.upper)) continue;  // patterns move both tactors
       for (const PatternSpec& spec : specs) {
         const std::string subject = name + " " + std::string(to_string(spec.kind));
-        if (!d.geometry) {
+        if (!d.get<Geometry>()) {
           add("pattern", subject, false, "not checked: the collision checks need a geometry: section");
           continue;
         }
         say(options, "export gate: pattern " + subject);
-        const PatternResult r = check_pattern(s, *d.geometry, spec, d.patterns->max_joint_speed);
+        const PatternResult r = check_pattern(s, *d.get<Geometry>(), spec, d.get<PatternSettings>()->max_joint_speed);
         if (r.passed) {
           add("pattern", subject, true,
               "renderable: " + std::to_string(r.samples.size()) + " samples, peak motor speed " +
@@ -433,12 +433,12 @@ Design export_view(const Design& d, const std::vector<std::string>& wanted) {
   for (const Station& s : d.stations) {
     if (kept(s.name)) v.stations.push_back(s);
   }
-  v.geometry = d.geometry;
-  v.patterns = d.patterns;
-  if (v.patterns) std::erase_if(v.patterns->per_station, [&](const auto& e) { return !kept(e.first); });
-  v.controller = d.controller;
-  if (v.controller) {
-    std::erase_if(v.controller->overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
+  if (const Geometry* g = d.get<Geometry>()) v.set(*g);
+  if (const PatternSettings* p = d.get<PatternSettings>()) {
+    std::erase_if(v.set(*p).per_station, [&](const auto& e) { return !kept(e.first); });
+  }
+  if (const ControllerSettings* c = d.get<ControllerSettings>()) {
+    std::erase_if(v.set(*c).overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
   }
   return v;
 }
@@ -522,9 +522,9 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
   }
   p["joint_names"] = joint_names;
   p["stations"] = station_tree;
-  Json collision = {{"priority", c.collision_priority}, {"checked", d.geometry.has_value()}};
-  if (d.geometry) {
-    const Geometry& g = *d.geometry;
+  Json collision = {{"priority", c.collision_priority}, {"checked", d.has<Geometry>()}};
+  if (d.get<Geometry>()) {
+    const Geometry& g = *d.get<Geometry>();
     Json widths = Json::array(), layers = Json::array();
     for (double w : g.link_width) widths.push_back(metres(w));
     for (int l : g.layers) layers.push_back(l);

@@ -269,9 +269,9 @@ void check_printable(const Design& design, const Station& s, const Derived& d) {
 
 /// Design-wide derived sizes and rules.
 Derived derive(const Design& design, const PartsOptions& options) {
-  const Geometry& g = *design.geometry;
+  const Geometry& g = *design.get<Geometry>();
   static const PrintSettings kDefaultPrint{};
-  const PrintSettings& print = design.print ? *design.print : kDefaultPrint;
+  const PrintSettings& print = design.get<PrintSettings>() ? *design.get<PrintSettings>() : kDefaultPrint;
   Derived d{g, print, options.hardware};
   d.fn = options.fn.value_or(print.fn);
   if (d.fn < 8 || d.fn > 1024) {
@@ -388,7 +388,7 @@ std::optional<fs::path> find_openscad(const std::string& name) {
 
 std::vector<PartSpec> plan_parts(const Design& design, const PartsOptions& options) {
   const std::string origin = design.source.empty() ? "design '" + design.name + "'" : design.source.string();
-  if (!design.geometry) {
+  if (!design.get<Geometry>()) {
     throw InputError(origin + ": no geometry: section: printed parts need the link widths, thickness, pins, "
                               "bosses and tactor sizes it gives");
   }

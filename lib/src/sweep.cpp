@@ -157,10 +157,10 @@ Station apply_sweep(const Design& design, const SweepSettings& s, const std::vec
     }
   }
   st.validate();
-  if (design.geometry) {
+  if (design.get<Geometry>()) {
     for (const Mechanism* m : targets) {
       for (std::size_t i = 0; i < 4; ++i) {
-        if (m->L[i] < design.geometry->boss_diameter) {
+        if (m->L[i] < design.get<Geometry>()->boss_diameter) {
           throw ValidationError("mechanisms." + m->name + ".links[" + std::to_string(i) + "]",
                                 "= " + num(m->L[i]) + " mm: shorter than geometry.boss_diameter");
         }
@@ -241,9 +241,9 @@ void footprint(const Station& st, const std::vector<const Mechanism*>& targets, 
       if (x2i.status != Status::unreachable) add(x2i.point);
     }
   }
-  const double pad = design.geometry ? 0.5 * std::max(design.geometry->boss_diameter,
-                                                      *std::max_element(design.geometry->link_width.begin(),
-                                                                        design.geometry->link_width.end()))
+  const double pad = design.get<Geometry>() ? 0.5 * std::max(design.get<Geometry>()->boss_diameter,
+                                                      *std::max_element(design.get<Geometry>()->link_width.begin(),
+                                                                        design.get<Geometry>()->link_width.end()))
                                      : 0.0;
   row.footprint_w_mm = x1 - x0 + 2 * pad;
   row.footprint_h_mm = y1 - y0 + 2 * pad;
@@ -302,9 +302,9 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
   }
   footprint(st, targets, design, row);
   // Soft: the collision fraction (the costliest metric, so last and only for covered designs).
-  if (design.geometry && st.lower && st.upper && s.collision_spacing_mm > 0.0) {
+  if (design.get<Geometry>() && st.lower && st.upper && s.collision_spacing_mm > 0.0) {
     row.collision_fraction =
-        collision_fraction(st, *design.geometry, sweep_collision_spacing(s, st.target)).fraction;
+        collision_fraction(st, *design.get<Geometry>(), sweep_collision_spacing(s, st.target)).fraction;
   }
   row.covered = true;
   row.status = "covered";
@@ -476,8 +476,8 @@ std::string csv_name(const SweepOptions& o) {
 }  // namespace
 
 SweepResult run_sweep(const Design& design, const SweepOptions& options) {
-  if (!design.sweep) throw InputError(design.name + ": the design has no sweep: section");
-  const SweepSettings& s = *design.sweep;
+  if (!design.get<SweepSettings>()) throw InputError(design.name + ": the design has no sweep: section");
+  const SweepSettings& s = *design.get<SweepSettings>();
   if (options.shards == 0 || options.shard >= options.shards) throw InputError("shard out of range");
   SweepResult result;
   const std::uint64_t all = sweep_size(s);
@@ -577,7 +577,7 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
     for (Station& x : d.stations) {
       if (x.name == st.name) x = st;
     }
-    d.sweep.reset();
+    d.reset<SweepSettings>();
     d.products.reset();
     // Its own name, so that `fivebar run best.yaml` does not overwrite the swept design's outputs.
     d.name = design.name.substr(0, 59) + "-best";

@@ -8,6 +8,8 @@
 #include <random>
 #include <vector>
 
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
 #include "fivebar/collision.hpp"
 #include "fivebar/pattern.hpp"
 
@@ -38,7 +40,7 @@ void BM_interference_pose_pair(benchmark::State& state) {
   const Station& s = *design().station("index");
   const Pose up = ik(*s.upper, {6.25, 19.5});
   const Pose low = ik(*s.lower, {6.25, 11.5});
-  for (auto _ : state) benchmark::DoNotOptimize(interference(*s.upper, up, *s.lower, low, *design().geometry).min_clearance_mm);
+  for (auto _ : state) benchmark::DoNotOptimize(interference(*s.upper, up, *s.lower, low, *design().get<Geometry>()).min_clearance_mm);
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_interference_pose_pair);
@@ -48,7 +50,7 @@ void BM_priority_rule_search(benchmark::State& state) {
   const Station& s = *design().station("index");
   for (auto _ : state) {
     benchmark::DoNotOptimize(
-        apply_priority(*s.upper, *s.lower, *design().geometry, s.target.center, s.target.center).moved_mm);
+        apply_priority(*s.upper, *s.lower, *design().get<Geometry>(), s.target.center, s.target.center).moved_mm);
   }
   state.SetItemsProcessed(state.iterations());
 }
@@ -56,9 +58,9 @@ BENCHMARK(BM_priority_rule_search)->Unit(benchmark::kMillisecond);
 
 void BM_pattern_twist_1s_100hz(benchmark::State& state) {
   const Station& s = *design().station("index");
-  const PatternSpec spec = design().patterns->for_station("index")[2];
+  const PatternSpec spec = design().get<PatternSettings>()->for_station("index")[2];
   for (auto _ : state) {
-    benchmark::DoNotOptimize(check_pattern(s, *design().geometry, spec, design().patterns->max_joint_speed).passed);
+    benchmark::DoNotOptimize(check_pattern(s, *design().get<Geometry>(), spec, design().get<PatternSettings>()->max_joint_speed).passed);
   }
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(spec.samples()));
 }
@@ -66,7 +68,7 @@ BENCHMARK(BM_pattern_twist_1s_100hz)->Unit(benchmark::kMillisecond);
 
 void BM_collision_map_index(benchmark::State& state) {
   const Station& s = *design().station("index");
-  for (auto _ : state) benchmark::DoNotOptimize(collision_map(s, *design().geometry).colliding);
+  for (auto _ : state) benchmark::DoNotOptimize(collision_map(s, *design().get<Geometry>()).colliding);
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_collision_map_index)->Unit(benchmark::kMillisecond);
@@ -74,7 +76,7 @@ BENCHMARK(BM_collision_map_index)->Unit(benchmark::kMillisecond);
 /// The per-design collision fraction of a sweep (2 mm grid: 35 points, 1225 pairs on the index).
 void BM_collision_fraction_index(benchmark::State& state) {
   const Station& s = *design().station("index");
-  for (auto _ : state) benchmark::DoNotOptimize(collision_fraction(s, *design().geometry, 2.0).colliding);
+  for (auto _ : state) benchmark::DoNotOptimize(collision_fraction(s, *design().get<Geometry>(), 2.0).colliding);
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK(BM_collision_fraction_index)->Unit(benchmark::kMicrosecond);

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <numbers>
 
+#include "fivebar/sections/sweep.hpp"
 #include "fivebar/sweep.hpp"
 
 namespace {
@@ -31,7 +32,7 @@ Design design(bool limits_and_shared, bool collision = false) {
       st.upper->joint_limits = std::array<JointRange, 2>{JointRange{160 * r, 320 * r}, JointRange{-140 * r, 20 * r}};
     }
   }
-  d.sweep = s;
+  d.set<SweepSettings>(s);
   d.validate();
   return d;
 }
@@ -67,7 +68,7 @@ void BM_sweep_evaluate_one(benchmark::State& state) {
   const std::uint64_t index = state.range(0) ? 0 : 150 * 300 + 150;
   bool covered = false;
   for (auto _ : state) {
-    const SweepRow r = evaluate_sweep_design(d, *d.sweep, index);
+    const SweepRow r = evaluate_sweep_design(d, *d.get<SweepSettings>(), index);
     covered = r.covered;
     benchmark::DoNotOptimize(r.margin_lower_mm);
   }

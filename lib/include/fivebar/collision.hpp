@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/geometry.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 

@@ -5,7 +5,10 @@
 
 #include <Eigen/Core>
 
+#include <any>
 #include <array>
+#include <functional>
+#include <map>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -111,187 +114,41 @@ struct Station {
   const Mechanism* mechanism(std::string_view which) const;
 };
 
-/// Physical link geometry (`geometry:`), for collision checking and printed parts. Defaults
-/// follow the paper's resin-printed device in spirit (mm).
-struct Geometry {
-  std::array<double, 4> link_width{4.0, 4.0, 4.0, 4.0};  ///< L1..L4: outline is a capsule this wide
-  double link_thickness = 2.5;         ///< of every link plate
-  double pin_diameter = 2.0;           ///< nominal pin at every joint (O_i, A_i, P)
-  double boss_diameter = 5.0;          ///< rounded link end around each pin
-  double tactor_diameter = 4.0;        ///< contact disk at P
-  double tactor_height = 6.0;          ///< above the top link plane
-  std::array<int, 4> layers{0, 0, 1, 1};  ///< plane of L1..L4, 0 nearest the base plate
-  double layer_gap = 0.4;              ///< between planes (washers)
-  double motor_shaft_diameter = 3.0;   ///< D-shaft of the motors
-  double motor_shaft_flat = 0.5;       ///< depth of the shaft's flat
-  double min_clearance = 0.3;          ///< a smaller gap between links counts as a collision
-  /// Throws ValidationError naming the key ("link_width[2]", "pin_diameter").
-  void validate() const;
-};
+/// The optional sections of a design file beside its stations (`geometry:`, `controller:`, ...),
+/// held without knowing their types. Each section is a module: a settings type T with
+/// `static constexpr std::string_view kKey` (its top-level key) in fivebar/sections/<key>.hpp,
+/// and its loader, writer and cross-section rules in lib/src/sections/<key>.cpp
+/// (docs/architecture.md "Design sections").
+class Sections {
+ public:
+  /// The section of type T, or nullptr when the design has none.
+  template <class T>
+  const T* get() const {
+    const auto it = items_.find(T::kKey);
+    return it == items_.end() ? nullptr : std::any_cast<T>(&it->second);
+  }
+  template <class T>
+  T* get() {
+    const auto it = items_.find(T::kKey);
+    return it == items_.end() ? nullptr : std::any_cast<T>(&it->second);
+  }
+  /// Adds or replaces the section of type T; returns the stored copy.
+  template <class T>
+  T& set(T value) {
+    std::any& slot = items_[std::string(T::kKey)];
+    slot = std::move(value);
+    return *std::any_cast<T>(&slot);
+  }
+  template <class T>
+  void reset() {
+    items_.erase(std::string(T::kKey));
+  }
+  /// True when the design has the section whose top-level key is `key`.
+  bool has(std::string_view key) const { return items_.find(key) != items_.end(); }
 
-/// Resin printing (`print:`): clearances and minimums of the printer and material.
-struct PrintSettings {
-  double pin_clearance = 0.15;  ///< radial, mm (Tough 2000 guides: 0.1 - 0.25)
-  double min_wall = 0.8;        ///< the printer's minimum wall, mm
-  int fn = 96;                  ///< OpenSCAD $fn for printed circles
-  double layer_height = 0.05;   ///< mm
-  std::string material = "Formlabs Tough 2000";
-  void validate() const;
+ private:
+  std::map<std::string, std::any, std::less<>> items_;
 };
-
-/// One swept design variable (`sweep.vary`): NAME = LO:HI:N, in file units (mm).
-struct SweepVariable {
-  std::string name;  ///< one of sweep_variable_names()
-  double lo = 0.0;
-  double hi = 0.0;
-  int n = 1;  ///< grid points (grid sampling); ignored by random / sobol
-};
-
-/// A link-dimension sweep (`sweep:`) over one station.
-struct SweepSettings {
-  std::string station;
-  std::string mechanism;             ///< "lower", "upper" or empty: every mechanism and shared
-  std::vector<SweepVariable> vary;
-  std::string sample = "grid";       ///< grid | random | sobol
-  std::uint64_t count = 0;           ///< random / sobol designs (0: the grid's size)
-  std::uint64_t seed = 1;
-  std::vector<std::string> objectives{"margin", "min_lci"};  ///< see sweep_objective_names()
-  /// Grid spacing (mm) of the per-design collision fraction (see collision_fraction()), computed
-  /// for covered designs when the design has `geometry:` and the station both mechanisms; 0: off.
-  /// Never finer than 1/24 of the ellipse's larger axis (sweep_collision_spacing()).
-  double collision_spacing_mm = 2.0;
-  /// Rules that need no design (names, ranges, counts); the design checks the station.
-  void validate() const;
-};
-/// L1 L2 L3 L4, L12 (L1 = L2), L34 (L3 = L4), spacing (base spacing), upper_height (y of the
-/// upper bases), ellipse_a, ellipse_b (full axes of the target).
-const std::vector<std::string>& sweep_variable_names();
-/// margin (max), min_lci (max), force (max), footprint (min: bounding-box area of the linkage),
-/// collision (min: fraction of tactor-position pairs in the ellipse whose mechanisms collide).
-const std::vector<std::string>& sweep_objective_names();
-/// Skin-deformation patterns (paper Sec. IV-A, Fig. 6) and pivoting (Sec. IV-B).
-enum class PatternKind : std::uint8_t {
-  stretch,  ///< tactors start near the centre and move apart horizontally
-  slip,     ///< tactors start in the upper region and move together to the lower one
-  twist,    ///< tactors start separated about the centre and turn along a circle
-  pivot,    ///< tactors track two contact points of an object rotating about the centre
-};
-std::string_view to_string(PatternKind kind);
-std::optional<PatternKind> parse_pattern_kind(std::string_view text);
-/// stretch, slip, twist, pivot.
-std::array<PatternKind, 4> all_pattern_kinds();
-
-/// One pattern's parameters (`patterns.<kind>` or `patterns.stations.<station>.<kind>`).
-/// Lengths mm, angles radians, times s. The paths themselves are in fivebar/pattern.hpp.
-struct PatternSpec {
-  PatternKind kind = PatternKind::stretch;
-  double amplitude_mm = 3.0;    ///< stretch: travel of each tactor; slip: travel; twist: arc length
-  double duration_s = 1.0;      ///< length of the pattern
-  double rate_hz = 100.0;       ///< samples per second (the controller loop rate)
-  std::optional<Vec2> centre;   ///< default: the station's target centre (mm)
-  double separation_mm = 8.0;   ///< distance between the two tactors at the start
-  double pivot_amplitude = 0.3490658503988659;  ///< pivot: peak object angle (rad; file: amplitude_deg, 20)
-  double pivot_frequency_hz = 0.5;               ///< pivot: angle(t) = amplitude sin(2 pi f t)
-  /// Pivot: contact points {upper, lower} relative to the centre (mm); default (0, +-separation/2).
-  std::optional<std::array<Vec2, 2>> contact_points;
-  /// Number of samples: floor(duration * rate) + 1, both ends included (a product within rounding
-  /// of a whole number counts as that number).
-  std::size_t samples() const;
-  /// Throws ValidationError naming the key ("amplitude_mm", "contact_points[1]").
-  void validate() const;
-};
-
-/// `patterns:`: which patterns to check, on which stations, at what rate and motor speed.
-struct PatternSettings {
-  double rate_hz = 100.0;  ///< default rate of every pattern (paper: 100 Hz control loop)
-  /// Largest motor speed (rad/s; file: max_joint_speed_deg_s, default 360 deg/s). In a design
-  /// with a `controller:` section this is controller.max_velocity (its max_velocity_deg_s).
-  double max_joint_speed = 6.283185307179586;
-  std::vector<PatternSpec> global;  ///< kinds given at the top level: checked on every station
-  /// Kinds given under `stations.<name>`, already merged over the top-level entry of that kind.
-  std::vector<std::pair<std::string, PatternSpec>> per_station;
-  /// The patterns of a station: for each kind in the order stretch, slip, twist, pivot, its own
-  /// entry if any, else the top-level one.
-  std::vector<PatternSpec> for_station(std::string_view station) const;
-  void validate() const;
-};
-
-/// PID gains of one motor (`controller.pid`). The controller acts on the joint angle error
-/// e = theta_target - theta_measured in radians (ROS convention) and outputs the PWM duty cycle in
-/// [-1, 1]: duty = kp e + clamp(ki * integral(e dt), -i_clamp, i_clamp) + kd de/dt.
-struct PidGains {
-  double kp = 5.0;        ///< duty per rad: full duty at 0.2 rad (11.5 deg) of error
-  double ki = 1.0;        ///< duty per (rad s)
-  double kd = 0.05;       ///< duty per (rad/s)
-  double i_clamp = 0.2;   ///< bound of the integral term, duty in [0, 1]
-  void validate() const;
-};
-
-/// Potentiometer on a motor shaft, read through the ADC (`controller.potentiometer`):
-/// theta = rad_per_volt * (V - volts_at_zero), theta in the station frame (DESIGN.md: from +x,
-/// counter-clockwise). The file takes volts_per_rad (the datasheet's sensitivity) or rad_per_volt.
-struct Potentiometer {
-  double volts_at_zero = 2.5;                   ///< reading at theta = 0, V
-  double rad_per_volt = 1.0471975511965976;     ///< 5 V over 300 deg: 60 deg/V; negative when wired reversed
-  void validate() const;
-};
-
-/// What one joint of the controller gets once the overrides are applied.
-struct JointControl {
-  PidGains pid;
-  Potentiometer potentiometer;
-};
-
-/// An override of some PID or potentiometer keys. Scopes, from the widest: the lower or upper
-/// mechanism of every station (`controller.mechanisms.<mechanism>`), one of its joints
-/// (`...<mechanism>.theta1|theta2`), a station (`controller.stations.<station>`), one of its
-/// mechanisms, one of their joints. A scope naming a station is narrower than any that does not.
-/// Unset keys keep the value of the wider scope.
-struct ControlOverride {
-  std::string station;    ///< empty: every station (then `mechanism` is set)
-  std::string mechanism;  ///< "lower", "upper", or empty: every mechanism of the station
-  int joint = 0;          ///< 1 or 2 (theta1, theta2), or 0: both joints
-  std::optional<double> kp, ki, kd, i_clamp;
-  std::optional<double> volts_at_zero, rad_per_volt;
-  /// Key path of this scope relative to `controller` ("stations.index.lower.theta1",
-  /// "mechanisms.upper").
-  std::string key() const;
-  /// 0 ... 4, widest first, in the order above.
-  int level() const;
-};
-
-/// The ROS controller on the device (`controller:`; paper Sec. II-D): per mechanism an IK module,
-/// FK of the measured joints for collision checks with the upper mechanism's priority, and a PID
-/// per motor at loop_rate_hz driving the motor by PWM at pwm_hz; joint angles read from
-/// potentiometers through an ADC (the paper's 16-bit DAQ, USB-1608G). Read by fivebar/export.hpp.
-///
-/// Joint speed limit: max_velocity is the one source of truth when a design has this section;
-/// `patterns:` then takes it from here (the loader refuses patterns.max_joint_speed_deg_s next to
-/// a controller section, and Design::validate() requires both values to agree).
-struct ControllerSettings {
-  std::string node = "fivebar_controller";  ///< ROS 2 node name: the parameters file's top key
-  double loop_rate_hz = 100.0;   ///< PID, IK and collision loop (paper: 100 Hz)
-  double pwm_hz = 1000.0;        ///< motor PWM (paper: 1 kHz)
-  int adc_bits = 16;             ///< DAQ resolution (paper: 16-bit)
-  std::array<double, 2> adc_range_v{-10.0, 10.0};  ///< input range of the DAQ, V
-  double max_velocity = 6.283185307179586;  ///< rad/s (file: max_velocity_deg_s, default 360)
-  std::string collision_priority = "upper";  ///< the paper's rule; the only one fivebar checks
-  /// Export gate: LCI over every target ellipse must be at least max(min_lci, the mechanism's
-  /// min_lci): the ellipse keeps this far from singularities.
-  double min_lci = 0.05;
-  PidGains pid;                   ///< every joint, unless overridden
-  Potentiometer potentiometer;    ///< every joint, unless overridden
-  std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first
-
-  /// Gains and calibration of joint `joint` (1 or 2) of a mechanism: the defaults, then the
-  /// overrides from the widest scope to the narrowest (ControlOverride), in file order within one.
-  JointControl joint(std::string_view station, std::string_view mechanism, int joint) const;
-  /// Rules that need no design (ranges, names); Design::validate() checks the override scopes.
-  void validate() const;
-};
-
-/// True when `name` is a ROS 2 node name: [A-Za-z_][A-Za-z0-9_]*, at most 255 characters.
-bool is_ros_node_name(std::string_view name);
 
 /// A whole design (and scene).
 struct Design {
@@ -299,11 +156,19 @@ struct Design {
   std::filesystem::path source;       ///< file it was loaded from (may be empty)
   std::vector<Station> stations;      ///< in file order
   std::optional<std::vector<std::string>> products;  ///< absent: every product the data allows
-  std::optional<Geometry> geometry;       ///< `geometry:`; absent: collision and parts left out
-  std::optional<PrintSettings> print;     ///< `print:`; parts use defaults when absent
-  std::optional<SweepSettings> sweep;     ///< `sweep:`; the sweep product of `fivebar run`
-  std::optional<PatternSettings> patterns;  ///< `patterns:`; absent: the pattern product is left out
-  std::optional<ControllerSettings> controller;  ///< `controller:`; absent: nothing to export
+  Sections sections;                  ///< `geometry:`, `print:`, `controller:`, ... (any subset)
+
+  /// The section of type T (fivebar/sections/<key>.hpp), or nullptr when the file has none.
+  template <class T>
+  const T* get() const { return sections.get<T>(); }
+  template <class T>
+  T* get() { return sections.get<T>(); }
+  template <class T>
+  T& set(T value) { return sections.set(std::move(value)); }
+  template <class T>
+  void reset() { sections.reset<T>(); }
+  template <class T>
+  bool has() const { return sections.get<T>() != nullptr; }
 
   void validate() const;
   /// The station named `name`, or nullptr.
@@ -320,7 +185,7 @@ struct Design {
 /// outputs/: 1 to 64 characters from [A-Za-z0-9_.-], the first not '.' or '-'.
 bool is_safe_name(std::string_view name);
 
-/// Product names a scene may list, in build order.
+/// Product names a scene may list, in build order (lib/src/products/products.def).
 const std::vector<std::string>& known_products();
 
 /// The design as a design file (YAML, file units, numbers in shortest round-trip form) that

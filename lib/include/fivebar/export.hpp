@@ -53,6 +53,9 @@
 
 #include "fivebar/coverage.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
 #include "fivebar/json.hpp"
 
 namespace fivebar {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/geometry.hpp"
 #include "fivebar/kinematics.hpp"
 
 namespace fivebar {

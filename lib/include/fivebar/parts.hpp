@@ -25,6 +25,8 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/print.hpp"
 #include "fivebar/json.hpp"
 
 namespace fivebar {

@@ -26,6 +26,8 @@
 
 #include "fivebar/collision.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 

@@ -15,6 +15,7 @@
 
 #include "fivebar/coverage.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/sections/sweep.hpp"
 
 namespace fivebar {
 
@@ -105,7 +106,7 @@ struct SweepResult {
   std::vector<std::filesystem::path> files;  ///< every file written
 };
 
-/// Runs (a shard of) the sweep of `design.sweep`, writing `sweep.csv` (or
+/// Runs (a shard of) the design's `sweep:` section, writing `sweep.csv` (or
 /// `sweep.shard-K-of-N.csv`), `pareto.csv`, `best.yaml` and the plots into options.out_dir.
 SweepResult run_sweep(const Design& design, const SweepOptions& options);
 

@@ -70,7 +70,7 @@ SweepResult run_sweep_mpi(const Design& design, const SweepOptions& options) {
     return local;
   }
 
-  const SweepSettings& s = *design.sweep;
+  const SweepSettings& s = *design.get<SweepSettings>();
   SweepResult merged;
   merged.total = sweep_size(s);
   merged.evaluated = sums[0];
@@ -129,7 +129,7 @@ SweepResult run_sweep_mpi(const Design& design, const SweepOptions& options) {
     for (Station& x : d.stations) {
       if (x.name == st.name) x = st;
     }
-    d.sweep.reset();
+    d.reset<SweepSettings>();
     d.products.reset();
     // Its own name, so that `fivebar run best.yaml` does not overwrite the swept design's outputs.
     d.name = design.name.substr(0, 59) + "-best";

@@ -1,8 +1,9 @@
 #pragma once
-/// The product registry behind run_scene() (fivebar/scene.hpp). A product is one entry: a name
-/// from known_products(), what it needs first, whether a design has the data for it, and how to
-/// build it. Each capability adds one entry: a `Product <name>_product()` in its own file here,
-/// listed once in registry.cpp.
+/// The product plug-in behind run_scene() (fivebar/scene.hpp; docs/architecture.md "Products").
+/// A product is one folder lib/src/products/<name>/ whose product.cpp defines
+/// `Product <name>_product()`: its name, what it needs first, whether a design has the data for it,
+/// and how to build it (results, summary section, files). It is registered by one line in
+/// products.def, which also gives known_products() its names and the build order.
 
 #include <nlohmann/json.hpp>
 
@@ -69,7 +70,7 @@ inline bool has_pair(const Station& s) { return s.lower.has_value() && s.upper.h
 /// Product::unavailable for the products on a station's two tactors: they need the design's
 /// `geometry:` (`geometry_for` says what for) and a station with both mechanisms.
 inline std::optional<std::string> without_pairs(const Design& d, std::string_view geometry_for) {
-  if (!d.geometry) return "the design has no `geometry:` section (" + std::string(geometry_for) + ")";
+  if (!d.get<Geometry>()) return "the design has no `geometry:` section (" + std::string(geometry_for) + ")";
   for (const Station& s : d.stations)
     if (has_pair(s)) return std::nullopt;
   return "no station has both a lower and an upper mechanism";
@@ -80,24 +81,9 @@ const std::vector<Product>& registry();
 /// The entry named `name`, or nullptr when this build does not implement it.
 const Product* find_product(std::string_view name);
 
-// --- Entries (one file each) -----------------------------------------------------------------
-/// Link data, modes and the pose at the target centre and axis ends of every mechanism.
-Product kinematics_product();
-/// The scene's `sweep:` section: CSV, Pareto set, best design, plots.
-Product sweep_product();
-/// Exact regions, restricted areas, VTK files and the picture of every station (workspace/).
-Product workspace_product();
-/// Coverage of every station's target ellipse by each mechanism and the shared region.
-Product coverage_product();
-/// OpenSCAD sources, STL renders, mesh and fit checks and the BOM of every station (parts.hpp).
-Product parts_product();
-/// Collision map of the two tactors of every station and the priority rule at the centre.
-Product collision_product();
-/// The skin-deformation patterns of `patterns:`, checked, with joint trajectories and pictures.
-Product pattern_product();
-/// The validated controller configuration (`controller:`): gate, ROS 2 YAML, JSON, C++ header.
-Product export_product();
-/// Accuracy of the main numbers (quick work-precision) and the stability catalogue.
-Product report_product();
+// --- Entries: one folder each (products.def) --------------------------------------------------
+#define FIVEBAR_PRODUCT(name) Product name##_product();
+#include "products/products.def"
+#undef FIVEBAR_PRODUCT
 
 }  // namespace fivebar::products

@@ -3,18 +3,10 @@
 namespace fivebar::products {
 
 const std::vector<Product>& registry() {
-  // One line per product; later capabilities append theirs (workspace, coverage, collision,
-  // pattern, sweep, parts, export, report).
   static const std::vector<Product> entries = {
-      kinematics_product(),
-      workspace_product(),
-      coverage_product(),
-      sweep_product(),
-      parts_product(),
-      collision_product(),
-      pattern_product(),
-      export_product(),
-      report_product(),
+#define FIVEBAR_PRODUCT(name) name##_product(),
+#include "products/products.def"
+#undef FIVEBAR_PRODUCT
   };
   return entries;
 }

@@ -28,6 +28,7 @@
 
 #include "design_keys.hpp"
 #include "fivebar/design.hpp"
+#include "sections/section.hpp"
 
 namespace fivebar {
 
@@ -388,6 +389,7 @@ class Loader {
   Design load(const std::string& text);
 
  private:
+  friend class fivebar::sections::Value;
   /// One `key: value` pair of a YAML map, with its full key path and the line of its key.
   struct Entry {
     std::string name;
@@ -427,8 +429,13 @@ class Loader {
   }
 
   Entries entries(const YAML::Node& map, const std::string& path, int line,
-                  std::initializer_list<std::string_view> allowed, const std::string& expected,
+                  const std::vector<std::string_view>& allowed, const std::string& expected,
                   bool any_key = false);
+  Entries entries(const YAML::Node& map, const std::string& path, int line,
+                  std::initializer_list<std::string_view> allowed, const std::string& expected,
+                  bool any_key = false) {
+    return entries(map, path, line, std::vector<std::string_view>(allowed), expected, any_key);
+  }
   const Entry* find(const Entries& all, std::string_view name) const;
   const Entry& require(const Entries& all, std::string_view name, const std::string& path, int line) const;
 
@@ -438,21 +445,11 @@ class Loader {
   std::vector<YAML::Node> list(const YAML::Node& node, const std::string& path, int line, std::size_t n,
                                const std::string& expected);
   Vec2 point(const YAML::Node& node, const std::string& path, int line, const std::string& expected);
+  std::uint64_t whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const;
+  /// A section's value as the section modules see it (lib/src/sections/section.hpp).
+  sections::Value value(const Entry& entry);
 
   Ellipse target(const Entry& entry);
-  Geometry geometry(const Entry& entry);
-  PrintSettings print(const Entry& entry);
-  SweepSettings sweep(const Entry& entry);
-  std::uint64_t whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const;
-  /// `patterns:`; `controller` (parsed first) supplies the default rate and the speed limit.
-  PatternSettings patterns(const Entry& entry, const std::optional<ControllerSettings>& controller);
-  ControllerSettings controller(const Entry& entry);
-  /// The `pid:` and `potentiometer:` keys of one scope of `controller:` into `o`.
-  void control_keys(const Entries& all, ControlOverride& o);
-  /// One `<kind>:` map of patterns, over `base` (the defaults, or the top-level entry of the kind).
-  PatternSpec pattern(const Entry& entry, const PatternSpec& base);
-  /// An optional number: `fallback` when the key is absent.
-  double optional_number(const Entries& all, std::string_view name, double fallback, std::string_view unit) const;
   Mechanism mechanism(const Entry& entry);
   Station station(const Entry& entry);
 
@@ -461,7 +458,7 @@ class Loader {
 };
 
 Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, int line,
-                                std::initializer_list<std::string_view> allowed, const std::string& expected,
+                                const std::vector<std::string_view>& allowed, const std::string& expected,
                                 bool any_key) {
   if (!map.IsMap()) {
     if (path.empty()) fail(line, "", "a design file must hold a map " + expected + ", not " + render(map));
@@ -591,69 +588,6 @@ Ellipse Loader::target(const Entry& entry) {
   return ellipse;
 }
 
-double Loader::optional_number(const Entries& all, std::string_view name, double fallback,
-                               std::string_view unit) const {
-  const Entry* e = find(all, name);
-  return e ? number(e->value, e->path, e->line, unit) : fallback;
-}
-
-Geometry Loader::geometry(const Entry& entry) {
-  Geometry g;
-  if (entry.value.IsNull()) return g;  // `geometry:` alone: every default
-  const Entries all = entries(entry.value, entry.path, entry.line,
-                              {"link_width", "link_thickness", "pin_diameter", "boss_diameter", "tactor_diameter",
-                               "tactor_height", "layers", "layer_gap", "motor_shaft_diameter", "motor_shaft_flat",
-                               "min_clearance"},
-                              "of link geometry (link_width, link_thickness, ...)");
-  if (const Entry* w = find(all, "link_width")) {
-    if (w->value.IsScalar()) {
-      g.link_width.fill(number(w->value, w->path, w->line, "mm"));
-    } else {
-      const auto items = list(w->value, w->path, w->line, 4, "a width (mm) or a list of 4 widths [L1, L2, L3, L4]");
-      for (std::size_t i = 0; i < 4; ++i) {
-        g.link_width[i] = number(items[i], key_index(w->path, i), line_of(items[i], w->line), "mm");
-      }
-    }
-  }
-  g.link_thickness = optional_number(all, "link_thickness", g.link_thickness, "mm");
-  g.pin_diameter = optional_number(all, "pin_diameter", g.pin_diameter, "mm");
-  g.boss_diameter = optional_number(all, "boss_diameter", g.boss_diameter, "mm");
-  g.tactor_diameter = optional_number(all, "tactor_diameter", g.tactor_diameter, "mm");
-  g.tactor_height = optional_number(all, "tactor_height", g.tactor_height, "mm");
-  if (const Entry* l = find(all, "layers")) {
-    const auto items = list(l->value, l->path, l->line, 4, "a list of 4 plane indices [L1, L2, L3, L4]");
-    for (std::size_t i = 0; i < 4; ++i) {
-      const std::string path = key_index(l->path, i);
-      const int line = line_of(items[i], l->line);
-      const double v = number(items[i], path, line, "");
-      if (v != std::floor(v) || std::fabs(v) > 1e6) fail_value(items[i], line, path, "must be a whole number");
-      g.layers[i] = int(v);
-    }
-  }
-  g.layer_gap = optional_number(all, "layer_gap", g.layer_gap, "mm");
-  g.motor_shaft_diameter = optional_number(all, "motor_shaft_diameter", g.motor_shaft_diameter, "mm");
-  g.motor_shaft_flat = optional_number(all, "motor_shaft_flat", g.motor_shaft_flat, "mm");
-  g.min_clearance = optional_number(all, "min_clearance", g.min_clearance, "mm");
-  return g;
-}
-
-PrintSettings Loader::print(const Entry& entry) {
-  PrintSettings p;
-  if (entry.value.IsNull()) return p;
-  const Entries all = entries(entry.value, entry.path, entry.line,
-                              {"pin_clearance", "min_wall", "fn", "layer_height", "material"},
-                              "of print settings (pin_clearance, min_wall, fn, layer_height, material)");
-  p.pin_clearance = optional_number(all, "pin_clearance", p.pin_clearance, "mm");
-  p.min_wall = optional_number(all, "min_wall", p.min_wall, "mm");
-  if (const Entry* fn = find(all, "fn")) {
-    const double v = number(fn->value, fn->path, fn->line, "");
-    if (v != std::floor(v) || std::fabs(v) > 1e6) fail_value(fn->value, fn->line, fn->path, "must be a whole number");
-    p.fn = int(v);
-  }
-  p.layer_height = optional_number(all, "layer_height", p.layer_height, "mm");
-  if (const Entry* m = find(all, "material")) p.material = string(m->value, m->path, m->line, "must be a material name");
-  return p;
-}
 
 std::uint64_t Loader::whole(const YAML::Node& node, const std::string& path, int line, double lo, double hi) const {
   const double v = number(node, path, line, "");
@@ -663,241 +597,6 @@ std::uint64_t Loader::whole(const YAML::Node& node, const std::string& path, int
     fail_value(node, line, path, rule.str());
   }
   return std::uint64_t(v);
-}
-
-SweepSettings Loader::sweep(const Entry& entry) {
-  SweepSettings sw;
-  const Entries all = entries(entry.value, entry.path, entry.line,
-                              {"station", "mechanism", "vary", "sample", "count", "seed", "objectives",
-                               "collision_spacing_mm"},
-                              "(station, mechanism, vary, sample, count, seed, objectives, collision_spacing_mm)");
-  const Entry& st = require(all, "station", entry.path, entry.line);
-  sw.station = string(st.value, st.path, st.line, "must be a station name");
-  if (const Entry* m = find(all, "mechanism")) sw.mechanism = string(m->value, m->path, m->line, "must be lower or upper");
-  const Entry& vary = require(all, "vary", entry.path, entry.line);
-  for (const Entry& v : entries(vary.value, vary.path, vary.line, {}, "of variable names to [lo, hi, n]",
-                                /*any_key=*/true)) {
-    const auto items = list(v.value, v.path, v.line, 3, "a list [lo, hi, n] (mm, mm, points)");
-    SweepVariable var;
-    var.name = v.name;
-    var.lo = number(items[0], key_index(v.path, 0), line_of(items[0], v.line), "mm");
-    var.hi = number(items[1], key_index(v.path, 1), line_of(items[1], v.line), "mm");
-    var.n = int(whole(items[2], key_index(v.path, 2), line_of(items[2], v.line), 1, 1e8));
-    sw.vary.push_back(var);
-  }
-  if (const Entry* sample = find(all, "sample")) sw.sample = string(sample->value, sample->path, sample->line, "must be grid, random or sobol");
-  if (const Entry* count = find(all, "count")) sw.count = whole(count->value, count->path, count->line, 1, 1e15);
-  if (const Entry* seed = find(all, "seed")) sw.seed = whole(seed->value, seed->path, seed->line, 0, 9007199254740992.0);
-  if (const Entry* cs = find(all, "collision_spacing_mm")) {
-    sw.collision_spacing_mm = number(cs->value, cs->path, cs->line, "mm");
-  }
-  if (const Entry* obj = find(all, "objectives")) {
-    if (!obj->value.IsSequence()) fail_value(obj->value, obj->line, obj->path, "must be a list of objectives");
-    sw.objectives.clear();
-    for (std::size_t i = 0; i < obj->value.size(); ++i) {
-      const std::string path = key_index(obj->path, i);
-      const int line = line_of(obj->value[i], obj->line);
-      note(path, line);
-      sw.objectives.push_back(string(obj->value[i], path, line, "must be an objective name"));
-    }
-  }
-  return sw;
-}
-
-PatternSpec Loader::pattern(const Entry& entry, const PatternSpec& base) {
-  PatternSpec spec = base;
-  if (entry.value.IsNull()) return spec;  // `stretch:` alone: the defaults (or the top-level entry)
-  const bool pivot = spec.kind == PatternKind::pivot;
-  const Entries all =
-      pivot ? entries(entry.value, entry.path, entry.line,
-                      {"amplitude_deg", "frequency_hz", "duration_s", "rate_hz", "center", "separation_mm",
-                       "contact_points", "amplitude_mm"},
-                      "of pivot parameters (amplitude_deg, frequency_hz, duration_s, contact_points, ...)")
-            : entries(entry.value, entry.path, entry.line,
-                      {"amplitude_mm", "duration_s", "rate_hz", "center", "separation_mm"},
-                      "of pattern parameters (amplitude_mm, duration_s, rate_hz, center, separation_mm)");
-  if (!pivot) spec.amplitude_mm = optional_number(all, "amplitude_mm", spec.amplitude_mm, "mm");
-  if (const Entry* a = find(all, "amplitude_mm"); a != nullptr && pivot) {
-    fail_value(a->value, a->line, a->path, "a pivot's amplitude is the object's angle: use amplitude_deg");
-  }
-  spec.duration_s = optional_number(all, "duration_s", spec.duration_s, "s");
-  spec.rate_hz = optional_number(all, "rate_hz", spec.rate_hz, "Hz");
-  if (const Entry* c = find(all, "center")) spec.centre = point(c->value, c->path, c->line, "a point [x, y] (mm)");
-  spec.separation_mm = optional_number(all, "separation_mm", spec.separation_mm, "mm");
-  if (pivot) {
-    if (const Entry* a = find(all, "amplitude_deg")) spec.pivot_amplitude = kRadPerDeg * number(a->value, a->path, a->line, "deg");
-    spec.pivot_frequency_hz = optional_number(all, "frequency_hz", spec.pivot_frequency_hz, "Hz");
-    if (const Entry* cp = find(all, "contact_points")) {
-      if (const Entry* sep = find(all, "separation_mm")) {
-        fail(sep->line, sep->path, "give contact_points or separation_mm, not both (separation_mm only places the "
-                                   "default contact points at (0, +-separation/2))");
-      }
-      const auto items = list(cp->value, cp->path, cp->line, 2,
-                              "a list of 2 points [[x, y] upper, [x, y] lower] relative to the center (mm)");
-      std::array<Vec2, 2> points;
-      for (std::size_t i = 0; i < 2; ++i) {
-        points[i] = point(items[i], key_index(cp->path, i), line_of(items[i], cp->line), "a point [x, y] (mm)");
-      }
-      spec.contact_points = points;
-    }
-  }
-  return spec;
-}
-
-PatternSettings Loader::patterns(const Entry& entry, const std::optional<ControllerSettings>& controller) {
-  PatternSettings ps;
-  if (controller) {  // the patterns run at the controller's rate and speed limit
-    ps.rate_hz = controller->loop_rate_hz;
-    ps.max_joint_speed = controller->max_velocity;
-  }
-  const auto defaults = [&](PatternKind kind) {
-    PatternSpec spec;
-    spec.kind = kind;
-    spec.rate_hz = ps.rate_hz;
-    if (kind == PatternKind::pivot) spec.duration_s = 2.0;  // one period of the default 0.5 Hz
-    return spec;
-  };
-  if (entry.value.IsNull()) {  // `patterns:` alone: the four patterns with their defaults
-    for (PatternKind kind : all_pattern_kinds()) ps.global.push_back(defaults(kind));
-    return ps;
-  }
-  const Entries all = entries(entry.value, entry.path, entry.line,
-                              {"rate_hz", "max_joint_speed_deg_s", "stretch", "slip", "twist", "pivot", "stations"},
-                              "(rate_hz, max_joint_speed_deg_s, stretch, slip, twist, pivot, stations)");
-  ps.rate_hz = optional_number(all, "rate_hz", ps.rate_hz, "Hz");
-  if (const Entry* v = find(all, "max_joint_speed_deg_s")) {
-    if (controller) {
-      fail(v->line, v->path, "the joint speed limit of a design with a controller: section is "
-                             "controller.max_velocity_deg_s (patterns take it from there): remove this key");
-    }
-    ps.max_joint_speed = kRadPerDeg * number(v->value, v->path, v->line, "deg/s");
-  }
-  for (PatternKind kind : all_pattern_kinds()) {
-    if (const Entry* e = find(all, to_string(kind))) ps.global.push_back(pattern(*e, defaults(kind)));
-  }
-  if (const Entry* stations = find(all, "stations")) {
-    for (const Entry& st : entries(stations->value, stations->path, stations->line, {},
-                                   "of station names to their patterns", /*any_key=*/true)) {
-      for (const Entry& k : entries(st.value, st.path, st.line, {"stretch", "slip", "twist", "pivot"},
-                                    "of pattern kinds (stretch, slip, twist, pivot)")) {
-        const PatternKind kind = *parse_pattern_kind(k.name);
-        PatternSpec base = defaults(kind);
-        for (const PatternSpec& g : ps.global) {
-          if (g.kind == kind) base = g;
-        }
-        ps.per_station.emplace_back(st.name, pattern(k, base));
-      }
-    }
-  }
-  return ps;
-}
-
-void Loader::control_keys(const Entries& all, ControlOverride& o) {
-  if (const Entry* pid = find(all, "pid")) {
-    for (const Entry& k : entries(pid->value, pid->path, pid->line, {"kp", "ki", "kd", "i_clamp"},
-                                  "of PID gains (kp, ki, kd, i_clamp)")) {
-      const double v = number(k.value, k.path, k.line, "");
-      (k.name == "kp" ? o.kp : k.name == "ki" ? o.ki : k.name == "kd" ? o.kd : o.i_clamp) = v;
-    }
-  }
-  if (const Entry* pot = find(all, "potentiometer")) {
-    const Entries keys = entries(pot->value, pot->path, pot->line, {"volts_at_zero", "volts_per_rad", "rad_per_volt"},
-                                 "(volts_at_zero, and volts_per_rad or rad_per_volt)");
-    if (const Entry* v0 = find(keys, "volts_at_zero")) o.volts_at_zero = number(v0->value, v0->path, v0->line, "V");
-    const Entry* vpr = find(keys, "volts_per_rad");
-    const Entry* rpv = find(keys, "rad_per_volt");
-    if (vpr != nullptr && rpv != nullptr) {
-      fail(rpv->line, rpv->path, "give volts_per_rad or rad_per_volt, not both (one is 1 / the other)");
-    }
-    if (rpv != nullptr) o.rad_per_volt = number(rpv->value, rpv->path, rpv->line, "rad/V");
-    if (vpr != nullptr) {
-      const double v = number(vpr->value, vpr->path, vpr->line, "V/rad");
-      if (!(std::abs(v) >= 1e-6) || !(std::abs(v) <= 1e6)) {
-        fail_value(vpr->value, vpr->line, vpr->path, "|volts_per_rad| must be in [1e-6, 1e6] (never 0)");
-      }
-      o.rad_per_volt = 1.0 / v;
-      // validate() names rad_per_volt; a rule broken there is this key's.
-      note(detail::key_join(detail::key_parent(vpr->path), "rad_per_volt"), vpr->line);
-    }
-  }
-}
-
-ControllerSettings Loader::controller(const Entry& entry) {
-  ControllerSettings c;
-  if (entry.value.IsNull()) return c;  // `controller:` alone: every default
-  const Entries all = entries(entry.value, entry.path, entry.line,
-                              {"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                               "min_lci", "pid", "potentiometer", "mechanisms", "stations"},
-                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                              "pid, potentiometer, mechanisms, stations)");
-  if (const Entry* n = find(all, "node")) c.node = string(n->value, n->path, n->line, "must be a ROS 2 node name");
-  c.loop_rate_hz = optional_number(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
-  c.pwm_hz = optional_number(all, "pwm_hz", c.pwm_hz, "Hz");
-  if (const Entry* adc = find(all, "adc")) {
-    const Entries keys = entries(adc->value, adc->path, adc->line, {"bits", "range_v"}, "(bits, range_v)");
-    if (const Entry* b = find(keys, "bits")) c.adc_bits = int(whole(b->value, b->path, b->line, 1, 32));
-    if (const Entry* r = find(keys, "range_v")) {
-      const auto ends = list(r->value, r->path, r->line, 2, "a list [low, high] (V)");
-      for (std::size_t i = 0; i < 2; ++i) {
-        c.adc_range_v[i] = number(ends[i], key_index(r->path, i), line_of(ends[i], r->line), "V");
-      }
-    }
-  }
-  if (const Entry* v = find(all, "max_velocity_deg_s")) {
-    c.max_velocity = kRadPerDeg * number(v->value, v->path, v->line, "deg/s");
-  }
-  if (const Entry* p = find(all, "collision_priority")) {
-    c.collision_priority = string(p->value, p->path, p->line, "must be upper");
-  }
-  c.min_lci = optional_number(all, "min_lci", c.min_lci, "");
-  ControlOverride defaults;
-  control_keys(all, defaults);
-  if (defaults.kp) c.pid.kp = *defaults.kp;
-  if (defaults.ki) c.pid.ki = *defaults.ki;
-  if (defaults.kd) c.pid.kd = *defaults.kd;
-  if (defaults.i_clamp) c.pid.i_clamp = *defaults.i_clamp;
-  if (defaults.volts_at_zero) c.potentiometer.volts_at_zero = *defaults.volts_at_zero;
-  if (defaults.rad_per_volt) c.potentiometer.rad_per_volt = *defaults.rad_per_volt;
-
-  // One mechanism's scope (of a station, or of every station when `station` is empty) and its joints.
-  const auto mechanism_scope = [&](const Entry& m, const std::string& station) {
-    const Entries mech_keys = entries(m.value, m.path, m.line, {"pid", "potentiometer", "theta1", "theta2"},
-                                      "(pid, potentiometer, theta1, theta2)");
-    ControlOverride mo;
-    mo.station = station;
-    mo.mechanism = m.name;
-    control_keys(mech_keys, mo);
-    c.overrides.push_back(mo);
-    for (const Entry& j : mech_keys) {
-      if (j.name != "theta1" && j.name != "theta2") continue;
-      ControlOverride jo = mo;
-      jo.kp = jo.ki = jo.kd = jo.i_clamp = jo.volts_at_zero = jo.rad_per_volt = std::nullopt;
-      jo.joint = j.name == "theta1" ? 1 : 2;
-      control_keys(entries(j.value, j.path, j.line, {"pid", "potentiometer"}, "(pid, potentiometer)"), jo);
-      c.overrides.push_back(jo);
-    }
-  };
-  if (const Entry* mechanisms = find(all, "mechanisms")) {
-    for (const Entry& m : entries(mechanisms->value, mechanisms->path, mechanisms->line, {"lower", "upper"},
-                                  "with keys lower and/or upper (every station's)")) {
-      mechanism_scope(m, "");
-    }
-  }
-  if (const Entry* stations = find(all, "stations")) {
-    for (const Entry& st : entries(stations->value, stations->path, stations->line, {},
-                                   "of station names to their overrides", /*any_key=*/true)) {
-      const Entries station_keys = entries(st.value, st.path, st.line, {"pid", "potentiometer", "lower", "upper"},
-                                           "(pid, potentiometer, lower, upper)");
-      ControlOverride so;
-      so.station = st.name;
-      control_keys(station_keys, so);
-      c.overrides.push_back(so);
-      for (const Entry& m : station_keys) {
-        if (m.name == "lower" || m.name == "upper") mechanism_scope(m, st.name);
-      }
-    }
-  }
-  return c;
 }
 
 Mechanism Loader::mechanism(const Entry& entry) {
@@ -1044,10 +743,12 @@ Design Loader::load(const std::string& text) {
 
   Design design;
   try {
-    const Entries all =
-        entries(root, "", root_line,
-                {"name", "stations", "products", "geometry", "print", "patterns", "sweep", "controller"},
-                "at the top level (name, stations, products, geometry, print, patterns, sweep, controller)");
+    // The top level: name, stations, products, and one key per design section (sections.def).
+    std::vector<std::string_view> allowed{"name", "stations", "products"};
+    for (const sections::Section& section : sections::all()) allowed.push_back(section.key);
+    std::string listing;
+    for (std::string_view k : allowed) listing += (listing.empty() ? "" : ", ") + std::string(k);
+    const Entries all = entries(root, "", root_line, allowed, "at the top level (" + listing + ")");
     const Entry& name = require(all, "name", "", root_line);
     design.name = string(name.value, name.path, name.line, "must be a name (letters, digits, _ . -)");
 
@@ -1057,11 +758,9 @@ Design Loader::load(const std::string& text) {
       design.stations.push_back(station(s));
     }
 
-    if (const Entry* g = find(all, "geometry")) design.geometry = geometry(*g);
-    if (const Entry* p = find(all, "print")) design.print = print(*p);
-    if (const Entry* sw = find(all, "sweep")) design.sweep = sweep(*sw);
-    if (const Entry* c = find(all, "controller")) design.controller = controller(*c);
-    if (const Entry* p = find(all, "patterns")) design.patterns = patterns(*p, design.controller);
+    for (const sections::Section* section : sections::in_load_order()) {
+      if (const Entry* e = find(all, section->key)) section->load(value(*e), design);
+    }
 
     if (const Entry* products = find(all, "products")) {
       if (!products->value.IsSequence()) fail_value(products->value, products->line, products->path, "must be a list of product names");
@@ -1085,6 +784,100 @@ Design Loader::load(const std::string& text) {
     fail(line_for(e.key()), e.key(), e.rule());
   }
   return design;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// sections::Value over yaml-cpp: the section modules read the file only through it.
+
+namespace sections {
+
+struct Value::Impl {
+  Loader* loader;
+  YAML::Node node;
+  std::string name;
+  std::string path;
+  int line = 0;
+};
+
+namespace {
+Value make(Loader* loader, YAML::Node node, std::string name, std::string path, int line) {
+  return Value(std::make_shared<const Value::Impl>(Value::Impl{loader, std::move(node), std::move(name), std::move(path), line}));
+}
+}  // namespace
+
+Value::Value(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+const std::string& Value::name() const { return impl_->name; }
+const std::string& Value::path() const { return impl_->path; }
+int Value::line() const { return impl_->line; }
+bool Value::is_null() const { return impl_->node.IsNull(); }
+bool Value::is_scalar() const { return impl_->node.IsScalar(); }
+bool Value::is_list() const { return impl_->node.IsSequence(); }
+
+std::vector<Value> Value::entries(std::initializer_list<std::string_view> allowed, std::string_view expected,
+                                  bool any_key) const {
+  std::vector<Value> out;
+  for (const auto& e : impl_->loader->entries(impl_->node, impl_->path, impl_->line, allowed, std::string(expected), any_key)) {
+    out.push_back(make(impl_->loader, e.value, e.name, e.path, e.line));
+  }
+  return out;
+}
+
+std::vector<Value> Value::items(std::size_t n, std::string_view expected) const {
+  const auto nodes = impl_->loader->list(impl_->node, impl_->path, impl_->line, n, std::string(expected));
+  std::vector<Value> out;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    out.push_back(make(impl_->loader, nodes[i], "", detail::key_index(impl_->path, i), Loader::line_of(nodes[i], impl_->line)));
+  }
+  return out;
+}
+
+std::vector<Value> Value::list(std::string_view rule) const {
+  if (!impl_->node.IsSequence()) fail_value(std::string(rule));
+  std::vector<Value> out;
+  for (std::size_t i = 0; i < impl_->node.size(); ++i) {
+    const YAML::Node element = impl_->node[i];
+    const std::string path = detail::key_index(impl_->path, i);
+    const int line = Loader::line_of(element, impl_->line);
+    impl_->loader->note(path, line);
+    out.push_back(make(impl_->loader, element, "", path, line));
+  }
+  return out;
+}
+
+double Value::number(std::string_view unit) const { return impl_->loader->number(impl_->node, impl_->path, impl_->line, unit); }
+
+std::uint64_t Value::whole(double lo, double hi) const {
+  return impl_->loader->whole(impl_->node, impl_->path, impl_->line, lo, hi);
+}
+
+std::string Value::text(std::string_view rule) const {
+  return impl_->loader->string(impl_->node, impl_->path, impl_->line, std::string(rule));
+}
+
+Vec2 Value::point(std::string_view expected) const {
+  return impl_->loader->point(impl_->node, impl_->path, impl_->line, std::string(expected));
+}
+
+void Value::fail(const std::string& rule) const { impl_->loader->fail(impl_->line, impl_->path, rule); }
+
+void Value::fail_value(const std::string& rule) const {
+  impl_->loader->fail_value(impl_->node, impl_->line, impl_->path, rule);
+}
+
+void Value::fail_missing(std::string_view name) const {
+  impl_->loader->fail(impl_->line, detail::key_child(impl_->path, name), "required key is missing");
+}
+
+void Value::note_as(const std::string& path) const { impl_->loader->note(path, impl_->line); }
+
+}  // namespace sections
+
+namespace {
+sections::Value Loader::value(const Entry& entry) {
+  return sections::Value(std::make_shared<const sections::Value::Impl>(
+      sections::Value::Impl{this, entry.value, entry.name, entry.path, entry.line}));
 }
 
 }  // namespace

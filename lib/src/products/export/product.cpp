@@ -30,7 +30,7 @@ Product export_product() {
   p.name = "export";
   p.title = "Controller export";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    if (!d.controller) return "the design has no `controller:` section";
+    if (!d.get<ControllerSettings>()) return "the design has no `controller:` section";
     return std::nullopt;
   };
   p.build = [](Context& ctx) {
@@ -42,7 +42,7 @@ Product export_product() {
 
     Built b;
     std::string markdown = kPreamble;
-    markdown += "Node " + md::code(d.controller->node) + ", design hash " + md::code(r.hash) + ".\n\n";
+    markdown += "Node " + md::code(d.get<ControllerSettings>()->node) + ", design hash " + md::code(r.hash) + ".\n\n";
     md::Table checks({"check", "subject", "verdict", "detail"}, "llcl");
     for (const GateCheck& c : r.gate.checks) {
       checks.row({c.kind, md::code(c.subject), c.passed ? "✓" : "✗ **failed**", c.detail});
@@ -67,7 +67,7 @@ Product export_product() {
     } else {
       markdown += "**Export refused**: no file written.\n";
     }
-    b.result = {{"node", d.controller->node}, {"design_hash", r.hash}, {"exported", r.gate.passed()},
+    b.result = {{"node", d.get<ControllerSettings>()->node}, {"design_hash", r.hash}, {"exported", r.gate.passed()},
                 {"files", files}, {"gate", to_json(r.gate)}};
     b.markdown = markdown;
     b.passed = r.gate.passed();

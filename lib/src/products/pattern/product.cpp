@@ -35,13 +35,13 @@ Product pattern_product() {
   p.name = "pattern";
   p.title = "Skin-deformation patterns";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    if (!d.patterns) return "the design has no `patterns:` section";
+    if (!d.get<PatternSettings>()) return "the design has no `patterns:` section";
     return without_pairs(d, "collision checks need the link outlines");
   };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
-    const Geometry& g = *d.geometry;
-    const PatternSettings& settings = *d.patterns;
+    const Geometry& g = *d.get<Geometry>();
+    const PatternSettings& settings = *d.get<PatternSettings>();
     Built b;
     Json stations = Json::array();
     std::string markdown = kPreamble;

@@ -34,11 +34,11 @@ Product sweep_product() {
   p.name = "sweep";
   p.title = "Link-dimension sweep";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    if (!d.sweep) return "the design has no sweep: section";
+    if (!d.get<SweepSettings>()) return "the design has no sweep: section";
     return std::nullopt;
   };
   p.build = [](Context& ctx) {
-    const SweepSettings& s = *ctx.design.sweep;
+    const SweepSettings& s = *ctx.design.get<SweepSettings>();
     SweepOptions o;
     o.out_dir = ctx.dir / "sweep";
     o.progress = [&ctx](std::uint64_t done, std::uint64_t total, double) {

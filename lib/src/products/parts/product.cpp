@@ -69,7 +69,7 @@ Product parts_product() {
   p.name = "parts";
   p.title = "Printable parts";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
-    if (!d.geometry) return "no `geometry:` section (link widths, pins, bosses, tactor sizes)";
+    if (!d.get<Geometry>()) return "no `geometry:` section (link widths, pins, bosses, tactor sizes)";
     bool any = false;
     for (const Station& s : d.stations) any = any || !s.mechanisms().empty();
     if (!any) return "no station has a mechanism";

@@ -33,7 +33,7 @@ Product collision_product() {
   p.unavailable = [](const Design& d) { return without_pairs(d, "link widths and planes are needed"); };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
-    const Geometry& g = *d.geometry;
+    const Geometry& g = *d.get<Geometry>();
     Built b;
     Json stations = Json::array();
     std::string markdown = kPreamble;

@@ -1,0 +1,97 @@
+#pragma once
+/// The `controller:` section of a design file: the ROS controller of the device (loop, PWM, ADC, PID, potentiometers). One module of the design (see
+/// docs/architecture.md "Design sections"): the struct and its validate() here, its loader and
+/// writer hooks in lib/src/sections/controller.cpp. A Design holds it as `design.get<ControllerSettings>()`.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "fivebar/design.hpp"
+
+namespace fivebar {
+
+/// PID gains of one motor (`controller.pid`). The controller acts on the joint angle error
+/// e = theta_target - theta_measured in radians (ROS convention) and outputs the PWM duty cycle in
+/// [-1, 1]: duty = kp e + clamp(ki * integral(e dt), -i_clamp, i_clamp) + kd de/dt.
+struct PidGains {
+  double kp = 5.0;        ///< duty per rad: full duty at 0.2 rad (11.5 deg) of error
+  double ki = 1.0;        ///< duty per (rad s)
+  double kd = 0.05;       ///< duty per (rad/s)
+  double i_clamp = 0.2;   ///< bound of the integral term, duty in [0, 1]
+  void validate() const;
+};
+
+/// Potentiometer on a motor shaft, read through the ADC (`controller.potentiometer`):
+/// theta = rad_per_volt * (V - volts_at_zero), theta in the station frame (DESIGN.md: from +x,
+/// counter-clockwise). The file takes volts_per_rad (the datasheet's sensitivity) or rad_per_volt.
+struct Potentiometer {
+  double volts_at_zero = 2.5;                   ///< reading at theta = 0, V
+  double rad_per_volt = 1.0471975511965976;     ///< 5 V over 300 deg: 60 deg/V; negative when wired reversed
+  void validate() const;
+};
+
+/// What one joint of the controller gets once the overrides are applied.
+struct JointControl {
+  PidGains pid;
+  Potentiometer potentiometer;
+};
+
+/// An override of some PID or potentiometer keys. Scopes, from the widest: the lower or upper
+/// mechanism of every station (`controller.mechanisms.<mechanism>`), one of its joints
+/// (`...<mechanism>.theta1|theta2`), a station (`controller.stations.<station>`), one of its
+/// mechanisms, one of their joints. A scope naming a station is narrower than any that does not.
+/// Unset keys keep the value of the wider scope.
+struct ControlOverride {
+  std::string station;    ///< empty: every station (then `mechanism` is set)
+  std::string mechanism;  ///< "lower", "upper", or empty: every mechanism of the station
+  int joint = 0;          ///< 1 or 2 (theta1, theta2), or 0: both joints
+  std::optional<double> kp, ki, kd, i_clamp;
+  std::optional<double> volts_at_zero, rad_per_volt;
+  /// Key path of this scope relative to `controller` ("stations.index.lower.theta1",
+  /// "mechanisms.upper").
+  std::string key() const;
+  /// 0 ... 4, widest first, in the order above.
+  int level() const;
+};
+
+/// The ROS controller on the device (`controller:`; paper Sec. II-D): per mechanism an IK module,
+/// FK of the measured joints for collision checks with the upper mechanism's priority, and a PID
+/// per motor at loop_rate_hz driving the motor by PWM at pwm_hz; joint angles read from
+/// potentiometers through an ADC (the paper's 16-bit DAQ, USB-1608G). Read by fivebar/export.hpp.
+///
+/// Joint speed limit: max_velocity is the one source of truth when a design has this section;
+/// `patterns:` then takes it from here (the loader refuses patterns.max_joint_speed_deg_s next to
+/// a controller section, and Design::validate() requires both values to agree).
+struct ControllerSettings {
+  static constexpr std::string_view kKey = "controller";
+  std::string node = "fivebar_controller";  ///< ROS 2 node name: the parameters file's top key
+  double loop_rate_hz = 100.0;   ///< PID, IK and collision loop (paper: 100 Hz)
+  double pwm_hz = 1000.0;        ///< motor PWM (paper: 1 kHz)
+  int adc_bits = 16;             ///< DAQ resolution (paper: 16-bit)
+  std::array<double, 2> adc_range_v{-10.0, 10.0};  ///< input range of the DAQ, V
+  double max_velocity = 6.283185307179586;  ///< rad/s (file: max_velocity_deg_s, default 360)
+  std::string collision_priority = "upper";  ///< the paper's rule; the only one fivebar checks
+  /// Export gate: LCI over every target ellipse must be at least max(min_lci, the mechanism's
+  /// min_lci): the ellipse keeps this far from singularities.
+  double min_lci = 0.05;
+  PidGains pid;                   ///< every joint, unless overridden
+  Potentiometer potentiometer;    ///< every joint, unless overridden
+  std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first
+
+  /// Gains and calibration of joint `joint` (1 or 2) of a mechanism: the defaults, then the
+  /// overrides from the widest scope to the narrowest (ControlOverride), in file order within one.
+  JointControl joint(std::string_view station, std::string_view mechanism, int joint) const;
+  /// Rules that need no design (ranges, names); Design::validate() checks the override scopes.
+  void validate() const;
+};
+
+/// True when `name` is a ROS 2 node name: [A-Za-z_][A-Za-z0-9_]*, at most 255 characters.
+bool is_ros_node_name(std::string_view name);
+
+}  // namespace fivebar

@@ -1,0 +1,82 @@
+#include "sections/rules.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <sstream>
+
+namespace fivebar::rules {
+
+std::string format_number(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return std::string(buffer, result.ptr);
+}
+
+std::string format_degrees(double radians) {
+  if (!std::isfinite(radians)) return format_number(radians);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", radians * (180.0 / std::numbers::pi));
+  return buffer;
+}
+
+std::string plain_number(double v) {
+  if (!std::isfinite(v)) return format_number(v);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.12g", v);
+  return buffer;
+}
+
+void check_length(const std::string& key, double value_mm) {
+  if (!std::isfinite(value_mm)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be finite");
+  if (!(value_mm > 0.0)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be > 0");
+  if (value_mm > kMaxLengthMm) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be <= 1e12");
+}
+
+void check_coordinate(const std::string& key, double value_mm) {
+  if (!std::isfinite(value_mm)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be finite");
+  if (std::abs(value_mm) > kMaxLengthMm) {
+    throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be within [-1e12, 1e12]");
+  }
+}
+
+void check_point(const char* key, const Vec2& p_mm) {
+  // Keys are built only on failure: sweeps validate millions of designs.
+  auto ok = [](double v) { return std::isfinite(v) && std::abs(v) <= kMaxLengthMm; };
+  if (!ok(p_mm.x())) check_coordinate(detail::key_index(key, 0), p_mm.x());
+  if (!ok(p_mm.y())) check_coordinate(detail::key_index(key, 1), p_mm.y());
+}
+
+void require_length(const std::string& key, double v, double lo_exclusive, double hi) {
+  if (!(v > lo_exclusive) || !(v <= hi)) {
+    std::ostringstream s;
+    s << "= " << v << " mm: must be > " << lo_exclusive << " and <= " << hi << " mm";
+    throw ValidationError(key, s.str());
+  }
+}
+
+void require_range(const std::string& key, double v, double lo_exclusive, double hi, std::string_view unit) {
+  if (!(v > lo_exclusive) || !(v <= hi)) {
+    std::ostringstream s;
+    s << "= " << plain_number(v) << (unit.empty() ? "" : " ") << unit << ": must be > " << plain_number(lo_exclusive)
+      << " and <= " << plain_number(hi) << (unit.empty() ? "" : " ") << unit;
+    throw ValidationError(key, s.str());
+  }
+}
+
+std::string joined(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
+  return out;
+}
+
+std::string station_list(const Design& design) {
+  std::string list;
+  for (const Station& s : design.stations) list += (list.empty() ? "" : ", ") + s.name;
+  return list;
+}
+
+}  // namespace fivebar::rules
