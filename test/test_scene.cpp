@@ -50,8 +50,11 @@ class Scene : public ::testing::Test {
 TEST(Registry, EveryEntryIsAKnownProductOnce) {
   const auto& known = known_products();
   std::set<std::string> seen;
-  for (const auto& p : products::registry()) {
-    EXPECT_TRUE(std::find(known.begin(), known.end(), p.name) != known.end()) << p.name;
+  ASSERT_EQ(products::registry().size(), known.size());
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    const products::Product& p = products::registry()[i];
+    // products.def gives both lists: an entry point returning another name is caught here.
+    EXPECT_EQ(p.name, known[i]);
     EXPECT_TRUE(seen.insert(p.name).second) << "duplicate " << p.name;
     EXPECT_FALSE(p.title.empty()) << p.name;
     EXPECT_TRUE(p.build) << p.name;
@@ -63,6 +66,58 @@ TEST(Registry, EveryEntryIsAKnownProductOnce) {
   }
   EXPECT_NE(products::find_product("kinematics"), nullptr);
   EXPECT_EQ(products::find_product("teleport"), nullptr);
+}
+
+/// Lines `FIVEBAR_PRODUCT(name)` of lib/src/products/products.def, in order.
+std::vector<std::string> registered_in_def() {
+  std::vector<std::string> names;
+  std::istringstream in(slurp(fs::path(FIVEBAR_SOURCE_DIR) / "lib/src/products/products.def"));
+  for (std::string line; std::getline(in, line);) {
+    const std::string open = "FIVEBAR_PRODUCT(";
+    if (line.rfind(open, 0) == 0) names.push_back(line.substr(open.size(), line.find(')') - open.size()));
+  }
+  return names;
+}
+
+TEST(Registry, EveryProductFolderIsRegisteredAndEveryRegistrationHasItsFolder) {
+  // docs/architecture.md "Adding a product": a folder lib/src/products/<name>/ with product.cpp,
+  // and one line in products.def; nothing else in the library names the product.
+  const fs::path root = fs::path(FIVEBAR_SOURCE_DIR) / "lib/src/products";
+  std::set<std::string> folders;
+  for (const auto& e : fs::directory_iterator(root)) {
+    if (e.is_directory()) {
+      folders.insert(e.path().filename().string());
+      EXPECT_TRUE(fs::exists(e.path() / "product.cpp")) << e.path();
+    }
+  }
+  const std::vector<std::string> def = registered_in_def();
+  EXPECT_EQ(std::set<std::string>(def.begin(), def.end()), folders);
+  EXPECT_EQ(def, known_products());
+
+  // The entry point `<name>_product` is defined in its folder and named nowhere else in lib/ or cli/
+  // (products.def builds the registry by token pasting).
+  for (const std::string& name : def) {
+    const std::string entry = name + "_product(";
+    for (const char* tree : {"lib", "cli"}) {
+      for (const auto& e : fs::recursive_directory_iterator(fs::path(FIVEBAR_SOURCE_DIR) / tree)) {
+        if (!e.is_regular_file()) continue;
+        const std::string text = slurp(e.path());
+        if (text.find(entry) == std::string::npos) continue;
+        EXPECT_EQ(e.path(), root / name / "product.cpp") << entry << " named outside its folder";
+      }
+    }
+  }
+}
+
+TEST(Registry, TheSceneRunnerAndTheDesignNameNoProduct) {
+  // The scene, the design model and the loader learn product names from products.def only.
+  for (const char* file : {"lib/src/scene.cpp", "lib/src/design.cpp", "lib/src/yaml/design_loader.cpp",
+                           "lib/src/products/registry.cpp", "lib/include/fivebar/design.hpp"}) {
+    const std::string text = slurp(fs::path(FIVEBAR_SOURCE_DIR) / file);
+    for (const std::string& name : known_products()) {
+      EXPECT_EQ(text.find('"' + name + '"'), std::string::npos) << file << " names product " << name;
+    }
+  }
 }
 
 TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
@@ -143,6 +198,76 @@ TEST_F(Scene, AFailingKinematicsCheckIsReportedNotThrown) {
   const std::string md = slurp(r.summary_md);
   EXPECT_THAT(md, HasSubstr("attention needed"));
   EXPECT_THAT(md, HasSubstr("index/lower: target centre unreachable"));
+}
+
+/// A product made up for the test: it needs `needs`, records that it ran and what it saw.
+products::Product throwaway(std::string name, std::vector<std::string> needs, std::vector<std::string>* seen) {
+  products::Product p;
+  p.name = std::move(name);
+  p.title = "Throwaway " + p.name;
+  p.prerequisites = std::move(needs);
+  p.build = [seen, pre = p.prerequisites, own = p.name](products::Context& ctx) {
+    for (const auto& n : pre) {
+      if (ctx.result_of(n) == nullptr) throw std::logic_error(own + " built before its prerequisite " + n);
+    }
+    seen->push_back(own);
+    ctx.write_file(own + "/note.txt", "built\n");
+    products::Built b;
+    b.result = {{"prerequisites_seen", pre.size()}};
+    b.markdown = "Built by the test.\n";
+    b.check = "made up";
+    return b;
+  };
+  return p;
+}
+
+TEST_F(Scene, AThrowawayProductBuildsWithItsPrerequisitesOnly) {
+  // A product added to the list (as a new folder + one line of products.def would add it) runs
+  // after its prerequisites, transitively, and nothing else is built.
+  std::vector<products::Product> list = products::registry();
+  std::vector<std::string> seen;
+  list.push_back(throwaway("alpha", {"kinematics"}, &seen));
+  list.push_back(throwaway("beta", {"alpha"}, &seen));
+  list.push_back(throwaway("gamma", {}, &seen));
+  const Design d = load_design(kDesign);
+  SceneOptions o = options();
+  o.products = std::vector<std::string>{"beta"};
+  const SceneReport r = products::run_scene_with(d, o, list);
+
+  EXPECT_EQ(seen, (std::vector<std::string>{"alpha", "beta"}));
+  ASSERT_EQ(r.products.size(), list.size());
+  for (const ProductOutcome& p : r.products) {
+    const bool built = p.name == "kinematics" || p.name == "alpha" || p.name == "beta";
+    EXPECT_EQ(p.state == ProductOutcome::State::built, built) << p.name;
+    EXPECT_EQ(p.requested, p.name == "beta") << p.name;
+    EXPECT_EQ(p.prerequisite, p.name == "kinematics" || p.name == "alpha") << p.name;
+  }
+  EXPECT_TRUE(fs::exists(r.out_dir / "beta" / "note.txt"));
+  EXPECT_FALSE(fs::exists(r.out_dir / "gamma"));
+  const std::string md = slurp(r.summary_md);
+  EXPECT_THAT(md, HasSubstr("| `alpha` | built (prerequisite) |"));
+  EXPECT_THAT(md, HasSubstr("| `kinematics` | built (prerequisite) |"));
+  EXPECT_THAT(md, HasSubstr("## Throwaway beta (`beta`)"));
+  const auto json = Json::parse(slurp(r.summary_json));
+  EXPECT_EQ(json["results"]["beta"]["prerequisites_seen"], 1);
+  EXPECT_EQ(json["built"].size(), 3u);
+}
+
+TEST_F(Scene, AProductWhosePrerequisiteCannotBeBuiltIsLeftOutWithTheReason) {
+  std::vector<products::Product> list = products::registry();
+  std::vector<std::string> seen;
+  products::Product never = throwaway("never", {}, &seen);
+  never.unavailable = [](const Design&) -> std::optional<std::string> { return "no data for it"; };
+  list.push_back(never);
+  list.push_back(throwaway("after", {"never"}, &seen));
+  SceneOptions o = options();
+  o.products = std::vector<std::string>{"after"};
+  const SceneReport r = products::run_scene_with(load_design(kDesign), o, list);
+  EXPECT_TRUE(seen.empty());
+  EXPECT_EQ(r.products.back().state, ProductOutcome::State::left_out);
+  EXPECT_THAT(r.products.back().reason, HasSubstr("needs never, which could not be built"));
+  EXPECT_EQ(r.missing(), std::vector<std::string>{"after"});
+  EXPECT_FALSE(r.ok());
 }
 
 TEST_F(Scene, ADesignNameEscapingTheRootIsRefused) {

@@ -25,11 +25,6 @@ std::string join(const std::vector<std::string>& items, std::string_view sep) {
   return out;
 }
 
-bool is_known(std::string_view name) {
-  const auto& known = known_products();
-  return std::find(known.begin(), known.end(), name) != known.end();
-}
-
 }  // namespace
 
 bool SceneReport::ok() const {
@@ -122,7 +117,19 @@ std::string SceneReport::to_markdown() const {
 }
 
 SceneReport run_scene(const Design& design, const SceneOptions& options) {
-  const auto& known = known_products();
+  return products::run_scene_with(design, options, products::registry());
+}
+
+SceneReport products::run_scene_with(const Design& design, const SceneOptions& options,
+                                     const std::vector<Product>& registry) {
+  const auto find = [&registry](std::string_view name) -> const Product* {
+    for (const Product& p : registry) {
+      if (p.name == name) return &p;
+    }
+    return nullptr;
+  };
+  std::vector<std::string> known;
+  for (const Product& p : registry) known.push_back(p.name);
 
   SceneReport report;
   report.design_name = design.name;
@@ -138,9 +145,7 @@ SceneReport run_scene(const Design& design, const SceneOptions& options) {
   std::set<std::string> requested;
   if (listed) {
     for (const auto& name : *listed) {
-      if (!is_known(name)) {
-        throw InputError("unknown product '" + name + "' (known: " + join(known, ", ") + ")");
-      }
+      if (find(name) == nullptr) throw InputError("unknown product '" + name + "' (known: " + join(known, ", ") + ")");
       requested.insert(name);
     }
   }
@@ -157,9 +162,7 @@ SceneReport run_scene(const Design& design, const SceneOptions& options) {
     const std::string name = stack.back();
     stack.pop_back();
     if (!needed.insert(name).second) continue;
-    if (const auto* p = products::find_product(name)) {
-      for (const auto& pre : p->prerequisites) stack.push_back(pre);
-    }
+    for (const auto& pre : find(name)->prerequisites) stack.push_back(pre);
   }
 
   report.out_dir = resolve_output_dir(options.out_root, design.name);
@@ -172,11 +175,9 @@ SceneReport run_scene(const Design& design, const SceneOptions& options) {
     outcome.name = name;
     outcome.requested = listed && requested.count(name) > 0;
     outcome.prerequisite = needed.count(name) > 0 && !wanted(name);
-    const products::Product* product = products::find_product(name);
+    const Product* product = find(name);
     if (needed.count(name) == 0) {
       outcome.reason = "not listed in the scene's products";
-    } else if (product == nullptr) {
-      outcome.reason = "not implemented in fivebar " + std::string(version());
     } else if (auto why = product->unavailable ? product->unavailable(design) : std::nullopt) {
       outcome.reason = *why;
     } else {
@@ -188,8 +189,8 @@ SceneReport run_scene(const Design& design, const SceneOptions& options) {
         outcome.reason = "needs " + join(missing_pre, ", ") + ", which could not be built";
       } else {
         if (options.progress) options.progress("building " + name);
-        products::Context ctx{design, report.out_dir, results, options.progress, {}};
-        products::Built result = product->build(ctx);
+        Context ctx{design, report.out_dir, results, options.progress, {}};
+        Built result = product->build(ctx);
         outcome.state = ProductOutcome::State::built;
         outcome.passed = result.passed;
         outcome.check = result.check;

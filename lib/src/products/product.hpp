@@ -18,6 +18,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/json.hpp"
+#include "fivebar/scene.hpp"
 
 namespace fivebar::products {
 
@@ -76,8 +77,12 @@ inline std::optional<std::string> without_pairs(const Design& d, std::string_vie
   return "no station has both a lower and an upper mechanism";
 }
 
-/// All implemented products; run_scene() follows known_products() for the order.
+/// Every product, in the order of products.def (the build order).
 const std::vector<Product>& registry();
+/// run_scene() over a given list of products instead of registry(): the scene knows products only
+/// through this list (names, order, prerequisites), which tests extend with throwaway products.
+/// Prerequisites must come earlier in the list.
+SceneReport run_scene_with(const Design& design, const SceneOptions& options, const std::vector<Product>& registry);
 /// The entry named `name`, or nullptr when this build does not implement it.
 const Product* find_product(std::string_view name);
 
