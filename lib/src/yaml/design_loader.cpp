@@ -20,6 +20,7 @@
 #include <fstream>
 #include <initializer_list>
 #include <map>
+#include <set>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -418,6 +419,10 @@ class Loader {
 
   void note(const std::string& key, int line) { lines_.emplace(key, line); }
 
+  static std::string shape_child(const std::string& parent, std::string_view name) {
+    return parent.empty() ? std::string(name) : parent + "." + std::string(name);
+  }
+
   /// Line of a key path, or of its nearest recorded parent.
   int line_for(std::string key) const {
     while (true) {
@@ -455,6 +460,12 @@ class Loader {
 
   std::string origin_;
   std::map<std::string, int> lines_;
+  /// Key path -> the same path with the names a file chooses (stations, sweep variables) as <name>.
+  std::map<std::string, std::string> shapes_;
+
+ public:
+  /// When set, every key a visited map allows is added here, as its shape ("stations.<name>.target").
+  std::set<std::string>* catalogue = nullptr;
 };
 
 Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, int line,
@@ -466,6 +477,12 @@ Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, 
   }
   Entries all;
   std::map<std::string, int> first_line;
+  const auto known_shape = shapes_.find(path);
+  const std::string parent_shape = known_shape == shapes_.end() ? path : known_shape->second;
+  if (catalogue != nullptr) {
+    if (any_key) catalogue->insert(shape_child(parent_shape, "<name>"));
+    for (std::string_view a : allowed) catalogue->insert(shape_child(parent_shape, a));
+  }
   for (const auto& pair : map) {
     const int key_line = line_of(pair.first, line);
     if (!pair.first.IsScalar()) {
@@ -499,6 +516,7 @@ Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, 
     }
     first_line.emplace(name, key_line);
     note(key, key_line);
+    shapes_[key] = shape_child(parent_shape, any_key ? std::string_view("<name>") : std::string_view(name));
     all.push_back(Entry{name, key, pair.second, key_line});
   }
   return all;
@@ -884,6 +902,14 @@ sections::Value Loader::value(const Entry& entry) {
 
 Design load_design_from_string(const std::string& text, const std::string& origin) {
   return Loader(origin).load(text);
+}
+
+std::set<std::string> detail::design_file_keys(const std::string& text) {
+  std::set<std::string> keys;
+  Loader loader("design_file_keys");
+  loader.catalogue = &keys;
+  (void)loader.load(text);
+  return keys;
 }
 
 Design load_design(const std::filesystem::path& path) {
