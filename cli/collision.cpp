@@ -68,8 +68,8 @@ void print_interference(const Geometry& g, const Interference& in) {
 }
 
 int run_pair(const CollisionOptions& opt, const Design& design, const Station& s, const Geometry& g) {
-  const auto u = parse_pair(opt.upper, "--upper", "X,Y in mm");
-  const auto l = parse_pair(opt.lower, "--lower", "X,Y in mm");
+  const auto u = parse_point_mm(opt.upper, "--upper");
+  const auto l = parse_point_mm(opt.lower, "--lower");
   const PriorityResult r = apply_priority(*s.upper, *s.lower, g, Vec2(u[0], u[1]), Vec2(l[0], l[1]));
   const bool collides = r.before && r.before->collides;
   const bool unusable = r.status == PriorityStatus::upper_unusable || r.status == PriorityStatus::lower_unusable;

@@ -1,5 +1,7 @@
 #include "common.hpp"
 
+#include "fivebar/ranges.hpp"
+
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -140,12 +142,30 @@ std::array<double, 2> parse_pair(std::string_view text, std::string_view option,
   return out;
 }
 
+std::array<double, 2> parse_point_mm(std::string_view text, std::string_view option) {
+  const auto p = parse_pair(text, option, "X,Y in mm");
+  for (double v : p) {
+    if (const auto rule = ranges::coordinate_rule(v)) {
+      throw InputError(std::string(option) + " '" + std::string(text) + "': coordinate " + exact(v) + " mm " + *rule +
+                       " (docs/reliability.md \"Numeric ranges\")");
+    }
+  }
+  return p;
+}
+
 // --- Output -----------------------------------------------------------------------------------
 
 void print_json(const Json& doc) { std::cout << doc.dump(2) << "\n"; }
 
 std::string fixed(double value, int digits) {
   char buf[64];
+  // A value that would print as 0.000 though it is not zero, or as an integer of 16 or more
+  // digits, is shown in scientific form instead ("1e-06", "1e+308").
+  const double magnitude = std::fabs(value);
+  if (std::isfinite(value) && value != 0.0 && (magnitude < 0.5 * std::pow(10.0, -digits) || magnitude >= 1e15)) {
+    std::snprintf(buf, sizeof buf, "%.4g", value);
+    return buf;
+  }
   std::snprintf(buf, sizeof buf, "%.*f", digits, value);
   std::string s(buf);
   if (s.front() == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
@@ -298,6 +318,12 @@ bool CsvReader::next(std::vector<double>& values) {
     if (!v) {
       throw InputError(where() + ": " + columns_[k] + " = '" + std::string(fields[index_[k]]) +
                        "' is not a finite number");
+    }
+    // Lengths and coordinates (mm) obey the design files' range; angles only need to be finite.
+    if (columns_[k].ends_with("_mm")) {
+      if (const auto rule = ranges::coordinate_rule(*v)) {
+        throw InputError(where() + ": " + columns_[k] + " = " + exact(*v) + " " + *rule);
+      }
     }
     values[k] = *v;
   }

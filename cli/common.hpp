@@ -65,6 +65,8 @@ std::function<void(std::string_view)> terminal_progress(std::string_view command
 
 /// "A,B" -> two finite numbers; InputError naming `option` and the expected form otherwise.
 std::array<double, 2> parse_pair(std::string_view text, std::string_view option, std::string_view form);
+/// "X,Y" -> a point in mm within the range of fivebar/ranges.hpp (the design files' rule).
+std::array<double, 2> parse_point_mm(std::string_view text, std::string_view option);
 /// A finite number; std::nullopt when `text` is not exactly one.
 std::optional<double> parse_number(std::string_view text);
 

@@ -88,7 +88,7 @@ int run_ik(const IkOptions& opt) {
   const WorkingMode mode = mode_of(opt, m);
   if (!opt.point_file.empty()) return run_batch(opt, m, mode);
 
-  const auto xy = parse_pair(opt.point, "--point", "X,Y in mm");
+  const auto xy = parse_point_mm(opt.point, "--point");
   const Vec2 p(xy[0], xy[1]);
 
   if (opt.all) {

@@ -65,7 +65,7 @@ PatternSpec spec_for(const PatternOptions& opt, const Design& design, const Stat
     spec.contact_points.reset();  // the contact points follow the separation again
   }
   if (!opt.center.empty()) {
-    const auto c = parse_pair(opt.center, "--center", "X,Y in mm");
+    const auto c = parse_point_mm(opt.center, "--center");
     spec.centre = Vec2(c[0], c[1]);
   }
   try {

@@ -15,6 +15,7 @@
 
 #include "design_keys.hpp"
 #include "fivebar/tolerances.hpp"
+#include "fivebar/ranges.hpp"
 #include "sections/rules.hpp"
 #include "sections/section.hpp"
 
@@ -216,7 +217,7 @@ void Mechanism::validate() const {
   check_point("bases[0]", O1);
   check_point("bases[1]", O2);
   for (std::size_t i = 0; i < L.size(); ++i) {
-    if (!(L[i] > 0.0 && L[i] <= kMaxLengthMm)) check_length(detail::key_index("links", i), L[i]);
+    if (!(L[i] >= ranges::kMinLengthMm && L[i] <= kMaxLengthMm)) check_length(detail::key_index("links", i), L[i]);
   }
 
   auto valid_sign = [](std::int8_t s) { return s == 1 || s == -1; };

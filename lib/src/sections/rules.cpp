@@ -1,5 +1,7 @@
 #include "sections/rules.hpp"
 
+#include "fivebar/ranges.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -31,15 +33,14 @@ std::string plain_number(double v) {
 }
 
 void check_length(const std::string& key, double value_mm) {
-  if (!std::isfinite(value_mm)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be finite");
-  if (!(value_mm > 0.0)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be > 0");
-  if (value_mm > kMaxLengthMm) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be <= 1e12");
+  if (const auto rule = ranges::length_rule(value_mm)) {
+    throw ValidationError(key, "= " + format_number(value_mm) + " mm: " + *rule);
+  }
 }
 
 void check_coordinate(const std::string& key, double value_mm) {
-  if (!std::isfinite(value_mm)) throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be finite");
-  if (std::abs(value_mm) > kMaxLengthMm) {
-    throw ValidationError(key, "= " + format_number(value_mm) + " mm: must be within [-1e12, 1e12]");
+  if (const auto rule = ranges::coordinate_rule(value_mm)) {
+    throw ValidationError(key, "= " + format_number(value_mm) + " mm: " + *rule);
   }
 }
 

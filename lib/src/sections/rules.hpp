@@ -8,12 +8,12 @@
 
 #include "design_keys.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/ranges.hpp"
 
 namespace fivebar::rules {
 
-/// Largest admissible length or |coordinate|, mm. Far beyond any device, it keeps squared lengths
-/// (1e24) and sums of them far from overflow, so every later formula stays finite.
-inline constexpr double kMaxLengthMm = 1e12;
+/// Largest admissible length or |coordinate|, mm (fivebar/ranges.hpp).
+inline constexpr double kMaxLengthMm = ranges::kMaxLengthMm;
 
 /// Shortest text that reads back as the same double ("-3", "12.5", "1e+13", "nan").
 std::string format_number(double value);
@@ -22,7 +22,7 @@ std::string format_degrees(double radians);
 /// A value for messages as a person types it: 100000, 0.15, 1e-09.
 std::string plain_number(double value);
 
-/// A length in (0, kMaxLengthMm], mm.
+/// A length in [ranges::kMinLengthMm, ranges::kMaxLengthMm], mm.
 void check_length(const std::string& key, double value_mm);
 /// A coordinate within [-kMaxLengthMm, kMaxLengthMm], mm.
 void check_coordinate(const std::string& key, double value_mm);

@@ -40,9 +40,9 @@ void SweepSettings::validate() const {
     for (std::size_t j = 0; j < i; ++j) {
       if (vary[j].name == v.name) throw ValidationError(key, "is varied twice");
     }
-    if (!(v.lo > 0.0) || !(v.hi >= v.lo) || !(v.hi <= rules::kMaxLengthMm)) {
+    if (!(v.lo >= ranges::kMinLengthMm) || !(v.hi >= v.lo) || !(v.hi <= rules::kMaxLengthMm)) {
       throw ValidationError(key, "= [" + format_number(v.lo) + ", " + format_number(v.hi) +
-                                     "] mm: needs 0 < lo <= hi <= 1e12");
+                                     "] mm: needs 1e-09 <= lo <= hi <= 1e12");
     }
     if (v.n < 1 || v.n > 100000000) {
       throw ValidationError(key, "= " + std::to_string(v.n) + " points: must be 1 ... 1e8");
