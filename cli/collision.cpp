@@ -114,6 +114,7 @@ int run_map(const CollisionOptions& opt, const Design& design, const Station& s,
   }
   const CollisionMap map = collision_map(s, g, options);
   const std::filesystem::path dir = output_dir(design, opt.out, "collision");
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const RenderedPlot pic = plot_collision_map(s, g, map);
   const std::filesystem::path svg = dir / (s.name + ".svg");
   const std::filesystem::path png = dir / (s.name + ".png");

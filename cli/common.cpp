@@ -343,6 +343,7 @@ void BatchSink::commit() {
     file_->commit();
   } else {
     std::cout.flush();
+    if (!std::cout.good()) throw IoError("cannot write standard output: the write failed");
   }
 }
 
@@ -378,6 +379,11 @@ BatchTally stream_batch(const std::string& file, std::vector<std::string> column
   while (reader.next(row)) {
     ++tally.rows;
     if (!solve(row, out)) ++tally.unsolved;
+    // Stop at the first refused write (a full disk, a closed stdout) instead of computing the rest.
+    if (!out.good()) {
+      throw IoError("cannot write " + (output.empty() ? std::string("standard output") : "'" + output + "'") +
+                    ": the write failed at row " + std::to_string(tally.rows) + " of " + file);
+    }
   }
   sink.commit();
   return tally;

@@ -102,6 +102,7 @@ int run_export(const ExportCliOptions& opt) {
   // The directory is created only once the gate has passed.
   const std::filesystem::path dir =
       opt.out.empty() ? resolve_output_dir("outputs", design.name) / "export" : std::filesystem::path(opt.out);
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const ExportResult r = export_controller(design, formats, dir, options);
 
   if (opt.json) {

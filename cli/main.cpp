@@ -1,9 +1,12 @@
 // fivebar: command-line front end, fivebar::cli::main (cli/cli.hpp). Subcommands live in one file
-// each (setup_<cmd> / run_<cmd>); this file maps every outcome to the exit codes of DESIGN.md. The
+// each (setup_<cmd> / run_<cmd>); this file maps every outcome to the exit codes of docs/conventions.md. The
 // process entry point is fivebar_main.cpp; the fuzzer (test/fuzz/fuzz_cli.cpp) calls this in-process.
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <set>
 #include <string>
@@ -45,7 +48,34 @@ std::vector<std::string> join_dash_values(int argc, char** argv) {
 
 }  // namespace
 
-int fivebar::cli::main(int argc, char** argv) {
+namespace fivebar::cli {
+namespace {
+
+/// Flushes standard output and reports what the kernel refused (a full disk, a closed or broken
+/// descriptor): a lost result is an error, exit 3, whatever the command's own outcome was.
+int finish_stdout(int code) {
+  std::cout.flush();
+  errno = 0;
+  const bool flushed = std::fflush(stdout) == 0;
+  const int error = errno;
+  if (std::cout.good() && flushed && std::ferror(stdout) == 0) return code;
+  std::cerr << "fivebar: error: cannot write standard output: "
+            << (error != 0 ? std::string(std::strerror(error)) : std::string("the write failed (a full disk, or standard output closed)"))
+            << "\n";
+  std::cout.clear();
+  std::clearerr(stdout);
+  return kInternal;
+}
+
+int run(int argc, char** argv);
+
+}  // namespace
+
+int main(int argc, char** argv) { return finish_stdout(run(argc, argv)); }
+
+namespace {
+
+int run(int argc, char** argv) {
   CLI::App app{
       "fivebar " + std::string(fivebar::version()) +
           ": design five-bar-linkage cutaneous haptic devices (IROS 2022).\n"
@@ -114,3 +144,6 @@ int fivebar::cli::main(int argc, char** argv) {
     return kInternal;
   }
 }
+
+}  // namespace
+}  // namespace fivebar::cli

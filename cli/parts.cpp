@@ -58,6 +58,7 @@ int run_parts(const PartsCliOptions& opt) {
   const Design design = load(opt.design);
   PartsOptions options;
   options.out_dir = resolve_output_dir(opt.out, design.name) / "parts";
+  const WriteFence fence(options.out_dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   if (!opt.station.empty()) options.station = opt.station;
   options.render = !opt.no_render;
   options.jobs = opt.jobs;

@@ -137,6 +137,7 @@ int run_pattern(const PatternOptions& opt) {
   const PatternResult r = check_pattern(s, g, spec, max_speed);
 
   const std::filesystem::path dir = output_dir(design, opt.out, "patterns");
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const std::string stem = s.name + "-" + std::string(to_string(*kind));
   const std::filesystem::path csv = dir / (stem + ".csv");
   {

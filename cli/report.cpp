@@ -34,6 +34,7 @@ int run_accuracy(const ReportOptions& opt) {
   options.progress = progress_sink(opt.quiet);
   // Resolve the output directory before the long computation so that a bad --out fails early.
   const std::filesystem::path dir = resolve_output_dir(opt.out, design.name) / "report";
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const AccuracyReport report = accuracy_report(design, options);
   const auto files = write_accuracy_plots(report, dir);
   if (opt.json) {

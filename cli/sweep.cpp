@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "fivebar/io.hpp"
 #include "fivebar/sweep.hpp"
 
 namespace fivebar::cli {
@@ -138,9 +139,15 @@ int run_sweep_cmd(const SweepCliOptions& o) {
   design.set<SweepSettings>(settings);
   SweepOptions options;
   options.out_dir = o.out.empty() ? std::filesystem::path("outputs") / design.name / "sweep" : std::filesystem::path(o.out);
+  const WriteFence fence(options.out_dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   if (!o.shard.empty()) std::tie(options.shard, options.shards) = parse_shard(o.shard);
   options.resume = o.resume;
   options.plots = !o.no_plots;
+  if (o.threads < 0 || o.threads > kMaxSweepThreads) {
+    throw InputError("--threads " + std::to_string(o.threads) + ": must be 1 ... " + std::to_string(kMaxSweepThreads) +
+                     " (absent: every core)");
+  }
+  (void)sweep_threads(o.threads);  // OMP_NUM_THREADS too, before any file is written
   options.threads = o.threads;
   options.stop = &g_stop;
   const bool mpi = launched_by_mpi();

@@ -59,6 +59,7 @@ int run_workspace(const WorkspaceCliOptions& opt) {
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
   const std::filesystem::path dir =
       opt.out.empty() ? resolve_output_dir("outputs", design.name) / "workspace" : std::filesystem::path(opt.out);
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const auto progress = terminal_progress("workspace");
 
   // Analyse every station before writing anything: a bad --mechanism for the second station must

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -9,6 +10,8 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <cctype>
+#include <set>
 #include <random>
 #include <streambuf>
 #include <vector>
@@ -141,16 +144,66 @@ fs::path absolute_normal(const fs::path& p) {
   return a;
 }
 
-/// IoError unless `target` is inside every live fence.
+/// `p` absolute, normalised, with every symbolic link of its existing part resolved: where a
+/// write to `p` really lands.
+fs::path resolved(const fs::path& p) {
+  std::error_code ec;
+  fs::path r = fs::weakly_canonical(absolute_normal(p), ec);
+  if (ec) return absolute_normal(p);
+  if (!r.has_filename() && r != r.root_path()) r = r.parent_path();
+  return r;
+}
+
+/// IoError unless `target` lands inside every live fence. Both sides are resolved through their
+/// symbolic links, so a link inside the output directory cannot carry a write out of it.
 void check_fences(const fs::path& target) {
   if (fences().empty()) return;
-  const fs::path t = absolute_normal(target);
-  for (const fs::path& root : fences()) {
+  const fs::path t = resolved(target);
+  for (const fs::path& fence : fences()) {
+    const fs::path root = resolved(fence);
     const fs::path inside = t.lexically_relative(root);
     if (inside.empty() || *inside.begin() == "..") {
-      throw IoError("refusing to write '" + target.string() + "': outside the output directory '" + root.string() +
-                    "'");
+      const fs::path lexical = absolute_normal(target).lexically_relative(absolute_normal(fence));
+      const bool linked = !lexical.empty() && *lexical.begin() != "..";
+      throw IoError("refusing to write '" + target.string() + "': " +
+                    (linked ? "a symbolic link leads it to '" + t.string() + "', " : std::string()) +
+                    "outside the output directory '" + fence.string() + "'");
     }
+  }
+}
+
+/// Name of a temporary of write_file_atomic/AtomicFile: ".NAME.tmp.PID.TOKEN" (16 hex digits).
+/// The PID, or 0 when `name` is not one.
+long temporary_pid(const std::string& name) {
+  if (name.size() < 24 || name[0] != '.') return 0;
+  const std::size_t dot = name.rfind('.');
+  if (dot == std::string::npos || name.size() - dot - 1 != 16) return 0;
+  for (std::size_t i = dot + 1; i < name.size(); ++i) {
+    if (!std::isxdigit(static_cast<unsigned char>(name[i]))) return 0;
+  }
+  const std::size_t pid_dot = name.rfind('.', dot - 1);
+  if (pid_dot == std::string::npos || pid_dot < 5 || name.compare(pid_dot - 4, 4, ".tmp") != 0) return 0;
+  long pid = 0;
+  for (std::size_t i = pid_dot + 1; i < dot; ++i) {
+    if (name[i] < '0' || name[i] > '9' || pid > 100000000) return 0;
+    pid = pid * 10 + (name[i] - '0');
+  }
+  return pid;
+}
+
+/// Removes, once per directory and process, the temporaries that killed runs left in `dir`: those
+/// whose process no longer exists (a live process's, or one we may not signal, are kept).
+void remove_stale_temporaries(const fs::path& dir) {
+  static std::set<fs::path> swept;
+  const fs::path key = absolute_normal(dir.empty() ? fs::path(".") : dir);
+  if (!swept.insert(key).second) return;
+  std::error_code ec;
+  for (fs::directory_iterator it(key, ec), end; !ec && it != end; it.increment(ec)) {
+    const long pid = temporary_pid(it->path().filename().string());
+    if (pid <= 0 || pid == ::getpid()) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    if (it->is_regular_file(ignored) && !it->is_symlink(ignored)) fs::remove(it->path(), ignored);
   }
 }
 
@@ -182,6 +235,9 @@ struct AtomicFile::Impl {
   std::unique_ptr<FdStreambuf> buf;
   std::unique_ptr<std::ostream> os;
   bool committed = false;
+  /// Written in place, as `>` does: the target is a device, a FIFO, a socket or a symbolic link
+  /// (only a regular file is replaced atomically).
+  bool through = false;
 
   void close_and_remove() noexcept {
     os.reset();
@@ -202,7 +258,24 @@ AtomicFile::AtomicFile(fs::path path) : impl_(std::make_unique<Impl>()) {
     throw_io(impl_->target, "not a file name", 0);
   }
   check_fences(impl_->target);
+  struct stat link_status {};
+  if (::lstat(impl_->target.c_str(), &link_status) == 0) {
+    struct stat status {};
+    const bool exists = ::stat(impl_->target.c_str(), &status) == 0;
+    if (exists && S_ISDIR(status.st_mode)) throw_io(impl_->target, "is a directory", 0);
+    if (S_ISLNK(link_status.st_mode) || (exists && !S_ISREG(status.st_mode))) {
+      // /dev/stdout, /dev/null, a FIFO, a link the user made: write through it, never replace it.
+      const int fd = ::open(impl_->target.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+      if (fd < 0) throw_io(impl_->target, "cannot open", errno);
+      impl_->through = true;
+      impl_->fd = fd;
+      impl_->buf = std::make_unique<FdStreambuf>(fd);
+      impl_->os = std::make_unique<std::ostream>(impl_->buf.get());
+      return;
+    }
+  }
   const fs::path dir = impl_->target.parent_path();
+  remove_stale_temporaries(dir);
   for (int attempt = 0; attempt < 16; ++attempt) {
     char token[17];
     std::snprintf(token, sizeof token, "%016llx", static_cast<unsigned long long>(random_token()));
@@ -249,8 +322,8 @@ void AtomicFile::commit() {
     f.close_and_remove();
     throw_io(f.target, "write failed", err);
   }
-  if (::fsync(f.fd) != 0) {
-    const int err = errno;
+  if (::fsync(f.fd) != 0 && !(f.through && (errno == EINVAL || errno == EROFS || errno == ENOTSUP))) {
+    const int err = errno;  // a pipe or a terminal cannot be synced: that is not a failure
     f.close_and_remove();
     throw_io(f.target, "fsync failed", err);
   }
@@ -262,6 +335,10 @@ void AtomicFile::commit() {
     const int err = errno;
     f.close_and_remove();
     throw_io(f.target, "close failed", err);
+  }
+  if (f.through) {
+    f.committed = true;
+    return;
   }
   if (::rename(f.temp.c_str(), f.target.c_str()) != 0) {
     const int err = errno;
@@ -286,7 +363,7 @@ void AtomicFile::discard() noexcept {
 }
 
 const fs::path& AtomicFile::path() const noexcept { return impl_->target; }
-const fs::path& AtomicFile::temp_path() const noexcept { return impl_->temp; }
+const fs::path& AtomicFile::temp_path() const noexcept { return impl_->through ? impl_->target : impl_->temp; }
 
 void write_file_atomic(const fs::path& path, std::string_view content) {
   AtomicFile file(path);

@@ -475,7 +475,21 @@ std::string csv_name(const SweepOptions& o) {
 
 }  // namespace
 
+int sweep_threads(int requested) {
+  const std::string bound = std::to_string(kMaxSweepThreads);
+  if (requested < 0 || requested > kMaxSweepThreads) {
+    throw InputError("threads = " + std::to_string(requested) + ": must be 1 ... " + bound + " (0: every core)");
+  }
+  if (requested > 0) return requested;
+  const int fallback = omp_get_max_threads();
+  if (fallback > kMaxSweepThreads) {
+    throw InputError("OMP_NUM_THREADS asks for " + std::to_string(fallback) + " threads: a sweep runs at most " + bound);
+  }
+  return fallback;
+}
+
 SweepResult run_sweep(const Design& design, const SweepOptions& options) {
+  const int threads = sweep_threads(options.threads);
   if (!design.get<SweepSettings>()) throw InputError(design.name + ": the design has no sweep: section");
   const SweepSettings& s = *design.get<SweepSettings>();
   if (options.shards == 0 || options.shard >= options.shards) throw InputError("shard out of range");
@@ -520,7 +534,7 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
     unit_points(s, next, n, u);
     rows.assign(n, SweepRow{});
     const std::int64_t count = std::int64_t(n);
-#pragma omp parallel for schedule(dynamic, 64) num_threads(options.threads > 0 ? options.threads : omp_get_max_threads())
+#pragma omp parallel for schedule(dynamic, 64) num_threads(threads)
     for (std::int64_t k = 0; k < count; ++k) {
       std::vector<double> values;
       to_values(s, u.data() + std::size_t(k) * dims, values, is_grid);

@@ -1,8 +1,10 @@
 #pragma once
-/// Output files (DESIGN.md "Files are written atomically"): every file fivebar writes is first
+/// Output files (docs/conventions.md "Output files"): every regular file fivebar writes is first
 /// written to a temporary sibling `.<name>.tmp.<pid>.<random>`, flushed and fsync'ed, then renamed
 /// over the target. A failed run therefore leaves either the old file or the new one, never a
-/// partial file, and no temporary behind.
+/// partial file, and no temporary behind; the temporaries of a killed run are removed by the next
+/// write into the same directory. A target that is not a regular file (a device such as /dev/null,
+/// a FIFO, /dev/stdout, any symbolic link) is written through, as the shell's `>` does.
 
 #include <filesystem>
 #include <memory>
@@ -58,7 +60,7 @@ class AtomicFile {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Interrupted runs (DESIGN.md "a failed run leaves no partial file"): installs handlers for SIGINT,
+/// Interrupted runs (docs/conventions.md "Output files": a failed run leaves no partial file): installs handlers for SIGINT,
 /// SIGTERM, SIGHUP and SIGPIPE that remove the temporary of every AtomicFile still open in this
 /// process and then let the signal take its default action, so the process still ends as killed by
 /// that signal. Files already renamed into place are complete; nothing else is left behind. Call
@@ -67,9 +69,10 @@ class AtomicFile {
 void install_interrupt_cleanup();
 
 /// Confines this process's writes: while a WriteFence on `root` is alive, AtomicFile,
-/// write_file_atomic and make_directories refuse with IoError any target that is not `root` or
-/// lexically inside it (both made absolute against the current directory and normalised; symbolic
-/// links are not resolved). Fences nest: every live fence must contain the target. `fivebar run`
+/// write_file_atomic and make_directories refuse with IoError any target that does not land in
+/// `root` (both made absolute and resolved through their symbolic links: a link inside the output
+/// directory that points elsewhere is refused). The check and the write are two steps: another
+/// process that swaps a directory for a link in between is not guarded against. Fences nest: every live fence must contain the target. `fivebar run`
 /// fences its --out root, so no product can write outside it. Create and destroy fences on one
 /// thread while no other thread writes.
 class WriteFence {

@@ -83,7 +83,7 @@ struct SweepOptions {
   bool resume = false;                ///< continue an interrupted CSV in out_dir
   bool plots = true;                  ///< SVG/PNG of the objectives
   std::uint64_t chunk = 16384;        ///< designs per parallel chunk (memory stays flat)
-  int threads = 0;                    ///< 0: every core
+  int threads = 0;                    ///< 0: every core (OMP_NUM_THREADS); at most kMaxSweepThreads
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT) to stop after the chunk
   std::function<void(std::uint64_t done, std::uint64_t total, double seconds)> progress;
   CoverageOptions coverage = sweep_coverage_options();
@@ -105,6 +105,14 @@ struct SweepResult {
   std::filesystem::path csv;
   std::vector<std::filesystem::path> files;  ///< every file written
 };
+
+/// Most worker threads a sweep runs (docs/reliability.md "Resource bounds"): far above any
+/// machine's cores, low enough that thread creation cannot exhaust the process.
+inline constexpr int kMaxSweepThreads = 256;
+
+/// The worker threads a sweep with `requested` threads (0: the OpenMP default, OMP_NUM_THREADS)
+/// runs; InputError naming `threads` (or OMP_NUM_THREADS) above kMaxSweepThreads or below 0.
+int sweep_threads(int requested);
 
 /// Runs (a shard of) the design's `sweep:` section, writing `sweep.csv` (or
 /// `sweep.shard-K-of-N.csv`), `pareto.csv`, `best.yaml` and the plots into options.out_dir.
