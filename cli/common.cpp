@@ -1,3 +1,4 @@
+#include "fivebar/format.hpp"
 #include "common.hpp"
 
 #include "fivebar/ranges.hpp"
@@ -21,11 +22,7 @@ namespace fivebar::cli {
 
 namespace {
 
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
+std::string join(const std::vector<std::string>& items) { return format::join(items); }
 
 std::string_view trim(std::string_view s) {
   const auto first = s.find_first_not_of(" \t\r");
@@ -166,17 +163,10 @@ std::string fixed(double value, int digits) {
     std::snprintf(buf, sizeof buf, "%.4g", value);
     return buf;
   }
-  std::snprintf(buf, sizeof buf, "%.*f", digits, value);
-  std::string s(buf);
-  if (s.front() == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
+  return format::fixed(value, digits);
 }
 
-std::string exact(double value) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, value);
-  return ec == std::errc() ? std::string(buf, end) : fixed(value, 17);
-}
+std::string exact(double value) { return format::shortest(value); }
 
 std::string limits_text(const Mechanism& m, const Pose& pose) {
   if (!m.joint_limits) return "none set";
@@ -184,7 +174,7 @@ std::string limits_text(const Mechanism& m, const Pose& pose) {
 }
 
 void print_pose(std::ostream& out, const Mechanism& m, const Pose& pose) {
-  constexpr double kDeg = 180.0 / std::numbers::pi;
+  constexpr double kDeg = format::kDegPerRad;
   const auto row = [&](std::string_view key, const std::string& value) {
     std::string k(key);
     k.resize(std::max<std::size_t>(k.size() + 2, 30), ' ');

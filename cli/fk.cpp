@@ -4,6 +4,7 @@
 #include <memory>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/json.hpp"
@@ -12,7 +13,7 @@ namespace fivebar::cli {
 
 namespace {
 
-constexpr double kDegToRad = std::numbers::pi / 180.0;
+constexpr double kDegToRad = format::kRadPerDeg;
 
 struct FkOptions {
   Target target;

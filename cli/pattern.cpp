@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include "fivebar/format.hpp"
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
@@ -19,7 +20,7 @@ namespace fivebar::cli {
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using format::kDegPerRad;
 
 struct PatternOptions {
   std::string design;

@@ -30,6 +30,7 @@
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/version.hpp"
@@ -100,9 +101,9 @@ TEST(FormatDouble, ReadsBackBitForBit) {
 
 TEST(Hash, Fnv1a64KnownVectors) {
   // Reference values of the FNV-1a 64-bit function (Fowler, Noll, Vo).
-  EXPECT_EQ(fnv1a64(""), 0xcbf29ce484222325ULL);
-  EXPECT_EQ(fnv1a64("a"), 0xaf63dc4c8601ec8cULL);
-  EXPECT_EQ(fnv1a64("foobar"), 0x85944171f73967e8ULL);
+  EXPECT_EQ(format::fnv1a64(""), 0xcbf29ce484222325ULL);
+  EXPECT_EQ(format::fnv1a64("a"), 0xaf63dc4c8601ec8cULL);
+  EXPECT_EQ(format::fnv1a64("foobar"), 0x85944171f73967e8ULL);
 }
 
 TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
@@ -112,7 +113,7 @@ TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
   EXPECT_EQ(h.size(), 8u + 16u);
   char expected[32];
   std::snprintf(expected, sizeof expected, "fnv1a64:%016llx",
-                static_cast<unsigned long long>(fnv1a64(to_yaml(export_view(d, {})))));
+                static_cast<unsigned long long>(format::fnv1a64(to_yaml(export_view(d, {})))));
   EXPECT_EQ(h, expected);
   EXPECT_EQ(design_hash(paper(), {}), h);  // deterministic
 

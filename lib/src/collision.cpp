@@ -1,6 +1,7 @@
 // Link outlines as capsules, exact capsule clearances, interference of the two mechanisms of a
 // station, the paper's priority rule and the sampled collision map (fivebar/collision.hpp).
 
+#include "fivebar/format.hpp"
 #include "fivebar/collision.hpp"
 
 #include <algorithm>
@@ -270,11 +271,7 @@ std::string pose_problem(const Mechanism& m, const Pose& pose) {
   return "on the wrong assembly side (" + to_string(m.assembly_mode) + " required)";
 }
 
-std::string fixed3(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", v);
-  return buf;
-}
+std::string fixed3(double v) { return format::fixed(v, 3); }
 
 /// Is the lower tactor free (usable and clear of the fixed upper outline) at q?
 class LowerProbe {

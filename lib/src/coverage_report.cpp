@@ -1,4 +1,5 @@
 // Coverage results as JSON, and the --ellipse text form (fivebar/coverage_report.hpp).
+#include "fivebar/format.hpp"
 #include "fivebar/coverage_report.hpp"
 
 #include <charconv>
@@ -63,7 +64,7 @@ Ellipse parse_ellipse(std::string_view text, std::string_view option) {
   Ellipse e;
   e.center = {v[0], v[1]};
   e.axes = {v[2], v[3]};
-  e.angle = v[4] * std::numbers::pi / 180.0;
+  e.angle = v[4] * format::kRadPerDeg;
   try {
     e.validate();
   } catch (const InputError& err) {

@@ -2,6 +2,7 @@
 // writing the files and checking an exported file against a design. The three formats' text is
 // in export_formats.cpp (and yaml/export_yaml_reader.cpp for reading ROS YAML back).
 
+#include "fivebar/format.hpp"
 #include "fivebar/export.hpp"
 
 #include <algorithm>
@@ -26,20 +27,14 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using format::kDegPerRad;
 /// Lengths leave in metres (REP 103). Divided, not multiplied by 1e-3: the quotient is the double
 /// nearest the true value, so 9 mm is written 0.009 rather than 0.009000000000000001.
 constexpr double kMmPerMetre = 1000.0;
 /// Version of the exported layout; a controller may refuse a layout it does not know.
 constexpr int kFormatVersion = 1;
 
-std::string fixed(double v, int digits) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof buffer, "%.*f", digits, v);
-  std::string s = buffer;
-  if (s.find_first_not_of("-0.") == std::string::npos && s.front() == '-') s.erase(0, 1);  // no "-0.00"
-  return s;
-}
+using format::fixed;
 
 std::string point_text(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ") mm"; }
 
@@ -416,15 +411,6 @@ Json to_json(const ExportGate& gate) {
 // ---------------------------------------------------------------------------------------------
 // Hash and view
 
-std::uint64_t fnv1a64(std::string_view bytes) {
-  std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char b : bytes) {
-    h ^= b;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
-
 Design export_view(const Design& d, const std::vector<std::string>& wanted) {
   const std::vector<std::string> stations = chosen_stations(d, wanted);
   const auto kept = [&](const std::string& s) { return std::find(stations.begin(), stations.end(), s) != stations.end(); };
@@ -446,7 +432,7 @@ Design export_view(const Design& d, const std::vector<std::string>& wanted) {
 std::string design_hash(const Design& d, const std::vector<std::string>& stations) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "fnv1a64:%016llx",
-                static_cast<unsigned long long>(fnv1a64(to_yaml(export_view(d, stations)))));
+                static_cast<unsigned long long>(format::fnv1a64(to_yaml(export_view(d, stations)))));
   return buffer;
 }
 

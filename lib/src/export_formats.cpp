@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/format.hpp"
 #include "export_detail.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export.hpp"
@@ -19,11 +20,8 @@
 namespace fivebar {
 
 std::string format_double(double value) {
-  if (std::isnan(value)) return "nan";
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char buffer[40];
-  const auto r = std::to_chars(buffer, buffer + sizeof buffer, value);  // shortest round trip
-  std::string s(buffer, r.ptr);
+  if (!std::isfinite(value)) return format::shortest(value);
+  std::string s = format::shortest(value);
   // A '.' in every mantissa: "5" -> "5.0", "3e-04" -> "3.0e-04". YAML 1.1 readers (PyYAML) take
   // a number without one for an integer or a string; the value is unchanged.
   const std::size_t e = s.find('e');

@@ -1,3 +1,4 @@
+#include "fivebar/format.hpp"
 #include "fivebar/json.hpp"
 
 #include <cmath>
@@ -10,7 +11,7 @@ namespace {
 
 json xy(const Vec2& v) { return json::array({v.x(), v.y()}); }
 
-double rad_to_deg(double rad) { return rad * (180.0 / std::numbers::pi); }
+double rad_to_deg(double rad) { return rad * format::kDegPerRad; }
 
 }  // namespace
 

@@ -3,6 +3,7 @@
 // checks and the bill of materials. Reading STL and fitting hole walls: parts_mesh.cpp; CGAL's
 // mesh checks: cgal/mesh_checks.cpp.
 
+#include "fivebar/format.hpp"
 #include "fivebar/parts.hpp"
 
 #include <fcntl.h>
@@ -50,23 +51,9 @@ constexpr const char* kBomFile = "bom.csv";
 // --- Small helpers -----------------------------------------------------------------------------
 
 /// Shortest text that reads back as the same double: OpenSCAD then gets the design's exact value.
-std::string num(double value) {
-  char buffer[32];
-  const auto r = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, r.ptr);
-}
-
-std::string fixed(double value, int digits) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof buffer, "%.*f", digits, value == 0.0 ? 0.0 : value);
-  return buffer;
-}
-
-std::string join(const std::vector<std::string>& items, std::string_view sep) {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : std::string(sep)) + s;
-  return out;
-}
+std::string num(double value) { return format::shortest(value); }
+using format::fixed;
+using format::join;
 
 std::string read_text(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -74,15 +61,6 @@ std::string read_text(const fs::path& path) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-/// FNV-1a, 64 bit: detects changed render inputs (not a security hash).
-std::uint64_t fnv1a(std::string_view data, std::uint64_t h = 14695981039346656037ull) {
-  for (const unsigned char c : data) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
 }
 
 std::string hex64(std::uint64_t v) {
@@ -725,14 +703,14 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
   // pieces it makes, not its shape), the library and openscad's flags.
   const std::vector<std::string> flags{"--export-format", "binstl", "--hardwarnings", "--check-parameters", "true",
                                        "--check-parameter-ranges", "true"};
-  const std::uint64_t common = fnv1a(join(flags, " "), fnv1a(library));
+  const std::uint64_t common = format::fnv1a64(join(flags, " "), format::fnv1a64(library));
   const auto inputs_hash = [&](const PartSpec& spec) {
     std::string code;
     std::istringstream in(spec.scad);
     for (std::string line; std::getline(in, line);) {
       if (!line.starts_with("//")) code += line + "\n";
     }
-    return "fnv1a64 " + hex64(fnv1a(code, common)) + "\n";
+    return "fnv1a64 " + hex64(format::fnv1a64(code, common)) + "\n";
   };
   if (!options.render) {
     // Sources only: an earlier STL that no longer matches its source must not stay behind.

@@ -1,6 +1,7 @@
 // Skin-deformation patterns: paths, per-sample checks with the priority rule, trajectory CSV and
 // JSON (fivebar/pattern.hpp). The picture is in lib/src/plot/pattern_plot.cpp.
 
+#include "fivebar/format.hpp"
 #include "fivebar/pattern.hpp"
 
 #include <algorithm>
@@ -17,7 +18,7 @@ namespace fivebar {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kDegPerRad = 180.0 / kPi;
+using format::kDegPerRad;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// Smooth ramp from 0 to 1 over [0, T], at rest at both ends.
@@ -45,11 +46,7 @@ std::string num(double v, int digits = 3) {
 std::string point_text(const Vec2& p) { return "(" + num(p.x()) + ", " + num(p.y()) + ")"; }
 
 /// Shortest text that reads back as the same double (CSV).
-std::string exact(double v) {
-  char buf[32];
-  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc() ? std::string(buf, end) : num(v, 17);
-}
+std::string exact(double v) { return format::shortest(v); }
 
 /// The pose's own problem, ignoring collisions and speed: the precedence of SampleStatus.
 SampleStatus pose_status(const Mechanism& m, const Pose& pose) {

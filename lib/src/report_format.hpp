@@ -7,6 +7,8 @@
 #include <optional>
 #include <string>
 
+#include "fivebar/format.hpp"
+
 namespace fivebar::report_fmt {
 
 /// Scientific with `digits` decimals ("1.2e-15"); "0" for zero.
@@ -19,13 +21,7 @@ inline std::string sci(double v, int digits = 1) {
 inline std::string sci(const std::optional<double>& v, int digits = 1) { return v ? sci(*v, digits) : "—"; }
 
 /// Fixed-point with `digits` decimals ("-0.000" printed as "0.000").
-inline std::string fixed(double v, int digits = 3) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  std::string s = buf;
-  if (s.find_first_not_of("-0.") == std::string::npos && s.front() == '-') s.erase(0, 1);
-  return s;
-}
+inline std::string fixed(double v, int digits = 3) { return format::fixed(v, digits); }
 
 /// A number with the significant digits that an uncertainty `err` leaves (at least 1 decimal
 /// place of the error's leading digit), e.g. value 512.3412, err 0.02 -> "512.34".

@@ -1,3 +1,4 @@
+#include "fivebar/format.hpp"
 #include "fivebar/scene.hpp"
 
 #include <algorithm>
@@ -16,14 +17,7 @@ using json = Json;
 
 namespace {
 
-std::string join(const std::vector<std::string>& items, std::string_view sep) {
-  std::string out;
-  for (const auto& s : items) {
-    if (!out.empty()) out += sep;
-    out += s;
-  }
-  return out;
-}
+using format::join;
 
 }  // namespace
 

@@ -1,6 +1,7 @@
 // Link-dimension sweeps: enumeration, evaluation with early exit, CSV streaming, Pareto archive,
 // resume. Parallel with OpenMP over chunks of designs; rows are written in index order, so the
 // output does not depend on the number of threads.
+#include "fivebar/format.hpp"
 #include "fivebar/sweep.hpp"
 
 #include <boost/random/sobol.hpp>
@@ -36,12 +37,8 @@ std::uint64_t splitmix64(std::uint64_t x) {
 /// Uniform [0, 1) from 53 random bits.
 double unit(std::uint64_t bits) { return double(bits >> 11) * 0x1.0p-53; }
 
-std::string num(double v) {
-  if (std::isnan(v)) return "";
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
+/// CSV cell of a number: shortest round-trip form, empty for "no value" (NaN).
+std::string num(double v) { return std::isnan(v) ? std::string() : format::shortest(v); }
 
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;

@@ -123,12 +123,9 @@ ExportGate export_gate(const Design& design, const ExportOptions& options = {});
 
 /// `<station>_<mechanism>_theta<joint>`.
 std::string joint_name(std::string_view station, std::string_view mechanism, int joint);
-
-/// FNV-1a, 64 bits (offset basis 0xcbf29ce484222325, prime 0x100000001b3).
-std::uint64_t fnv1a64(std::string_view bytes);
 /// The part of the design the export depends on (see the header comment); `stations` empty = all.
 Design export_view(const Design& design, const std::vector<std::string>& stations);
-/// "fnv1a64:" + 16 lower-case hex digits of fnv1a64(to_yaml(export_view(design, stations))).
+/// "fnv1a64:" + 16 lower-case hex digits of format::fnv1a64(to_yaml(export_view(design, stations))).
 std::string design_hash(const Design& design, const std::vector<std::string>& stations);
 
 /// The parameter tree `{<node>: {ros__parameters: {...}}}` (layout above). Needs `controller:`

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "fivebar/pattern.hpp"
 #include "fivebar/workspace.hpp"
 #include "plot/tactor_canvas.hpp"
@@ -113,7 +114,7 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
   text(cr, x0 + kMargin, y0 + 42.0, verdict, 12.0, verdict_colour);
   std::string params;
   if (r.spec.kind == PatternKind::pivot) {
-    params = "amplitude " + fmt("%g", r.spec.pivot_amplitude * 180.0 / std::numbers::pi) + " deg, " +
+    params = "amplitude " + fmt("%g", r.spec.pivot_amplitude * format::kDegPerRad) + " deg, " +
              fmt("%g", r.spec.pivot_frequency_hz) + " Hz, ";
   } else {
     params = "amplitude " + fmt("%g", r.spec.amplitude_mm) + " mm, ";
@@ -216,8 +217,8 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
   // Footer: the worst margins.
   const double fy = panel.y() + panel.h() + 32.0;
   std::string line1 = "min LCI upper " + fmt("%.3f", r.min_lci[0]) + ", lower " + fmt("%.3f", r.min_lci[1]) +
-                      ";  peak motor speed " + fmt("%.0f", r.peak_joint_speed * 180.0 / std::numbers::pi) +
-                      " deg/s (limit " + fmt("%.0f", r.max_joint_speed * 180.0 / std::numbers::pi) + ")";
+                      ";  peak motor speed " + fmt("%.0f", r.peak_joint_speed * format::kDegPerRad) +
+                      " deg/s (limit " + fmt("%.0f", r.max_joint_speed * format::kDegPerRad) + ")";
   text(cr, x0 + kMargin, fy, line1, 11.0, kInk);
   std::string line2 = r.moved_samples > 0 ? "priority rule moved the lower target in " +
                                                 std::to_string(r.moved_samples) + " samples, by up to " +

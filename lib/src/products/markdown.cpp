@@ -1,3 +1,4 @@
+#include "fivebar/format.hpp"
 #include "products/markdown.hpp"
 
 #include <cstdio>
@@ -49,14 +50,7 @@ std::string Table::str() const {
   return out;
 }
 
-std::string fixed(double value, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, value);
-  std::string s(buf);
-  // "-0.000" -> "0.000"
-  if (s.front() == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
-}
+std::string fixed(double value, int digits) { return format::fixed(value, digits); }
 
 std::string sci(double value, int digits) {
   char buf[64];

@@ -1,4 +1,5 @@
 // The `controller:` section (fivebar/sections/controller.hpp): the ROS controller of the device.
+#include "fivebar/format.hpp"
 #include "fivebar/sections/controller.hpp"
 
 #include <algorithm>
@@ -16,8 +17,8 @@ using rules::require_range;
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+using format::kDegPerRad;
+using format::kRadPerDeg;
 
 /// Largest gain accepted: far beyond any duty-per-radian a motor loop uses, it keeps every product
 /// of a gain and an angle (or rate) finite.

@@ -1,4 +1,5 @@
 // The `patterns:` section (fivebar/sections/patterns.hpp): which skin-deformation patterns to check.
+#include "fivebar/format.hpp"
 #include "fivebar/sections/patterns.hpp"
 
 #include <algorithm>
@@ -39,8 +40,8 @@ std::array<PatternKind, 4> all_pattern_kinds() {
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+using format::kDegPerRad;
+using format::kRadPerDeg;
 
 /// Most samples one pattern may have (10 minutes at 1 kHz is 600000).
 constexpr double kMaxPatternSamples = 1e6;

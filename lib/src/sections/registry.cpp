@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "sections/section.hpp"
 
 namespace fivebar::sections {
@@ -53,27 +54,19 @@ double number_or(const std::vector<Value>& entries, std::string_view name, doubl
   return e ? e->number(unit) : fallback;
 }
 
-namespace {
-std::string shortest(double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-}  // namespace
-
-Out Out::number(double v) { return plain(shortest(v)); }
+Out Out::number(double v) { return plain(format::shortest(v)); }
 
 Out Out::integer(long long v) { return plain(std::to_string(v)); }
 
 Out Out::degrees(double rad) {
   for (int digits = 12; digits <= 17; ++digits) {
     char buf[40];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, rad * 180.0 / std::numbers::pi);
+    std::snprintf(buf, sizeof buf, "%.*g", digits, rad * format::kDegPerRad);
     double v = std::strtod(buf, nullptr);
     if (v == 0.0) v = 0.0;  // no "-0"
-    if (v * (std::numbers::pi / 180.0) == rad || digits == 17) return number(v);
+    if (v * format::kRadPerDeg == rad || digits == 17) return number(v);
   }
-  return number(rad * 180.0 / std::numbers::pi);
+  return number(rad * format::kDegPerRad);
 }
 
 Out Out::point(const Vec2& p) {

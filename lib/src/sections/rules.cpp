@@ -1,3 +1,4 @@
+#include "fivebar/format.hpp"
 #include "sections/rules.hpp"
 
 #include "fivebar/ranges.hpp"
@@ -10,18 +11,12 @@
 
 namespace fivebar::rules {
 
-std::string format_number(double value) {
-  if (std::isnan(value)) return "nan";
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  char buffer[32];
-  const auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
-  return std::string(buffer, result.ptr);
-}
+std::string format_number(double value) { return format::shortest(value); }
 
 std::string format_degrees(double radians) {
   if (!std::isfinite(radians)) return format_number(radians);
   char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.12g", radians * (180.0 / std::numbers::pi));
+  std::snprintf(buffer, sizeof buffer, "%.12g", radians * format::kDegPerRad);
   return buffer;
 }
 
@@ -68,11 +63,7 @@ void require_range(const std::string& key, double v, double lo_exclusive, double
   }
 }
 
-std::string joined(const std::vector<std::string>& items) {
-  std::string out;
-  for (const auto& s : items) out += (out.empty() ? "" : ", ") + s;
-  return out;
-}
+std::string joined(const std::vector<std::string>& items) { return format::join(items); }
 
 std::string station_list(const Design& design) {
   std::string list;

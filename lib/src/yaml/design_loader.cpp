@@ -27,6 +27,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fivebar/format.hpp"
 #include "design_keys.hpp"
 #include "fivebar/design.hpp"
 #include "sections/section.hpp"
@@ -38,7 +39,7 @@ namespace {
 using detail::key_child;
 using detail::key_index;
 
-constexpr double kRadPerDeg = std::numbers::pi / 180.0;
+using format::kRadPerDeg;
 
 constexpr std::size_t kMaxShownValue = 60;
 /// Longest map key (section, field or station name) accepted, so that key paths in messages stay

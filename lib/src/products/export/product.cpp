@@ -5,6 +5,7 @@
 #include <numbers>
 #include <string>
 
+#include "fivebar/format.hpp"
 #include "fivebar/export.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
@@ -13,7 +14,7 @@ namespace fivebar::products {
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using format::kDegPerRad;
 
 constexpr const char* kPreamble =
     "The configuration of the device's ROS controller (paper Sec. II-D: an IK module per mechanism, FK of the "

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/tolerances.hpp"
@@ -18,7 +19,7 @@ using json = Json;
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+constexpr double kRadToDeg = format::kDegPerRad;
 
 struct AxisEnd {
   const char* label;

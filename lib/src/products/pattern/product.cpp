@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include "fivebar/format.hpp"
 #include "fivebar/pattern.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
@@ -17,7 +18,7 @@ namespace fivebar::products {
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using format::kDegPerRad;
 
 constexpr const char* kPreamble =
     "The skin-deformation patterns of the paper (Fig. 6: stretching, slipping, twisting) and pivoting "
