@@ -114,7 +114,9 @@ int run(int argc, char** argv) {
         known += (known.empty() ? "" : ", ") + sub->get_name();
       }
       if (match == nullptr) {
-        throw fivebar::InputError("unknown subcommand '" + word + "'" + (path.empty() ? "" : " of '" + path + "'") +
+        std::string shown;  // a word from the command line must not bring terminal escapes along
+        for (const char c : word) shown += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
+        throw fivebar::InputError("unknown subcommand '" + shown + "'" + (path.empty() ? "" : " of '" + path + "'") +
                                   " (known: " + known + ")");
       }
       path += (path.empty() ? "" : " ") + match->get_name();

@@ -31,6 +31,7 @@ struct SweepCliOptions {
   std::string out;
   std::string shard;
   bool resume = false;
+  bool yes = false;
   bool no_plots = false;
   int threads = 0;
   bool json = false;
@@ -142,6 +143,7 @@ int run_sweep_cmd(const SweepCliOptions& o) {
   const WriteFence fence(options.out_dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   if (!o.shard.empty()) std::tie(options.shard, options.shards) = parse_shard(o.shard);
   options.resume = o.resume;
+  options.confirmed = o.yes;
   options.plots = !o.no_plots;
   if (o.threads < 0 || o.threads > kMaxSweepThreads) {
     throw InputError("--threads " + std::to_string(o.threads) + ": must be 1 ... " + std::to_string(kMaxSweepThreads) +
@@ -260,6 +262,7 @@ void setup_sweep(CLI::App& app) {
   sub->add_option("-o,--out", opt->out, "Output directory (default outputs/<name>/sweep)")->type_name("DIR");
   sub->add_option("--shard", opt->shard, "Run shard K of N (0-based K/N): contiguous blocks of the designs")->type_name("K/N");
   sub->add_flag("--resume", opt->resume, "Continue an interrupted sweep.csv in the output directory");
+  sub->add_flag("--yes", opt->yes, "Run a sweep estimated at over an hour or a gigabyte of CSV (refused otherwise)");
   sub->add_flag("--no-plots", opt->no_plots, "Skip the SVG/PNG plots");
   sub->add_option("--threads", opt->threads, "Worker threads (default: every core)");
   sub->add_flag("--json", opt->json, "One JSON document on stdout");

@@ -359,7 +359,7 @@ const Station& Design::require_station(std::string_view wanted) const {
   if (const Station* s = station(wanted)) return *s;
   std::string names;
   for (const Station& s : stations) names += (names.empty() ? "" : ", ") + s.name;
-  throw InputError("unknown station '" + std::string(wanted) + "' in design '" + name + "' (it has: " + names + ")");
+  throw InputError("unknown station " + detail::quoted(wanted) + " in design '" + name + "' (it has: " + names + ")");
 }
 
 std::vector<const Station*> Design::select_stations(std::string_view wanted) const {

@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 
+#include "design_keys.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/json.hpp"
@@ -139,7 +140,7 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
   std::set<std::string> requested;
   if (listed) {
     for (const auto& name : *listed) {
-      if (find(name) == nullptr) throw InputError("unknown product '" + name + "' (known: " + join(known, ", ") + ")");
+      if (find(name) == nullptr) throw InputError("unknown product " + detail::quoted(name) + " (known: " + join(known, ", ") + ")");
       requested.insert(name);
     }
   }

@@ -19,6 +19,7 @@
 
 #include "fivebar/collision.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 
 namespace fivebar {
@@ -485,9 +486,51 @@ int sweep_threads(int requested) {
   return fallback;
 }
 
+std::string SweepEstimate::text() const {
+  char buffer[200];
+  const double hours = seconds / 3600.0;
+  std::snprintf(buffer, sizeof buffer, "%.3g designs: about %s on %d thread%s and %.3g MB of CSV", double(designs),
+                (hours >= 1.0 ? format::fixed(hours, 1) + " h" : format::fixed(seconds, 1) + " s").c_str(), threads,
+                threads == 1 ? "" : "s", csv_bytes / 1e6);
+  return buffer;
+}
+
+SweepEstimate estimate_sweep(const Design& design, const SweepOptions& options, std::uint64_t probe) {
+  if (!design.get<SweepSettings>()) throw InputError(design.name + ": the design has no sweep: section");
+  const SweepSettings& s = *design.get<SweepSettings>();
+  SweepEstimate e;
+  e.threads = sweep_threads(options.threads);
+  const std::uint64_t all = sweep_size(s);
+  const std::uint64_t shards = std::max<std::uint64_t>(options.shards, 1);
+  e.designs = all / shards + (options.shard < all % shards ? 1 : 0);
+  const std::uint64_t n = std::min(probe, e.designs);
+  if (n == 0) return e;
+  std::vector<double> u, values;
+  double bytes = 0.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::uint64_t index = (e.designs / n) * k;  // spread over the sweep: sizes change along it
+    unit_points(s, index, 1, u);
+    to_values(s, u.data(), values, s.sample == "grid");
+    const SweepRow row = evaluate_values(design, s, index, values, options.coverage);
+    bytes += double(sweep_csv_row(row).size() + 1);
+  }
+  const double per_design = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / double(n);
+  e.seconds = per_design * double(e.designs) / double(e.threads);
+  e.csv_bytes = bytes / double(n) * double(e.designs);
+  return e;
+}
+
 SweepResult run_sweep(const Design& design, const SweepOptions& options) {
   const int threads = sweep_threads(options.threads);
   if (!design.get<SweepSettings>()) throw InputError(design.name + ": the design has no sweep: section");
+  if (!options.confirmed) {
+    const SweepEstimate e = estimate_sweep(design, options);
+    if (e.seconds > kSweepConfirmSeconds || e.csv_bytes > kSweepConfirmBytes) {
+      throw InputError("this sweep is large: " + e.text() +
+                       "; confirm with `fivebar sweep --yes`, or sample it (sweep.sample: sobol, sweep.count)");
+    }
+  }
   const SweepSettings& s = *design.get<SweepSettings>();
   if (options.shards == 0 || options.shard >= options.shards) throw InputError("shard out of range");
   SweepResult result;
@@ -505,14 +548,53 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
     if (r.covered && (!best || better_lexicographic(r, *best, s.objectives))) best = r;
   };
 
+  // The identity of this sweep (docs/reliability.md "Resume"): the whole design with its sweep
+  // section, the CSV layout and the shard. --resume continues only a CSV written under the same one.
+  std::filesystem::path identity_path = result.csv;
+  identity_path.replace_extension(".identity.json");
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "fnv1a64:%016llx", static_cast<unsigned long long>(format::fnv1a64(to_yaml(design))));
+  Json identity = {{"design_hash", hash},
+                   {"csv_header", sweep_csv_header(s)},
+                   {"first", result.first},
+                   {"total", result.total}};
+  const bool resuming = options.resume && std::filesystem::exists(result.csv);
+  if (resuming) {
+    std::ifstream in(identity_path);
+    Json found;
+    try {
+      if (in) found = Json::parse(in);
+    } catch (const Json::exception&) {
+      found = Json();
+    }
+    if (!in || found != identity) {
+      throw InputError(result.csv.string() + ": cannot resume: " +
+                       (in ? "not the same sweep: " + identity_path.filename().string() + " names another (design hash " +
+                                 (found.contains("design_hash") ? found["design_hash"].dump() : std::string("unknown")) +
+                                 ", this one " + hash + ")"
+                           : "no " + identity_path.filename().string() +
+                                 " beside it, so it cannot be shown to belong to this sweep") +
+                       "; rerun without --resume to start afresh");
+    }
+  }
+  write_file_atomic(identity_path, identity.dump(2) + "\n");
+
   AtomicFile csv(result.csv);
   csv.stream() << sweep_csv_header(s) << '\n';
   std::uint64_t next = result.first;
-  if (options.resume && std::filesystem::exists(result.csv)) {
+  if (resuming) {
+    std::vector<double> u_row, expected;
     read_sweep_csv(result.csv, s, [&](const SweepRow& r, const std::string& line) {
       if (r.index != next || next >= end) {
         throw InputError(result.csv.string() + ": row with index " + std::to_string(r.index) + " where " +
                          std::to_string(next) + " was expected: not a prefix of this sweep");
+      }
+      // Every resumed row must hold the values this sweep gives its index, to the last bit.
+      unit_points(s, r.index, 1, u_row);
+      to_values(s, u_row.data(), expected, s.sample == "grid");
+      if (expected != r.values) {
+        throw InputError(result.csv.string() + ": row " + std::to_string(r.index) +
+                         " holds other swept values than this sweep gives that index: not the same sweep");
       }
       csv.stream() << line << '\n';
       account(r);
@@ -565,6 +647,7 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
   }
   csv.commit();  // a valid CSV of every completed row, interrupted or not
   result.files.push_back(result.csv);
+  result.files.push_back(identity_path);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   result.designs_per_s = result.seconds > 0 ? double(result.evaluated) / result.seconds : 0.0;
 

@@ -84,6 +84,9 @@ struct SweepOptions {
   bool plots = true;                  ///< SVG/PNG of the objectives
   std::uint64_t chunk = 16384;        ///< designs per parallel chunk (memory stays flat)
   int threads = 0;                    ///< 0: every core (OMP_NUM_THREADS); at most kMaxSweepThreads
+  /// Run even when estimate_sweep() says it exceeds kSweepConfirmSeconds or kSweepConfirmBytes
+  /// (`fivebar sweep --yes`); otherwise run_sweep() refuses such a sweep before writing anything.
+  bool confirmed = false;
   const std::atomic<bool>* stop = nullptr;  ///< set (e.g. by SIGINT) to stop after the chunk
   std::function<void(std::uint64_t done, std::uint64_t total, double seconds)> progress;
   CoverageOptions coverage = sweep_coverage_options();
@@ -105,6 +108,21 @@ struct SweepResult {
   std::filesystem::path csv;
   std::vector<std::filesystem::path> files;  ///< every file written
 };
+
+/// What a sweep will cost, measured on a probe of its own designs before it starts.
+struct SweepEstimate {
+  std::uint64_t designs = 0;  ///< in this shard
+  double seconds = 0.0;       ///< wall time on `threads` threads
+  double csv_bytes = 0.0;     ///< size of its CSV
+  int threads = 1;
+  /// "1.0e+12 designs: about 3.2e+05 h on 2 threads and 1.5e+14 bytes of CSV".
+  std::string text() const;
+};
+/// Beyond these a sweep runs only when confirmed (docs/reliability.md "Resource bounds").
+inline constexpr double kSweepConfirmSeconds = 3600.0;  ///< one hour
+inline constexpr double kSweepConfirmBytes = 1e9;       ///< one gigabyte of CSV
+/// Evaluates `probe` designs spread over the shard (one thread) and extrapolates.
+SweepEstimate estimate_sweep(const Design& design, const SweepOptions& options, std::uint64_t probe = 128);
 
 /// Most worker threads a sweep runs (docs/reliability.md "Resource bounds"): far above any
 /// machine's cores, low enough that thread creation cannot exhaust the process.

@@ -70,7 +70,8 @@ void load(const Value& v, Design& design) {
     const auto items = l->items(4, "a list of 4 plane indices [L1, L2, L3, L4]");
     for (std::size_t i = 0; i < 4; ++i) {
       const double layer = items[i].number("");
-      if (layer != std::floor(layer) || std::fabs(layer) > 1e6) items[i].fail_value("must be a whole number");
+      if (layer != std::floor(layer)) items[i].fail_value("must be a whole number, 0 ... 7");
+      if (layer < 0 || layer > 7) items[i].fail_value("must be 0 ... 7");
       g.layers[i] = int(layer);
     }
   }

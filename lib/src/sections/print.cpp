@@ -34,7 +34,8 @@ void load(const Value& v, Design& design) {
   p.min_wall = number_or(all, "min_wall", p.min_wall, "mm");
   if (const Value* fn = find(all, "fn")) {
     const double n = fn->number("");
-    if (n != std::floor(n) || std::fabs(n) > 1e6) fn->fail_value("must be a whole number");
+    if (n != std::floor(n)) fn->fail_value("must be a whole number, 8 ... 1024");
+    if (n < 8 || n > 1024) fn->fail_value("must be 8 ... 1024");
     p.fn = int(n);
   }
   p.layer_height = number_or(all, "layer_height", p.layer_height, "mm");

@@ -718,7 +718,19 @@ class DocumentStarts : public YAML::EventHandler {
   bool fresh_ = false;
 };
 
-Design Loader::load(const std::string& text) {
+Design Loader::load(const std::string& raw) {
+  // YAML's line breaks are LF, CR LF and a lone CR (old Mac files); yaml-cpp reads only the first
+  // two, and a file of lone CRs looked empty to it. Every break becomes LF, so lines count alike.
+  std::string text;
+  text.reserve(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    if (raw[i] == '\r') {
+      text += '\n';
+      if (i + 1 < raw.size() && raw[i + 1] == '\n') ++i;
+    } else {
+      text += raw[i];
+    }
+  }
   Prescan(origin_).check(text);
   std::vector<YAML::Node> documents;
   try {
