@@ -1,5 +1,5 @@
 # shellcheck shell=bash
-# Set-up shared by ./run.sh and ./test.sh (DESIGN.md "Two commands"); source it, then call
+# Set-up shared by ./run.sh and ./test.sh (README "Quick start"); source it, then call
 # fivebar_setup [TARGET...]. It installs the Debian packages that are missing (apt-get, via sudo
 # when not root), configures a Release build in build/ (Ninja when available) and builds.
 

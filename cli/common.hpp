@@ -23,7 +23,7 @@
 
 namespace fivebar::cli {
 
-/// DESIGN.md "Exit codes".
+/// docs/conventions.md "Exit codes".
 enum Exit : int {
   kOk = 0,           ///< success
   kCheckFailed = 1,  ///< a check failed / no solution
@@ -58,7 +58,7 @@ struct Selection {
 /// for a name that is not there, InputError listing the choices.
 Selection select(const Design& design, const Target& target);
 
-/// Progress lines on stderr, only when it is a terminal (DESIGN.md: long work shows progress).
+/// Progress lines on stderr, only when it is a terminal (docs/conventions.md "Progress").
 std::function<void(std::string_view)> terminal_progress(std::string_view command);
 
 // --- Values -----------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-// fivebar run: build the products a scene asks for into <out>/<name>/ (DESIGN.md "Scenes").
+// fivebar run: build the products a scene asks for into <out>/<name>/ (docs/architecture.md "Products").
 
 #include <cstdio>
 #include <iostream>

@@ -1,5 +1,5 @@
 // End-to-end tests of the `fivebar` executable: real processes, their stdout, stderr and exit
-// code (DESIGN.md "Command line"). Expected values are derived here from the geometry of the
+// code (docs/conventions.md "Exit codes"). Expected values are derived here from the geometry of the
 // paper's device (Table 1), independently of the library.
 
 #include <gmock/gmock.h>

@@ -1,4 +1,4 @@
-// Output hygiene (README "Hardening"; DESIGN.md "Files are written atomically"):
+// Output hygiene (README "Hardening"; docs/reliability.md "Output files"):
 //   - every writer in lib/ and cli/ goes through fivebar/io.hpp (a source scan);
 //   - a signal removes the temporaries of unfinished files and still ends the process;
 //   - WriteFence confines writes, and `fivebar run` fences its --out;

@@ -1,5 +1,5 @@
 // Scalar five-bar kinematics. Derivations: FK/IK are circle-circle intersections (paper eqs.
-// (1)-(4)) in the stable form of STYLE.md; the Jacobian follows from differentiating the loop
+// (1)-(4)) in the stable form of docs/conventions.md "Numerics" (no acos); the Jacobian follows from differentiating the loop
 // constraints |P - A_i|^2 = L_{i+2}^2:  (P - A_i) . dP = cross(A_i - O_i, P - A_i) dtheta_i,
 // i.e. B dP = C dtheta with B = [(P-A1)^T; (P-A2)^T], C = diag(c1, c2), so J = B^-1 C
 // (det B = cross(P-A1, P-A2): type II; c_i = 0: type I; Gosselin & Angeles 1990).

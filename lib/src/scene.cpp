@@ -78,7 +78,7 @@ std::string SceneReport::to_markdown() const {
   out += "Built by fivebar " + std::string(version()) + " from " +
          (design_source.empty() ? std::string("an in-memory design") : md::code(design_source.generic_string())) +
          " into " + md::code(out_dir.generic_string()) + ". Lengths in mm, angles in degrees, " +
-         "frames as in DESIGN.md (x from a station's first lower base joint toward its second, y upward).\n\n";
+         "frames as in docs/conventions.md of the fivebar repository (x from a station's first lower base joint toward its second, y upward).\n\n";
   std::string station_list;
   for (const auto& [name, mechanisms] : stations) {
     station_list += (station_list.empty() ? "" : ", ") + md::code(name) + " (" + join(mechanisms, ", ") + ")";

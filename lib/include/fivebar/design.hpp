@@ -1,5 +1,5 @@
 #pragma once
-/// The validated design model (DESIGN.md "Design file"): stations, their target ellipse and
+/// The validated design model (docs/design-file.md): stations, their target ellipse and
 /// their lower/upper five-bar mechanisms. Lengths in mm, angles in radians inside the library.
 /// A Design is built once by load_design() (or by hand followed by validate()) and then only read.
 

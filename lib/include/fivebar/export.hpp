@@ -1,5 +1,5 @@
 #pragma once
-/// Validated controller export (DESIGN.md `export`): the configuration the device's ROS controller
+/// Validated controller export (docs/architecture.md "Products", README `export`): the configuration the device's ROS controller
 /// runs with (paper Sec. II-D: per mechanism an IK module, FK of the measured joints for collision
 /// checks with the upper mechanism's priority, a PID per motor at 100 Hz with 1 kHz PWM, joints
 /// read from potentiometers through a 16-bit DAQ), written only for a design that passes the

@@ -1,5 +1,5 @@
 #pragma once
-/// JSON at the edges (DESIGN.md "Geometry conventions"): millimetres and degrees, keys ending in
+/// JSON at the edges (docs/conventions.md "Units"): millimetres and degrees, keys ending in
 /// `_mm` / `_deg`; the library's radians never leave through here. Used by `--json` output and by
 /// the scene summaries.
 

@@ -69,7 +69,7 @@ std::array<Pose, 4> ik_all(const Mechanism& m, const Vec2& P);
 /// 1 / condition number of a 2x2 matrix, in [0, 1], computed without inverting it.
 double lci(const Eigen::Matrix2d& J);
 
-/// Stable circle-circle intersection (no acos, STYLE.md): circles (c1, r1) and (c2, r2); `side` = +1
+/// Stable circle-circle intersection (no acos, docs/conventions.md "Numerics"): circles (c1, r1) and (c2, r2); `side` = +1
 /// picks the point left of c1->c2 (cross(c2 - c1, p - c1) >= 0), -1 the other. Computed from the
 /// squared centre distance d^2 alone: foot a/d = 1/2 + (r1^2 - r2^2)/(2 d^2) and height from
 /// Heron's factors (d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2) = (2 d h)^2, each vanishing at one

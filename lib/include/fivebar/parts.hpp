@@ -1,5 +1,5 @@
 #pragma once
-/// Printable parts (DESIGN.md `parts`): for every station, the distinct parts of its linkages
+/// Printable parts (README `parts`): for every station, the distinct parts of its linkages
 /// (proximal links with a motor D-bore, distal links, the tactor post and tip) and its base, as
 /// small OpenSCAD files that `use` the hand-written library scad/fivebar.scad with the design's
 /// numbers; binary STL renders by `openscad --hardwarnings` (two jobs in parallel, skipping parts

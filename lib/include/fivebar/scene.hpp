@@ -1,5 +1,5 @@
 #pragma once
-/// The scene runner (DESIGN.md "Scenes"): a design file is also a scene. run_scene() builds the
+/// The scene runner (docs/architecture.md "Products"): a design file is also a scene. run_scene() builds the
 /// products the scene asks for (default: every product the file has data for) plus their
 /// prerequisites, and nothing else, then writes `<out_root>/<design name>/summary.md` and
 /// `summary.json` (atomically) listing what was built, what was left out and why, and each

@@ -8,7 +8,7 @@
 /// sigma*(0, pi): a curvilinear rectangle bounded by the stretched circle |P - O_i| = L_i + L_{i+2},
 /// the folded circle |P - O_i| = |L_i - L_{i+2}| and two half circles of radius L_{i+2} around the
 /// extreme elbow positions. Without limits it is the annulus. The mechanism's region is the
-/// intersection of its two legs' regions (NOTES.md; Gosselin & Angeles 1990 for the annuli).
+/// intersection of its two legs' regions (Gosselin & Angeles 1990 for the annuli).
 
 #include <Eigen/Core>
 

@@ -1,4 +1,4 @@
-// The only translation unit that includes CGAL's 2-D Boolean set operations (STYLE.md: CGAL in
+// The only translation unit that includes CGAL's 2-D Boolean set operations (docs/architecture.md "Dependencies and where each is walled": CGAL in
 // few TUs). Regions are General_polygon_set_2 over Gps_circle_segment_traits_2<Epeck>: arcs of
 // circles with rational centres and squared radii, endpoints with one-root coordinates.
 //

@@ -1,4 +1,4 @@
-// YAML design loader (DESIGN.md "Design file"). yaml-cpp stays in this file.
+// YAML design loader (docs/design-file.md). yaml-cpp stays in this file.
 //
 // The loader checks the shape of the file (known keys, no duplicates, types, list lengths,
 // required values, finite numbers) and converts units (degrees -> radians); the value rules live

@@ -28,7 +28,7 @@ struct PidGains {
 };
 
 /// Potentiometer on a motor shaft, read through the ADC (`controller.potentiometer`):
-/// theta = rad_per_volt * (V - volts_at_zero), theta in the station frame (DESIGN.md: from +x,
+/// theta = rad_per_volt * (V - volts_at_zero), theta in the station frame (docs/conventions.md "Frames": from +x,
 /// counter-clockwise). The file takes volts_per_rad (the datasheet's sensitivity) or rad_per_volt.
 struct Potentiometer {
   double volts_at_zero = 2.5;                   ///< reading at theta = 0, V

@@ -1,0 +1,113 @@
+// The repository's own documents (docs/): the design-file reference cannot drift from the loader,
+// and no file of the repository cites a document that is not in it.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include "design_keys.hpp"
+#include "fivebar/design.hpp"
+
+namespace fivebar {
+namespace {
+
+namespace fs = std::filesystem;
+const fs::path kSource = FIVEBAR_SOURCE_DIR;
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Key shapes in the first column of the tables of docs/design-file.md: "| `key` | ...".
+std::set<std::string> documented_keys() {
+  std::set<std::string> keys;
+  std::istringstream in(slurp(kSource / "docs" / "design-file.md"));
+  const std::regex row(R"(^\|\s*`([^`]+)`\s*\|)");
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (!std::regex_search(line, m, row)) continue;
+    std::string key = m[1];  // a '|' inside a table cell is written "\|"
+    for (std::size_t at; (at = key.find("\\|")) != std::string::npos;) key.erase(at, 1);
+    keys.insert(key);
+  }
+  return keys;
+}
+
+/// A key shape as docs/design-file.md writes it: maps of the same keys under several names share
+/// one row (`stations.<name>.mechanisms.<lower|upper>.links`, `patterns.<stretch|slip|twist>`,
+/// `controller.<scope>.pid.kp` for every override scope).
+std::string documented_form(std::string key) {
+  static const std::vector<std::pair<std::regex, std::string>> rules = {
+      {std::regex(R"(^(stations\.<name>\.mechanisms\.)(lower|upper))"), "$1<lower|upper>"},
+      {std::regex(R"(^patterns\.stations\.<name>\.(stretch|slip|twist|pivot)(\..*)?$)"), "patterns.stations.<name>.<kind>"},
+      {std::regex(R"(^patterns\.(stretch|slip|twist)\b)"), "patterns.<stretch|slip|twist>"},
+      {std::regex(R"(^controller\.mechanisms\.(lower|upper)(\.theta[12])?(?=\.|$))"), "controller.<scope>"},
+      {std::regex(R"(^controller\.stations\.<name>(\.(lower|upper)(\.theta[12])?)?(?=\.|$))"), "controller.<scope>"},
+  };
+  for (const auto& [from, to] : rules) key = std::regex_replace(key, from, to);
+  return key;
+}
+
+TEST(DesignFileDoc, EveryKeyTheLoaderAcceptsIsDocumentedAndNoOther) {
+  const std::string fixture = slurp(kSource / "test" / "data" / "every_key.yaml");
+  ASSERT_NO_THROW((void)load_design_from_string(fixture, "every_key.yaml"));
+  std::set<std::string> accepted;
+  for (const std::string& key : detail::design_file_keys(fixture)) accepted.insert(documented_form(key));
+  const std::set<std::string> documented = documented_keys();
+  ASSERT_GT(accepted.size(), 60u);  // the fixture visits every map
+  for (const std::string& key : accepted) {
+    EXPECT_TRUE(documented.count(key)) << "docs/design-file.md does not document `" << key << "`";
+  }
+  for (const std::string& key : documented) {
+    EXPECT_TRUE(accepted.count(key)) << "docs/design-file.md documents `" << key << "`, which the loader does not accept";
+  }
+}
+
+/// Tracked text files of the repository (git ls-files), or every file under the usual folders.
+std::vector<fs::path> repository_files() {
+  std::vector<fs::path> files;
+  for (const char* top : {"lib", "cli", "test", "designs", "scad", "docs", ".ci", "outputs"}) {
+    if (!fs::exists(kSource / top)) continue;
+    for (const auto& e : fs::recursive_directory_iterator(kSource / top)) {
+      if (e.is_regular_file()) files.push_back(e.path());
+    }
+  }
+  for (const char* top : {"README.md", "CMakeLists.txt", "run.sh", "test.sh"}) files.push_back(kSource / top);
+  return files;
+}
+
+TEST(RepositoryDocs, EveryCitedDocumentIsInTheRepository) {
+  // A name ending in .md (or a path under docs/ or paper/) must resolve inside the repository:
+  // relative to the root, to docs/, or to the citing file's folder.
+  const std::regex cited(R"(([A-Za-z0-9_./-]*[A-Za-z0-9_-]+\.md)\b|\b(paper/[A-Za-z0-9_./-]+))");
+  for (const fs::path& file : repository_files()) {
+    const std::string ext = file.extension().string();
+    if (ext == ".png" || ext == ".stl" || ext == ".svg") continue;
+    if (file.filename() == "test_docs.cpp") continue;  // this file names examples in its comments
+    std::istringstream in(slurp(file));
+    int n = 0;
+    for (std::string line; std::getline(in, line);) {
+      ++n;
+      for (std::sregex_iterator it(line.begin(), line.end(), cited), end; it != end; ++it) {
+        const std::string name = (*it)[1].matched ? (*it)[1].str() : (*it)[2].str();
+        if (name.ends_with("summary.md")) continue;  // the name of a file fivebar writes, not a citation
+        const bool found = fs::exists(kSource / name) || fs::exists(kSource / "docs" / name) ||
+                           fs::exists(file.parent_path() / name);
+        EXPECT_TRUE(found) << fs::relative(file, kSource).string() << ":" << n << " cites " << name
+                           << ", which is not in the repository";
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fivebar
