@@ -67,6 +67,10 @@ std::function<void(std::string_view)> terminal_progress(std::string_view command
 std::array<double, 2> parse_pair(std::string_view text, std::string_view option, std::string_view form);
 /// "X,Y" -> a point in mm within the range of fivebar/ranges.hpp (the design files' rule).
 std::array<double, 2> parse_point_mm(std::string_view text, std::string_view option);
+/// "--shard K/N" -> (K, N) with 0 <= K < N; InputError naming --shard otherwise.
+std::pair<std::uint64_t, std::uint64_t> parse_shard(const std::string& text);
+/// "CX,CY,AX,AY,ANGLE" (mm, mm, full axes in mm, deg) -> an ellipse; InputError naming `option`.
+Ellipse parse_ellipse(std::string_view text, std::string_view option = "--ellipse");
 /// A finite number; std::nullopt when `text` is not exactly one.
 std::optional<double> parse_number(std::string_view text);
 

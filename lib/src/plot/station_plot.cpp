@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "fivebar/error.hpp"
-#include "fivebar/workspace_io.hpp"
+#include "fivebar/polyline.hpp"
 #include "fivebar/workspace_plot.hpp"
 #include "plot/cairo_bytes.hpp"
 
