@@ -67,6 +67,14 @@ std::function<void(std::string_view)> terminal_progress(std::string_view command
 std::array<double, 2> parse_pair(std::string_view text, std::string_view option, std::string_view form);
 /// "X,Y" -> a point in mm within the range of fivebar/ranges.hpp (the design files' rule).
 std::array<double, 2> parse_point_mm(std::string_view text, std::string_view option);
+/// "--shard K/N" -> (K, N) with 0 <= K < N; InputError naming --shard otherwise.
+std::pair<std::uint64_t, std::uint64_t> parse_shard(const std::string& text);
+/// "CX,CY,AX,AY,ANGLE" (mm, mm, full axes in mm, deg) -> an ellipse; InputError naming `option`.
+Ellipse parse_ellipse(std::string_view text, std::string_view option = "--ellipse");
+/// `s` without leading and trailing blanks.
+std::string_view trim(std::string_view s);
+/// The fields of `line` between `sep`, each trimmed.
+std::vector<std::string_view> split(std::string_view line, char sep);
 /// A finite number; std::nullopt when `text` is not exactly one.
 std::optional<double> parse_number(std::string_view text);
 
@@ -82,69 +90,6 @@ std::string exact(double value);
 void print_pose(std::ostream& out, const Mechanism& m, const Pose& pose);
 /// Compact description of the joint-limit verdict: "within", "OUTSIDE", "none set".
 std::string limits_text(const Mechanism& m, const Pose& pose);
-
-// --- Batch CSV --------------------------------------------------------------------------------
-
-/// Reads a CSV with a header line, streaming: only the current row is held. Columns are found by
-/// name (extra columns are ignored, so a previous command's output can be fed back). Blank lines
-/// and lines starting with '#' are skipped; '-' reads stdin. Errors are InputError "FILE:LINE: ...".
-class CsvReader {
- public:
-  CsvReader(const std::string& path, std::vector<std::string> columns);
-  ~CsvReader();
-  /// The next row's values of the requested columns, in the requested order; false at the end.
-  bool next(std::vector<double>& values);
-  /// "FILE:LINE" of the row last returned.
-  std::string where() const;
-
- private:
-  bool next_line(std::string& line);
-  std::string name_;
-  std::unique_ptr<std::istream> file_;
-  std::istream* in_ = nullptr;
-  std::size_t line_no_ = 0;
-  std::vector<std::string> columns_;
-  std::vector<std::size_t> index_;
-  std::size_t width_ = 0;
-};
-
-/// Where batch rows go: stdout, or an atomically written file (--output).
-class BatchSink {
- public:
-  explicit BatchSink(const std::string& output_path);
-  std::ostream& out();
-  /// Commits the file (no-op for stdout). Without it the file is discarded.
-  void commit();
-
- private:
-  std::optional<AtomicFile> file_;
-};
-
-/// The batch form's options beside the single form `single`: `--<name>-file FILE` (a CSV with
-/// header columns `columns`, '-' = stdin) and -o/--output. Returns the file option, for excludes().
-CLI::Option* add_batch_options(CLI::App& sub, const std::string& name, const std::string& columns, CLI::Option* single,
-                               std::string& file, std::string& output);
-
-/// Exactly one of the single form (`single`, shown as `single_usage`) and the batch file
-/// (`file`, option `file_flag`), and --output only with the file; InputError otherwise.
-void require_single_or_batch(std::string_view command, const std::string& single, std::string_view single_usage,
-                             const std::string& file, std::string_view file_flag, const std::string& output);
-
-/// Streams the batch form: reads `file` row by row and writes kBatchHeader and one row per input
-/// row through `solve`, which writes its row and returns whether it has a solution. The output
-/// (stdout, or the --output file, atomically) is committed after the last row; a bad row throws
-/// before that. Returns how many rows were read and how many had no solution.
-struct BatchTally {
-  std::size_t rows = 0, unsolved = 0;
-};
-BatchTally stream_batch(const std::string& file, std::vector<std::string> columns, const std::string& output,
-                        const std::function<bool(const std::vector<double>& row, std::ostream& out)>& solve);
-
-/// Header and one row of batch output: x_mm,y_mm,theta1_deg,theta2_deg,status,lci,mode,assembly,
-/// within_joint_limits. For an unreachable row the known inputs are echoed and the rest left empty.
-extern const char* const kBatchHeader;
-void write_batch_row(std::ostream& out, const Pose& pose, const std::optional<Vec2>& point_mm,
-                     const std::optional<std::array<double, 2>>& theta_deg);
 
 // --- Subcommands (one file each) ----------------------------------------------------------------
 void setup_fk(CLI::App& app);

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "fivebar/format.hpp"
+#include "batch.hpp"
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/json.hpp"

@@ -3,6 +3,7 @@
 #include <iostream>
 #include <memory>
 
+#include "batch.hpp"
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/json.hpp"

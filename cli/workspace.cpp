@@ -9,6 +9,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/station_workspace.hpp"
+#include "fivebar/workspace_files.hpp"
 #include "fivebar/workspace_io.hpp"
 #include "fivebar/workspace_plot.hpp"
 
@@ -54,7 +55,13 @@ int run_workspace(const WorkspaceCliOptions& opt) {
   WorkspaceOptions options;
   options.spacing_mm = opt.spacing_mm;
   options.mechanism = opt.mechanism;
-  options.validate("--spacing");
+  try {
+    options.validate();
+  } catch (const InputError& e) {  // the library names the field, the user typed the flag
+    std::string message = e.what();
+    if (message.rfind("spacing_mm", 0) == 0) message.replace(0, 10, "--spacing");
+    throw InputError(message);
+  }
   const auto stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
   const std::filesystem::path dir =

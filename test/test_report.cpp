@@ -23,8 +23,8 @@
 #include "fivebar/report.hpp"
 #include "fivebar/scene.hpp"
 #include "fivebar/workspace.hpp"
-#include "report_precision.hpp"
-#include "report_quad.hpp"
+#include "report/precision.hpp"
+#include "report/quad.hpp"
 
 namespace fivebar {
 namespace {

@@ -360,13 +360,6 @@ TEST(DesignFile, ToYamlRoundTrips) {
   EXPECT_EQ(back.get<PrintSettings>()->material, d.get<PrintSettings>()->material);
 }
 
-TEST(Shard, ParseRules) {
-  EXPECT_EQ(parse_shard("0/4"), (std::pair<std::uint64_t, std::uint64_t>{0, 4}));
-  EXPECT_EQ(parse_shard("3/4"), (std::pair<std::uint64_t, std::uint64_t>{3, 4}));
-  for (const char* bad : {"4/4", "1", "/2", "a/b", "1/0", "-1/3", "1/2x"}) {
-    EXPECT_THAT([&] { parse_shard(bad); }, ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("--shard"))) << bad;
-  }
-}
 
 }  // namespace
 }  // namespace fivebar

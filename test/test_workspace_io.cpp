@@ -41,6 +41,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/station_workspace.hpp"
+#include "fivebar/workspace_files.hpp"
 #include "fivebar/workspace_io.hpp"
 #include "fivebar/workspace_plot.hpp"
 

@@ -41,10 +41,10 @@ Json region_json(const Region& r) {
 
 }  // namespace
 
-void WorkspaceOptions::validate(std::string_view option) const {
+void WorkspaceOptions::validate() const {
   if (!(std::isfinite(spacing_mm) && spacing_mm > 0.0)) {
     std::ostringstream msg;
-    msg << option << " = " << spacing_mm << " mm: must be a finite number > 0";
+    msg << "spacing_mm = " << spacing_mm << " mm: must be a finite number > 0";
     throw InputError(msg.str());
   }
   if (!mechanism.empty() && mechanism != "lower" && mechanism != "upper") {

@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <numbers>
@@ -439,19 +440,6 @@ void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& setti
   }
 }
 
-std::pair<std::uint64_t, std::uint64_t> parse_shard(const std::string& text) {
-  const auto slash = text.find('/');
-  std::uint64_t k = 0, n = 0;
-  bool ok = slash != std::string::npos;
-  if (ok) {
-    const auto a = std::from_chars(text.data(), text.data() + slash, k);
-    const auto b = std::from_chars(text.data() + slash + 1, text.data() + text.size(), n);
-    ok = a.ec == std::errc{} && a.ptr == text.data() + slash && b.ec == std::errc{} &&
-         b.ptr == text.data() + text.size() && slash > 0 && n > 0 && k < n;
-  }
-  if (!ok) throw InputError("--shard = '" + text + "': must be K/N with 0 <= K < N (e.g. 0/4)");
-  return {k, n};
-}
 
 // --- run -----------------------------------------------------------------------------------------
 
@@ -472,6 +460,14 @@ std::string csv_name(const SweepOptions& o) {
 }
 
 }  // namespace
+
+// Whichever launcher started us (Open MPI, or any PMI/PMIx one) says how many ranks there are.
+bool launched_by_mpi() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"}) {
+    if (const char* s = std::getenv(v)) return std::atoi(s) > 1;
+  }
+  return false;
+}
 
 int sweep_threads(int requested) {
   const std::string bound = std::to_string(kMaxSweepThreads);

@@ -46,13 +46,6 @@ double CurvePiece::sweep() const {
 
 double CurvePiece::length() const { return is_arc ? radius * std::fabs(sweep()) : (target - source).norm(); }
 
-Vec2 CurvePiece::point_at(double s) const {
-  if (!is_arc) return source + s * (target - source);
-  const double a0 = std::atan2((source - center).y(), (source - center).x());
-  const double a = a0 + s * sweep();
-  return center + radius * Vec2(std::cos(a), std::sin(a));
-}
-
 Vec2 CurvePiece::closest_point(const Vec2& p) const {
   if (!is_arc) {
     const Vec2 d = target - source;

@@ -1,6 +1,6 @@
 // Cost of the `report` machinery on the paper's index lower mechanism: the __float128 reference
 // (what every error of the report is measured against) beside the same FK/IK in float, double and
-// long double (report_precision.hpp), and one mechanism's whole stability catalogue.
+// long double (report/precision.hpp), and one mechanism's whole stability catalogue.
 //   ./build/fivebar_bench --benchmark_filter='report'
 #include <benchmark/benchmark.h>
 
@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "fivebar/report.hpp"
-#include "report_precision.hpp"
-#include "report_quad.hpp"
+#include "report/precision.hpp"
+#include "report/quad.hpp"
 #include "paper.hpp"
 
 namespace {

@@ -8,6 +8,7 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/station_workspace.hpp"
+#include "fivebar/workspace_files.hpp"
 #include "fivebar/workspace_io.hpp"
 #include "fivebar/workspace_plot.hpp"
 

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/rendered_plot.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
@@ -234,12 +235,6 @@ struct CollisionFraction {
 CollisionFraction collision_fraction(const Station& station, const Geometry& g, double spacing_mm);
 
 // --- Output -------------------------------------------------------------------------------------
-
-/// An image in two formats, as bytes (written by the caller, atomically).
-struct RenderedPlot {
-  std::string svg;
-  std::string png;
-};
 
 /// Three panels: the fraction of lower positions colliding per upper position, the lower positions
 /// blocked by the upper tactor at the centre (with its links), and the colliding fraction against

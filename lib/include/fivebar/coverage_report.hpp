@@ -16,8 +16,5 @@ Json to_json(const CoverageResult& result);
 /// {"lower": {...}, "upper": {...}, "shared": {...}} with the parts the station has.
 Json to_json(const StationCoverage& station);
 
-/// The ellipse of `--ellipse CX,CY,AX,AY,ANGLE` (mm, mm, full axes mm, deg). InputError naming
-/// `option` when the text is not five finite numbers or an axis is not > 0.
-Ellipse parse_ellipse(std::string_view text, std::string_view option = "--ellipse");
 
 }  // namespace fivebar

@@ -26,6 +26,7 @@
 
 #include "fivebar/collision.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/rendered_plot.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/json.hpp"

@@ -25,8 +25,8 @@ struct WorkspaceOptions {
   double spacing_mm = 0.2;
   /// Only this mechanism ("lower" or "upper"); empty: every mechanism of the station.
   std::string mechanism;
-  /// Throws InputError naming `spacing_mm` (as "--spacing" when `option` says so) when broken.
-  void validate(std::string_view option = "spacing_mm") const;
+  /// Throws InputError naming `spacing_mm` or `mechanism` when broken.
+  void validate() const;
 };
 
 /// One mechanism's share of a StationWorkspace.

@@ -158,7 +158,5 @@ std::vector<std::filesystem::path> write_sweep_plots(const std::filesystem::path
                                                      const std::vector<SweepRow>& pareto,
                                                      const std::filesystem::path& out_dir);
 
-/// "K/N" -> (K, N) with 0 <= K < N; InputError naming --shard otherwise.
-std::pair<std::uint64_t, std::uint64_t> parse_shard(const std::string& text);
 
 }  // namespace fivebar

@@ -37,8 +37,6 @@ struct CurvePiece {
   double length() const;
   /// Closest point of the piece to p.
   Vec2 closest_point(const Vec2& p) const;
-  /// Point at fraction s in [0, 1] along the piece.
-  Vec2 point_at(double s) const;
 };
 
 /// Is the direction of v (from an arc's centre) within the arc that runs from direction `from` to

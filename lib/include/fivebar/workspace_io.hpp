@@ -11,31 +11,14 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <numbers>
 #include <string>
 #include <vector>
 
 #include "fivebar/station_workspace.hpp"
 #include "fivebar/workspace.hpp"
-#include "fivebar/workspace_plot.hpp"
+#include "fivebar/polyline.hpp"
 
 namespace fivebar {
-
-/// Largest angle an arc advances between two polyline points (1 degree).
-inline constexpr double kArcStepRad = std::numbers::pi / 180.0;
-
-/// Points along a piece from source to target, both included: a segment as its two ends, an arc
-/// in equal steps of at most `max_step_rad` (> 0) around its centre, each point on the circle.
-std::vector<Vec2> discretise(const CurvePiece& piece, double max_step_rad = kArcStepRad);
-/// A loop as a closed polyline: its pieces in order, shared ends once, the first point not repeated.
-std::vector<Vec2> discretise(const BoundaryLoop& loop, double max_step_rad = kArcStepRad);
-/// Joins polylines whose ends meet within `tol_mm` (marching squares gives one segment per cell)
-/// into the longest chains; a chain that returns to its start is closed (first point not repeated).
-struct Polyline {
-  std::vector<Vec2> points;
-  bool closed = false;
-};
-std::vector<Polyline> chain_segments(const std::vector<std::vector<Vec2>>& pieces, double tol_mm);
 
 /// What a curve of the `.vtp` is (cell data array `kind`; its names are in the field data array
 /// `kind_names` in this order).
@@ -48,9 +31,6 @@ enum class CurveKind : std::int32_t {
 };
 const char* to_string(CurveKind kind);
 
-/// Polylines of the target ellipse: `segments` equal parameter steps, closed.
-std::vector<Vec2> ellipse_polyline(const Ellipse& e, int segments = 360);
-
 /// The `.vtp` document (VTK XML, binary appended data) of a station's curves.
 std::string regions_vtp(const StationWorkspace& workspace);
 /// The `.vti` document of one field.
@@ -59,17 +39,5 @@ std::string field_vti(const WorkspaceField& field);
 /// Writes regions_vtp() / field_vti() to `path` atomically; IoError when it cannot.
 void write_regions_vtp(const std::filesystem::path& path, const StationWorkspace& workspace);
 void write_field_vti(const std::filesystem::path& path, const WorkspaceField& field);
-
-/// Every output of a station, named by workspace_file_names(): the `.vtp`, one `.vti` per
-/// mechanism, the picture as SVG and PNG.
-struct OutputFile {
-  std::string name;  ///< relative to the output directory
-  std::string content;
-};
-std::vector<OutputFile> workspace_files(const StationWorkspace& workspace, const PlotOptions& plot = {});
-/// Writes workspace_files() into `dir` (created when missing), each atomically; returns the paths.
-std::vector<std::filesystem::path> write_workspace_files(const std::filesystem::path& dir,
-                                                         const StationWorkspace& workspace,
-                                                         const PlotOptions& plot = {});
 
 }  // namespace fivebar

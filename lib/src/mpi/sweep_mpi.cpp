@@ -14,13 +14,6 @@ namespace fivebar {
 
 bool built_with_mpi() { return true; }
 
-bool launched_by_mpi() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"}) {
-    if (const char* s = std::getenv(v)) return std::atoi(s) > 1;
-  }
-  return false;
-}
-
 SweepResult run_sweep_mpi(const Design& design, const SweepOptions& options) {
   int initialized = 0;
   MPI_Initialized(&initialized);

@@ -8,13 +8,6 @@ namespace fivebar {
 
 bool built_with_mpi() { return false; }
 
-bool launched_by_mpi() {
-  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"}) {
-    if (const char* s = std::getenv(v)) return std::atoi(s) > 1;
-  }
-  return false;
-}
-
 SweepResult run_sweep_mpi(const Design&, const SweepOptions&) {
   throw std::runtime_error("this fivebar was built without MPI (configure with -DFIVEBAR_WITH_MPI=ON)");
 }

@@ -22,9 +22,9 @@
 #include <vector>
 
 #include "fivebar/error.hpp"
-#include "fivebar/workspace_io.hpp"
+#include "fivebar/polyline.hpp"
 #include "fivebar/workspace_plot.hpp"
-#include "plot/cairo_bytes.hpp"
+#include "plot/canvas.hpp"
 
 namespace fivebar {
 
@@ -830,36 +830,20 @@ Rgb viridis(double v) {
   return {a.r + u * (b.r - a.r), a.g + u * (b.g - a.g), a.b + u * (b.b - a.b)};
 }
 
+namespace {
+plot_detail::Surface surface_of(const PlotOptions& o) {
+  return {double(o.width_px), double(o.height_px), /*svg_unit_px=*/true, CAIRO_FORMAT_ARGB32};
+}
+}  // namespace
+
 std::string station_svg(const StationWorkspace& ws, const PlotOptions& options) {
   options.validate();
-  std::string out;
-  cairo_surface_t* surface = cairo_svg_surface_create_for_stream(append, &out, options.width_px, options.height_px);
-  cairo_svg_surface_set_document_unit(surface, CAIRO_SVG_UNIT_PX);
-  cairo_t* cr = cairo_create(surface);
-  draw(cr, ws, options);
-  const cairo_status_t drawn = cairo_status(cr);
-  cairo_destroy(cr);
-  cairo_surface_finish(surface);
-  const cairo_status_t finished = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  check(drawn, "drawing the SVG");
-  check(finished, "finishing the SVG");
-  return out;
+  return plot_detail::draw_svg(surface_of(options), [&](cairo_t* cr) { draw(cr, ws, options); });
 }
 
 std::string station_png(const StationWorkspace& ws, const PlotOptions& options) {
   options.validate();
-  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, options.width_px, options.height_px);
-  cairo_t* cr = cairo_create(surface);
-  draw(cr, ws, options);
-  const cairo_status_t drawn = cairo_status(cr);
-  cairo_destroy(cr);
-  std::string out;
-  const cairo_status_t written = drawn == CAIRO_STATUS_SUCCESS ? cairo_surface_write_to_png_stream(surface, append, &out) : drawn;
-  cairo_surface_destroy(surface);
-  check(drawn, "drawing the PNG");
-  check(written, "encoding the PNG");
-  return out;
+  return plot_detail::draw_png(surface_of(options), [&](cairo_t* cr) { draw(cr, ws, options); });
 }
 
 }  // namespace fivebar

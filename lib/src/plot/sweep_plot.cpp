@@ -15,7 +15,7 @@
 
 #include "fivebar/io.hpp"
 #include "fivebar/sweep.hpp"
-#include "plot/cairo_bytes.hpp"
+#include "plot/canvas.hpp"
 
 namespace fivebar {
 
@@ -128,28 +128,13 @@ void colour(cairo_t* cr, double t) {
                        stops[i][2] + f * (stops[i + 1][2] - stops[i][2]));
 }
 
-using plot_detail::append;
 
 /// Draws with `draw` into an SVG and a PNG next to each other (atomically written).
 template <class Draw>
 std::vector<std::filesystem::path> save(const std::filesystem::path& dir, const std::string& stem, Draw draw) {
-  std::string svg, png;
-  {
-    cairo_surface_t* s = cairo_svg_surface_create_for_stream(append, &svg, kWidth, kHeight);
-    cairo_t* cr = cairo_create(s);
-    draw(cr);
-    cairo_destroy(cr);
-    cairo_surface_finish(s);
-    cairo_surface_destroy(s);
-  }
-  {
-    cairo_surface_t* s = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, kWidth, kHeight);
-    cairo_t* cr = cairo_create(s);
-    draw(cr);
-    cairo_destroy(cr);
-    cairo_surface_write_to_png_stream(s, append, &png);
-    cairo_surface_destroy(s);
-  }
+  const RenderedPlot pic = plot_detail::draw_both({double(kWidth), double(kHeight)}, draw);
+  const std::string& svg = pic.svg;
+  const std::string& png = pic.png;
   write_file_atomic(dir / (stem + ".svg"), svg);
   write_file_atomic(dir / (stem + ".png"), png);
   return {dir / (stem + ".svg"), dir / (stem + ".png")};

@@ -1,7 +1,7 @@
 // Cairo canvas shared by the collision-map and pattern pictures (see tactor_canvas.hpp).
 
 #include "plot/tactor_canvas.hpp"
-#include "plot/cairo_bytes.hpp"
+#include "plot/canvas.hpp"
 
 #include <cairo-svg.h>
 
@@ -36,28 +36,11 @@ Canvas::~Canvas() {
 
 RenderedPlot Canvas::render() const {
   check(cairo_status(cr_), "drawing");
-  RenderedPlot out;
-  {
-    cairo_surface_t* svg = cairo_svg_surface_create_for_stream(append, &out.svg, width_, height_);
-    cairo_t* cr = cairo_create(svg);
+  // The picture was recorded once; both formats replay the recording.
+  return plot_detail::draw_both({width_, height_}, [this](cairo_t* cr) {
     cairo_set_source_surface(cr, surface_, 0.0, 0.0);
     cairo_paint(cr);
-    cairo_destroy(cr);
-    cairo_surface_finish(svg);
-    check(cairo_surface_status(svg), "SVG");
-    cairo_surface_destroy(svg);
-  }
-  {
-    cairo_surface_t* png = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(std::ceil(width_)),
-                                                      static_cast<int>(std::ceil(height_)));
-    cairo_t* cr = cairo_create(png);
-    cairo_set_source_surface(cr, surface_, 0.0, 0.0);
-    cairo_paint(cr);
-    cairo_destroy(cr);
-    check(cairo_surface_write_to_png_stream(png, append, &out.png), "PNG");
-    cairo_surface_destroy(png);
-  }
-  return out;
+  });
 }
 
 Panel::Panel(cairo_t* cr, double x_px, double y_px, double w_px, double h_px, std::array<double, 4> b)

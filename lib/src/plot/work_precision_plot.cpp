@@ -1,6 +1,6 @@
 // Work-precision plots with cairo (SVG and PNG surfaces, written to memory).
 #include "plot/work_precision_plot.hpp"
-#include "plot/cairo_bytes.hpp"
+#include "plot/canvas.hpp"
 
 #include <cairo-svg.h>
 #include <cairo.h>
@@ -255,33 +255,17 @@ void draw(cairo_t* cr, const PlotSpec& spec) {
   }
 }
 
-using plot_detail::append;
+/// RGB24: the accuracy plots have no transparency.
+const plot_detail::Surface kSurface{kWidth, kHeight, false, CAIRO_FORMAT_RGB24};
 
 }  // namespace
 
 std::string render_svg(const PlotSpec& spec) {
-  std::string out;
-  cairo_surface_t* surface = cairo_svg_surface_create_for_stream(append, &out, kWidth, kHeight);
-  cairo_t* cr = cairo_create(surface);
-  draw(cr, spec);
-  cairo_destroy(cr);
-  cairo_surface_finish(surface);
-  const cairo_status_t status = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) throw std::runtime_error(std::string("cairo SVG: ") + cairo_status_to_string(status));
-  return out;
+  return plot_detail::draw_svg(kSurface, [&](cairo_t* cr) { draw(cr, spec); });
 }
 
 std::string render_png(const PlotSpec& spec) {
-  std::string out;
-  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, int(kWidth), int(kHeight));
-  cairo_t* cr = cairo_create(surface);
-  draw(cr, spec);
-  cairo_destroy(cr);
-  const cairo_status_t status = cairo_surface_write_to_png_stream(surface, append, &out);
-  cairo_surface_destroy(surface);
-  if (status != CAIRO_STATUS_SUCCESS) throw std::runtime_error(std::string("cairo PNG: ") + cairo_status_to_string(status));
-  return out;
+  return plot_detail::draw_png(kSurface, [&](cairo_t* cr) { draw(cr, spec); });
 }
 
 }  // namespace fivebar::plot

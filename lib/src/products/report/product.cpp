@@ -7,7 +7,7 @@
 #include "fivebar/report.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
-#include "report_format.hpp"
+#include "report/format.hpp"
 
 namespace fivebar::products {
 

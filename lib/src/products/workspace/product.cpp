@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "fivebar/station_workspace.hpp"
+#include "fivebar/workspace_files.hpp"
 #include "fivebar/workspace_io.hpp"
 #include "fivebar/workspace_plot.hpp"
 #include "products/markdown.hpp"

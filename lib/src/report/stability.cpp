@@ -1,6 +1,6 @@
 // `fivebar report stability`: a catalogue of extreme cases run through FK, IK, the Jacobian and
 // LCI, the workspace area and coverage, each compared with the __float128 reference
-// (report_quad.hpp) against the error its conditioning allows.
+// (report/quad.hpp) against the error its conditioning allows.
 //
 // Error bounds (S = the largest coordinate or length the computation handles, L = the largest
 // link, eps = 2^-52):
@@ -56,8 +56,8 @@
 #include "fivebar/report.hpp"
 #include "fivebar/tolerances.hpp"
 #include "fivebar/workspace.hpp"
-#include "report_format.hpp"
-#include "report_quad.hpp"
+#include "report/format.hpp"
+#include "report/quad.hpp"
 
 namespace fivebar {
 

@@ -14,8 +14,8 @@
 #include "fivebar/kinematics.hpp"
 #include "fivebar/report.hpp"
 #include "fivebar/workspace.hpp"
-#include "report_precision.hpp"
-#include "report_quad.hpp"
+#include "report/precision.hpp"
+#include "report/quad.hpp"
 
 namespace fivebar {
 

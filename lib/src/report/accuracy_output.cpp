@@ -7,7 +7,7 @@
 #include "fivebar/io.hpp"
 #include "fivebar/report.hpp"
 #include "plot/work_precision_plot.hpp"
-#include "report_format.hpp"
+#include "report/format.hpp"
 
 namespace fivebar {
 

@@ -1,5 +1,5 @@
-// Quad-precision reference kinematics (see report_quad.hpp for the formulas and their accuracy).
-#include "report_quad.hpp"
+// Quad-precision reference kinematics (see report/quad.hpp for the formulas and their accuracy).
+#include "report/quad.hpp"
 
 #include <algorithm>
 #include <vector>
