@@ -189,7 +189,7 @@ Ellipse parse_ellipse(std::string_view text, std::string_view option) {
   Ellipse e;
   e.center = {v[0], v[1]};
   e.axes = {v[2], v[3]};
-  e.angle = v[4] * format::kRadPerDeg;
+  e.angle = format::rad_from_deg(v[4]);
   try {
     e.validate();
   } catch (const InputError& err) {

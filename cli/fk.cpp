@@ -14,8 +14,6 @@ namespace fivebar::cli {
 
 namespace {
 
-constexpr double kDegToRad = format::kRadPerDeg;
-
 struct FkOptions {
   Target target;
   std::string theta;       ///< "T1,T2" in degrees
@@ -44,7 +42,8 @@ Json context_json(const Design& design, const Selection& sel, const std::array<d
 int run_batch(const FkOptions& opt, const Mechanism& m, AssemblyMode branch) {
   const BatchTally tally = stream_batch(opt.theta_file, {"theta1_deg", "theta2_deg"}, opt.output,
                                         [&](const std::vector<double>& row, std::ostream& out) {
-                                          const Pose pose = fk(m, row[0] * kDegToRad, row[1] * kDegToRad, branch);
+                                          const Pose pose =
+                                              fk(m, format::rad_from_deg(row[0]), format::rad_from_deg(row[1]), branch);
                                           write_batch_row(out, pose, std::nullopt, std::array<double, 2>{row[0], row[1]});
                                           return pose.status != Status::unreachable;
                                         });
@@ -65,8 +64,8 @@ int run_fk(const FkOptions& opt) {
   if (!opt.theta_file.empty()) return run_batch(opt, m, branch);
 
   const auto theta_deg = parse_pair(opt.theta, "--theta", "T1,T2 in degrees");
-  const double t1 = theta_deg[0] * kDegToRad;
-  const double t2 = theta_deg[1] * kDegToRad;
+  const double t1 = format::rad_from_deg(theta_deg[0]);
+  const double t2 = format::rad_from_deg(theta_deg[1]);
 
   if (opt.all) {
     const auto poses = fk_all(m, t1, t2);

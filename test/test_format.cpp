@@ -40,6 +40,20 @@ TEST(Format, FixedNeverWritesANegativeZero) {
   EXPECT_EQ(format::fixed(12.34567, 2), "12.35");
 }
 
+TEST(Format, AnglesBeyondOneTurnAreReducedExactlyBeforeTheConversion) {
+  // Up to one turn: the plain product.
+  for (const double d : {0.0, 100.0, -179.5, 270.0, -360.0}) {
+    EXPECT_EQ(format::rad_from_deg(d), d * format::kRadPerDeg) << d;
+  }
+  // Beyond: the remainder by integer arithmetic (10^16 = 280 = -80 mod 360; 10^16 + 360 too;
+  // 2^60 = 136 mod 360), exact before the one rounding of the conversion.
+  EXPECT_EQ(format::rad_from_deg(1e16), -80.0 * format::kRadPerDeg);
+  EXPECT_EQ(format::rad_from_deg(10000000000000360.0), -80.0 * format::kRadPerDeg);
+  EXPECT_EQ(format::rad_from_deg(-1e16), 80.0 * format::kRadPerDeg);
+  EXPECT_EQ(format::rad_from_deg(std::ldexp(1.0, 60)), 136.0 * format::kRadPerDeg);
+  EXPECT_EQ(format::rad_from_deg(720.5), 0.5 * format::kRadPerDeg);
+}
+
 TEST(Format, JoinSeparatesItems) {
   EXPECT_EQ(format::join({}), "");
   EXPECT_EQ(format::join({"a"}), "a");

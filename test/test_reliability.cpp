@@ -224,6 +224,100 @@ TEST_F(Reliability, EveryScaleGivesTheScaleFreeAnswerOrExit2) {
   }
 }
 
+/// The point components of an `ik`/`fk` JSON answer.
+std::vector<double> point_of(const nlohmann::json& j) { return j["point_mm"].get<std::vector<double>>(); }
+
+TEST_F(Reliability, IkAndFkAtEveryScaleAreScaleFreeOrExit2) {
+  // Reference: the unscaled station. IK angles and LCI are scale-free; FK points scale with s.
+  write("unit.yaml", scaled_design(1.0));
+  const Outcome ik1 = run({"ik", "unit.yaml", "-s", "index", "-m", "lower", "--point", "6.25,15.5", "--json"});
+  ASSERT_EQ(ik1.code, 0) << ik1.err;
+  const auto ref_ik = parse(ik1);
+  const Outcome fk1 = run({"fk", "unit.yaml", "-s", "index", "-m", "lower", "--theta", "100,80", "--json"});
+  ASSERT_EQ(fk1.code, 0) << fk1.err;
+  const auto ref_fk = parse(fk1);
+  const auto coord = [](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  for (const double s : {1e-300, 1e-200, 1e-60, 1e-30, 1e-9, 1e-6, 1e-3, 1e3, 1e6, 1e10, 1e11, 1e30, 1e300}) {
+    SCOPED_TRACE(s);
+    write("s.yaml", scaled_design(s));
+    const bool in_range = 9.0 * s >= 1e-9 && 31.0 * s <= 1e12;
+    const std::string p = coord(6.25 * s) + "," + coord(15.5 * s);
+    const Outcome ik = run({"ik", "s.yaml", "-s", "index", "-m", "lower", "--point", p, "--json"});
+    const Outcome fk = run({"fk", "s.yaml", "-s", "index", "-m", "lower", "--theta", "100,80", "--json"});
+    for (const Outcome* r : {&ik, &fk}) {
+      EXPECT_EQ(r->signal, 0);
+      EXPECT_THAT(r->out, Not(HasSubstr("nan")));
+      EXPECT_THAT(r->out, Not(HasSubstr("inf")));
+    }
+    if (!in_range) {
+      for (const Outcome* r : {&ik, &fk}) {
+        EXPECT_EQ(r->code, 2) << r->err;
+        EXPECT_THAT(r->err, HasSubstr("s.yaml:"));
+      }
+      continue;
+    }
+    ASSERT_EQ(ik.code, 0) << ik.err;
+    const auto j = parse(ik);
+    EXPECT_EQ(j["status"], "ok");
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(j["theta_deg"][k].get<double>(), ref_ik["theta_deg"][k].get<double>(), 1e-9);
+    }
+    EXPECT_NEAR(j["lci"].get<double>(), ref_ik["lci"].get<double>(), 1e-12);
+    ASSERT_EQ(fk.code, 0) << fk.err;
+    const auto f = parse(fk);
+    EXPECT_EQ(f["status"], "ok");
+    const auto got = point_of(f);
+    const auto want = point_of(ref_fk);
+    for (int k = 0; k < 2; ++k) EXPECT_NEAR(got[k] / s, want[k], 1e-12 * std::abs(want[k]) + 1e-12);
+    EXPECT_NEAR(f["lci"].get<double>(), ref_fk["lci"].get<double>(), 1e-12);
+  }
+}
+
+TEST_F(Reliability, PointsAndAnglesAtTheExtremesOfDoubleGiveAStatusOrExit2) {
+  // A point at 1e-300 mm sits on the lower mechanism's first base: inside no leg's annulus
+  // (|L1 - L3| = 6 mm > 0), so unreachable, exit 1.
+  const Outcome tiny = run({"ik", kDesign, "-s", "index", "-m", "lower", "--point", "1e-300,-1e-300", "--json"});
+  EXPECT_EQ(tiny.code, 1) << tiny.err;
+  EXPECT_EQ(parse(tiny)["status"], "unreachable");
+  for (const char* far : {"1e300,0", "-1e-300,1e300", "1e12,1.0000001e12"}) {
+    const Outcome r = run({"ik", kDesign, "-s", "index", "-m", "lower", "--point", far});
+    SCOPED_TRACE(far);
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_THAT(r.out + r.err, Not(HasSubstr("nan")));
+  }
+  // Angles are any finite number of degrees: 1e16 deg (an exact integer, 10^16 = 280 mod 360) is
+  // the pose at -80 deg, and so is 1e16 + 360 (both were poses of a rounded multiple of pi, and
+  // different ones). The reduction here is independent of the code's: integer arithmetic.
+  const Outcome huge = run({"fk", kDesign, "-s", "index", "-m", "lower", "--theta", "1e16,10000000000000360", "--json"});
+  const char* buf = "-80,-80";
+  const Outcome same = run({"fk", kDesign, "-s", "index", "-m", "lower", "--theta", buf, "--json"});
+  ASSERT_EQ(huge.code, same.code) << huge.err << same.err;
+  EXPECT_THAT(huge.out, Not(HasSubstr("nan")));
+  const auto a = parse(huge);
+  const auto b = parse(same);
+  EXPECT_EQ(a["status"], b["status"]);
+  if (b["status"] == "ok") {
+    for (int k = 0; k < 2; ++k) EXPECT_NEAR(point_of(a)[k], point_of(b)[k], 1e-12);
+  }
+  EXPECT_EQ(a["status"], "ok");
+  // 1e300 deg: its exact remainder, computed by the independent formula of std::fmod.
+  double reduced = std::fmod(1e300, 360.0);
+  if (reduced > 180.0) reduced -= 360.0;
+  char text[64];
+  std::snprintf(text, sizeof text, "%.17g,%.17g", reduced, -reduced);
+  const Outcome far = run({"fk", kDesign, "-s", "index", "-m", "lower", "--theta", "1e300,-1e300", "--json"});
+  const Outcome near = run({"fk", kDesign, "-s", "index", "-m", "lower", "--theta", text, "--json"});
+  ASSERT_EQ(far.code, near.code) << far.err;
+  EXPECT_EQ(parse(far)["status"], parse(near)["status"]);
+  if (parse(near)["status"] == "ok") {
+    for (int k = 0; k < 2; ++k) EXPECT_NEAR(point_of(parse(far))[k], point_of(parse(near))[k], 1e-12);
+  }
+}
+
 // --- 7 and 8. sweeps that cannot mix runs or start blindly -------------------------------------
 
 TEST_F(Reliability, ResumeRefusesARowOfAnotherGridAndContinuesItsOwn) {

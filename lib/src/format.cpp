@@ -6,6 +6,12 @@
 
 namespace fivebar::format {
 
+double rad_from_deg(double deg) {
+  // Up to one turn the plain product (bit-identical to what every angle gave before); beyond it
+  // the exact remainder, so that no multiple of 360 deg is rounded into a different pose.
+  return (std::abs(deg) <= 360.0 ? deg : std::remainder(deg, 360.0)) * kRadPerDeg;
+}
+
 std::string shortest(double value) {
   if (std::isnan(value)) return "nan";
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";

@@ -14,6 +14,10 @@ namespace fivebar::format {
 /// Radians per degree and degrees per radian (files and the command line speak degrees).
 inline constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+/// Radians of an angle given in degrees (any finite value); beyond one turn it is reduced exactly
+/// to [-180, 180] deg first (std::remainder is exact): 1e16 deg is the pose of its true remainder (-80 deg), not of
+/// a multiple of pi rounded to a double. docs/reliability.md "Numeric ranges".
+double rad_from_deg(double deg);
 
 /// Shortest text that reads back as the same double ("0.1", "-3", "1e+13"); "nan", "inf", "-inf".
 std::string shortest(double value);

@@ -602,7 +602,7 @@ Ellipse Loader::target(const Entry& entry) {
   const Entry& axes = require(all, "axes", entry.path, entry.line);
   ellipse.axes = point(axes.value, axes.path, axes.line, "a list of 2 full axis lengths [a, b] (mm)");
   if (const Entry* angle = find(all, "angle")) {
-    ellipse.angle = kRadPerDeg * number(angle->value, angle->path, angle->line, "deg");
+    ellipse.angle = format::rad_from_deg(number(angle->value, angle->path, angle->line, "deg"));
   }
   return ellipse;
 }
