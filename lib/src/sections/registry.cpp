@@ -77,12 +77,12 @@ Out Out::point(const Vec2& p) {
 }
 
 Out& Out::add(std::string key, Out value) {
-  entries.emplace_back(std::move(key), std::move(value));
+  entries.push_back(Entry{std::move(key), std::move(value)});
   return entries.back().second;
 }
 
 Out& Out::push(Out value) {
-  entries.emplace_back(std::string(), std::move(value));
+  entries.push_back(Entry{std::string(), std::move(value)});
   return entries.back().second;
 }
 

@@ -77,20 +77,21 @@ double number_or(const std::vector<Value>& entries, std::string_view name, doubl
 /// A YAML tree to write, built by a section's writer and emitted by lib/src/yaml/design_writer.cpp.
 struct Out {
   enum class Kind { plain, quoted, list, map };
+  struct Entry;  ///< a map entry (key, value) or a list item (empty key)
   Kind kind = Kind::map;
   bool flow = false;  ///< [a, b] / {k: v} on one line
   std::string text;   ///< plain or quoted scalar
-  std::vector<std::pair<std::string, Out>> entries;  ///< map entries, or list items (empty names)
+  std::vector<Entry> entries;  ///< map entries, or list items
 
-  static Out map(bool flow = false) { return Out{Kind::map, flow, {}, {}}; }
-  static Out list(bool flow = true) { return Out{Kind::list, flow, {}, {}}; }
+  static Out map(bool flow = false);
+  static Out list(bool flow = true);
   /// A number in its shortest round-trip form (0.1, not 0.10000000000000001).
   static Out number(double v);
   static Out integer(long long v);
   /// Radians as degrees with the fewest digits (from 12) that read back as the same radians.
   static Out degrees(double radians);
-  static Out plain(std::string text) { return Out{Kind::plain, false, std::move(text), {}}; }
-  static Out quoted(std::string text) { return Out{Kind::quoted, false, std::move(text), {}}; }
+  static Out plain(std::string text);
+  static Out quoted(std::string text);
   /// [x, y] (mm).
   static Out point(const Vec2& p);
 
@@ -99,6 +100,16 @@ struct Out {
   /// Appends an item to a list.
   Out& push(Out value);
 };
+
+struct Out::Entry {
+  std::string first;  ///< the key (empty for a list item)
+  Out second;
+};
+
+inline Out Out::map(bool flow) { Out o; o.kind = Kind::map; o.flow = flow; return o; }
+inline Out Out::list(bool flow) { Out o; o.kind = Kind::list; o.flow = flow; return o; }
+inline Out Out::plain(std::string text) { Out o; o.kind = Kind::plain; o.text = std::move(text); return o; }
+inline Out Out::quoted(std::string text) { Out o; o.kind = Kind::quoted; o.text = std::move(text); return o; }
 
 /// One design section's hooks.
 struct Section {
