@@ -149,7 +149,13 @@ TEST_F(CliSweep, InterruptLeavesAValidCsvAndResumeCompletesIt) {
   args.insert(args.end(), {"--collision-spacing", "0", "--threads", "1"});
   ft::Child child = spawn(FIVEBAR_BINARY, args);
   ASSERT_GT(child.pid, 0);
-  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  // Interrupt once the sweep has started: its identity file is written before the first row (a
+  // fixed delay raced with a slow sanitized start, which the default SIGINT action then ended).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(dir_ / "cut" / "sweep.identity.json") && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ::kill(child.pid, SIGINT);
   const Outcome cut = wait_for(child);
   if (cut.code == 0) GTEST_SKIP() << "the sweep finished before the interrupt (a very fast machine)";
