@@ -128,6 +128,21 @@ Json row_json(const SweepSettings& s, const SweepRow& r) {
 }
 
 int run_sweep_cmd(const SweepCliOptions& o) {
+  // An interrupt from here on stops the sweep cleanly (after its current chunk, CSV resumable);
+  // one that comes before the sweep starts stops it before its first chunk.
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  struct sigaction old_int {}, old_term {};
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+  struct Restore {
+    const struct sigaction *i, *t;
+    ~Restore() {
+      sigaction(SIGINT, i, nullptr);
+      sigaction(SIGTERM, t, nullptr);
+    }
+  } restore{&old_int, &old_term};
   Design design = load(o.design);
   SweepSettings settings = settings_of(design, o);
   try {
@@ -156,15 +171,7 @@ int run_sweep_cmd(const SweepCliOptions& o) {
   if (mpi && !o.shard.empty()) throw InputError("--shard and an MPI launch both split the sweep: use one");
   if (mpi && o.resume) throw InputError("--resume is not supported in an MPI launch: rerun with the same ranks");
   if (::isatty(STDERR_FILENO)) options.progress = progress_bar;
-  struct sigaction sa {};
-  sa.sa_handler = on_interrupt;
-  sigemptyset(&sa.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
   const SweepResult r = mpi ? run_sweep_mpi(design, options) : run_sweep(design, options);
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
   if (mpi) {
     int rank = 0;
     if (const char* v = std::getenv("OMPI_COMM_WORLD_RANK")) rank = std::atoi(v);
