@@ -42,7 +42,6 @@ class CliTactors : public ft::CliTest {
   CliTactors() : CliTest("fivebar_test_cli_tactors") {}
 };
 
-
 // --- collision: a pair of points --------------------------------------------------------------------
 
 TEST_F(CliTactors, PairClearOfEachOther) {
@@ -214,6 +213,5 @@ TEST_F(CliTactors, RunLeavesTheProductsOutAndSaysWhy) {
   }
   EXPECT_THAT(pattern_reason, HasSubstr("patterns:"));
 }
-
 
 }  // namespace

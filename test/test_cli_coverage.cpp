@@ -44,9 +44,6 @@ class CliWorkspace : public ft::CliTest {
   CliWorkspace() : CliTest("fivebar_test_cli_cov") {}
 };
 
-// --- workspace --------------------------------------------------------------------------------
-
-
 // --- coverage ---------------------------------------------------------------------------------
 
 const std::vector<std::string> kResultKeys{"covered",          "inside",  "margin_mm", "covered_fraction",
@@ -211,6 +208,5 @@ TEST_F(CliWorkspace, RunCoverageFailsForAStationThatIsNotCoveredAndOnlyScansTheS
   EXPECT_THAT(md, AllOf(HasSubstr("✗ **not covered**"), Not(HasSubstr("Station `thumb`"))));
   EXPECT_FALSE(fs::exists(out / "iros2022" / "workspace"));  // not asked for, not built
 }
-
 
 }  // namespace

@@ -41,9 +41,6 @@ class Cli : public ft::CliTest {
   Cli() : CliTest("fivebar_test_cli") {}
 };
 
-// --- General --------------------------------------------------------------------------------------
-
-
 // --- fk -------------------------------------------------------------------------------------------
 
 TEST_F(Cli, FkJsonMatchesTheGeometryAndHasTheContractKeys) {
@@ -155,6 +152,5 @@ TEST_F(Cli, BadThetaSyntaxExitsTwoNamingTheOption) {
     EXPECT_THAT(r.err, HasSubstr("--theta"));
   }
 }
-
 
 }  // namespace

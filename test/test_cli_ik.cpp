@@ -41,9 +41,6 @@ class Cli : public ft::CliTest {
   Cli() : CliTest("fivebar_test_cli") {}
 };
 
-// --- General --------------------------------------------------------------------------------------
-
-
 // --- ik -------------------------------------------------------------------------------------------
 
 TEST_F(Cli, IkAnglesPlaceTheElbowsAtTheDistalLengths) {
@@ -187,6 +184,5 @@ TEST_F(Cli, BatchBadRowExitsTwoNamingFileAndLineAndLeavesNoOutputFile) {
   EXPECT_EQ(missing.code, 2);
   EXPECT_THAT(missing.err, HasSubstr("nope.csv"));
 }
-
 
 }  // namespace

@@ -144,5 +144,4 @@ TEST_F(Cli, MalformedDesignExitsTwoNamingTheKeyAndWritesNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
-
 }  // namespace

@@ -39,12 +39,7 @@ class CliTactors : public ft::CliTest {
   CliTactors() : CliTest("fivebar_test_cli_pattern") {}
 };
 
-
-// --- collision: a pair of points --------------------------------------------------------------------
-
-
 // --- pattern ------------------------------------------------------------------------------------------
-
 
 TEST_F(CliTactors, StretchWritesTrajectoriesThatCloseTheLoop) {
   const fs::path out = dir_ / "pat";
@@ -134,6 +129,5 @@ TEST_F(CliTactors, PatternBadInputExitsTwo) {
   EXPECT_EQ(none.code, 2);
   EXPECT_FALSE(fs::exists(dir_ / "outputs")) << "bad input writes nothing";
 }
-
 
 }  // namespace

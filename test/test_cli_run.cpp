@@ -40,9 +40,6 @@ class Cli : public ft::CliTest {
   Cli() : CliTest("fivebar_test_cli") {}
 };
 
-// --- General --------------------------------------------------------------------------------------
-
-
 // --- run ------------------------------------------------------------------------------------------
 
 TEST_F(Cli, RunWritesTheTwoSummariesAndNothingElse) {
@@ -117,6 +114,5 @@ TEST_F(Cli, RunIntoAnUnusableOutputRootFailsWithoutPartialFiles) {
   EXPECT_THAT(r.err, HasSubstr("occupied"));
   EXPECT_EQ(slurp(file), "not a directory\n");
 }
-
 
 }  // namespace

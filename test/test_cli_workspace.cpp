@@ -167,5 +167,4 @@ TEST_F(CliWorkspace, RunBuildsWorkspaceAndCoverageWithSummarySections) {
                         HasSubstr("| lower | ✓ covered |"), HasSubstr("exact area (mm²)")));
 }
 
-
 }  // namespace
