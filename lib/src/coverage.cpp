@@ -522,12 +522,13 @@ void decide(const Mechanism& m, const Ellipse& e, const LegFit& fit, RegionFn&& 
 }
 
 /// Type II (assembly side) over the filled ellipse, certified: h(P) = cross(P - A1, P - A2) /
-/// (l3 l4) is the sine of the angle between the distal links, |grad h| <= sum_i 1 / (l_d,i
-/// |sin(theta_i - phi_i)|) (differentiate P = O_i + l_p e(theta_i) + l_d e(phi_i) and dot with
-/// e(theta_i)), and |sin(theta_i - phi_i)| is bounded below on a cell from the range of |P - O_i|
-/// (law of cosines). Polar cells (r, t) of the ellipse are split until h keeps the design's sign
-/// with |h(centre)| > bound * cell radius (no crossing), or a cell centre is on the wrong side
-/// (a crossing, with its point), or the cells shrink to rounding (undecided).
+/// (l3 l4) is the sine of the angle between the distal links, so |h(P) - h(Q)| is at most the
+/// sum of the changes of the distal link directions phi_i; differentiating P = O_i + l_p
+/// e(theta_i) + l_d e(phi_i) and dotting with e(theta_i) gives |dphi_i| <= |dP| / (l_d
+/// |sin(theta_i - phi_i)|), integrated over a cell below. Polar cells (r, t) of the ellipse are
+/// split until h keeps the design's sign with |h(centre)| above that range (no crossing), or a
+/// cell centre is on the wrong side (a crossing, with its point), or the cells shrink to
+/// rounding (undecided).
 struct AssemblyCheck {
   bool ok = true;
   bool decided = true;
@@ -572,12 +573,21 @@ AssemblyCheck certified_assembly(const Mechanism& m, const Ellipse& e) {
         break;
       }
       elbow[i] = x.point;
-      // |cos(phi - theta)| over the cell from |P - O| in [d - rho, d + rho].
+      // Range of phi over the cell: phi = alpha + f(r) in polar coordinates (r, alpha) about O
+      // (the triangle O, elbow, tactor depends on r alone). alpha moves by at most
+      // rho / (d - rho); |df| <= |dP| / (l_d |sin psi|) with cos psi = kappa(r) = (r^2 - l_p^2 -
+      // l_d^2) / (2 l_p l_d), and dr = l_p l_d dkappa / r turns it into |df| <= l_p / r |dpsi|:
+      // bounded by the change of psi = acos(kappa) over [d - rho, d + rho], finite even at a
+      // type I singularity.
       const double d = (P - O[i]).norm();
-      auto cosine = [&](double r) { return (r * r - lp[i] * lp[i] - ld[i] * ld[i]) / (2 * lp[i] * ld[i]); };
-      const double cmax = std::max(std::fabs(cosine(std::max(0.0, d - rho))), std::fabs(cosine(d + rho)));
-      const double smin = cmax >= 1.0 ? 0.0 : std::sqrt(1.0 - cmax * cmax);
-      bound = smin > 0.0 ? bound + 1.0 / (ld[i] * smin) : std::numeric_limits<double>::infinity();
+      if (d <= rho) {
+        bound = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      auto psi = [&](double r) {
+        return std::acos(std::clamp((r * r - lp[i] * lp[i] - ld[i] * ld[i]) / (2 * lp[i] * ld[i]), -1.0, 1.0));
+      };
+      bound += rho / (d - rho) + lp[i] / (d - rho) * std::fabs(psi(d + rho) - psi(d - rho));
     }
     if (!reachable) {
       // Only asked over an ellipse inside the region: a centre outside it is a rounding case.
@@ -592,7 +602,8 @@ AssemblyCheck certified_assembly(const Mechanism& m, const Ellipse& e) {
       out.crossing = P;
       return out;
     }
-    if (h * want > 0.0 && std::fabs(h) > bound * rho) continue;  // the whole cell keeps the sign
+    // |h(P) - h(centre)| <= sum of the ranges of phi_i (|dh / dphi_i| <= 1), plus rounding.
+    if (h * want > 0.0 && std::fabs(h) > bound * (1.0 + 1e-12) + 64 * tol::kEps) continue;
     if (rho < rho_min || out.cells >= kMaxCells) {
       out.ok = false;
       out.decided = false;

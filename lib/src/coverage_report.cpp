@@ -26,7 +26,8 @@ Json to_json(const CoverageResult& r) {
   j["min_force_capability"] = r.min_force_capability;
   j["lci_ok"] = r.lci_ok;
   j["assembly_ok"] = r.assembly_ok;
-  if (r.assembly_crossing) j["assembly_crossing_mm"] = {r.assembly_crossing->x(), r.assembly_crossing->y()};
+  j["assembly_crossing_mm"] =
+      r.assembly_crossing ? Json{r.assembly_crossing->x(), r.assembly_crossing->y()} : Json(nullptr);
   j["method"] = r.method;
   j["reason"] = r.reason;
   return j;

@@ -411,7 +411,9 @@ class Catalogue {
       c.conditioning = 1.0;
       c.finite = std::isfinite(r.margin_mm) && std::isfinite(r.min_lci) && std::isfinite(r.covered_fraction) &&
                  std::isfinite(r.min_force_capability) && r.worst_point.allFinite() && r.min_lci_point.allFinite();
-      c.error = std::fabs(r.margin_mm - qmargin);
+      // Outside, coverage() measures the depth against the whole region, which the legs' annuli
+      // margin (the reference) only bounds from above.
+      c.error = qmargin >= 0 ? std::fabs(r.margin_mm - qmargin) : std::max(0.0, r.margin_mm - qmargin);
       c.bound = bound;
       judge(c, true, S, "");
     }
