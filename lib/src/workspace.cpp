@@ -393,7 +393,8 @@ double cell_area(const Vec2& base, double h, const double (&f)[4], const Margin&
 /// half diagonal (the slope estimated from the differences along its edges and those of its
 /// parent, times kSlopeSafety). `fine` accumulates the area at the leaves, `coarse` the same
 /// with every deepest split undone (the Richardson-like difference of the two is the
-/// discretisation error), `hidden` the area of deepest cells that could still hide a component.
+/// discretisation error), `hidden` the change where a deepest cell near zero showed the other sign
+/// at an edge midpoint or its centre (a piece between its corners, measured on its half cells).
 constexpr double kSlopeSafety = 2.0;
 struct Adaptive {
   double fine = 0.0, coarse = 0.0, hidden = 0.0;
@@ -421,10 +422,25 @@ void refine_cell(const Vec2& base, double h, const double (&f)[4], double parent
     out.fine += a;
     out.coarse += a;
     if (!mixed) {
-      // Same sign at the corners of a deepest cell: it can hide a piece only where f is far from
-      // bilinear across it (the centre value off the corners' mean by as much as the mean).
-      const double centre = margin(base + Vec2(0.5 * h, 0.5 * h)), mean = 0.25 * (f[0] + f[1] + f[2] + f[3]);
-      if ((centre > 0.0) != (f[0] > 0.0) || std::fabs(centre - mean) >= std::fabs(mean)) out.hidden += h * h;
+      // Same sign at the corners of a deepest cell that is close to zero: look at its edge
+      // midpoints and centre for the other sign (a piece between the corners).
+      const double g = 0.5 * h;
+      const double v[5] = {margin(base + Vec2(g, 0)), margin(base + Vec2(h, g)), margin(base + Vec2(g, h)),
+                           margin(base + Vec2(0, g)), margin(base + Vec2(g, g))};
+      bool other = false;
+      for (int k = 0; k < 5; ++k) other = other || (v[k] > 0.0) != (f[0] > 0.0);
+      if (other) {
+        // A piece seen between the corners: measured on the four half cells, the change
+        // counted as error (as one more level of refinement would).
+        const double q[4][4] = {{f[0], v[0], v[4], v[3]}, {v[0], f[1], v[1], v[4]}, {v[4], v[1], f[2], v[2]},
+                                {v[3], v[4], v[2], f[3]}};
+        const Vec2 b[4] = {base, base + Vec2(g, 0), base + Vec2(g, g), base + Vec2(0, g)};
+        double sub = 0.0;
+        for (int k = 0; k < 4; ++k) sub += cell_area(b[k], g, q[k], margin, &out.segments);
+        out.fine += sub - a;
+        out.coarse += sub - a;
+        out.hidden += std::fabs(sub - a);
+      }
     }
     return;
   }

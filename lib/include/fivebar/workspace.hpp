@@ -138,8 +138,8 @@ WorkspaceField sample_field(const Mechanism& m, const Grid& grid);
 /// by marching squares with every crossing bisected on the margin function (docs/coverage.md).
 struct SampledArea {
   double area_mm2 = 0.0;
-  /// Estimate: the change from undoing the deepest split, plus the area of deepest cells that
-  /// could still hide a piece of the region.
+  /// Estimate: the change from undoing the deepest split, plus the change where a deepest cell
+  /// showed the other sign between its corners and was measured on its half cells.
   double error_mm2 = 0.0;
   std::size_t cells = 0;  ///< cells visited (grid cells and their refinements)
   std::vector<std::vector<Vec2>> contours;  ///< segments of the refined boundary

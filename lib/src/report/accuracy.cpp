@@ -321,7 +321,7 @@ void restricted_study(const Mechanism& m, const Region& region, const AccuracyOp
     thin.min_lci = 0.98 * top;
     const double ref = restricted_area(thin, Restriction::lci, ref_grid, 1).area_mm2;
     WorkSeries s{"thin LCI-restricted area", "h_mm", "mm2", {}, {}, {},
-                 "restricted_area(lci) with LCI >= " + fixed(thin.min_lci, 4) +
+                 "restricted_area(lci) with LCI >= " + format::fixed(thin.min_lci, 4) +
                      " (98 % of the largest LCI: a thin island) against the same on a grid 16x finer than the finest; "
                      "estimate = its own error estimate"};
     for (int k = k_lo; k <= k_hi; ++k) {
