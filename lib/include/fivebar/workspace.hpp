@@ -154,6 +154,6 @@ enum class Restriction {
 /// Signed margin of `restriction` at p (> 0 inside; continuous; length units where possible).
 double restriction_margin(const Mechanism& m, Restriction restriction, const Vec2& p);
 /// Area of the restricted region on `grid`, each cell refined down to spacing / 2^max_depth.
-SampledArea restricted_area(const Mechanism& m, Restriction restriction, const Grid& grid, int max_depth = 4);
+SampledArea restricted_area(const Mechanism& m, Restriction restriction, const Grid& grid, int max_depth = 3);
 
 }  // namespace fivebar
