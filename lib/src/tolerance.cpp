@@ -1,0 +1,141 @@
+// Manufacturing tolerance of a five-bar: closed-form first-order sensitivity and a Monte Carlo
+// reference (derivation in fivebar/tolerance.hpp).
+#include "fivebar/tolerance.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace fivebar {
+namespace {
+
+double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+bool finite(const Eigen::Ref<const Eigen::MatrixXd>& x) { return x.allFinite(); }
+
+}  // namespace
+
+const std::array<const char*, kToleranceParameters>& tolerance_parameter_names() {
+  static const std::array<const char*, kToleranceParameters> names{"L1",  "L2",  "L3",  "L4",     "O1x",
+                                                                   "O1y", "O2x", "O2y", "theta1", "theta2"};
+  return names;
+}
+
+Sensitivity tolerance_sensitivity(const Mechanism& m, const Vec2& P) {
+  Sensitivity out;
+  const Pose pose = ik(m, P);
+  out.status = pose.status;
+  if (pose.status != Status::ok) return out;
+  // Unit distal directions u_i = (P - A_i) / |P - A_i| (|P - A_i| = L_{i+2} within closure).
+  const Vec2 u1 = (pose.P - pose.A1).normalized();
+  const Vec2 u2 = (pose.P - pose.A2).normalized();
+  const Vec2 e1(std::cos(pose.theta1), std::sin(pose.theta1));
+  const Vec2 e2(std::cos(pose.theta2), std::sin(pose.theta2));
+  // Rows of R: leg 1 then leg 2; columns in ToleranceParameter order.
+  Eigen::Matrix<double, 2, static_cast<int>(kToleranceParameters)> R =
+      Eigen::Matrix<double, 2, static_cast<int>(kToleranceParameters)>::Zero();
+  R(0, 0) = u1.dot(e1);             // L1
+  R(1, 1) = u2.dot(e2);             // L2
+  R(0, 2) = 1.0;                    // L3
+  R(1, 3) = 1.0;                    // L4
+  R(0, 4) = u1.x();                 // O1x
+  R(0, 5) = u1.y();                 // O1y
+  R(1, 6) = u2.x();                 // O2x
+  R(1, 7) = u2.y();                 // O2y
+  R(0, 8) = m.L[0] * cross(e1, u1);  // theta1
+  R(1, 9) = m.L[1] * cross(e2, u2);  // theta2
+  // M^{-1} = [u2y -u1y; -u2x u1x] / det, det = cross(u1, u2) (the type II sine, >= kSingularSin
+  // here because ik() reported ok).
+  const double det = cross(u1, u2);
+  Eigen::Matrix2d inv;
+  inv << u2.y(), -u1.y(), -u2.x(), u1.x();
+  inv /= det;
+  out.S = inv * R;
+  if (!finite(out.S)) {
+    out = Sensitivity{};
+    out.status = Status::singular_type2;
+    return out;
+  }
+  out.pose = pose;
+  return out;
+}
+
+double angle_per_count(int bits) {
+  return 2.0 * std::numbers::pi / std::ldexp(1.0, std::clamp(bits, 1, 32));
+}
+
+ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+                                        double rad_per_count) {
+  ToleranceEstimate out;
+  const Sensitivity s = tolerance_sensitivity(m, P);
+  out.status = s.status;
+  if (s.status != Status::ok) return out;
+  Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 1> var;
+  for (std::size_t j = 0; j < kToleranceParameters; ++j) var(static_cast<Eigen::Index>(j)) = sigma[j] * sigma[j];
+  out.covariance = s.S * var.asDiagonal() * s.S.transpose();
+  const double a = out.covariance(0, 0);
+  const double b = out.covariance(0, 1);
+  const double c = out.covariance(1, 1);
+  const double mid = 0.5 * (a + c);
+  const double rad = std::hypot(0.5 * (a - c), b);
+  out.ellipse_semi_axes = {3.0 * std::sqrt(std::max(0.0, mid + rad)), 3.0 * std::sqrt(std::max(0.0, mid - rad))};
+  out.ellipse_angle = (rad > 0.0) ? 0.5 * std::atan2(2.0 * b, a - c) : 0.0;
+  double worst = 0.0;
+  for (std::size_t j = 0; j < kToleranceParameters; ++j) {
+    worst += s.S.col(static_cast<Eigen::Index>(j)).norm() * 3.0 * sigma[j];
+  }
+  out.worst_case_mm = worst;
+  const double step = std::max(s.pose.J.col(0).norm(), s.pose.J.col(1).norm()) * rad_per_count;
+  out.resolution_um = 1000.0 * step;
+  if (!out.covariance.allFinite() || !std::isfinite(worst) || !std::isfinite(out.resolution_um)) {
+    out = ToleranceEstimate{};
+    out.status = Status::singular_type2;
+  }
+  return out;
+}
+
+MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+                                          std::size_t samples, std::uint64_t seed) {
+  MonteCarloTolerance out;
+  const Pose nominal = ik(m, P);
+  out.status = nominal.status;
+  if (nominal.status != Status::ok) return out;
+  Mechanism printed = m;
+  printed.joint_limits.reset();  // a device off its limits still puts its tactor somewhere
+  printed.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  // Welford's running mean and co-moment: one pass, no cancellation.
+  Vec2 mean{0.0, 0.0};
+  Eigen::Matrix2d comoment = Eigen::Matrix2d::Zero();
+  std::array<double, kToleranceParameters> dq{};
+  for (std::size_t k = 0; k < samples; ++k) {
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) dq[j] = sigma[j] * normal(rng);
+    for (std::size_t i = 0; i < 4; ++i) printed.L[i] = m.L[i] + dq[i];
+    printed.O1 = m.O1 + Vec2(dq[4], dq[5]);
+    printed.O2 = m.O2 + Vec2(dq[6], dq[7]);
+    const bool lengths_ok = std::all_of(printed.L.begin(), printed.L.end(), [](double l) { return l > 0.0; });
+    const PointResult r = lengths_ok ? fk_point(printed, nominal.theta1 + dq[8], nominal.theta2 + dq[9])
+                                     : PointResult{};
+    if (r.status != Status::ok) {
+      ++out.failed;
+      continue;
+    }
+    const Vec2 err = r.P - P;
+    ++out.used;
+    const Vec2 delta = err - mean;
+    mean += delta / static_cast<double>(out.used);
+    comoment += delta * (err - mean).transpose();
+  }
+  out.mean_error = mean;
+  if (out.used > 1) {
+    out.covariance = comoment / static_cast<double>(out.used - 1);
+    out.covariance(0, 1) = out.covariance(1, 0) = 0.5 * (out.covariance(0, 1) + out.covariance(1, 0));
+  }
+  return out;
+}
+
+}  // namespace fivebar
