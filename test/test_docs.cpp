@@ -18,6 +18,7 @@
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/print.hpp"
 #include "fivebar/sections/sweep.hpp"
+#include "fivebar/sections/tolerance.hpp"
 
 namespace fivebar {
 namespace {
@@ -68,7 +69,7 @@ TEST(DesignFileDoc, FixtureIsAValidDesignWithEverySection) {
   Design d;
   ASSERT_NO_THROW(d = load_design(kEveryKey));
   EXPECT_TRUE(d.get<Geometry>() && d.get<PrintSettings>() && d.get<SweepSettings>() && d.get<PatternSettings>() &&
-              d.get<ControllerSettings>());
+              d.get<ControllerSettings>() && d.get<ToleranceSettings>());
   ASSERT_EQ(d.stations.size(), 1u);
   for (const Mechanism* m : d.stations[0].mechanisms()) {
     EXPECT_TRUE(m->joint_limits.has_value()) << m->name;
@@ -88,7 +89,7 @@ TEST(DesignFileDoc, FixtureVisitsEveryMap) {
   std::vector<std::string> maps{"name", "geometry.min_clearance", "print.fn", "sweep.collision_spacing_mm",
                                 "sweep.vary.<name>", "stations.<name>.target.angle", "patterns.max_joint_speed_deg_s",
                                 "controller.adc.range_v", "controller.pid.i_clamp",
-                                "controller.potentiometer.volts_per_rad"};
+                                "controller.potentiometer.volts_per_rad", "tolerance.seed"};
   for (const char* m : {"lower", "upper"}) {
     maps.push_back("stations.<name>.mechanisms." + std::string(m) + ".min_lci");
   }

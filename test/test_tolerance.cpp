@@ -9,7 +9,9 @@
 #include <sstream>
 #include <string>
 
+#include "fivebar/error.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 #include "paper.hpp"
 
@@ -197,6 +199,74 @@ TEST(Tolerance, TypeTwoSingularityGivesAStatusNotNaN) {
   // Unreachable points carry their own status.
   EXPECT_EQ(tolerance_first_order(m, Vec2(6.25, 100.0), uniform_sigmas(0.05, 0.01), 1e-4).status,
             Status::unreachable);
+}
+
+// --- The `tolerance:` section -------------------------------------------------------------------
+
+const char* const kStation = R"(name: tol
+stations:
+  index:
+    target: {center: [6.25, 15.5], axes: [15, 12], angle: 0}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 15, 15], working_mode: "-+"}
+)";
+
+TEST(ToleranceSection, DefaultsRoundTripAndSigmas) {
+  const Design bare = load_design_from_string(std::string(kStation), "bare.yaml");
+  EXPECT_EQ(bare.get<ToleranceSettings>(), nullptr);
+  const Design d = load_design_from_string(std::string(kStation) + "tolerance:\n", "defaults.yaml");
+  const ToleranceSettings* t = d.get<ToleranceSettings>();
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->adc_bits, 16);
+  const Design given = load_design_from_string(
+      std::string(kStation) +
+          "tolerance: {link_sigma_mm: 0.03, pin_sigma_mm: 0.04, base_sigma_mm: 0.2, angle_sigma_deg: 1.5,\n"
+          "            adc_bits: 12, samples: 500, seed: 9}\n",
+      "given.yaml");
+  const ToleranceSettings* g = given.get<ToleranceSettings>();
+  ASSERT_NE(g, nullptr);
+  EXPECT_EQ(g->adc_bits, 12);
+  EXPECT_EQ(g->samples, 500u);
+  EXPECT_EQ(g->seed, 9u);
+  const Design again = load_design_from_string(to_yaml(given), "again.yaml");
+  const ToleranceSettings* r = again.get<ToleranceSettings>();
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->link_sigma_mm, 0.03);
+  EXPECT_EQ(r->pin_sigma_mm, 0.04);
+  EXPECT_EQ(r->base_sigma_mm, 0.2);
+  EXPECT_EQ(r->angle_sigma_deg, 1.5);
+  EXPECT_EQ(r->adc_bits, 12);
+  EXPECT_EQ(r->samples, 500u);
+  EXPECT_EQ(r->seed, 9u);
+  // Link length: 0.03 mm of length and two holes of 0.04 mm along it: sqrt(0.0009 + 0.0032).
+  const ParameterSigmas s = parameter_sigmas(*g);
+  EXPECT_NEAR(s[0], std::sqrt(0.0041), 1e-15);
+  EXPECT_EQ(s[3], s[0]);
+  EXPECT_EQ(s[4], 0.2);
+  EXPECT_EQ(s[7], 0.2);
+  EXPECT_NEAR(s[9], 1.5 * std::numbers::pi / 180.0, 1e-15);
+}
+
+TEST(ToleranceSection, BadValuesNameFileLineAndKey) {
+  const struct {
+    const char* text;
+    const char* expect;
+  } cases[] = {
+      {"tolerance:\n  link_sigma_mm: -1\n", "bad.yaml:8: tolerance.link_sigma_mm"},
+      {"tolerance:\n  angle_sigma_deg: 20\n", "bad.yaml:8: tolerance.angle_sigma_deg"},
+      {"tolerance:\n  adc_bits: 40\n", "bad.yaml:8: tolerance.adc_bits"},
+      {"tolerance:\n  samples: 1.5\n", "bad.yaml:8: tolerance.samples"},
+      {"tolerance:\n  sigma: 1\n", "bad.yaml:8: tolerance.sigma"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.text);
+    try {
+      (void)load_design_from_string(std::string(kStation) + c.text, "bad.yaml");
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

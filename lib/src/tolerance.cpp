@@ -63,6 +63,13 @@ Sensitivity tolerance_sensitivity(const Mechanism& m, const Vec2& P) {
   return out;
 }
 
+ParameterSigmas parameter_sigmas(const ToleranceSettings& t) {
+  const double link = std::sqrt(t.link_sigma_mm * t.link_sigma_mm + 2.0 * t.pin_sigma_mm * t.pin_sigma_mm);
+  const double angle = t.angle_sigma_deg * std::numbers::pi / 180.0;
+  const double base = t.base_sigma_mm;
+  return {link, link, link, link, base, base, base, base, angle, angle};
+}
+
 double angle_per_count(int bits) {
   return 2.0 * std::numbers::pi / std::ldexp(1.0, std::clamp(bits, 1, 32));
 }

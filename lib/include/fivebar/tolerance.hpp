@@ -34,6 +34,7 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/sections/tolerance.hpp"
 
 namespace fivebar {
 
@@ -67,6 +68,12 @@ struct ToleranceEstimate {
 /// Closed-form sensitivity of the tactor to the ten parameters at P (derivation above).
 /// Status is ik()'s: not ok (unreachable or within tol::kSingularSin of a singularity) gives zeros.
 Sensitivity tolerance_sensitivity(const Mechanism& m, const Vec2& P);
+
+/// Standard deviations of the ten parameters from a `tolerance:` section: a link's pin-centre
+/// distance moves with its length error and with the along-link component of each of its two
+/// holes' position errors, sqrt(link^2 + 2 pin^2); base positions by base_sigma_mm per axis; the
+/// joint angle offsets by angle_sigma_deg (converted to rad).
+ParameterSigmas parameter_sigmas(const ToleranceSettings& settings);
 
 /// Joint angle of one ADC count (rad) when `bits` resolve one full turn: 2 pi / 2^bits.
 /// Precondition: 1 <= bits <= 32.

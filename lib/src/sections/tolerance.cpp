@@ -1,0 +1,81 @@
+// The `tolerance:` section (fivebar/sections/tolerance.hpp): manufacturing and sensing errors.
+#include "fivebar/sections/tolerance.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "fivebar/design.hpp"
+#include "sections/rules.hpp"
+#include "sections/section.hpp"
+
+namespace fivebar {
+namespace {
+
+void require_sigma(const char* key, double v, double hi, const char* unit) {
+  if (!(v >= 0.0) || !(v <= hi)) {
+    std::ostringstream s;
+    s << "= " << v << " " << unit << ": must be >= 0 and <= " << hi << " " << unit;
+    throw ValidationError(key, s.str());
+  }
+}
+
+}  // namespace
+
+void ToleranceSettings::validate() const {
+  require_sigma("link_sigma_mm", link_sigma_mm, 10.0, "mm");
+  require_sigma("pin_sigma_mm", pin_sigma_mm, 10.0, "mm");
+  require_sigma("base_sigma_mm", base_sigma_mm, 10.0, "mm");
+  require_sigma("angle_sigma_deg", angle_sigma_deg, 10.0, "deg");
+  if (adc_bits < 1 || adc_bits > 32) {
+    throw ValidationError("adc_bits", "= " + std::to_string(adc_bits) + ": must be 1 ... 32");
+  }
+  if (samples < 2 || samples > 100000000) {
+    throw ValidationError("samples", "= " + std::to_string(samples) + ": must be 2 ... 1e8");
+  }
+}
+
+namespace sections {
+namespace {
+
+void load(const Value& v, Design& design) {
+  ToleranceSettings& t = design.set(ToleranceSettings{});
+  if (v.is_null()) return;
+  const auto all = v.entries({"link_sigma_mm", "pin_sigma_mm", "base_sigma_mm", "angle_sigma_deg", "adc_bits",
+                              "samples", "seed"},
+                             "of tolerances (link_sigma_mm, pin_sigma_mm, base_sigma_mm, angle_sigma_deg, "
+                             "adc_bits, samples, seed)");
+  t.link_sigma_mm = number_or(all, "link_sigma_mm", t.link_sigma_mm, "mm");
+  t.pin_sigma_mm = number_or(all, "pin_sigma_mm", t.pin_sigma_mm, "mm");
+  t.base_sigma_mm = number_or(all, "base_sigma_mm", t.base_sigma_mm, "mm");
+  t.angle_sigma_deg = number_or(all, "angle_sigma_deg", t.angle_sigma_deg, "deg");
+  if (const Value* bits = find(all, "adc_bits")) t.adc_bits = int(bits->whole(1, 32));
+  if (const Value* n = find(all, "samples")) t.samples = n->whole(2, 1e8);
+  if (const Value* seed = find(all, "seed")) t.seed = seed->whole(0, 9007199254740992.0);
+}
+
+void validate(const Design& design) {
+  const ToleranceSettings* t = design.get<ToleranceSettings>();
+  if (t == nullptr) return;
+  rules::validate_nested("tolerance", [&] { t->validate(); });
+}
+
+void write(const Design& design, Out& top) {
+  const ToleranceSettings* t = design.get<ToleranceSettings>();
+  if (t == nullptr) return;
+  Out& o = top.add("tolerance", Out::map());
+  o.add("link_sigma_mm", Out::number(t->link_sigma_mm));
+  o.add("pin_sigma_mm", Out::number(t->pin_sigma_mm));
+  o.add("base_sigma_mm", Out::number(t->base_sigma_mm));
+  o.add("angle_sigma_deg", Out::number(t->angle_sigma_deg));
+  o.add("adc_bits", Out::integer(t->adc_bits));
+  o.add("samples", Out::integer(static_cast<long long>(t->samples)));
+  o.add("seed", Out::integer(static_cast<long long>(t->seed)));
+}
+
+}  // namespace
+
+Section tolerance_section() { return {ToleranceSettings::kKey, &load, &validate, &write}; }
+
+}  // namespace sections
+}  // namespace fivebar
