@@ -1,0 +1,146 @@
+// End-to-end tests of `fivebar tolerance`: real processes, stdout, stderr and exit codes. The
+// expected relations are independent of the library's arithmetic: the index station is mirror
+// symmetric about y = 15.5 (lower bases at y = 0, upper at y = 31, target centre at y = 15.5), the
+// first-order figures scale linearly with the tolerances and the resolution with 2^-bits, zero
+// tolerances give zero error, and the Monte Carlo spread agrees with the first order.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "cli_test.hpp"
+
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using nlohmann::json;
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+
+namespace {
+
+class CliTolerance : public ft::CliTest {
+ protected:
+  CliTolerance() : CliTest("fivebar_test_cli_tol") {}
+};
+
+const char* const kSection =
+    "tolerance:\n"
+    "  link_sigma_mm: 0.05        # assumption: a resin print's pin-centre distance\n"
+    "  pin_sigma_mm: 0.025        # assumption: each pin hole's position, per axis\n"
+    "  base_sigma_mm: 0.1         # assumption: base joints placed by hand\n"
+    "  angle_sigma_deg: 0.5       # assumption: joint angle offset left after calibration\n"
+    "  adc_bits: 16 ";
+
+TEST_F(CliTolerance, JsonShapeMirrorSymmetryAndMonteCarloAgreement) {
+  const Outcome r = run({"tolerance", kDesign, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["tolerance"]["source"], "design");
+  EXPECT_EQ(j["tolerance"]["adc_bits"], 16);
+  ASSERT_TRUE(j["stations"].contains("index"));
+  ASSERT_TRUE(j["stations"].contains("thumb"));
+  const json& lo = j["stations"]["index"]["lower"];
+  const json& up = j["stations"]["index"]["upper"];
+  for (const char* key : {"centre_3sigma_mm", "centre_3sigma_minor_mm", "centre_worst_case_mm", "centre_resolution_um",
+                          "target_worst_3sigma_mm", "target_worst_case_mm"}) {
+    SCOPED_TRACE(key);
+    EXPECT_NEAR(lo[key].get<double>(), up[key].get<double>(), 1e-9 * lo[key].get<double>());
+    EXPECT_GT(lo[key].get<double>(), 0.0);
+  }
+  // The worst points mirror about y = 15.5.
+  EXPECT_NEAR(lo["target_worst_case_at_mm"][0].get<double>(), up["target_worst_case_at_mm"][0].get<double>(), 1e-9);
+  EXPECT_NEAR(lo["target_worst_case_at_mm"][1].get<double>() + up["target_worst_case_at_mm"][1].get<double>(), 31.0,
+              1e-9);
+  for (const char* station : {"index", "thumb"}) {
+    for (const char* which : {"lower", "upper"}) {
+      SCOPED_TRACE(std::string(station) + " " + which);
+      const json& m = j["stations"][station][which];
+      EXPECT_EQ(m["centre_status"], "ok");
+      EXPECT_EQ(m["target_points_not_ok"], 0);
+      EXPECT_EQ(m["monte_carlo_samples_used"], 10000);
+      // Worst case (every parameter at 3 sigma, worst sign) bounds the 3-sigma semi-axis.
+      EXPECT_GE(m["centre_worst_case_mm"].get<double>(), m["centre_3sigma_mm"].get<double>());
+      EXPECT_GE(m["target_worst_3sigma_mm"].get<double>(), m["centre_3sigma_mm"].get<double>());
+      // 10,000 devices: the spread's relative standard error is ~1/sqrt(2 n) = 0.7 %; the
+      // tolerances (0.06 mm, 0.5 deg on 9 to 17.5 mm links) leave the first order a few per mille.
+      EXPECT_NEAR(m["centre_monte_carlo_3sigma_mm"].get<double>(), m["centre_3sigma_mm"].get<double>(),
+                  0.04 * m["centre_3sigma_mm"].get<double>());
+    }
+  }
+}
+
+TEST_F(CliTolerance, FiguresScaleWithTolerancesAndCounts) {
+  const Outcome base = run({"tolerance", kDesign, "--station", "thumb", "--json"});
+  const auto doubled = design_with("doubled.yaml", kSection,
+                                   "tolerance:\n  link_sigma_mm: 0.1\n  pin_sigma_mm: 0.05\n  base_sigma_mm: 0.2\n"
+                                   "  angle_sigma_deg: 1.0\n  adc_bits: 12 ");
+  const Outcome twice = run({"tolerance", doubled.string(), "--station", "thumb", "--json"});
+  ASSERT_EQ(base.code, 0) << base.err;
+  ASSERT_EQ(twice.code, 0) << twice.err;
+  const json a = parse(base);
+  const json b = parse(twice);
+  EXPECT_EQ(b["stations"].size(), 1u);
+  for (const char* which : {"lower", "upper"}) {
+    SCOPED_TRACE(which);
+    const json& x = a["stations"]["thumb"][which];
+    const json& y = b["stations"]["thumb"][which];
+    for (const char* key : {"centre_3sigma_mm", "centre_worst_case_mm", "target_worst_3sigma_mm",
+                            "target_worst_case_mm"}) {
+      EXPECT_NEAR(y[key].get<double>(), 2.0 * x[key].get<double>(), 1e-9 * x[key].get<double>()) << key;
+    }
+    // 12 bits instead of 16: each count is 16 times the angle.
+    EXPECT_NEAR(y["centre_resolution_um"].get<double>(), 16.0 * x["centre_resolution_um"].get<double>(),
+                1e-9 * y["centre_resolution_um"].get<double>());
+  }
+}
+
+TEST_F(CliTolerance, ZeroTolerancesGiveZeroError) {
+  const auto zero = design_with("zero.yaml", kSection,
+                                "tolerance:\n  link_sigma_mm: 0\n  pin_sigma_mm: 0\n  base_sigma_mm: 0\n"
+                                "  angle_sigma_deg: 0\n  adc_bits: 16 ");
+  const Outcome r = run({"tolerance", zero.string(), "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  for (const auto& [station, mechanisms] : j["stations"].items()) {
+    for (const auto& [which, m] : mechanisms.items()) {
+      SCOPED_TRACE(station + " " + which);
+      EXPECT_EQ(m["centre_3sigma_mm"].get<double>(), 0.0);
+      EXPECT_EQ(m["centre_worst_case_mm"].get<double>(), 0.0);
+      EXPECT_EQ(m["target_worst_case_mm"].get<double>(), 0.0);
+      EXPECT_EQ(m["centre_monte_carlo_3sigma_mm"].get<double>(), 0.0);
+      EXPECT_GT(m["centre_resolution_um"].get<double>(), 0.0);
+    }
+  }
+}
+
+TEST_F(CliTolerance, TextSaysWhereTheTolerancesComeFrom) {
+  const Outcome r = run({"tolerance", kDesign, "--station", "index"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("tolerances from the design"));
+  EXPECT_THAT(r.out, HasSubstr("station index"));
+  EXPECT_THAT(r.out, HasSubstr("worst case"));
+  const auto bare = design_without("bare.yaml", "tolerance:\n", "# A small link-dimension sweep");
+  const Outcome d = run({"tolerance", bare.string(), "--station", "index"});
+  ASSERT_EQ(d.code, 0) << d.err;
+  EXPECT_THAT(d.out, HasSubstr("by default (assumptions to replace)"));
+}
+
+TEST_F(CliTolerance, BadInputIsExitTwoNamingFileLineAndKey) {
+  const auto bad = design_with("bad.yaml", "  adc_bits: 16 ", "  adc_bits: 40 ");
+  const Outcome r = run({"tolerance", bad.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.out, IsEmpty());
+  EXPECT_THAT(r.err, HasSubstr("bad.yaml:"));
+  EXPECT_THAT(r.err, HasSubstr("tolerance.adc_bits"));
+  const Outcome s = run({"tolerance", kDesign, "--station", "pinky"});
+  EXPECT_EQ(s.code, 2);
+  EXPECT_THAT(s.out, IsEmpty());
+  EXPECT_THAT(s.err, HasSubstr("pinky"));
+}
+
+}  // namespace
