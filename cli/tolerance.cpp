@@ -93,7 +93,7 @@ Json to_json(const MechanismTolerance& r) {
   j["centre_status"] = std::string(to_string(r.centre.status));
   j["centre_3sigma_mm"] = r.centre.ellipse_semi_axes.x();
   j["centre_3sigma_minor_mm"] = r.centre.ellipse_semi_axes.y();
-  j["centre_3sigma_angle_deg"] = r.centre.ellipse_angle * 180.0 / 3.14159265358979323846;
+  j["centre_3sigma_angle_deg"] = angle_deg(r.centre.ellipse_angle);
   j["centre_worst_case_mm"] = r.centre.worst_case_mm;
   j["centre_resolution_um"] = r.centre.resolution_um;
   j["centre_monte_carlo_3sigma_mm"] = r.mc_3sigma_mm;
@@ -120,7 +120,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
 
   Json doc;
   doc["tolerance"] = {{"source", given ? "design" : "defaults (assumptions)"},
-                      {"link_sigma_mm", sigma[0]},
+                      {"link_length_sigma_mm", sigma[0]},
                       {"base_sigma_mm", sigma[4]},
                       {"angle_sigma_deg", t.angle_sigma_deg},
                       {"adc_bits", t.adc_bits},
