@@ -827,6 +827,16 @@ Containment containment(const Mechanism& m, const Ellipse& target) {
 
 void conditioning(const Mechanism& m, const Ellipse& target, const CoverageOptions& options, CoverageResult& out) {
   conditioning_over(m, target, options, out);
+  if (m.assembly_mode == AssemblyMode::Any) return;
+  const AssemblyCheck a = certified_assembly(m, target);
+  out.assembly_ok = a.ok;
+  out.decided = a.decided;
+  if (!a.ok) out.assembly_crossing = a.crossing;
+  if (!a.ok && a.decided) {
+    out.min_lci = 0.0;
+    out.min_lci_point = a.crossing;
+    out.lci_ok = out.min_lci >= m.min_lci;
+  }
 }
 
 CoverageResult coverage(const Mechanism& m, const Ellipse& target, const CoverageOptions& options) {
