@@ -551,7 +551,7 @@ AssemblyCheck certified_assembly(const Mechanism& m, const Ellipse& e) {
   // Breadth first (largest cells first): a wrong-side centre is found at the coarsest level that
   // has one, before any cell along the curve is split down to rounding.
   std::deque<Cell> stack;
-  constexpr int kRings = 4, kAngles = 32;
+  constexpr int kRings = 2, kAngles = 8;
   for (int i = 0; i < kRings; ++i)
     for (int k = 0; k < kAngles; ++k)
       stack.push_back({double(i) / kRings, double(i + 1) / kRings, 2 * kPi * k / kAngles, 2 * kPi * (k + 1) / kAngles});
