@@ -14,6 +14,8 @@ FIVEBAR_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
   openscad
+  # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
+  prusa-slicer unzip
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
   clang libclang-rt-14-dev libomp-dev
 )
