@@ -16,6 +16,8 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/parts.hpp"
+#include "fivebar/sections/contact.hpp"
+#include "fivebar/sections/motor.hpp"
 
 namespace fivebar {
 namespace {
@@ -146,6 +148,71 @@ TEST(MassProperties, InwardOrOpenMeshIsRefused) {
   EXPECT_THROW(mass_properties(inward, 1.0), InputError);
   EXPECT_THROW(mass_properties(TriangleMesh{}, 1.0), InputError);
   EXPECT_THROW(mass_properties(box(1, 1, 1), 0.0), InputError);
+}
+
+// --- motor: and contact: sections ----------------------------------------------------------------
+
+const std::string kStations = R"(name: t
+stations:
+  index:
+    target: {center: [6.25, 15.5], axes: [15, 12]}
+    mechanisms:
+      lower: {bases: [[0, 0], [12.5, 0]], links: [9, 9, 15, 15], working_mode: "-+"}
+      upper: {bases: [[0, 31], [12.5, 31]], links: [9, 9, 15, 15], working_mode: "+-"}
+)";
+
+TEST(MotorSection, NarrowerScopesWinAndTheFileReadsBack) {
+  const std::string text = kStations + R"(motor:
+  gear_ratio: 40
+  mechanisms:
+    upper: {gear_ratio: 50, theta2: {supply_voltage_V: 12}}
+  stations:
+    index:
+      current_limit_A: 2
+      upper: {gear_ratio: 60}
+contact: {shear_stiffness_N_per_mm: 2.5}
+)";
+  const Design d = load_design_from_string(text, "m.yaml");
+  const MotorSettings& m = *d.get<MotorSettings>();
+  EXPECT_EQ(m.joint("index", "lower", 1).gear_ratio, 40.0);
+  EXPECT_EQ(m.joint("index", "upper", 1).gear_ratio, 60.0);  // station scope beats every station's
+  EXPECT_EQ(m.joint("other", "upper", 1).gear_ratio, 50.0);
+  EXPECT_EQ(m.joint("index", "upper", 2).supply_voltage_V, 12.0);
+  EXPECT_EQ(m.joint("index", "upper", 1).supply_voltage_V, 6.0);
+  EXPECT_EQ(m.joint("index", "lower", 2).current_limit_A, 2.0);
+  EXPECT_EQ(d.get<ContactSettings>()->shear_stiffness_N_per_mm, 2.5);
+  // SI accessors: 1 mV/rpm = 60 / (2 pi) mV s/rad.
+  MotorParams p;
+  p.back_emf_mV_per_rpm = 2.0 * std::numbers::pi / 60.0;
+  EXPECT_NEAR(p.back_emf_constant(), 1e-3, 1e-18);
+  const Design back = load_design_from_string(to_yaml(d), "back.yaml");
+  for (const char* mech : {"lower", "upper"}) {
+    for (int j : {1, 2}) {
+      const MotorParams a = m.joint("index", mech, j);
+      const MotorParams b = back.get<MotorSettings>()->joint("index", mech, j);
+      for (const MotorField& f : motor_fields()) EXPECT_EQ(a.*f.member, b.*f.member) << mech << j << f.key;
+    }
+  }
+}
+
+TEST(MotorSection, BadValuesNameFileLineAndKey) {
+  const auto message = [&](const std::string& section) {
+    try {
+      (void)load_design_from_string(kStations + section, "bad.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message("motor: {gearbox_efficiency: 1.5}\n"),
+            "bad.yaml:8: motor.gearbox_efficiency = 1.5: must be > 0 and <= 1");
+  EXPECT_NE(message("motor:\n  stations: {index: {upper: {theta2: {inductance_mH: 0}}}}\n")
+                .find("bad.yaml:9: motor.stations.index.upper.theta2.inductance_mH = 0"),
+            std::string::npos);
+  EXPECT_NE(message("motor:\n  stations: {nowhere: {gear_ratio: 2}}\n").find("motor.stations.nowhere: no such station"),
+            std::string::npos);
+  EXPECT_NE(message("contact: {friction_coefficient: -1}\n").find("bad.yaml:8: contact.friction_coefficient = -1"),
+            std::string::npos);
 }
 
 }  // namespace
