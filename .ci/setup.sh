@@ -13,6 +13,7 @@ FIVEBAR_PACKAGES=(
   libvtk9-dev libcairo2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
+  libsundials-dev
   openscad
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
   clang libclang-rt-14-dev libomp-dev

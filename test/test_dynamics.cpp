@@ -11,11 +11,18 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numbers>
+#include <string>
 #include <vector>
 
+#include "fivebar/dynamics.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/kinematics.hpp"
 #include "fivebar/parts.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/print.hpp"
 #include "fivebar/sections/contact.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -213,6 +220,310 @@ TEST(MotorSection, BadValuesNameFileLineAndKey) {
             std::string::npos);
   EXPECT_NE(message("contact: {friction_coefficient: -1}\n").find("bad.yaml:8: contact.friction_coefficient = -1"),
             std::string::npos);
+}
+
+// --- Dynamics ---------------------------------------------------------------------------------------
+
+const Design& paper() {
+  static const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  return d;
+}
+
+MechanismModel paper_model(const std::string& station, const std::string& which) {
+  const Design& d = paper();
+  const Mechanism& m = *d.require_station(station).mechanism(which);
+  MechanismModel model;
+  model.mechanism = m;
+  model.inertia = closed_form_inertia(m, *d.get<Geometry>(), *d.get<PrintSettings>());
+  for (int j = 0; j < 2; ++j) model.motors[static_cast<std::size_t>(j)] = d.get<MotorSettings>()->joint(station, which, j + 1);
+  return model;
+}
+
+/// Joint angles on a grid over the station's target ellipse (IK in the working mode).
+std::vector<Eigen::Vector2d> workspace_grid(const Station& s, const Mechanism& m) {
+  std::vector<Eigen::Vector2d> out;
+  for (int a = 0; a < 5; ++a) {
+    for (int r = 0; r <= 4; ++r) {
+      const double rho = r / 4.0, phi = 2.0 * std::numbers::pi * a / 5.0 + 0.3 * r;
+      const Vec2 p = s.target.center + Vec2(0.5 * s.target.axes.x() * rho * std::cos(phi),
+                                            0.5 * s.target.axes.y() * rho * std::sin(phi));
+      const AnglesResult ik = ik_angles(m, p);
+      if (ik.status == Status::ok) out.emplace_back(ik.theta1, ik.theta2);
+    }
+  }
+  return out;
+}
+
+/// Kinetic energy by a second route: each body's centre of mass and angle from FK alone
+/// (fivebar/kinematics.hpp), differentiated by central differences along w.
+double kinetic_energy_by_differences(const MechanismModel& model, const Eigen::Vector2d& theta, const Eigen::Vector2d& w) {
+  const Mechanism& m = model.mechanism;
+  const MechanismInertia& in = model.inertia;
+  struct Bodies {
+    std::array<Vec2, 5> c;     // L1..L4 centres of mass, tip (m)
+    std::array<double, 4> phi; // link angles
+  };
+  const auto bodies = [&](const Eigen::Vector2d& th) {
+    const Pose p = fk(m, th[0], th[1]);
+    Bodies b;
+    const std::array<Vec2, 4> from{m.O1, m.O2, p.A1, p.A2};
+    const std::array<Vec2, 4> to{p.A1, p.A2, p.P, p.P};
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Vec2 axis = (to[i] - from[i]).normalized();
+      b.phi[i] = std::atan2(axis.y(), axis.x());
+      const Vec2 c = in.links[i].com_mm;
+      b.c[i] = 1e-3 * (from[i] + c.x() * axis + c.y() * Vec2(-axis.y(), axis.x()));
+    }
+    b.c[4] = 1e-3 * p.P;
+    return b;
+  };
+  const double h = 1e-6;
+  const Bodies plus = bodies(theta + h * w), minus = bodies(theta - h * w);
+  double T = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const Vec2 v = (plus.c[i] - minus.c[i]) / (2 * h);
+    double dphi = plus.phi[i] - minus.phi[i];
+    dphi = std::remainder(dphi, 2.0 * std::numbers::pi) / (2 * h);
+    double izz = in.links[i].izz_kg_mm2 * 1e-6;
+    if (static_cast<int>(i) == in.carrier) izz += in.tip_izz_kg_mm2 * 1e-6;
+    T += 0.5 * in.links[i].mass_kg * v.squaredNorm() + 0.5 * izz * dphi * dphi;
+  }
+  const Vec2 vp = (plus.c[4] - minus.c[4]) / (2 * h);
+  T += 0.5 * in.tip_mass_kg * vp.squaredNorm();
+  for (int j = 0; j < 2; ++j) {
+    const MotorParams& mp = model.motors[static_cast<std::size_t>(j)];
+    T += 0.5 * mp.gear_ratio * mp.gear_ratio * mp.rotor_inertia() * w[j] * w[j];
+  }
+  return T;
+}
+
+TEST(Dynamics, MassMatrixIsSymmetricPositiveDefiniteAndMatchesTheEnergyOfTheBodies) {
+  int checked = 0;
+  for (const Station& s : paper().stations) {
+    for (const Mechanism* m : s.mechanisms()) {
+      MechanismModel model = paper_model(s.name, m->name);
+      model.motors[0].rotor_inertia_g_cm2 = model.motors[1].rotor_inertia_g_cm2 = 0.0;  // the linkage alone
+      for (const Eigen::Vector2d& th : workspace_grid(s, *m)) {
+        SCOPED_TRACE(s.name + " " + m->name + " theta = " + std::to_string(th[0]) + ", " + std::to_string(th[1]));
+        const DynamicsTerms t = dynamics_terms(model, th, Eigen::Vector2d::Zero());
+        ASSERT_EQ(t.status, Status::ok);
+        EXPECT_LE(std::abs(t.M(0, 1) - t.M(1, 0)), 1e-14 * t.M.norm());
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(t.M);
+        EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0);
+        // The quadratic form against the bodies' energy from FK alone, for three directions.
+        for (const Eigen::Vector2d w : {Eigen::Vector2d(1.0, 0.0), Eigen::Vector2d(0.0, 1.0), Eigen::Vector2d(0.7, -1.3)}) {
+          const double reference = kinetic_energy_by_differences(model, th, w);
+          EXPECT_NEAR(0.5 * w.dot(t.M * w), reference, 1e-7 * reference);
+        }
+        // J against the library's kinematic Jacobian (mm/rad).
+        EXPECT_LT((1e3 * t.J - fk(*m, th[0], th[1]).J).norm(), 1e-9 * t.J.norm() * 1e3);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 60);
+}
+
+TEST(Dynamics, CoriolisTermEqualsTheChristoffelSymbolsOfM) {
+  // h_k = sum_ij (dM_kj/dtheta_i - 1/2 dM_ij/dtheta_k) w_i w_j (Lagrange), with dM by central
+  // differences of the library's M: an independent route to the projected accelerations.
+  MechanismModel model = paper_model("index", "lower");
+  // The linkage alone: the rotors' constant inertia would only add rounding to the differences.
+  model.motors[0].rotor_inertia_g_cm2 = model.motors[1].rotor_inertia_g_cm2 = 0.0;
+  const Station& s = paper().stations.front();
+  const double d = 1e-6;
+  for (const Eigen::Vector2d& th : workspace_grid(s, *s.lower)) {
+    const Eigen::Vector2d w(2.3, -1.1);
+    std::array<Eigen::Matrix2d, 2> dM;
+    for (int i = 0; i < 2; ++i) {
+      Eigen::Vector2d e = Eigen::Vector2d::Zero();
+      e[i] = d;
+      dM[static_cast<std::size_t>(i)] = (dynamics_terms(model, th + e, w).M - dynamics_terms(model, th - e, w).M) / (2 * d);
+    }
+    Eigen::Vector2d h = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 2; ++k)
+      for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+          h[k] += (dM[static_cast<std::size_t>(i)](k, j) - 0.5 * dM[static_cast<std::size_t>(k)](i, j)) * w[i] * w[j];
+    const Eigen::Vector2d lib = dynamics_terms(model, th, w).h;
+    SCOPED_TRACE(std::to_string(th[0]) + ", " + std::to_string(th[1]));
+    EXPECT_LT((lib - h).norm(), 1e-6 * h.norm() + 1e-15);
+  }
+}
+
+SimulationInput single(const MechanismModel& model, const Eigen::Vector2d& theta0) {
+  SimulationInput in;
+  in.station = "index";
+  in.reference_name = "test";
+  in.controller = *paper().get<ControllerSettings>();
+  SimulatedMechanism sm;
+  sm.name = model.mechanism.name;
+  sm.model = model;
+  sm.reference = {{theta0[0], theta0[1]}};
+  sm.reference_point_mm = {fk_point(model.mechanism, theta0[0], theta0[1]).P};
+  sm.theta0 = {theta0[0], theta0[1]};
+  for (auto& c : sm.control) c = in.controller.joint("index", model.mechanism.name, 1);
+  in.mechanisms.push_back(sm);
+  return in;
+}
+
+TEST(Dynamics, UnpoweredFrictionlessLinkageConservesEnergy) {
+  // No gravity (the design gives no orientation), so the linkage is set moving instead of being
+  // released: open windings, no friction, no skin, no rotor inertia (the linkage's own terms).
+  MechanismModel model = paper_model("index", "lower");
+  for (MotorParams& mp : model.motors) {
+    mp.viscous_friction_mNm_s_per_rad = mp.coulomb_friction_mNm = mp.rotor_inertia_g_cm2 = 0.0;
+  }
+  const Station& s = paper().stations.front();
+  const AnglesResult start = ik_angles(*s.lower, s.target.center + Vec2(2.0, -1.5));  // off-centre
+  ASSERT_EQ(start.status, Status::ok);
+  SimulationInput in = single(model, {start.theta1, start.theta2});
+  in.mechanisms[0].w0 = {0.05, -0.03};
+  SimulationOptions o;
+  o.drive = Drive::open_circuit;
+  o.contact = false;
+  o.duration_s = 10.0;
+  o.rtol = 1e-12;
+  o.rate_scale = 1e-2;
+  const SimulationResult r = simulate(in, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.samples.size(), 1001u);
+  const double e0 = r.samples.front().mechanisms[0].energy_J;
+  ASSERT_GT(e0, 0.0);
+  double worst = 0.0, travel = 0.0;
+  for (const TimeSample& t : r.samples) {
+    worst = std::max(worst, std::abs(t.mechanisms[0].energy_J - e0) / e0);
+    travel = std::max(travel, std::abs(t.mechanisms[0].theta[0] - start.theta1));
+  }
+  EXPECT_LT(worst, 1e-8);
+  EXPECT_GT(travel, 0.1);  // it really moved (and the speeds changed: a closed chain)
+  RecordProperty("energy_drift", std::to_string(worst));
+}
+
+TEST(Dynamics, LockedRotorDrawsTheStallCurrentVOverR) {
+  const MechanismModel model = paper_model("index", "lower");
+  const Station& s = paper().stations.front();
+  const AnglesResult start = ik_angles(*s.lower, s.target.center);
+  for (const double duty : {0.5, -0.8}) {
+    SimulationInput in = single(model, {start.theta1, start.theta2});
+    SimulationOptions o;
+    o.drive = Drive::constant_duty;
+    o.duty = duty;
+    o.lock_joints = true;
+    o.contact = false;
+    o.duration_s = 0.05;  // 500 L/R
+    o.rtol = 1e-10;
+    const SimulationResult r = simulate(in, o);
+    ASSERT_TRUE(r.ok()) << r.reason;
+    const MotorParams& mp = model.motors[0];
+    const double stall = duty * mp.supply_voltage_V / mp.terminal_resistance_ohm;  // 0.6 A, -0.96 A
+    SCOPED_TRACE(duty);
+    ASSERT_LT(std::abs(stall), mp.current_limit_A);
+    for (std::size_t j = 0; j < 2; ++j) EXPECT_NEAR(r.samples.back().mechanisms[0].current[j], stall, 1e-8);
+    EXPECT_NEAR(r.summary[0].peak_current_A, std::abs(stall), 1e-8);
+  }
+  // Above the driver's limit the current settles at the limit.
+  SimulationInput in = single(model, {start.theta1, start.theta2});
+  in.mechanisms[0].model.motors[0].current_limit_A = 0.25;
+  SimulationOptions o;
+  o.drive = Drive::constant_duty;
+  o.duty = 1.0;
+  o.lock_joints = true;
+  o.contact = false;
+  o.duration_s = 0.05;
+  o.rtol = 1e-10;
+  const SimulationResult r = simulate(in, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  EXPECT_NEAR(r.samples.back().mechanisms[0].current[0], 0.25, 1e-8);
+  // Joint 2 keeps the 1 A limit: 6 V / 5 ohm = 1.2 A would exceed it.
+  EXPECT_NEAR(r.samples.back().mechanisms[0].current[1], 1.0, 1e-8);
+}
+
+TEST(Dynamics, DiscretePidFollowsAHandComputedSequence) {
+  // kp 0.1, ki 10, kd 0.02, i_clamp 0.05, T = 10 ms (the accumulator's bound is 0.05/10 = 0.005):
+  //   e = 0.2:  s = 0.002,                 duty = 0.02 + 0.02          = 0.04
+  //   e = 0.3:  s = 0.005, d = 10,         duty = 0.03 + 0.05 + 0.2    = 0.28
+  //   e = 0.3:  s = 0.008 -> 0.005, d = 0, duty = 0.03 + 0.05          = 0.08
+  //   e = -0.4: s = 0.001, d = -70,        duty = -0.04 + 0.01 - 1.4   -> -1 (clamped)
+  //   e = -0.4: s = -0.003, d = 0,         duty = -0.04 - 0.03         = -0.07
+  PidGains g;
+  g.kp = 0.1;
+  g.ki = 10.0;
+  g.kd = 0.02;
+  g.i_clamp = 0.05;
+  DiscretePid pid(g, 0.01);
+  const std::array<double, 5> e{0.2, 0.3, 0.3, -0.4, -0.4};
+  const std::array<double, 5> expected{0.04, 0.28, 0.08, -1.0, -0.07};
+  for (std::size_t k = 0; k < e.size(); ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_NEAR(pid.update(e[k]), expected[k], 1e-12);
+  }
+}
+
+TEST(Dynamics, AdcQuantisesToTheNearestLevelAndClamps) {
+  Potentiometer pot;  // 2.5 V at 0, pi/3 rad per V
+  const std::array<double, 2> range{-10.0, 10.0};
+  const double q = 20.0 / 65535.0;  // V per level
+  for (double theta : {0.0, 0.1234567, -1.0, 2.0}) {
+    const double read = adc_reading(theta, pot, 16, range);
+    EXPECT_LE(std::abs(read - theta), 0.5 * q * pot.rad_per_volt * (1 + 1e-9)) << theta;
+  }
+  // 8 bits: levels 20/255 V apart; 40 rad is 40.7 V, beyond the range: reads the top level (10 V).
+  EXPECT_NEAR(adc_reading(40.0, pot, 8, range), pot.rad_per_volt * (10.0 - 2.5), 1e-12);
+  EXPECT_NEAR(adc_reading(0.0, pot, 8, range), pot.rad_per_volt * (-10.0 + std::round(12.5 / (20.0 / 255)) * (20.0 / 255) - 2.5),
+              1e-12);
+}
+
+TEST(Dynamics, ThePaperStationTracksItsStretchWithinTheDriverLimits) {
+  const Design& d = paper();
+  std::map<std::string, MechanismInertia> inertia;
+  for (const Mechanism* m : d.require_station("index").mechanisms()) {
+    inertia[m->name] = closed_form_inertia(*m, *d.get<Geometry>(), *d.get<PrintSettings>());
+  }
+  SimulationRequest request;
+  request.station = "index";
+  request.pattern = PatternKind::stretch;
+  const std::vector<SimulationInput> inputs = simulation_inputs(d, request, inertia);
+  ASSERT_EQ(inputs.size(), 1u);
+  const SimulationResult r = simulate(inputs[0]);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(r.summary.size(), 2u);
+  for (const MechanismSummary& s : r.summary) {
+    SCOPED_TRACE(s.name);
+    EXPECT_TRUE(std::isfinite(s.max_error_mm));
+    EXPECT_LT(s.rms_error_mm, s.max_error_mm + 1e-12);
+    // The clamp of the driver keeps the current within its limit (di/dt <= R (I - i) / L).
+    EXPECT_LE(s.peak_current_A, d.get<MotorSettings>()->defaults.current_limit_A * (1 + 1e-5));
+    EXPECT_LE(s.peak_duty, 1.0);
+  }
+  // The last sample has settled on the pattern's end point within a tenth of a millimetre.
+  for (const MechanismSample& m : r.samples.back().mechanisms) EXPECT_LT((m.P_mm - m.P_ref_mm).norm(), 0.1);
+}
+
+TEST(Dynamics, LowFrictionMakesTheTactorSlipAndHighFrictionDoesNot) {
+  const Design& d = paper();
+  std::map<std::string, MechanismInertia> inertia;
+  for (const Mechanism* m : d.require_station("index").mechanisms()) {
+    inertia[m->name] = closed_form_inertia(*m, *d.get<Geometry>(), *d.get<PrintSettings>());
+  }
+  SimulationRequest request;
+  request.station = "index";
+  request.pattern = PatternKind::stretch;
+  SimulationInput in = simulation_inputs(d, request, inertia).front();
+  // Stretch by 3 mm on a 1 N/mm skin: a spring force of ~3 N against mu N.
+  in.contact.friction_coefficient = 10.0;
+  const SimulationResult stick = simulate(in);
+  ASSERT_TRUE(stick.ok()) << stick.reason;
+  in.contact.friction_coefficient = 0.5;
+  const SimulationResult slip = simulate(in);
+  ASSERT_TRUE(slip.ok()) << slip.reason;
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_FALSE(stick.summary[k].slipped);
+    EXPECT_TRUE(slip.summary[k].slipped);
+    // Sliding caps the spring at mu N = 0.25 N (plus the damper's share while sticking).
+    EXPECT_GT(stick.summary[k].peak_shear_N, 1.0);
+    EXPECT_LT(slip.summary[k].peak_shear_N, 0.25 + 0.1);
+  }
 }
 
 }  // namespace

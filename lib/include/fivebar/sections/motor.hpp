@@ -29,7 +29,10 @@ struct MotorParams {
   /// k_e at the motor shaft; 0.5236 mV/rpm is 5 mV s/rad, equal to k_t in SI as for an ideal motor.
   double back_emf_mV_per_rpm = 0.5235987755982988;
   double rotor_inertia_g_cm2 = 0.5;         ///< J_r of the rotor, at the motor shaft
-  double gear_ratio = 30.0;                 ///< N = motor turns per output turn
+  /// N = motor turns per output turn. With the other defaults, 200 gives a no-load output speed of
+  /// 6 V / (k_e N) = 344 deg/s (the controller's 360 deg/s limit) and keeps the exported PID stable
+  /// at 100 Hz with one period of delay; 30 does not (fivebar simulate shows the limit cycle).
+  double gear_ratio = 200.0;
   double gearbox_efficiency = 0.7;          ///< eta, in (0, 1]: output torque = eta N k_t i
   double viscous_friction_mNm_s_per_rad = 0.01;  ///< b at the output shaft
   double coulomb_friction_mNm = 0.5;        ///< tau_c at the output shaft
