@@ -7,6 +7,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "fivebar/io.hpp"
+
 #include "fivebar/dynamics.hpp"
 #include "fivebar/parts.hpp"
 #include "fivebar/tolerances.hpp"
@@ -83,6 +85,8 @@ MechanismInertia closed_form_inertia(const Mechanism& m, const Geometry& g, cons
   const double rb = 0.5 * g.boss_diameter;
   const double tip_height = hw.tip_flange_height + hw.tip_dome_height;
   const double post_height = std::max(0.0, g.tactor_height - tip_height);
+  const double hole = g.pin_diameter + 2.0 * print.pin_clearance;
+  const double bore = g.motor_shaft_diameter + 2.0 * print.pin_clearance;
   for (std::size_t i = 0; i < 4; ++i) {
     Accum a;
     const double L = m.L[i];
@@ -91,13 +95,25 @@ MechanismInertia closed_form_inertia(const Mechanism& m, const Geometry& g, cons
     a.add(slab, {0.5 * L, 0.0}, slab * (L * L + w * w) / 12.0);
     add_half_disc(a, rho, rb, t, {0.0, 0.0}, -1.0);
     add_half_disc(a, rho, rb, t, {L, 0.0}, +1.0);
-    if (i < 2) add_cylinder(a, rho, rb, hw.hub_height, {0.0, 0.0});
-    if (static_cast<int>(i) == out.carrier) add_cylinder(a, rho, rb, post_height, {L, 0.0});
+    const bool carrier = static_cast<int>(i) == out.carrier;
+    if (i < 2) {
+      add_cylinder(a, rho, rb, hw.hub_height, {0.0, 0.0});
+      add_cylinder(a, -rho, 0.5 * bore, t + hw.hub_height, {0.0, 0.0});  // shaft bore
+    } else {
+      add_cylinder(a, -rho, 0.5 * hole, t, {0.0, 0.0});  // elbow pin hole
+    }
+    if (carrier) add_cylinder(a, rho, rb, post_height, {L, 0.0});
+    add_cylinder(a, -rho, 0.5 * hole, t + (carrier ? post_height : 0.0), {L, 0.0});  // far pin hole
     out.links[i] = a.link();
   }
+  // Tip: the flange, the dome as a cylinder of half its height (a low spherical cap holds about
+  // half its cylinder), and the peg down the post.
   const double rt = 0.5 * g.tactor_diameter;
-  out.tip_mass_kg = rho * kPi * rt * rt * tip_height;
-  out.tip_izz_kg_mm2 = 0.5 * out.tip_mass_kg * rt * rt;
+  Accum tip;
+  add_cylinder(tip, rho, rt, hw.tip_flange_height + 0.5 * hw.tip_dome_height, {0.0, 0.0});
+  add_cylinder(tip, rho, 0.5 * g.pin_diameter, post_height, {0.0, 0.0});
+  out.tip_mass_kg = tip.m;
+  out.tip_izz_kg_mm2 = tip.second;
   out.note = "closed form: slab with half-disc bosses, hub and post (density " +
              std::to_string(print.density_g_cm3).substr(0, 5) + " g/cm^3)";
   return out;
@@ -128,6 +144,32 @@ MechanismInertia stl_inertia(const Mechanism& m, const Geometry& g,
   // The tip turns with its carrier about its own axis (the z axis of its frame).
   out.tip_izz_kg_mm2 = inertia_about(tip, Eigen::Vector3d(0.0, 0.0, tip.com_mm.z()))(2, 2);
   out.note = "STL renders of the parts (density " + std::to_string(density_g_cm3).substr(0, 5) + " g/cm^3)";
+  return out;
+}
+
+std::map<std::string, MechanismInertia> station_inertia(const Design& design, const Station& station, const Json* parts,
+                                                        const std::filesystem::path& parts_dir) {
+  const Geometry* g = design.get<Geometry>();
+  if (g == nullptr) throw InputError("the design has no `geometry:` section (the links' outlines, for their masses)");
+  const PrintSettings print = design.get<PrintSettings>() ? *design.get<PrintSettings>() : PrintSettings{};
+  std::map<std::string, MechanismInertia> out;
+  for (const Mechanism* m : station.mechanisms()) {
+    if (parts == nullptr) {
+      out[m->name] = closed_form_inertia(*m, *g, print);
+      continue;
+    }
+    std::map<std::string, std::filesystem::path> stl;
+    const Json& list = parts->contains("parts") ? (*parts)["parts"] : *parts;
+    for (const Json& p : list) {
+      if (!p.is_object() || p.value("station", "") != station.name || !p.contains("uses") || !p["stl"].is_string()) continue;
+      for (const Json& use : p["uses"]) {
+        const std::string u = use.get<std::string>();
+        const std::string prefix = m->name + "/";
+        if (u.rfind(prefix, 0) == 0) stl[u.substr(prefix.size())] = parts_dir / p["stl"].get<std::string>();
+      }
+    }
+    out[m->name] = stl_inertia(*m, *g, stl, print.density_g_cm3);
+  }
   return out;
 }
 
