@@ -43,15 +43,17 @@ SimulatedMechanism base_mechanism(const Design& design, const Station& station, 
 std::vector<SimulationInput> simulation_inputs(const Design& design, const SimulationRequest& request,
                                                const std::map<std::string, MechanismInertia>& inertia) {
   const Station& station = design.require_station(request.station);
+  // Missing sections name the design file (there is no line to name).
+  const std::string where = design.source.empty() ? std::string("simulate: ") : design.source.string() + ": simulate: ";
   if (!station.lower || !station.upper) {
     throw InputError("simulate: station " + station.name + " needs both a lower and an upper mechanism");
   }
-  if (!design.get<Geometry>()) throw InputError("simulate: the design has no `geometry:` section (link outlines, masses)");
+  if (!design.get<Geometry>()) throw InputError(where + "the design has no `geometry:` section (link outlines, masses)");
   if (!design.get<MotorSettings>()) {
-    throw InputError("simulate: the design has no `motor:` section (motor.terminal_resistance_ohm, ... : the motors' data)");
+    throw InputError(where + "the design has no `motor:` section (motor.terminal_resistance_ohm, ... : the motors' data)");
   }
   if (!design.get<ControllerSettings>()) {
-    throw InputError("simulate: the design has no `controller:` section (controller.pid, loop_rate_hz: the PID to simulate)");
+    throw InputError(where + "the design has no `controller:` section (controller.pid, loop_rate_hz: the PID to simulate)");
   }
   const ControllerSettings& controller = *design.get<ControllerSettings>();
   const ContactSettings contact = design.get<ContactSettings>() ? *design.get<ContactSettings>() : ContactSettings{};
