@@ -108,6 +108,13 @@ int run_simulate(const SimulateOptions& opt) {
     request.pattern = kind;
     request.step = opt.step;
     for (const SimulationInput& in : simulation_inputs(design, request, inertia)) {
+      if (!in.unusable.empty()) {
+        all_ok = false;
+        runs.push_back({{"station", s->name}, {"reference", in.reference_name}, {"status", "not_simulated"},
+                        {"reason", in.unusable}});
+        if (!opt.json) std::cout << s->name << "  " << in.reference_name << ": not simulated, " << in.unusable << "\n";
+        continue;
+      }
       const SimulationResult r = simulate(in, so);
       const std::filesystem::path csv = dir / (s->name + "-" + in.reference_name + ".csv");
       AtomicFile file(csv);
@@ -137,7 +144,7 @@ int run_simulate(const SimulateOptions& opt) {
     }
   }
   if (!all_ok) {
-    std::cerr << "fivebar simulate: a simulation did not finish (its status and reason are above)\n";
+    std::cerr << "fivebar simulate: a simulation did not finish or could not start (its status and reason are above)\n";
     return kCheckFailed;
   }
   return kOk;

@@ -282,6 +282,9 @@ struct SimulationInput {
   std::vector<SimulatedMechanism> mechanisms;
   ControllerSettings controller;
   ContactSettings contact;
+  /// Non-empty when the reference cannot be followed (a sample unreachable or singular): the
+  /// reason; such an input is reported, not simulated.
+  std::string unusable;
 };
 
 struct SimulationResult {

@@ -119,18 +119,22 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
     for (const PatternSample& s : pr.samples) {
       for (const TactorSample* ts : {&s.lower, &s.upper}) {
         const SampleStatus st = ts->status;
-        if (st == SampleStatus::unreachable || st == SampleStatus::singular ||
-            st == SampleStatus::no_collision_free_point || st == SampleStatus::wrong_assembly) {
-          throw InputError("simulate: pattern " + in.reference_name + " on station " + station.name + " at t = " +
-                           format::fixed(s.time_s, 3) + " s: the " + (ts == &s.lower ? "lower" : "upper") +
-                           " tactor's reference is " + std::string(to_string(st)) +
-                           " (fivebar pattern shows where); no joint reference to follow");
+        if (in.unusable.empty() && (st == SampleStatus::unreachable || st == SampleStatus::singular ||
+                                    st == SampleStatus::no_collision_free_point || st == SampleStatus::wrong_assembly)) {
+          in.unusable = "at t = " + format::fixed(s.time_s, 3) + " s the " + (ts == &s.lower ? "lower" : "upper") +
+                        " tactor's reference is " + std::string(to_string(st)) +
+                        " (fivebar pattern shows where): no joint reference to follow";
         }
       }
       in.mechanisms[0].reference.push_back(s.lower.theta);
       in.mechanisms[0].reference_point_mm.push_back(s.lower.point);
       in.mechanisms[1].reference.push_back(s.upper.theta);
       in.mechanisms[1].reference_point_mm.push_back(s.upper.point);
+    }
+    if (!in.unusable.empty()) {
+      in.mechanisms.clear();
+      out.push_back(std::move(in));
+      continue;
     }
     if (in.mechanisms[0].reference.empty()) continue;
     for (SimulatedMechanism& sm : in.mechanisms) sm.theta0 = sm.reference.front();

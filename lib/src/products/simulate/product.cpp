@@ -57,6 +57,14 @@ Product simulate_product() {
       SimulationRequest request;
       request.station = s.name;
       for (const SimulationInput& in : simulation_inputs(d, request, inertia)) {
+        if (!in.unusable.empty()) {
+          ++total;
+          ++failed;
+          runs.push_back({{"station", s.name}, {"reference", in.reference_name}, {"status", "not_simulated"},
+                          {"reason", in.unusable}});
+          problems += "- ✗ " + s.name + " " + in.reference_name + ": not simulated, " + in.unusable + "\n";
+          continue;
+        }
         ctx.say("simulating " + s.name + " " + in.reference_name);
         const SimulationResult r = simulate(in);
         ++total;
