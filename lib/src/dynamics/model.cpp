@@ -40,7 +40,7 @@ struct Accum {
     first += mass * com;
     second += izz_own + mass * com.squaredNorm();
   }
-  LinkInertia link() const {
+  LinkInertia body() const {
     LinkInertia l;
     l.mass_kg = m;
     l.com_mm = m > 0.0 ? Vec2(first / m) : Vec2(0.0, 0.0);
@@ -104,7 +104,7 @@ MechanismInertia closed_form_inertia(const Mechanism& m, const Geometry& g, cons
     }
     if (carrier) add_cylinder(a, rho, rb, post_height, {L, 0.0});
     add_cylinder(a, -rho, 0.5 * hole, t + (carrier ? post_height : 0.0), {L, 0.0});  // far pin hole
-    out.links[i] = a.link();
+    out.links[i] = a.body();
   }
   // Tip: the flange, the dome as a cylinder of half its height (a low spherical cap holds about
   // half its cylinder), and the peg down the post.
