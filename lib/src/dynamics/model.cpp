@@ -114,7 +114,7 @@ MechanismInertia closed_form_inertia(const Mechanism& m, const Geometry& g, cons
   add_cylinder(tip, rho, 0.5 * g.pin_diameter, post_height, {0.0, 0.0});
   out.tip_mass_kg = tip.m;
   out.tip_izz_kg_mm2 = tip.second;
-  out.note = "closed form: slab with half-disc bosses, hub and post (density " +
+  out.note = "closed form: slab with half-disc bosses less pin holes, hub and post (density " +
              std::to_string(print.density_g_cm3).substr(0, 5) + " g/cm^3)";
   return out;
 }
