@@ -227,6 +227,9 @@ TEST(MotorSection, BadValuesNameFileLineAndKey) {
 
 // --- Dynamics ---------------------------------------------------------------------------------------
 
+/// `text` contains `part`.
+#define EXPECT_THAT_REASON(text, part) EXPECT_NE((text).find(part), std::string::npos) << (text)
+
 const Design& paper() {
   static const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
   return d;
@@ -475,6 +478,39 @@ TEST(Dynamics, LockedRotorDrawsTheStallCurrentVOverR) {
   EXPECT_NEAR(r.samples.back().mechanisms[0].current[0], 0.25, 1e-8);
   // Joint 2 keeps the 1 A limit: 6 V / 5 ohm = 1.2 A would exceed it.
   EXPECT_NEAR(r.samples.back().mechanisms[0].current[1], 1.0, 1e-8);
+}
+
+TEST(Dynamics, ASingularStartOrAnExhaustedBudgetIsAStatusWithTheStateNeverANaN) {
+  const MechanismModel model = paper_model("index", "lower");
+  // Distal links aligned (type II): theta1 = 180 deg puts A1 at (-9, 0); |A2 - A1| = L3 + L4 = 30
+  // when 21.5^2 + 2 21.5 9 cos(theta2) + 81 = 900, i.e. cos(theta2) = 356.75 / 387.
+  const double theta2 = std::acos(356.75 / 387.0);
+  SimulationInput in = single(model, {std::numbers::pi, theta2});
+  SimulationResult r = simulate(in);
+  EXPECT_EQ(r.status, SimStatus::singular);
+  EXPECT_THAT_REASON(r.reason, "t = 0 s");
+
+  const Station& s = paper().stations.front();
+  const AnglesResult start = ik_angles(*s.lower, s.target.center);
+  in = single(model, {start.theta1, start.theta2});
+  in.mechanisms[0].reference.push_back({start.theta1 + 0.3, start.theta2 + 0.3});  // a step to chase
+  in.mechanisms[0].reference_point_mm.push_back(s.target.center);
+  SimulationOptions o;
+  o.max_steps = 50;
+  r = simulate(in, o);
+  EXPECT_EQ(r.status, SimStatus::step_limit);
+  EXPECT_THAT_REASON(r.reason, "more than 50 integrator steps");
+  EXPECT_THAT_REASON(r.reason, "lower theta = (");
+  EXPECT_LE(r.steps, 51u);
+  EXPECT_TRUE(std::isfinite(r.t_end));
+  o = SimulationOptions{};
+  o.max_wall_s = 0.0;
+  r = simulate(in, o);
+  EXPECT_EQ(r.status, SimStatus::wall_time_limit);
+  EXPECT_THAT_REASON(r.reason, "of wall time");
+  for (const TimeSample& t : r.samples) {
+    for (double v : {t.mechanisms[0].theta[0], t.mechanisms[0].current[0], t.mechanisms[0].P_mm.x()}) EXPECT_TRUE(std::isfinite(v));
+  }
 }
 
 TEST(Dynamics, DiscretePidFollowsAHandComputedSequence) {

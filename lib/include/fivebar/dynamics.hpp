@@ -146,6 +146,10 @@ struct MechanismModel {
   Mechanism mechanism;
   MechanismInertia inertia;
   std::array<MotorParams, 2> motors;  ///< joint 1 (at O1), joint 2 (at O2)
+  /// The FK branch the motion stays on (Plus / Minus); Any: the mechanism's assembly mode as fk()
+  /// picks it. simulate() pins it to the branch of the initial pose, so that P moves continuously
+  /// (changing branch needs a type II singularity, where the run stops).
+  AssemblyMode branch = AssemblyMode::Any;
 };
 
 /// The terms of M(theta) dw/dt + h = tau at one state (SI).

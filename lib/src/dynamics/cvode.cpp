@@ -84,7 +84,14 @@ std::string_view to_string(SimStatus status) {
   return "?";
 }
 
-SimulationResult simulate(const SimulationInput& input, const SimulationOptions& options) {
+SimulationResult simulate(const SimulationInput& given, const SimulationOptions& options) {
+  // A copy whose mechanisms stay on the FK branch they start on.
+  SimulationInput input = given;
+  for (SimulatedMechanism& m : input.mechanisms) {
+    if (m.model.branch != AssemblyMode::Any) continue;
+    const Pose p0 = fk(m.model.mechanism, m.theta0[0], m.theta0[1]);
+    if (p0.assembly != 0) m.model.branch = p0.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  }
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   SimulationResult result;
