@@ -176,7 +176,7 @@ std::map<std::string, MechanismInertia> station_inertia(const Design& design, co
 DynamicsTerms dynamics_terms(const MechanismModel& model, const Eigen::Vector2d& theta, const Eigen::Vector2d& w) {
   DynamicsTerms out;
   const Mechanism& mech = model.mechanism;
-  const Pose pose = fk(mech, theta[0], theta[1], model.branch);
+  const Pose pose = model.branch == AssemblyMode::Any ? fk(mech, theta[0], theta[1]) : fk(mech, theta[0], theta[1], model.branch);
   out.status = pose.status;
   if (pose.status == Status::unreachable || pose.status == Status::singular_type2) return out;
   constexpr double kM = 1e-3;  // mm -> m
