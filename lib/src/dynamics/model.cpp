@@ -176,13 +176,23 @@ std::map<std::string, MechanismInertia> station_inertia(const Design& design, co
 DynamicsTerms dynamics_terms(const MechanismModel& model, const Eigen::Vector2d& theta, const Eigen::Vector2d& w) {
   DynamicsTerms out;
   const Mechanism& mech = model.mechanism;
-  const Pose pose = model.branch == AssemblyMode::Any ? fk(mech, theta[0], theta[1]) : fk(mech, theta[0], theta[1], model.branch);
-  out.status = pose.status;
-  if (pose.status == Status::unreachable || pose.status == Status::singular_type2) return out;
+  // Positions: the elbows from the angles, the tactor by the library's stable circle intersection
+  // (kinematics.hpp) on the pinned branch (side = sign of cross(A2 - A1, P - A1)); without a pinned
+  // branch, the one fk() chooses.
+  int side = static_cast<int>(model.branch);
+  if (side == 0) {
+    const Pose pose = fk(mech, theta[0], theta[1]);
+    if (pose.status == Status::unreachable) return out;
+    side = pose.assembly != 0 ? pose.assembly : 1;
+  }
+  const Vec2 A1mm = mech.O1 + mech.L[0] * e(theta[0]);
+  const Vec2 A2mm = mech.O2 + mech.L[1] * e(theta[1]);
+  const CircleIntersection x = intersect_circles(A1mm, mech.L[2], A2mm, mech.L[3], side);
+  if (x.status == Status::unreachable) return out;
+  out.status = Status::ok;
   constexpr double kM = 1e-3;  // mm -> m
   const double L1 = mech.L[0] * kM, L2 = mech.L[1] * kM, L3 = mech.L[2] * kM, L4 = mech.L[3] * kM;
-  // Positions from the library's FK (the stable circle intersection), in metres.
-  const Vec2 A1 = pose.A1 * kM, A2 = pose.A2 * kM, P = pose.P * kM;
+  const Vec2 A1 = A1mm * kM, A2 = A2mm * kM, P = x.point * kM;
   const Vec2 r3 = P - A1, r4 = P - A2;
   const double det = cross(r3, r4);
   out.type2_sin = std::abs(det) / (L3 * L4);
