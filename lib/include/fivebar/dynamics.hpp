@@ -154,7 +154,7 @@ struct MechanismModel {
 
 /// The terms of M(theta) dw/dt + h = tau at one state (SI).
 struct DynamicsTerms {
-  Status status = Status::unreachable;  ///< ok (or singular_type1: a stretched leg is harmless here)
+  Status status = Status::unreachable;  ///< ok, unreachable or singular_type2 (a stretched leg is harmless here)
   Eigen::Matrix2d M = Eigen::Matrix2d::Zero();   ///< kg m^2, rotors included
   Eigen::Vector2d h = Eigen::Vector2d::Zero();   ///< N m, Coriolis and centrifugal
   Eigen::Matrix2d J = Eigen::Matrix2d::Zero();   ///< dP/dtheta, m/rad

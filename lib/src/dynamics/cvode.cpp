@@ -16,6 +16,7 @@
 
 #include "dynamics/system.hpp"
 #include "fivebar/format.hpp"
+#include "fivebar/tolerances.hpp"
 
 namespace fivebar {
 
@@ -107,7 +108,7 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
   const ControllerSettings& ctl = input.controller;
   const double T = 1.0 / ctl.loop_rate_hz;
   const double duration = options.duration_s > 0.0 ? options.duration_s : double(n_ref - 1) * T + options.settle_s;
-  const auto n_samples = static_cast<std::size_t>(std::floor(duration / T + 1e-9));
+  const auto n_samples = static_cast<std::size_t>(std::floor(duration / T + tol::kSamplePeriodsRel));
   const std::size_t nm = input.mechanisms.size();
   const auto n = static_cast<sunindextype>(kStateSize * nm);
 

@@ -7,6 +7,7 @@
 
 #include "fivebar/dynamics.hpp"
 #include "fivebar/format.hpp"
+#include "fivebar/tolerances.hpp"
 #include "fivebar/pattern.hpp"
 
 namespace fivebar {
@@ -89,7 +90,7 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
     SimulationInput in = make("step");
     const Vec2 c = station.target.center;
     const std::array<Vec2, 2> start{c - Vec2(0.0, 0.5 * separation), c + Vec2(0.0, 0.5 * separation)};
-    const auto n = static_cast<std::size_t>(std::floor(request.step_hold_s * rate + 1e-9)) + 1;
+    const auto n = static_cast<std::size_t>(std::floor(request.step_hold_s * rate + tol::kSamplePeriodsRel)) + 1;
     for (std::size_t k = 0; k < 2; ++k) {
       SimulatedMechanism& sm = in.mechanisms[k];
       std::array<double, 2> previous{0.0, 0.0};
