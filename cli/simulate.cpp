@@ -25,6 +25,7 @@ struct SimulateOptions {
   bool step = false;
   bool no_render = false;
   std::optional<double> rtol;
+  double max_wall_s = 120.0;
   std::string out;
   bool json = false;
 };
@@ -54,6 +55,7 @@ int run_simulate(const SimulateOptions& opt) {
   if (opt.rtol && (!(*opt.rtol >= 1e-14) || !(*opt.rtol <= 1e-2))) {
     throw InputError("--rtol must be within [1e-14, 1e-2]");
   }
+  if (!(opt.max_wall_s > 0.0) || !(opt.max_wall_s <= 1e6)) throw InputError("--max-wall must be > 0 and <= 1e6 s");
   const Design design = load(opt.design);
   std::vector<const Station*> stations;
   if (!opt.station.empty()) {
@@ -94,6 +96,7 @@ int run_simulate(const SimulateOptions& opt) {
   }
   SimulationOptions so;
   if (opt.rtol) so.rtol = *opt.rtol;
+  so.max_wall_s = opt.max_wall_s;
   Json runs = Json::array();
   Json mass = Json::object();
   std::vector<std::string> files;
@@ -168,6 +171,9 @@ void setup_simulate(CLI::App& app) {
   sub->add_flag("--no-render", opt->no_render,
                 "Links' masses from the closed form (slab with bosses) instead of the parts' STL renders (openscad)");
   sub->add_option("--rtol", opt->rtol, "CVODE relative tolerance (default 1e-6)")->type_name("R");
+  sub->add_option("--max-wall", opt->max_wall_s, "Wall-time bound of each simulation (s, default 120): beyond it the run "
+                  "stops with status wall_time_limit")
+      ->type_name("S");
   sub->add_option("-o,--out", opt->out, "Directory for the CSV files (default: outputs/<design>/simulate)")
       ->type_name("DIR");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
