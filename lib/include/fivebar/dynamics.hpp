@@ -175,7 +175,9 @@ inline constexpr double kCoulombSmoothingSpeed = 1e-3;
 
 // --- The controller -------------------------------------------------------------------------------
 
-/// The exported PID of one joint as the device runs it once per period T:
+/// The exported PID of one joint as the device runs it once per period T (the convention of
+/// ros2_control's control_toolbox::Pid with an integral clamp: the integral term accumulates and
+/// is clamped, so it never winds up beyond i_clamp; the derivative is a backward difference):
 ///   s_k = s_{k-1} + e_k T, clamped so that |ki s_k| <= i_clamp (no wind-up beyond the clamp);
 ///   d_k = (e_k - e_{k-1}) / T (0 at the first sample);
 ///   duty_k = clamp(kp e_k + ki s_k + kd d_k, -1, 1).
