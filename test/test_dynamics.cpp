@@ -598,6 +598,16 @@ TEST(Dynamics, LowFrictionMakesTheTactorSlipAndHighFrictionDoesNot) {
     EXPECT_GT(stick.summary[k].peak_shear_N, 1.0);
     EXPECT_LT(slip.summary[k].peak_shear_N, 0.25 + 0.1);
   }
+  // While sliding the skin force is exactly mu N (the anchor keeps the stretch at mu N / k).
+  std::size_t sliding = 0;
+  for (const TimeSample& t : slip.samples) {
+    for (const MechanismSample& m : t.mechanisms) {
+      if (!m.slipping) continue;
+      ++sliding;
+      EXPECT_NEAR(m.force_N.norm(), 0.25, 1e-5) << "t = " << t.t;
+    }
+  }
+  EXPECT_GT(sliding, 10u);
 }
 
 }  // namespace
