@@ -574,6 +574,40 @@ TEST(Dynamics, ThePaperStationTracksItsStretchWithinTheDriverLimits) {
   for (const MechanismSample& m : r.samples.back().mechanisms) EXPECT_LT((m.P_mm - m.P_ref_mm).norm(), 0.1);
 }
 
+TEST(Dynamics, TheTrajectoryConvergesAsTheToleranceTightens) {
+  // Against a run at rtol 1e-11 (ADC quantisation off: a rounding level flipped by a tiny
+  // difference would change the next duty, a discontinuity no tolerance removes), the tactor
+  // error falls with the tolerance: BDF's local error control is proportional.
+  const Design& d = paper();
+  SimulationRequest request;
+  request.station = "index";
+  request.pattern = PatternKind::twist;
+  const SimulationInput in = simulation_inputs(d, request, station_inertia(d, d.require_station("index"), nullptr, {})).front();
+  SimulationOptions o;
+  o.quantise = false;
+  o.rtol = 1e-11;
+  const SimulationResult reference = simulate(in, o);
+  ASSERT_TRUE(reference.ok()) << reference.reason;
+  const auto error_at = [&](double rtol) {
+    o.rtol = rtol;
+    const SimulationResult r = simulate(in, o);
+    EXPECT_TRUE(r.ok()) << r.reason;
+    EXPECT_EQ(r.samples.size(), reference.samples.size());
+    double e = 0.0;
+    for (std::size_t s = 0; s < std::min(r.samples.size(), reference.samples.size()); ++s) {
+      for (std::size_t k = 0; k < 2; ++k) {
+        e = std::max(e, (r.samples[s].mechanisms[k].P_mm - reference.samples[s].mechanisms[k].P_mm).norm());
+      }
+    }
+    return e;
+  };
+  const double e5 = error_at(1e-5), e7 = error_at(1e-7), e9 = error_at(1e-9);
+  SCOPED_TRACE(std::to_string(e5) + " " + std::to_string(e7) + " " + std::to_string(e9));
+  EXPECT_LT(e5, 1e-4);  // mm, for a 6 mm twist
+  EXPECT_LT(e7, e5 / 10.0);
+  EXPECT_LT(e9, e7 / 10.0);
+}
+
 TEST(Dynamics, LowFrictionMakesTheTactorSlipAndHighFrictionDoesNot) {
   const Design& d = paper();
   std::map<std::string, MechanismInertia> inertia;
