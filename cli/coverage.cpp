@@ -36,14 +36,15 @@ void print_station(const Station& s, const Ellipse& e, bool overridden, const St
   if (c.upper) rows.emplace_back("upper", &*c.upper);
   if (c.shared) rows.emplace_back("shared", &*c.shared);
   for (const auto& [name, r] : rows) {
-    std::printf("  %-7s %-12s %11s %8s%% %-20s %8s %-20s %10s %9s %8s\n", name, r->covered ? "covered" : "NOT COVERED",
-                fixed(r->margin_mm, 4).c_str(), fixed(100.0 * r->covered_fraction, 2).c_str(),
+    std::printf("  %-7s %-12s %11s %8s%% %-20s %8s %-20s %10s %9s %8s\n", name,
+                !r->decided ? "UNDECIDED" : r->covered ? "covered" : "NOT COVERED", fixed(r->margin_mm, 4).c_str(), fixed(100.0 * r->covered_fraction, 2).c_str(),
                 point(r->worst_point).c_str(), fixed(r->min_lci, 4).c_str(), point(r->min_lci_point).c_str(),
-                fixed(r->min_force_capability, 4).c_str(), r->assembly_ok ? "ok" : "CROSSES", r->lci_ok ? "yes" : "NO");
+                fixed(r->min_force_capability, 4).c_str(), r->assembly_ok ? "ok" : r->decided ? "CROSSES" : "undecided", r->lci_ok ? "yes" : "NO");
   }
   std::fflush(stdout);
   for (const auto& [name, r] : rows) {
-    std::cout << "  " << name << ": " << (r->reason.empty() ? "" : r->reason + "; ") << "method: " << r->method << "\n";
+    std::cout << "  " << name << ": " << (r->reason.empty() ? "" : r->reason + "; ") << "margin " << r->margin_mm
+              << " mm +- " << r->margin_error_mm << " mm; method: " << r->method << "\n";
   }
   std::cout << "\n";
 }

@@ -46,9 +46,10 @@ class CliWorkspace : public ft::CliTest {
 
 // --- coverage ---------------------------------------------------------------------------------
 
-const std::vector<std::string> kResultKeys{"covered",          "inside",  "margin_mm", "covered_fraction",
-                                           "worst_point_mm",   "min_lci", "min_lci_point_mm",
-                                           "min_force_capability", "lci_ok", "assembly_ok", "method", "reason"};
+const std::vector<std::string> kResultKeys{
+    "covered", "inside",  "decided", "margin_mm", "margin_error_mm", "covered_fraction", "worst_point_mm",
+    "min_lci", "min_lci_point_mm", "min_force_capability", "lci_ok", "assembly_ok", "assembly_crossing_mm",
+    "method", "reason"};
 
 /// Keys in document order (parse with nlohmann::ordered_json to keep it).
 template <class J>

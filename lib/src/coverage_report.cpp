@@ -16,7 +16,9 @@ Json to_json(const CoverageResult& r) {
   Json j;
   j["covered"] = r.covered;
   j["inside"] = r.inside;
+  j["decided"] = r.decided;
   j["margin_mm"] = r.margin_mm;
+  j["margin_error_mm"] = r.margin_error_mm;
   j["covered_fraction"] = r.covered_fraction;
   j["worst_point_mm"] = {r.worst_point.x(), r.worst_point.y()};
   j["min_lci"] = r.min_lci;
@@ -24,6 +26,8 @@ Json to_json(const CoverageResult& r) {
   j["min_force_capability"] = r.min_force_capability;
   j["lci_ok"] = r.lci_ok;
   j["assembly_ok"] = r.assembly_ok;
+  j["assembly_crossing_mm"] =
+      r.assembly_crossing ? Json{r.assembly_crossing->x(), r.assembly_crossing->y()} : Json(nullptr);
   j["method"] = r.method;
   j["reason"] = r.reason;
   return j;

@@ -190,6 +190,10 @@ bool Region::contains_polygon_exact(const std::vector<Vec2>& polygon) const {
   return detail::exact_contains_polygon(*exact_, polygon);
 }
 
+bool Region::disjoint_polygon_exact(const std::vector<Vec2>& polygon) const {
+  return detail::exact_disjoint_polygon(*exact_, polygon);
+}
+
 
 double Region::polygon_overlap_area(const std::vector<Vec2>& polygon) const {
   return loops_area(detail::exact_polygon_overlap(*exact_, polygon).loops);

@@ -2,11 +2,15 @@
 /// Does a mechanism (or both mechanisms of a station) reach every point of the target ellipse,
 /// with margin, in its working mode, within joint limits, away from singularities?
 ///
-/// Containment and margin are exact in the sense of a certified decision: a double-precision
-/// fast path (closed-form annuli constraints with robust point-ellipse extrema; or distances from
-/// the ellipse to every boundary arc when there are joint limits) decides whenever |margin| is
-/// clear of rounding, and an exact CGAL test on polygons provably outside / inside the ellipse
-/// decides the rest. `method` says which one decided.
+/// Containment and margin are certified (docs/coverage.md): the margin comes with bounds (closed
+/// form against annuli, within rounding; a Lipschitz branch and bound of the signed distance to
+/// each leg's set along the ellipse when there are joint limits); the verdict follows the sign
+/// whenever the bounds exclude zero. In the band where they straddle zero an exact CGAL test
+/// decides (a polygon around the ellipse, refined where the ellipse nears the boundary, inside
+/// the region; or a point of the ellipse outside it); when neither holds the verdict is
+/// undecided (`decided` false) and never contradicts the margin. The assembly side is certified
+/// over the filled ellipse by a branch and bound on the sine of the angle between the distal
+/// links. `method` says what decided.
 
 #include <optional>
 #include <string>
@@ -29,6 +33,8 @@ struct CoverageResult {
   bool covered = false;          ///< filled ellipse inside the region and thresholds met
   bool inside = false;           ///< filled ellipse inside the (circle-bounded) region
   double margin_mm = 0.0;        ///< signed distance from the ellipse to the region boundary
+  double margin_error_mm = 0.0;  ///< certified bound of |margin_mm - true margin|
+  bool decided = true;           ///< false: within rounding of a boundary, verdict undecided
   double covered_fraction = 0.0; ///< of the ellipse area inside the region
   Vec2 worst_point{0.0, 0.0};    ///< ellipse point realising the margin
   double min_lci = 0.0;          ///< over the filled ellipse (0 if any point unreachable)
@@ -36,6 +42,7 @@ struct CoverageResult {
   double min_force_capability = 0.0;  ///< N per N*mm, over the filled ellipse
   bool lci_ok = true;            ///< min_lci >= the mechanism's min_lci
   bool assembly_ok = true;       ///< the design's assembly side holds over the whole ellipse
+  std::optional<Vec2> assembly_crossing;  ///< a point of the ellipse on the wrong side (when found)
   std::string method;            ///< how containment was decided
   std::string reason;            ///< why not covered (empty when covered)
 };
@@ -61,12 +68,14 @@ StationCoverage station_coverage(const Station& station, const std::optional<Ell
                                  const CoverageOptions& options = {});
 
 /// Containment and signed margin only (no covered fraction, no conditioning), decided as in
-/// coverage(): analytic per-leg fit, exact CGAL fallback within rounding of tangency.
+/// coverage(): certified per-leg bounds, exact CGAL test where they straddle zero.
 struct Containment {
   bool inside = false;
   double margin_mm = 0.0;
+  double margin_error_mm = 0.0;  ///< certified bound of |margin_mm - true margin|
   Vec2 worst_point{0.0, 0.0};
-  bool exact_fallback = false;  ///< the exact test decided
+  bool decided = true;           ///< false: within rounding of the boundary (inside is then false)
+  bool exact_fallback = false;   ///< the exact test was asked
 };
 Containment containment(const Mechanism& m, const Ellipse& target);
 /// Fills min_lci (+ point), min_force_capability, lci_ok and assembly_ok of `out` over the

@@ -77,6 +77,8 @@ class Region {
   Region intersection(const Region& other) const;
   /// Exact test: does the closed polygon (vertices in order) lie inside the closed region?
   bool contains_polygon_exact(const std::vector<Vec2>& polygon) const;
+  /// Exact test: does the closed polygon share no point with the closed region?
+  bool disjoint_polygon_exact(const std::vector<Vec2>& polygon) const;
   /// Exact area of the polygon's part inside the region (mm^2), from the arrangement.
   double polygon_overlap_area(const std::vector<Vec2>& polygon) const;
 

@@ -25,6 +25,8 @@ std::shared_ptr<const ExactRegion> exact_intersection(const ExactRegion& a, cons
 std::shared_ptr<const ExactRegion> exact_empty();
 ExtractedBoundary extract_boundary(const ExactRegion& r);
 bool exact_contains_polygon(const ExactRegion& r, const std::vector<Vec2>& polygon);
+/// Does the closed polygon share no point with the region (exact)?
+bool exact_disjoint_polygon(const ExactRegion& r, const std::vector<Vec2>& polygon);
 /// Boundary of (polygon ∩ r), for its area.
 ExtractedBoundary exact_polygon_overlap(const ExactRegion& r, const std::vector<Vec2>& polygon);
 

@@ -182,6 +182,13 @@ bool exact_contains_polygon(const ExactRegion& r, const std::vector<Vec2>& polyg
   return outside.is_empty();
 }
 
+bool exact_disjoint_polygon(const ExactRegion& r, const std::vector<Vec2>& polygon) {
+  PolygonSet inside(traits());
+  inside.insert(polygon_of(polygon));
+  inside.intersection(r.set);
+  return inside.is_empty();
+}
+
 ExtractedBoundary exact_polygon_overlap(const ExactRegion& r, const std::vector<Vec2>& polygon) {
   PolygonSet inside(traits());
   inside.insert(polygon_of(polygon));

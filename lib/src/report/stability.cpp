@@ -75,8 +75,6 @@ constexpr double kInputRoundings = 16.0;
 constexpr double kIllConditioned = 1e-6;
 /// coverage() re-decides |margin| <= 1e-9 L exactly with a circumscribed 1024-gon (coverage.hpp):
 /// an ellipse that close to tangency may be reported outside although it touches from inside.
-constexpr double kCoverageExactBandRel = 1e-9;
-constexpr int kCoveragePolygon = 1024;
 
 const std::vector<double> kDistances{1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9,
                                      1e-10, 1e-11, 1e-12, 1e-13, 1e-14, 1e-15, 1e-16, 0.0};
@@ -413,28 +411,29 @@ class Catalogue {
       c.conditioning = 1.0;
       c.finite = std::isfinite(r.margin_mm) && std::isfinite(r.min_lci) && std::isfinite(r.covered_fraction) &&
                  std::isfinite(r.min_force_capability) && r.worst_point.allFinite() && r.min_lci_point.allFinite();
-      c.error = std::fabs(r.margin_mm - qmargin);
+      // Outside, coverage() measures the depth against the whole region, which the legs' annuli
+      // margin (the reference) only bounds from above.
+      c.error = qmargin >= 0 ? std::fabs(r.margin_mm - qmargin) : std::max(0.0, r.margin_mm - qmargin);
       c.bound = bound;
       judge(c, true, S, "");
     }
     {
-      // The verdict: never inside when the ellipse sticks out; inside whenever clear of tangency.
-      const double a = 0.5 * std::max(e.axes.x(), e.axes.y());
-      const double gap = kCoverageExactBandRel * m.length_scale() +
-                         a * ((1.0 + 1e-12) / std::cos(kPi / kCoveragePolygon) - 1.0) + bound;
+      // The verdict: decided ones follow the sign of the reference margin; undecided only within
+      // the certified error bound of tangency.
+      const double band = r.margin_error_mm + bound;
       StabilityCase& c = add(group, name, "coverage verdict", parameter);
-      c.status = r.inside ? "inside" : "not inside";
-      c.expected = qmargin < 0 ? "not inside" : qmargin > gap ? "inside" : "inside|not inside";
+      c.status = !r.decided ? "undecided" : r.inside ? "inside" : "not inside";
+      c.expected = qmargin < -band ? "not inside" : qmargin > band ? "inside" : "inside|not inside|undecided";
       c.unit = "mm";
       c.conditioning = 1.0;
-      c.finite = std::isfinite(r.margin_mm);
-      const bool ok = r.inside ? qmargin >= 0 : qmargin <= gap;
-      if (!r.inside && qmargin >= 0 && qmargin <= gap) {
-        c.explanation = "reference margin " + sci(qmargin) + " mm: within " + sci(gap) +
-                        " mm of tangency coverage() decides conservatively (exact test of a circumscribed polygon)";
+      c.finite = std::isfinite(r.margin_mm) && std::isfinite(r.margin_error_mm);
+      const bool ok = r.decided ? (r.inside == (qmargin > 0) || std::fabs(qmargin) <= bound) : std::fabs(qmargin) <= band;
+      if (!r.decided) {
+        c.explanation = "reference margin " + sci(qmargin) + " mm: within the certified bound " + sci(band) +
+                        " mm of tangency the verdict is undecided";
       }
       judge(c, ok, S, "");
-      if (!r.inside && qmargin >= 0 && qmargin <= gap) c.ill_conditioned = true;
+      if (!r.decided) c.ill_conditioned = true;
     }
   }
 
