@@ -11,8 +11,8 @@
 /// Kinematics (fivebar/kinematics.hpp for the positions): A_i = O_i + L_i e(theta_i),
 /// e(a) = (cos a, sin a), e_perp(a) = (-sin a, cos a); distal vectors r3 = P - A1, r4 = P - A2
 /// with |r3| = L3, |r4| = L4. Differentiating the two loop constraints |P - A_i|^2 = L_{i+2}^2
-/// once and twice (velocity and acceleration analysis of closed chains: Waldron & Kinzel,
-/// "Kinematics, Dynamics, and Design of Machinery", ch. 4) gives, with G = [r3^T; r4^T]:
+/// once and twice (velocity and acceleration analysis of closed chains, e.g. Waldron & Kinzel,
+/// "Kinematics, Dynamics, and Design of Machinery") gives, with G = [r3^T; r4^T]:
 ///   G dP/dt   = [r3 . dA1/dt, r4 . dA2/dt],                          dA_i/dt = L_i w_i e_perp(theta_i)
 ///   G d2P/dt2 = [r3 . d2A1/dt2 - |dr3/dt|^2, r4 . d2A2/dt2 - |dr4/dt|^2],
 ///                                        d2A_i/dt2 = L_i (dw_i/dt e_perp - w_i^2 e(theta_i))
@@ -21,7 +21,8 @@
 /// distal links aligned): there the simulation stops with Status singular, never a NaN.
 ///
 /// Equations of motion by projection (Kane's method; Kane & Levinson, "Dynamics: Theory and
-/// Applications", 1985, ch. 6; equivalently Siciliano et al., "Robotics", 2009, sec. 7.2): every
+/// Applications", 1985; equivalently the Lagrange form of Siciliano et al., "Robotics: Modelling,
+/// Planning and Control", 2009, ch. 7): every
 /// body b (links L1..L4, the tactor tip as a point mass at P) has its centre-of-mass velocity
 /// v_b = Jv_b(theta) w and angular rate omega_b = Jw_b(theta) w, w = dtheta/dt. Then
 ///   M(theta) = sum_b m_b Jv_b^T Jv_b + I_b Jw_b^T Jw_b + N_j^2 J_rotor,j (diagonal),
@@ -35,7 +36,7 @@
 /// with J = dP/dtheta (m/rad) and F_contact the skin force on the tactor.
 ///
 /// DC motor per joint (e.g. Franklin, Powell & Emami-Naeini, "Feedback Control of Dynamic
-/// Systems", sec. 2.3), averaged PWM: V = duty V_supply, then
+/// Systems", ch. 2), averaged PWM: V = duty V_supply, then
 ///   L di/dt = V - R i - k_e N w,   tau_motor = eta N k_t i,
 ///   tau_friction = b w + tau_c tanh(w / w_s)   (output shaft; w_s = kCoulombSmoothingSpeed, a
 ///                                               regularisation of sign(w), an assumption),
@@ -49,11 +50,13 @@
 /// to an angle, and DiscretePid gives a duty; that duty is applied one period later (the
 /// computation delay of a ROS loop) and held constant until the next (zero-order hold). The
 /// reference is the IK of the pattern's commanded points (fivebar/pattern.hpp check_pattern, with
-/// the upper mechanism's priority rule applied to the targets as the controller does).
+/// the upper mechanism's priority rule applied to the targets once per sample, as `fivebar pattern`
+/// checks it; the device applies it to the measured pose, which this model does not).
 ///
-/// Skin contact per tactor (a reset-integrator, or "elasto-plastic", friction model: Dupont et
-/// al., "Single State Elastoplastic Friction Models", IEEE TAC 47(5), 2002, in its rigid-plastic
-/// limit): the skin is anchored at a where the tactor first touches (its start point).
+/// Skin contact per tactor (a reset-integrator friction model: Haessig & Friedland, "On the
+/// Modeling and Simulation of Friction", ASME J. Dyn. Syst. Meas. Control 113(3), 1991; the
+/// elasto-plastic family of Dupont et al., IEEE Trans. Automatic Control 47(5), 2002, without a
+/// pre-sliding zone): the skin is anchored at a where the tactor first touches (its start point).
 ///   sticking: F = -k (P - a) - c dP/dt, da/dt = 0, until k |P - a| = mu N_preload (a root);
 ///   sliding:  F = -k (P - a), with |P - a| = mu N / k kept by da/dt = (u . dP/dt) u,
 ///             u = (P - a)/|P - a|, until u . dP/dt = 0 (a root: the tactor turns back).
