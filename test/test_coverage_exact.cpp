@@ -399,5 +399,80 @@ TEST(CoverageExact, RandomDesignsNearTheThresholdsAgreeWithTheReference) {
   EXPECT_GE(crossings, 2);
 }
 
+// --- Restricted areas of thin regions against Monte Carlo --------------------------------------
+
+/// LCI by a second formulation: the loop constraints (P - A_i).(dP - dA_i) = 0 give
+/// A dP = B dtheta with A's rows P - A_i and B = diag(l_p (P - A_i).e_perp(theta_i)); the
+/// condition number of J = A^-1 B from its singular values in closed form.
+std::optional<LD> ref_lci(const Ref& ref, P2 p) {
+  LD a[2][2], b[2];
+  for (int i = 0; i < 2; ++i) {
+    const auto t = ref.legs[i].theta(p);
+    if (!t) return std::nullopt;
+    const P2 el{ref.legs[i].O.x + ref.legs[i].lp * std::cos(*t), ref.legs[i].O.y + ref.legs[i].lp * std::sin(*t)};
+    const P2 d = p - el;
+    a[i][0] = d.x;
+    a[i][1] = d.y;
+    b[i] = ref.legs[i].lp * (-d.x * std::sin(*t) + d.y * std::cos(*t));
+  }
+  const LD det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+  if (det == 0) return LD(0);
+  // J = A^-1 B.
+  const LD j00 = a[1][1] * b[0] / det, j01 = -a[0][1] * b[1] / det, j10 = -a[1][0] * b[0] / det,
+           j11 = a[0][0] * b[1] / det;
+  const LD fro = j00 * j00 + j01 * j01 + j10 * j10 + j11 * j11, dj = std::fabs(j00 * j11 - j01 * j10);
+  const LD smax = std::sqrt((fro + std::sqrt(std::max(LD(0), fro * fro - 4 * dj * dj))) / 2);
+  return smax > 0 ? dj / (smax * smax) : LD(0);  // smin / smax = det / smax^2
+}
+
+TEST(RestrictedArea, ThinRegionsAgreeWithMonteCarloWithinTheirErrorBars) {
+  // The ws27 (LCI >= 0.15: a thin region) and ws22 (assembly and LCI >= 0.3).
+  const Mechanism ws27 = mechanism({10.337237, -2.510651}, {11.026993, 12.81285, 13.13652, 16.906478}, "--", 1,
+                                   Limits{{{87.121, 228.946}, {-84.714, 96.375}}}, 0.15);
+  const Mechanism ws22 = mechanism({9.493489, -2.11873}, {8.399513, 7.191329, 14.753548, 8.448609}, "-+", -1,
+                                   Limits{{{-28.884, 141.546}, {153.843, 388.975}}}, 0.3);
+  std::mt19937_64 rng(test_seed());
+  for (const Mechanism* m : {&ws27, &ws22}) {
+    const Region region = reachable_region(*m);
+    const auto bb = region.bounds();
+    const Grid grid = Grid::covering(bb, 0.2, 0.2);  // the workspace command's default spacing
+    const Ref ref(*m);
+    for (Restriction r : {Restriction::assembly, Restriction::lci}) {
+      const SampledArea sa = restricted_area(*m, r, grid);
+      // Monte Carlo over the region's bounding box, membership by the reference formulation.
+      constexpr int kN = 1000000;
+      std::uniform_real_distribution<double> ux(bb[0], bb[2]), uy(bb[1], bb[3]);
+      int hits = 0;
+      for (int k = 0; k < kN; ++k) {
+        const P2 p{ux(rng), uy(rng)};
+        if (!ref.legs[0].contains(p) || !ref.legs[1].contains(p)) continue;
+        const auto side = ref.side(p);
+        if (!side || *side <= 0) continue;
+        if (r == Restriction::lci) {
+          const auto l = ref_lci(ref, p);
+          if (!l || *l < m->min_lci) continue;
+        }
+        ++hits;
+      }
+      const double box = (bb[2] - bb[0]) * (bb[3] - bb[1]), q = double(hits) / kN;
+      const double mc = box * q, se = box * std::sqrt(q * (1 - q) / kN);
+      SCOPED_TRACE(::testing::Message() << (m == &ws27 ? "ws27 " : "ws22 ") << (r == Restriction::lci ? "lci" : "assembly")
+                                        << ": " << sa.area_mm2 << " +- " << sa.error_mm2 << " vs MC " << mc << " +- "
+                                        << se);
+      EXPECT_GT(hits, 100);
+      EXPECT_LE(std::fabs(sa.area_mm2 - mc), sa.error_mm2 + 4 * se);
+    }
+  }
+  // The reference figures (mpmath and 1e7-sample Monte Carlo).
+  const Grid g27 = Grid::covering(reachable_region(ws27).bounds(), 0.2, 0.2);
+  const SampledArea lci27 = restricted_area(ws27, Restriction::lci, g27);
+  EXPECT_NEAR(lci27.area_mm2, 0.08147, lci27.error_mm2 + 1e-4);
+  const Grid g22 = Grid::covering(reachable_region(ws22).bounds(), 0.2, 0.2);
+  const SampledArea asm22 = restricted_area(ws22, Restriction::assembly, g22);
+  const SampledArea lci22 = restricted_area(ws22, Restriction::lci, g22);
+  EXPECT_NEAR(asm22.area_mm2, 11.364, asm22.error_mm2 + 1e-3);
+  EXPECT_NEAR(lci22.area_mm2, 0.0869, lci22.error_mm2 + 1e-4);
+}
+
 }  // namespace
 }  // namespace fivebar

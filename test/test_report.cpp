@@ -375,7 +375,11 @@ TEST(Accuracy, RestrictedAreasAgainstTheSixteenTimesFinerGrid) {
   EXPECT_LT(a.assembly_area_reference_mm2, a.exact_area_mm2);
   for (const WorkSeries* s : {&as, &ls}) {
     SCOPED_TRACE(s->method);
-    EXPECT_LT(s->points.back().error, s->points.front().error / 4);
+    // Converging: the estimate shrinks with h, and the finest is within 1e-4 of the area (the
+    // errors themselves need not fall monotonically: corners of the region cancel or add by luck).
+    ASSERT_TRUE(s->points.back().estimate && s->points.front().estimate);
+    EXPECT_LT(*s->points.back().estimate, *s->points.front().estimate / 2);
+    EXPECT_LT(s->points.back().error, 1e-4 * (s == &as ? a.assembly_area_reference_mm2 : a.lci_area_reference_mm2));
     // restricted_area's own estimate bounds the measured error on these regions at the quick
     // spacings (<= 3 mm; at 5.8 mm, in the default run, it does not).
     for (const WorkPoint& p : s->points) {

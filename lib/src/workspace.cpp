@@ -330,110 +330,171 @@ double restriction_margin(const Mechanism& m, Restriction restriction, const Vec
   return std::min(margin, (pose.lci - m.min_lci) * m.length_scale());
 }
 
+
 namespace {
 
-struct Marched {
-  double area = 0.0;
-  std::vector<std::array<Vec2, 2>> segments;
-};
-
-/// Marching squares over grid nodes with stride `step`; each crossing refined by bisection.
+/// Area of the part of a square cell where f > 0, by marching squares with every crossing
+/// bisected on f: corners c0 = (x, y), c1 = (x + h, y), c2 = (x + h, y + h), c3 = (x, y + h).
+/// Segments of the boundary are appended to `segments` when given.
 template <class Margin>
-Marched march(const Grid& g, const std::vector<double>& values, int step, const Margin& margin, bool keep) {
-  Marched out;
-  const double h = g.spacing * step;
-  auto value = [&](int i, int j) { return values[std::size_t(j) * g.nx + i]; };
+double cell_area(const Vec2& base, double h, const double (&f)[4], const Margin& margin,
+                 std::vector<std::array<Vec2, 2>>* segments) {
+  const Vec2 p[4] = {Vec2(0, 0), Vec2(h, 0), Vec2(h, h), Vec2(0, h)};
+  int inside = 0;
+  for (int c = 0; c < 4; ++c) inside += f[c] > 0.0;
+  if (inside == 0) return 0.0;
+  if (inside == 4) return h * h;
   auto crossing = [&](Vec2 a, double fa, Vec2 b) -> Vec2 {
-    // Bisection on the exact margin function between a (fa) and b (fb) of opposite signs.
-    for (int it = 0; it < 40; ++it) {
+    for (int it = 0; it < 30; ++it) {  // 2^-30 of the cell: far below the discretisation error
       const Vec2 mid = 0.5 * (a + b);
-      const double fm = margin(mid);
+      const double fm = margin(base + mid);
       if ((fm > 0.0) == (fa > 0.0)) {
         a = mid;
         fa = fm;
       } else {
         b = mid;
       }
-      if ((b - a).norm() <= 1e-12 * h) break;
     }
     return 0.5 * (a + b);
   };
+  auto cross_pt = [&](int c) { return crossing(p[c], f[c], p[(c + 1) % 4]); };
   auto poly_area = [](const std::vector<Vec2>& poly) {
     double a = 0.0;
     for (std::size_t k = 0; k < poly.size(); ++k) a += cross2(poly[k], poly[(k + 1) % poly.size()]);
-    return 0.5 * a;
+    return 0.5 * std::fabs(a);
   };
-  for (int j = 0; j + step < g.ny; j += step) {
-    for (int i = 0; i + step < g.nx; i += step) {
-      const int ci[4] = {i, i + step, i + step, i};
-      const int cj[4] = {j, j, j + step, j + step};
-      double f[4];
-      Vec2 p[4];
-      int inside = 0;
-      for (int c = 0; c < 4; ++c) {
-        f[c] = value(ci[c], cj[c]);
-        p[c] = g.point(ci[c], cj[c]) - g.point(i, j);  // local coordinates: small numbers
-        inside += f[c] > 0.0;
-      }
-      if (inside == 0) continue;
-      if (inside == 4) {
-        out.area += h * h;
-        continue;
-      }
-      const Vec2 base = g.point(i, j);
-      auto cross_pt = [&](int c) -> Vec2 {
-        const int d = (c + 1) % 4;
-        return crossing(p[c] + base, f[c], p[d] + base) - base;
-      };
-      const bool saddle = inside == 2 && (f[0] > 0.0) == (f[2] > 0.0);
-      if (saddle && !(margin(base + Vec2(0.5 * h, 0.5 * h)) > 0.0)) {
-        // Two separate corner pieces.
-        for (int c = 0; c < 4; ++c) {
-          if (!(f[c] > 0.0)) continue;
-          const Vec2 a = cross_pt(c), b = cross_pt((c + 3) % 4);
-          out.area += std::fabs(poly_area({p[c], a, b}));
-          if (keep) out.segments.push_back({a + base, b + base});
-        }
-        continue;
-      }
-      std::vector<Vec2> poly;
-      std::vector<Vec2> xs;
-      for (int c = 0; c < 4; ++c) {
-        const int d = (c + 1) % 4;
-        if (f[c] > 0.0) poly.push_back(p[c]);
-        if ((f[c] > 0.0) != (f[d] > 0.0)) {
-          const Vec2 x = cross_pt(c);
-          poly.push_back(x);
-          xs.push_back(x);
-        }
-      }
-      out.area += std::fabs(poly_area(poly));
-      if (keep) {
-        for (std::size_t k = 0; k + 1 < xs.size(); k += 2) out.segments.push_back({xs[k] + base, xs[k + 1] + base});
-      }
+  const bool saddle = inside == 2 && (f[0] > 0.0) == (f[2] > 0.0);
+  double area = 0.0;
+  if (saddle && !(margin(base + Vec2(0.5 * h, 0.5 * h)) > 0.0)) {
+    for (int c = 0; c < 4; ++c) {
+      if (!(f[c] > 0.0)) continue;
+      const Vec2 a = cross_pt(c), b = cross_pt((c + 3) % 4);
+      area += poly_area({p[c], a, b});
+      if (segments) segments->push_back({a + base, b + base});
+    }
+    return area;
+  }
+  std::vector<Vec2> poly, xs;
+  for (int c = 0; c < 4; ++c) {
+    if (f[c] > 0.0) poly.push_back(p[c]);
+    if ((f[c] > 0.0) != (f[(c + 1) % 4] > 0.0)) {
+      const Vec2 x = cross_pt(c);
+      poly.push_back(x);
+      xs.push_back(x);
     }
   }
-  return out;
+  if (segments)
+    for (std::size_t k = 0; k + 1 < xs.size(); k += 2) segments->push_back({xs[k] + base, xs[k + 1] + base});
+  return poly_area(poly);
+}
+
+/// Adaptive refinement of one cell (quadtree). A cell is split when its corners disagree in sign
+/// or when it could hide a sign change: min |f| at its corners below the local slope times its
+/// half diagonal (the slope estimated from the differences along its edges and those of its
+/// parent, times kSlopeSafety). `fine` accumulates the area at the leaves, `coarse` the same
+/// with every deepest split undone (the Richardson-like difference of the two is the
+/// discretisation error), `hidden` the change where a deepest cell near zero showed the other sign
+/// at an edge midpoint or its centre (a piece between its corners, measured on its half cells).
+constexpr double kSlopeSafety = 2.0;
+struct Adaptive {
+  double fine = 0.0, coarse = 0.0, hidden = 0.0;
+  std::size_t cells = 0;
+  std::vector<std::array<Vec2, 2>> segments;
+};
+template <class Margin>
+void refine_cell(const Vec2& base, double h, const double (&f)[4], double parent_slope, int depth, int max_depth,
+                 const Margin& margin, Adaptive& out) {
+  ++out.cells;
+  double slope = parent_slope;
+  for (int c = 0; c < 4; ++c) slope = std::max(slope, std::fabs(f[c] - f[(c + 1) % 4]) / h);
+  slope *= kSlopeSafety;
+  const bool mixed = !((f[0] > 0.0) == (f[1] > 0.0) && (f[1] > 0.0) == (f[2] > 0.0) && (f[2] > 0.0) == (f[3] > 0.0));
+  const double fmin = std::min({std::fabs(f[0]), std::fabs(f[1]), std::fabs(f[2]), std::fabs(f[3])});
+  const bool could_hide = fmin <= slope * h * std::numbers::sqrt2 / 2.0;
+  if (!mixed && !could_hide) {
+    const double a = f[0] > 0.0 ? h * h : 0.0;
+    out.fine += a;
+    out.coarse += a;
+    return;
+  }
+  if (depth == max_depth) {
+    const double a = cell_area(base, h, f, margin, &out.segments);
+    out.fine += a;
+    out.coarse += a;
+    if (!mixed) {
+      // Same sign at the corners of a deepest cell that is close to zero: look at its edge
+      // midpoints and centre for the other sign (a piece between the corners).
+      const double g = 0.5 * h;
+      const double v[5] = {margin(base + Vec2(g, 0)), margin(base + Vec2(h, g)), margin(base + Vec2(g, h)),
+                           margin(base + Vec2(0, g)), margin(base + Vec2(g, g))};
+      bool other = false;
+      for (int k = 0; k < 5; ++k) other = other || (v[k] > 0.0) != (f[0] > 0.0);
+      if (other) {
+        // A piece seen between the corners: measured on the four half cells, the change
+        // counted as error (as one more level of refinement would).
+        const double q[4][4] = {{f[0], v[0], v[4], v[3]}, {v[0], f[1], v[1], v[4]}, {v[4], v[1], f[2], v[2]},
+                                {v[3], v[4], v[2], f[3]}};
+        const Vec2 b[4] = {base, base + Vec2(g, 0), base + Vec2(g, g), base + Vec2(0, g)};
+        double sub = 0.0;
+        for (int k = 0; k < 4; ++k) sub += cell_area(b[k], g, q[k], margin, &out.segments);
+        out.fine += sub - a;
+        out.coarse += sub - a;
+        out.hidden += std::fabs(sub - a);
+      }
+    }
+    return;
+  }
+  const double g = 0.5 * h;
+  const double e0 = margin(base + Vec2(g, 0)), e1 = margin(base + Vec2(h, g)), e2 = margin(base + Vec2(g, h)),
+               e3 = margin(base + Vec2(0, g)), c = margin(base + Vec2(g, g));
+  const double q[4][4] = {{f[0], e0, c, e3}, {e0, f[1], e1, c}, {c, e1, f[2], e2}, {e3, c, e2, f[3]}};
+  const Vec2 b[4] = {base, base + Vec2(g, 0), base + Vec2(g, g), base + Vec2(0, g)};
+  if (depth + 1 == max_depth) {
+    // The deepest split: its undone version (this cell as a leaf) gives the coarse estimate.
+    Adaptive child;
+    for (int k = 0; k < 4; ++k) refine_cell(b[k], g, q[k], slope / kSlopeSafety, depth + 1, max_depth, margin, child);
+    out.fine += child.fine;
+    out.coarse += cell_area(base, h, f, margin, nullptr);
+    out.hidden += child.hidden;
+    out.cells += child.cells;
+    out.segments.insert(out.segments.end(), child.segments.begin(), child.segments.end());
+    return;
+  }
+  for (int k = 0; k < 4; ++k) refine_cell(b[k], g, q[k], slope / kSlopeSafety, depth + 1, max_depth, margin, out);
 }
 
 }  // namespace
 
-SampledArea restricted_area(const Mechanism& m, Restriction restriction, const Grid& grid) {
+SampledArea restricted_area(const Mechanism& m, Restriction restriction, const Grid& grid, int max_depth) {
   auto margin = [&](const Vec2& p) { return restriction_margin(m, restriction, p); };
   std::vector<double> values(grid.size());
   for (int j = 0; j < grid.ny; ++j)
     for (int i = 0; i < grid.nx; ++i) values[std::size_t(j) * grid.nx + i] = margin(grid.point(i, j));
-  const Marched fine = march(grid, values, 1, margin, true);
-  const Marched coarse = march(grid, values, 2, margin, false);
-  const Marched coarser = march(grid, values, 4, margin, false);
+  auto value = [&](int i, int j) { return values[std::size_t(j) * grid.nx + i]; };
+  Adaptive a;
+  const double h = grid.spacing;
+  for (int j = 0; j + 1 < grid.ny; ++j) {
+    for (int i = 0; i + 1 < grid.nx; ++i) {
+      const double f[4] = {value(i, j), value(i + 1, j), value(i + 1, j + 1), value(i, j + 1)};
+      // The slope of the neighbourhood: differences to the nodes around the cell.
+      double slope = 0.0;
+      for (int dj = -1; dj <= 2; ++dj)
+        for (int di = -1; di <= 2; ++di) {
+          const int x = i + di, y = j + dj;
+          if (x < 0 || y < 0 || x + 1 >= grid.nx || y >= grid.ny) continue;
+          slope = std::max(slope, std::fabs(value(x + 1, y) - value(x, y)) / h);
+          if (y + 1 < grid.ny) slope = std::max(slope, std::fabs(value(x, y + 1) - value(x, y)) / h);
+        }
+      refine_cell(grid.point(i, j), h, f, slope, 0, max_depth, margin, a);
+    }
+  }
   SampledArea out;
-  out.area_mm2 = fine.area;
-  // The refined boundary is piecewise linear: area error O(h^2), so A(h) - A(2h) ~ 3 err(h) where
-  // the boundary is smooth. Corners (joint limits) make the sequence non-monotone, and one
-  // difference can vanish by coincidence: take the larger of the last two differences, each
-  // scaled to step h, as a conservative estimate.
-  out.error_mm2 = std::max(std::fabs(fine.area - coarse.area), std::fabs(coarse.area - coarser.area) / 4.0);
-  for (const auto& s : fine.segments) out.contours.push_back({s[0], s[1]});
+  out.area_mm2 = a.fine;
+  // Discretisation (the last level against the one before, where the boundary was refined) plus
+  // every deepest cell that could still hide a piece of the region.
+  out.error_mm2 = std::fabs(a.fine - a.coarse) + a.hidden;
+  out.cells = a.cells;
+  for (const auto& seg : a.segments) out.contours.push_back({seg[0], seg[1]});
   return out;
 }
 

@@ -131,12 +131,18 @@ struct WorkspaceField {
 /// Samples every field of `m` over `grid` (batch kernels; no trigonometry but for the angles).
 WorkspaceField sample_field(const Mechanism& m, const Grid& grid);
 
-/// Area of a region defined by a signed margin function sampled on a grid (> 0 inside), by
-/// marching squares with bisection of every crossing edge on the exact margin function.
+/// Area of a region defined by a signed margin function sampled on a grid (> 0 inside): every
+/// grid cell is refined as a quadtree where its corners disagree or where it could hide a sign
+/// change (the smallest |margin| at its corners below the local slope times its half diagonal),
+/// so thin regions and small components between grid nodes are found; the leaves are measured
+/// by marching squares with every crossing bisected on the margin function (docs/coverage.md).
 struct SampledArea {
   double area_mm2 = 0.0;
-  double error_mm2 = 0.0;  ///< estimate: |A(h) - A(2h)| from the same refined contours
-  std::vector<std::vector<Vec2>> contours;  ///< closed polylines of the refined boundary
+  /// Estimate: the change from undoing the deepest split, plus the change where a deepest cell
+  /// showed the other sign between its corners and was measured on its half cells.
+  double error_mm2 = 0.0;
+  std::size_t cells = 0;  ///< cells visited (grid cells and their refinements)
+  std::vector<std::vector<Vec2>> contours;  ///< segments of the refined boundary
 };
 
 /// Which restricted region restricted_area() measures.
@@ -147,7 +153,7 @@ enum class Restriction {
 };
 /// Signed margin of `restriction` at p (> 0 inside; continuous; length units where possible).
 double restriction_margin(const Mechanism& m, Restriction restriction, const Vec2& p);
-/// Area of the restricted region on `grid` with boundary refinement.
-SampledArea restricted_area(const Mechanism& m, Restriction restriction, const Grid& grid);
+/// Area of the restricted region on `grid`, each cell refined down to spacing / 2^max_depth.
+SampledArea restricted_area(const Mechanism& m, Restriction restriction, const Grid& grid, int max_depth = 3);
 
 }  // namespace fivebar

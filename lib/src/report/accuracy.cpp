@@ -11,6 +11,7 @@
 
 #include "fivebar/coverage.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/report.hpp"
 #include "fivebar/workspace.hpp"
@@ -295,7 +296,7 @@ void restricted_study(const Mechanism& m, const Region& region, const AccuracyOp
   const Grid ref_grid = Grid::covering(b, h_ref, h_ref);
   for (Restriction r : {Restriction::assembly, Restriction::lci}) {
     const bool is_lci = r == Restriction::lci;
-    const double ref = restricted_area(ml, r, ref_grid).area_mm2;
+    const double ref = restricted_area(ml, r, ref_grid, 1).area_mm2;
     (is_lci ? out.lci_area_reference_mm2 : out.assembly_area_reference_mm2) = ref;
     WorkSeries s{is_lci ? "LCI-restricted area" : "assembly-restricted area", "h_mm", "mm2", {}, {}, {},
                  "restricted_area(" + std::string(is_lci ? "lci" : "assembly") +
@@ -308,6 +309,30 @@ void restricted_study(const Mechanism& m, const Region& region, const AccuracyOp
       s.points.push_back({h, t, sa.area_mm2, std::fabs(sa.area_mm2 - ref), sa.error_mm2});
     }
     fit(s, kFitFloorRel * std::max(ref, 1e-300), kGridFitPoints);
+    out.restricted.push_back(std::move(s));
+  }
+  // A thin region: LCI within 2 % of its largest value, a small island that slips between the
+  // nodes of a coarse grid unless the cells that could hide it are refined.
+  {
+    const WorkspaceField field = sample_field(m, Grid::covering(b, extent / 256.0, 0.0));
+    double top = 0.0;
+    for (std::size_t k = 0; k < field.lci.size(); ++k) top = std::max(top, field.reach[k] ? field.lci[k] : 0.0);
+    Mechanism thin = m;
+    thin.min_lci = 0.98 * top;
+    const double ref = restricted_area(thin, Restriction::lci, ref_grid, 1).area_mm2;
+    WorkSeries s{"thin LCI-restricted area", "h_mm", "mm2", {}, {}, {},
+                 "restricted_area(lci) with LCI >= " + format::fixed(thin.min_lci, 4) +
+                     " (98 % of the largest LCI: a thin island) against the same on a grid 16x finer than the finest; "
+                     "estimate = its own error estimate"};
+    for (int k = k_lo; k <= k_hi; ++k) {
+      const double h = extent / double(1 << k);
+      const Grid grid = Grid::covering(b, h, h);
+      SampledArea sa;
+      const double t = median_time(tm, [&] { sa = restricted_area(thin, Restriction::lci, grid); });
+      s.points.push_back({h, t, sa.area_mm2, std::fabs(sa.area_mm2 - ref), sa.error_mm2});
+    }
+    out.thin_lci_area_reference_mm2 = ref;
+    out.thin_lci_threshold = thin.min_lci;
     out.restricted.push_back(std::move(s));
   }
 }

@@ -159,8 +159,8 @@ plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station,
   } else if (kind == "restricted") {
     spec.title = "Sampled restricted regions, station " + station;
     spec.y_label = "|area - area on a 16x finer grid| (mm²)";
-    spec.footnote = "restricted_area (refined marching squares) of the assembly- and LCI-restricted regions; the grid "
-                    "spacing halves along each line.";
+    spec.footnote = "restricted_area (adaptive marching squares) of the assembly- and LCI-restricted regions and of a "
+                    "thin island (LCI within 2 % of its largest value); the grid spacing halves along each line.";
   } else if (kind == "margin") {
     spec.title = "Coverage margin, station " + station;
     spec.y_label = "|margin - coverage() margin| (mm)";
@@ -244,6 +244,8 @@ Json to_json(const AccuracyReport& r) {
     rs["reference_h_mm"] = m.reference_spacing_mm;
     rs["assembly_area_reference_mm2"] = m.assembly_area_reference_mm2;
     rs["lci_area_reference_mm2"] = m.lci_area_reference_mm2;
+    rs["thin_lci_threshold"] = m.thin_lci_threshold;
+    rs["thin_lci_area_reference_mm2"] = m.thin_lci_area_reference_mm2;
     rs["series"] = Json::array();
     for (const WorkSeries& s : m.restricted) rs["series"].push_back(series_json(s));
     a["restricted"] = rs;

@@ -66,7 +66,9 @@ struct MechanismAccuracy {
   double reference_spacing_mm = 0.0;       ///< h of the reference grid (finest h / 16)
   double assembly_area_reference_mm2 = 0.0;
   double lci_area_reference_mm2 = 0.0;
-  std::vector<WorkSeries> restricted;      ///< assembly-restricted and LCI-restricted areas
+  std::vector<WorkSeries> restricted;      ///< assembly-restricted, LCI-restricted and thin LCI areas
+  double thin_lci_threshold = 0.0;         ///< LCI threshold of the thin series (98 % of the largest)
+  double thin_lci_area_reference_mm2 = 0.0;
 };
 
 /// Error statistics of one method over one stratum of singularity distance.

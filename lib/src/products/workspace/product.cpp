@@ -51,8 +51,9 @@ constexpr const char* kPreamble =
     "arcs). The *assembly side* keeps the points where the tactor is on the design's side of the distal "
     "links (no crossing of the type II singularity), and *LCI ≥ min_lci* further keeps the points with "
     "conditioning at least the design's `min_lci`; neither is bounded by circles, so both are measured by "
-    "marching squares on a grid with every boundary crossing refined by bisection, ± an error estimate "
-    "from the same contours at twice the spacing. The *shared* region is where both tactors reach.\n\n"
+    "marching squares on grid cells refined as a quadtree wherever they could hold or hide a boundary "
+    "(so thin regions between grid nodes are found), every crossing bisected, ± an error estimate from "
+    "undoing the deepest refinement (docs/coverage.md). The *shared* region is where both tactors reach.\n\n"
     "In the pictures the lower mechanism is red and the upper blue (as in the paper's Fig. 4), the shared "
     "region is hatched, dashed lines bound the assembly side, and each linkage is drawn in its pose at the "
     "target centre; the right panel is the LCI (the smaller of both mechanisms) where both reach.\n\n";
