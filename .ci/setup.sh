@@ -13,6 +13,7 @@ FIVEBAR_PACKAGES=(
   libvtk9-dev libcairo2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
+  libsundials-dev
   openscad
   # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
   prusa-slicer unzip

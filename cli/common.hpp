@@ -103,5 +103,6 @@ void setup_collision(CLI::App& app);
 void setup_pattern(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_export(CLI::App& app);
+void setup_simulate(CLI::App& app);
 
 }  // namespace fivebar::cli

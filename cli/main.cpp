@@ -98,6 +98,7 @@ int run(int argc, char** argv) {
   setup_pattern(app);
   setup_report(app);
   setup_export(app);
+  setup_simulate(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);
