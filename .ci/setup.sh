@@ -13,7 +13,10 @@ FIVEBAR_PACKAGES=(
   libvtk9-dev libcairo2-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
+  libsundials-dev
   openscad
+  # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
+  prusa-slicer unzip
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
   clang libclang-rt-14-dev libomp-dev
 )

@@ -103,6 +103,7 @@ void setup_collision(CLI::App& app);
 void setup_pattern(CLI::App& app);
 void setup_report(CLI::App& app);
 void setup_export(CLI::App& app);
+void setup_simulate(CLI::App& app);
 void setup_tolerance(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -98,6 +98,7 @@ int run(int argc, char** argv) {
   setup_pattern(app);
   setup_report(app);
   setup_export(app);
+  setup_simulate(app);
   setup_tolerance(app);
 
   try {

@@ -14,6 +14,8 @@
 #include "design_keys.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/contact.hpp"
+#include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/print.hpp"
@@ -58,6 +60,8 @@ std::string documented_form(std::string key) {
       {std::regex(R"(^patterns\.(stretch|slip|twist)\b)"), "patterns.<stretch|slip|twist>"},
       {std::regex(R"(^controller\.mechanisms\.(lower|upper)(\.theta[12])?(?=\.|$))"), "controller.<scope>"},
       {std::regex(R"(^controller\.stations\.<name>(\.(lower|upper)(\.theta[12])?)?(?=\.|$))"), "controller.<scope>"},
+      {std::regex(R"(^motor\.mechanisms\.(lower|upper)(\.theta[12])?(?=\.|$))"), "motor.<scope>"},
+      {std::regex(R"(^motor\.stations\.<name>(\.(lower|upper)(\.theta[12])?)?(?=\.|$))"), "motor.<scope>"},
   };
   for (const auto& [from, to] : rules) key = std::regex_replace(key, from, to);
   return key;
@@ -81,6 +85,8 @@ TEST(DesignFileDoc, FixtureIsAValidDesignWithEverySection) {
   // Every override scope once: mechanisms.<m>, mechanisms.<m>.theta<j> (6), stations.<s>, its
   // mechanisms and their joints (7).
   EXPECT_EQ(d.get<ControllerSettings>()->overrides.size(), 13u);
+  ASSERT_TRUE(d.get<MotorSettings>() && d.get<ContactSettings>());
+  EXPECT_EQ(d.get<MotorSettings>()->overrides.size(), 13u);
 }
 
 TEST(DesignFileDoc, FixtureVisitsEveryMap) {
@@ -108,7 +114,10 @@ TEST(DesignFileDoc, FixtureVisitsEveryMap) {
   for (const std::string& scope : scopes) {
     maps.push_back("controller." + scope + ".pid.kp");
     maps.push_back("controller." + scope + ".potentiometer.volts_per_rad");
+    maps.push_back("motor." + scope + ".gear_ratio");
   }
+  maps.push_back("motor.current_limit_A");
+  maps.push_back("contact.normal_preload_N");
   const std::set<std::string> keys = detail::design_file_keys(slurp(kEveryKey));
   for (const std::string& key : maps) EXPECT_TRUE(keys.count(key)) << "test/data/every_key.yaml does not visit " << key;
 }

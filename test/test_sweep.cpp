@@ -299,6 +299,35 @@ TEST(Run, ResumeRefusesAnotherSweepsCsv) {
   std::filesystem::remove_all(o.out_dir);
 }
 
+TEST(Run, DensePlotsEmbedOneRasterAndStaySmall) {
+  // 121 x 121 designs: one rectangle per cell and one path per point would make megabytes.
+  SweepSettings s = grid({{"L34", 12, 19, 121}, {"L12", 6, 12, 121}});
+  s.collision_spacing_mm = 0.0;
+  const Design d = with_sweep(s);
+  SweepOptions o;
+  o.out_dir = temp_dir("dense_plots");
+  const SweepResult r = run_sweep(d, o);
+  const std::string heat = slurp(o.out_dir / "sweep_heatmap.svg"), scatter = slurp(o.out_dir / "sweep_scatter.svg");
+  auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  std::uint64_t covered = 0;
+  read_sweep_csv(r.csv, s, [&](const SweepRow& row, const std::string&) { covered += row.covered; });
+  ASSERT_GT(covered, 2000u);  // more points than the scatter draws as vectors
+  // The heat map's cells are one image (121 x 121 pixels); the scatter's points another.
+  EXPECT_GE(count(heat, "<image"), 1u);
+  EXPECT_THAT(heat, ::testing::HasSubstr("width=\"121\""));
+  EXPECT_GE(count(scatter, "<image"), 1u);
+  // Vector elements are the axes, labels and legend only: far fewer than the 14,641 cells.
+  EXPECT_LT(count(heat, "<path"), 2000u);
+  EXPECT_LT(count(scatter, "<path"), 2000u);
+  EXPECT_LT(heat.size(), 1000000u);
+  EXPECT_LT(scatter.size(), 1000000u);
+  std::filesystem::remove_all(o.out_dir);
+}
+
 TEST(Run, ParetoSetIsExactlyTheBruteForceNonDominatedSet) {
   SweepSettings s = grid({{"L34", 12, 18, 13}, {"L12", 7, 12, 11}});
   s.objectives = {"margin", "min_lci", "footprint"};

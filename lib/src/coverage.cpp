@@ -430,7 +430,8 @@ double ellipse_slack(const Ellipse& e) {
 
 /// A polygon around the ellipse whose excess is at most half the local margin: tangent points
 /// close together where the ellipse nears the boundary, far apart elsewhere (the excess of a
-/// tangent polygon over a step dt is about A dt^2 / 8).
+/// tangent polygon over a step dt is about A dt^2 / 8). Empty when it would need more than
+/// kMaxVertices (an ellipse that follows the boundary within rounding over a long stretch).
 std::vector<Vec2> adaptive_circumscribed_polygon(const Mechanism& m, const Ellipse& e, double* excess) {
   const JointRange* l1 = m.joint_limits ? &(*m.joint_limits)[0] : nullptr;
   const JointRange* l2 = m.joint_limits ? &(*m.joint_limits)[1] : nullptr;
@@ -443,7 +444,9 @@ std::vector<Vec2> adaptive_circumscribed_polygon(const Mechanism& m, const Ellip
   std::vector<double> tangents;
   double t = 0.0;
   *excess = 0.0;
-  while (t < 2 * kPi && tangents.size() < 400000) {
+  constexpr std::size_t kMaxVertices = 20000;  // beyond: the exact test would cost seconds
+  while (t < 2 * kPi) {
+    if (tangents.size() >= kMaxVertices) return {};
     tangents.push_back(t);
     double dt = kMaxStep;
     for (;;) {
@@ -478,7 +481,7 @@ ExactVerdict exact_verdict(const Mechanism& m, const Region& region, const Ellip
   double excess = 0.0;
   const std::vector<Vec2> poly = adaptive_circumscribed_polygon(m, e, &excess);
   std::ostringstream how;
-  if (region.contains_polygon_exact(poly)) {
+  if (!poly.empty() && region.contains_polygon_exact(poly)) {
     v.inside = v.decided = true;
     how << "; exact CGAL test: a circumscribed " << poly.size() << "-gon (excess <= " << excess
         << " mm) lies inside the region";
@@ -497,8 +500,13 @@ ExactVerdict exact_verdict(const Mechanism& m, const Region& region, const Ellip
     v.method = how.str();
     return v;
   }
-  how << "; undecided within " << excess << " mm: a circumscribed " << poly.size()
-      << "-gon is not inside the exact region and the worst point is not outside it";
+  if (poly.empty()) {
+    how << "; undecided: the ellipse follows the boundary within rounding over a long stretch (a polygon "
+           "around it would need more than 20000 vertices) and the worst point is not outside the region";
+  } else {
+    how << "; undecided within " << excess << " mm: a circumscribed " << poly.size()
+        << "-gon is not inside the exact region and the worst point is not outside it";
+  }
   v.method = how.str();
   return v;
 }
@@ -551,7 +559,7 @@ AssemblyCheck certified_assembly(const Mechanism& m, const Ellipse& e) {
   // Breadth first (largest cells first): a wrong-side centre is found at the coarsest level that
   // has one, before any cell along the curve is split down to rounding.
   std::deque<Cell> stack;
-  constexpr int kRings = 4, kAngles = 32;
+  constexpr int kRings = 2, kAngles = 8;
   for (int i = 0; i < kRings; ++i)
     for (int k = 0; k < kAngles; ++k)
       stack.push_back({double(i) / kRings, double(i + 1) / kRings, 2 * kPi * k / kAngles, 2 * kPi * (k + 1) / kAngles});
@@ -827,6 +835,16 @@ Containment containment(const Mechanism& m, const Ellipse& target) {
 
 void conditioning(const Mechanism& m, const Ellipse& target, const CoverageOptions& options, CoverageResult& out) {
   conditioning_over(m, target, options, out);
+  if (m.assembly_mode == AssemblyMode::Any) return;
+  const AssemblyCheck a = certified_assembly(m, target);
+  out.assembly_ok = a.ok;
+  out.decided = a.decided;
+  if (!a.ok) out.assembly_crossing = a.crossing;
+  if (!a.ok && a.decided) {
+    out.min_lci = 0.0;
+    out.min_lci_point = a.crossing;
+    out.lci_ok = out.min_lci >= m.min_lci;
+  }
 }
 
 CoverageResult coverage(const Mechanism& m, const Ellipse& target, const CoverageOptions& options) {

@@ -276,7 +276,8 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
     const Containment c = containment(*m, st.target);
     (m->name == "lower" ? row.margin_lower_mm : row.margin_upper_mm) = c.margin_mm;
     if (!c.inside) {
-      row.status = fmt_margin(m->name, c.margin_mm);
+      row.status = c.decided ? fmt_margin(m->name, c.margin_mm)
+                             : "undecided: " + m->name + " within rounding of the region boundary";
       return row;
     }
   }
@@ -289,7 +290,8 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
     row.min_lci = std::min(row.min_lci, r.min_lci);
     row.min_force_capability = std::min(row.min_force_capability, r.min_force_capability);
     if (!r.assembly_ok) {
-      row.status = "not covered: " + m->name + " tactor crosses to the wrong assembly side";
+      row.status = r.decided ? "not covered: " + m->name + " tactor crosses to the wrong assembly side"
+                             : "undecided: " + m->name + " within rounding of the type II curve";
       return row;
     }
     if (!r.lci_ok) {

@@ -63,4 +63,20 @@ void BM_coverage_margin_only(benchmark::State& state) {
 }
 BENCHMARK(BM_coverage_margin_only)->Unit(benchmark::kMicrosecond);
 
+/// The sweep's per-design verdict: containment with its certified margin bounds.
+void BM_containment(benchmark::State& state) {
+  const Mechanism m = index_lower(state.range(0) != 0);
+  const Ellipse e = index_target();
+  bool ok = true;
+  for (auto _ : state) {
+    const Containment c = containment(m, e);
+    ok = ok && c.inside && c.decided;
+    benchmark::DoNotOptimize(c.margin_mm);
+  }
+  if (!ok) state.SkipWithError("target not inside: the benchmark would time another path");
+  state.SetLabel(state.range(0) ? "joint limits" : "annuli");
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_containment)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 }  // namespace

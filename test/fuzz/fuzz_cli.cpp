@@ -91,15 +91,22 @@ std::vector<std::string> arguments(std::string_view line) {
   return out;
 }
 
+/// `simulate` runs without OpenSCAD (--no-render) and within half a second of wall time per run
+/// (eight patterns at most: under the 10 s timeout per input).
+void limit_simulate(std::vector<std::string>& args) {
+  if (args.empty() || args[0] != "simulate") return;
+  args.insert(args.begin() + 1, {"--no-render", "--max-wall", "0.5"});
+}
+
 /// `run` builds only the cheap products: report (a timing study by design), sweep (a grid of any
-/// size), parts (OpenSCAD processes) and workspace (sampled fields and pictures: ~6 s per design in
+/// size), parts and simulate (OpenSCAD processes) and workspace (sampled fields and pictures: ~6 s per design in
 /// this build, against a 10 s timeout per input) are left to their own tests and to the
 /// hostile-input suite. Names of those four in a --products list
 /// are dropped, and a run without a list gets the cheap ones, so that the design file's own
 /// `products:` cannot ask for them either.
 void limit_run_products(std::vector<std::string>& args) {
   if (args.empty() || args[0] != "run") return;
-  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace"};
+  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace", "simulate"};
   const auto filtered = [&](const std::string& list) {
     std::vector<std::string> kept;
     std::size_t start = 0;
@@ -210,6 +217,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   std::vector<std::string> args = arguments(line);
   limit_run_products(args);
+  limit_simulate(args);
   std::vector<std::string> storage{"fivebar"};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;

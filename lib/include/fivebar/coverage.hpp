@@ -78,8 +78,9 @@ struct Containment {
   bool exact_fallback = false;   ///< the exact test was asked
 };
 Containment containment(const Mechanism& m, const Ellipse& target);
-/// Fills min_lci (+ point), min_force_capability, lci_ok and assembly_ok of `out` over the
-/// filled ellipse, as coverage() does.
+/// Fills min_lci (+ point), min_force_capability, lci_ok, assembly_ok (certified, with
+/// assembly_crossing and decided) of `out` over the filled ellipse, as coverage() does; the
+/// ellipse must be inside the region (containment() first).
 void conditioning(const Mechanism& m, const Ellipse& target, const CoverageOptions& options, CoverageResult& out);
 
 /// Fast verdict without joint limits: closed-form margin of the ellipse against both annuli.

@@ -104,6 +104,35 @@ struct CircleFit {
 /// found (found = false). Needs at least 6 distinct wall vertices.
 CircleFit fit_circle_wall(const TriangleMesh& mesh, const HoleSpec& hole);
 
+// --- Mass properties ------------------------------------------------------------------------
+
+/// Mass properties of a homogeneous solid bounded by a closed, outward-oriented triangle mesh, in
+/// the mesh's frame (mm). Volume integrals turned into surface integrals by the divergence theorem
+/// and summed exactly per triangle: D. Eberly, "Polyhedral Mass Properties (Revisited)", Geometric
+/// Tools (2002, rev. 2009), after B. Mirtich, "Fast and Accurate Computation of Polyhedral Mass
+/// Properties", J. Graphics Tools 1(2), 1996. Coordinates are taken relative to the bounding-box
+/// centre first, so that a part far from its origin loses no digits.
+struct MassProperties {
+  double volume_mm3 = 0.0;                                 ///< signed: negative when inward oriented
+  double mass_kg = 0.0;                                    ///< density x volume
+  Eigen::Vector3d com_mm = Eigen::Vector3d::Zero();        ///< centre of mass
+  /// Inertia tensor about the centre of mass, axes of the mesh frame (kg mm^2):
+  /// I = integral rho (|r|^2 1 - r r^T) dV with r from the centre of mass.
+  Eigen::Matrix3d inertia_kg_mm2 = Eigen::Matrix3d::Zero();
+};
+
+/// Mass properties of `mesh` at `density_g_cm3` (g/cm^3 = 1e-6 kg/mm^3). The mesh must be closed
+/// and consistently oriented (check_mesh()); InputError when its volume is not positive.
+MassProperties mass_properties(const TriangleMesh& mesh, double density_g_cm3);
+
+/// The same body moved rigidly: rotated by `R` then translated by `t` (mm); the inertia about the
+/// centre of mass turns as R I R^T.
+MassProperties transformed(const MassProperties& m, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+
+/// Inertia tensor of `m` about the point `p` (mm), by the parallel-axis theorem:
+/// I_p = I_com + mass (|d|^2 1 - d d^T), d = com - p (kg mm^2).
+Eigen::Matrix3d inertia_about(const MassProperties& m, const Eigen::Vector3d& p);
+
 // --- Parts --------------------------------------------------------------------------------------
 
 enum class PartKind { proximal_link, distal_link, tactor_tip, station_base };

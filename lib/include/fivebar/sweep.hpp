@@ -33,7 +33,7 @@ Station apply_sweep(const Design& design, const SweepSettings& settings, const s
 struct SweepRow {
   std::uint64_t index = 0;
   std::vector<double> values;
-  std::string status;  ///< "covered", "not covered: ...", "invalid: ..."
+  std::string status;  ///< "covered", "not covered: ...", "undecided: ...", "invalid: ..."
   bool covered = false;
   double margin_lower_mm, margin_upper_mm, margin_shared_mm;
   double min_lci, min_force_capability;

@@ -43,4 +43,10 @@ inline constexpr double kPartDimensionMm = 0.01;
 /// before the final fit. Float32 vertices of a true polygon sit within ~1e-6 of the radius.
 inline constexpr double kCircleFitRejectRel = 1e-4;
 
+// --- Dynamics (fivebar/dynamics.hpp) ------------------------------------------------------------
+
+/// A duration times a rate within this of a whole number of controller periods counts as that
+/// number (0.29 s at 100 Hz is 28.999999999999996 periods in doubles): in periods.
+inline constexpr double kSamplePeriodsRel = 1e-9;
+
 }  // namespace fivebar::tol

@@ -1,11 +1,14 @@
 // Sweep plots (cairo, SVG and PNG from one drawing routine): a scatter of the first two
 // objectives with the Pareto set marked, and for grid sweeps a heat map of the first objective
 // over the first two variables (best over the others). Both are streamed from the CSV, so memory
-// stays bounded: the scatter keeps a fixed-size deterministic reservoir of points.
+// stays bounded: the scatter keeps a fixed-size deterministic reservoir of points. The heat map's
+// cells, and the scatter's points beyond a few thousand, are one embedded raster in the SVG (as
+// plotting libraries draw images); axes, labels and the Pareto set stay vectors.
 #include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -116,16 +119,72 @@ std::string label_of(const std::string& objective) {
   return objective;
 }
 
-/// Viridis-like colour map, t in [0, 1].
-void colour(cairo_t* cr, double t) {
+/// Viridis-like colour map, t in [0, 1], as RGB in [0, 1].
+std::array<double, 3> colour_rgb(double t) {
   static const double stops[5][3] = {{0.267, 0.005, 0.329}, {0.230, 0.322, 0.546}, {0.128, 0.567, 0.551},
                                      {0.369, 0.789, 0.383}, {0.993, 0.906, 0.144}};
   t = std::clamp(t, 0.0, 1.0) * 4.0;
   const int i = std::min(3, int(t));
   const double f = t - i;
-  cairo_set_source_rgb(cr, stops[i][0] + f * (stops[i + 1][0] - stops[i][0]),
-                       stops[i][1] + f * (stops[i + 1][1] - stops[i][1]),
-                       stops[i][2] + f * (stops[i + 1][2] - stops[i][2]));
+  return {stops[i][0] + f * (stops[i + 1][0] - stops[i][0]), stops[i][1] + f * (stops[i + 1][1] - stops[i][1]),
+          stops[i][2] + f * (stops[i + 1][2] - stops[i][2])};
+}
+void colour(cairo_t* cr, double t) {
+  const auto c = colour_rgb(t);
+  cairo_set_source_rgb(cr, c[0], c[1], c[2]);
+}
+
+/// Paints an image surface over the rectangle (x0, y0)-(x1, y1) of the plot, pixels kept sharp.
+/// In the SVG this is one embedded PNG: a dense field or point cloud costs its pixels, not one
+/// element per cell or point, while axes and labels stay vectors.
+void paint_raster(cairo_t* cr, cairo_surface_t* image, double x0, double y0, double x1, double y1, bool nearest) {
+  const int w = cairo_image_surface_get_width(image), h = cairo_image_surface_get_height(image);
+  cairo_save(cr);
+  cairo_translate(cr, x0, y0);
+  cairo_scale(cr, (x1 - x0) / w, (y1 - y0) / h);
+  cairo_set_source_surface(cr, image, 0, 0);
+  cairo_pattern_set_filter(cairo_get_source(cr), nearest ? CAIRO_FILTER_NEAREST : CAIRO_FILTER_GOOD);
+  cairo_rectangle(cr, 0, 0, w, h);
+  cairo_fill(cr);
+  cairo_restore(cr);
+}
+
+/// Above this many markers a layer is drawn as an embedded raster (one pixel per plot pixel, as in
+/// the PNG).
+constexpr std::size_t kVectorPoints = 2000;
+
+/// Disc (filled) or ring (stroked, width 2) markers of radius r at pixel positions inside the
+/// box (x0, y0)-(x1, y1): vector paths up to kVectorPoints, one raster layer beyond.
+void markers(cairo_t* cr, const std::vector<std::pair<double, double>>& at, double r, const std::array<double, 4>& rgba,
+             bool ring, double x0, double y0, double x1, double y1) {
+  auto draw = [&](cairo_t* c) {
+    cairo_set_source_rgba(c, rgba[0], rgba[1], rgba[2], rgba[3]);
+    cairo_set_line_width(c, 2.0);
+    for (const auto& [x, y] : at) {
+      cairo_new_sub_path(c);
+      cairo_arc(c, x, y, r, 0, 2 * M_PI);
+      if (ring) {
+        cairo_stroke(c);
+      } else {
+        cairo_fill(c);
+      }
+    }
+  };
+  if (at.size() <= kVectorPoints) {
+    draw(cr);
+    return;
+  }
+  constexpr int kRes = 1;
+  const int w = int(std::ceil(x1 - x0)) * kRes, h = int(std::ceil(y1 - y0)) * kRes;
+  cairo_surface_t* img = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, w, h);
+  cairo_t* ic = cairo_create(img);
+  cairo_scale(ic, kRes, kRes);
+  cairo_translate(ic, -x0, -y0);
+  draw(ic);
+  cairo_destroy(ic);
+  cairo_surface_flush(img);
+  paint_raster(cr, img, x0, y0, x0 + double(w) / kRes, y0 + double(h) / kRes, false);
+  cairo_surface_destroy(img);
 }
 
 
@@ -190,18 +249,16 @@ std::vector<std::filesystem::path> write_sweep_plots(const std::filesystem::path
     }
     axes(cr, f, "Sweep of " + s.station + ": " + std::to_string(covered) + " of " + std::to_string(total) +
                     " designs cover the target");
-    cairo_set_source_rgba(cr, 0.25, 0.45, 0.75, 0.45);
-    for (const auto& [x, y] : points) {
-      cairo_arc(cr, f.px(x), f.py(y), 2.2, 0, 2 * M_PI);
-      cairo_fill(cr);
-    }
-    cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
+    std::vector<std::pair<double, double>> at;
+    at.reserve(points.size());
+    for (const auto& [x, y] : points) at.emplace_back(f.px(x), f.py(y));
+    markers(cr, at, 2.2, {0.25, 0.45, 0.75, 0.45}, false, f.x0, f.y0, f.x1, f.y1);
+    at.clear();
     for (const SweepRow& r : pareto) {
       const double x = plotted(r, ox), y = plotted(r, oy);
-      if (std::isnan(x) || std::isnan(y)) continue;
-      cairo_arc(cr, f.px(x), f.py(y), 4.5, 0, 2 * M_PI);
-      cairo_fill(cr);
+      if (!std::isnan(x) && !std::isnan(y)) at.emplace_back(f.px(x), f.py(y));
     }
+    markers(cr, at, 4.5, {0.85, 0.1, 0.1, 1.0}, false, f.x0, f.y0, f.x1, f.y1);
     // Legend.
     const double lx = f.x1 - 230, ly = f.y0 + 18;
     cairo_set_source_rgba(cr, 1, 1, 1, 0.85);
@@ -234,25 +291,26 @@ std::vector<std::filesystem::path> write_sweep_plots(const std::filesystem::path
            f.ax.label = v1.name + " (mm)";
            f.ay.label = v0.name + " (mm)";
            axes(cr, f, label_of(ox) + " over " + v0.name + " x " + v1.name);
-           const double cw = (f.x1 - f.x0) / n1, ch = (f.y1 - f.y0) / n0;
+           // One pixel per cell (row 0 at the top of the image is the largest first variable).
+           cairo_surface_t* img = cairo_image_surface_create(CAIRO_FORMAT_RGB24, n1, n0);
+           unsigned char* data = cairo_image_surface_get_data(img);
+           const int stride = cairo_image_surface_get_stride(img);
            for (int i = 0; i < n0; ++i) {
+             auto* row = reinterpret_cast<std::uint32_t*>(data + std::size_t(n0 - 1 - i) * std::size_t(stride));
              for (int j = 0; j < n1; ++j) {
                const double c = cells[std::size_t(i) * n1 + j];
-               if (std::isnan(c)) {
-                 cairo_set_source_rgb(cr, 0.86, 0.86, 0.86);
-               } else {
-                 colour(cr, hi > lo ? (c - lo) / (hi - lo) : 1.0);
-               }
-               cairo_rectangle(cr, f.x0 + j * cw, f.y1 - (i + 1) * ch, cw + 0.5, ch + 0.5);
-               cairo_fill(cr);
+               const std::array<double, 3> rgb =
+                   std::isnan(c) ? std::array<double, 3>{0.86, 0.86, 0.86} : colour_rgb(hi > lo ? (c - lo) / (hi - lo) : 1.0);
+               auto byte = [](double v) { return std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+               row[j] = (byte(rgb[0]) << 16) | (byte(rgb[1]) << 8) | byte(rgb[2]);
              }
            }
-           cairo_set_source_rgb(cr, 0.85, 0.1, 0.1);
-           cairo_set_line_width(cr, 2.0);
-           for (const SweepRow& r : pareto) {
-             cairo_arc(cr, f.px(r.values[1]), f.py(r.values[0]), 5, 0, 2 * M_PI);
-             cairo_stroke(cr);
-           }
+           cairo_surface_mark_dirty(img);
+           paint_raster(cr, img, f.x0, f.y0, f.x1, f.y1, true);
+           cairo_surface_destroy(img);
+           std::vector<std::pair<double, double>> at;
+           for (const SweepRow& r : pareto) at.emplace_back(f.px(r.values[1]), f.py(r.values[0]));
+           markers(cr, at, 5, {0.85, 0.1, 0.1, 1.0}, true, f.x0, f.y0, f.x1, f.y1);
            // Colour bar.
            const double bx = kWidth - 100, by0 = f.y0, by1 = f.y1;
            for (int k = 0; k < 200; ++k) {

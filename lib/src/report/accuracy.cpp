@@ -99,7 +99,7 @@ void area_study(const Mechanism& m, const Region& region, double region_time_s, 
 
   WorkSeries cells{"cell counting", "h_mm", "mm2", {}, {}, {}, "reachable grid nodes x h^2 (sample_field)"};
   WorkSeries squares{"marching squares", "h_mm", "mm2", {}, {}, {},
-                     "restricted_area(reach): refined marching squares; estimate = its own error estimate"};
+                     "restricted_area(reach): adaptive marching squares; estimate = its own error estimate"};
   for (int k = k_lo; k <= k_hi; ++k) {
     const double h = extent / double(1 << k);
     const Grid grid = Grid::covering(b, h, h);

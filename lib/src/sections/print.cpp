@@ -20,6 +20,7 @@ void PrintSettings::validate() const {
   if (fn < 8 || fn > 1024) throw ValidationError("fn", "= " + std::to_string(fn) + ": must be 8 ... 1024");
   rules::require_length("layer_height", layer_height, 0.0, 1.0);
   if (material.empty() || material.size() > 200) throw ValidationError("material", "must be 1 ... 200 characters");
+  rules::require_range("density_g_cm3", density_g_cm3, 0.0, 25.0, "g/cm^3");
 }
 
 namespace sections {
@@ -28,8 +29,8 @@ namespace {
 void load(const Value& v, Design& design) {
   PrintSettings& p = design.set(PrintSettings{});
   if (v.is_null()) return;
-  const auto all = v.entries({"pin_clearance", "min_wall", "fn", "layer_height", "material"},
-                             "of print settings (pin_clearance, min_wall, fn, layer_height, material)");
+  const auto all = v.entries({"pin_clearance", "min_wall", "fn", "layer_height", "material", "density_g_cm3"},
+                             "of print settings (pin_clearance, min_wall, fn, layer_height, material, density_g_cm3)");
   p.pin_clearance = number_or(all, "pin_clearance", p.pin_clearance, "mm");
   p.min_wall = number_or(all, "min_wall", p.min_wall, "mm");
   if (const Value* fn = find(all, "fn")) {
@@ -40,6 +41,7 @@ void load(const Value& v, Design& design) {
   }
   p.layer_height = number_or(all, "layer_height", p.layer_height, "mm");
   if (const Value* m = find(all, "material")) p.material = m->text("must be a material name");
+  p.density_g_cm3 = number_or(all, "density_g_cm3", p.density_g_cm3, "g/cm^3");
 }
 
 void validate(const Design& design) {
@@ -66,6 +68,7 @@ void write(const Design& design, Out& top) {
   o.add("min_wall", Out::number(p->min_wall));
   o.add("layer_height", Out::number(p->layer_height));
   o.add("fn", Out::integer(p->fn));
+  o.add("density_g_cm3", Out::number(p->density_g_cm3));
 }
 
 }  // namespace

@@ -24,6 +24,9 @@ struct PrintSettings {
   int fn = 96;                  ///< OpenSCAD $fn for printed circles
   double layer_height = 0.05;   ///< mm
   std::string material = "Formlabs Tough 2000";
+  /// Density of the cured resin, g/cm^3, for the parts' mass properties. An assumption to
+  /// replace: a value typical of cured photopolymer resins; the paper (Tough 2000) gives none.
+  double density_g_cm3 = 1.15;
   void validate() const;
 };
 

@@ -1,0 +1,188 @@
+// fivebar simulate: the dynamics of a station's two tactors under the exported PID (motors,
+// driver limits, ADC, skin contact), integrated by CVODE (fivebar/dynamics.hpp); per pattern and
+// mechanism the tracking error, currents, saturation and shear force, and a CSV time series.
+
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "common.hpp"
+#include "fivebar/dynamics.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/parts.hpp"
+#include "tactors.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct SimulateOptions {
+  std::string design;
+  std::string station;
+  std::string pattern;
+  bool step = false;
+  bool no_render = false;
+  std::optional<double> rtol;
+  double max_wall_s = 120.0;
+  std::string out;
+  bool json = false;
+};
+
+void print_run(const SimulationInput& in, const SimulationResult& r, const std::string& file) {
+  std::cout << in.station << "  " << in.reference_name << ": " << to_string(r.status) << ", " << fixed(r.t_end, 3)
+            << " s simulated in " << fixed(r.wall_s, 3) << " s (" << r.steps << " steps, " << r.restarts
+            << " restarts)\n";
+  if (!r.ok()) std::cout << "  " << r.reason << "\n";
+  for (const MechanismSummary& s : r.summary) {
+    std::cout << "  " << s.name << ": tracking error max " << fixed(s.max_error_mm, 3) << " mm, rms "
+              << fixed(s.rms_error_mm, 3) << " mm (joint " << fixed(s.max_joint_error_deg, 2) << " deg); current peak "
+              << fixed(s.peak_current_A, 3) << " A, rms " << fixed(s.rms_current_A, 3) << " A; peak duty "
+              << fixed(s.peak_duty, 3) << ", saturated " << fixed(s.saturation_s, 3) << " s; peak shear "
+              << fixed(s.peak_shear_N, 3) << " N, " << (s.slipped ? "slipped (" + std::to_string(s.slips) + "x)" : "no slip")
+              << "\n";
+  }
+  std::cout << "  time series: " << file << "\n";
+}
+
+int run_simulate(const SimulateOptions& opt) {
+  std::optional<PatternKind> kind;
+  if (!opt.pattern.empty()) {
+    kind = parse_pattern_kind(opt.pattern);
+    if (!kind) throw InputError("--pattern '" + opt.pattern + "': expected stretch, slip, twist or pivot");
+  }
+  if (opt.rtol && (!(*opt.rtol >= 1e-14) || !(*opt.rtol <= 1e-2))) {
+    throw InputError("--rtol must be within [1e-14, 1e-2]");
+  }
+  if (!(opt.max_wall_s > 0.0) || !(opt.max_wall_s <= 1e6)) throw InputError("--max-wall must be > 0 and <= 1e6 s");
+  const Design design = load(opt.design);
+  std::vector<const Station*> stations;
+  if (!opt.station.empty()) {
+    stations.push_back(&select_pair_station(design, opt.station));
+  } else {
+    for (const Station& s : design.stations)
+      if (s.lower && s.upper) stations.push_back(&s);
+    if (stations.empty()) throw InputError("design '" + design.name + "' has no station with both mechanisms");
+  }
+  require_geometry(design);
+  // Missing sections are bad input before anything is written.
+  for (const Station* s : stations) {
+    SimulationRequest probe;
+    probe.station = s->name;
+    probe.pattern = kind;
+    probe.step = opt.step;
+    std::map<std::string, MechanismInertia> none;
+    for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
+    (void)simulation_inputs(design, probe, none);
+  }
+
+  const std::filesystem::path dir = output_dir(design, opt.out, "simulate");
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
+  std::optional<Json> parts;
+  std::filesystem::path parts_dir = dir / "parts";
+  if (!opt.no_render) {
+    PartsOptions po;
+    po.out_dir = parts_dir;
+    if (opt.station.size()) po.station = opt.station;
+    po.progress = terminal_progress("simulate");
+    const PartsReport report = build_parts(design, po);
+    if (!report.passed()) {
+      std::cerr << "fivebar simulate: the parts' renders failed their checks (see " << parts_dir.generic_string()
+                << "); no mass properties\n";
+      return kCheckFailed;
+    }
+    parts = to_json(report);
+  }
+  SimulationOptions so;
+  if (opt.rtol) so.rtol = *opt.rtol;
+  so.max_wall_s = opt.max_wall_s;
+  Json runs = Json::array();
+  Json mass = Json::object();
+  std::vector<std::string> files;
+  bool all_ok = true;
+  for (const Station* s : stations) {
+    const auto inertia = station_inertia(design, *s, parts ? &*parts : nullptr, parts_dir);
+    for (const auto& [name, in] : inertia) {
+      mass[s->name][name] = {{"source", std::string(to_string(in.source))}, {"note", in.note}};
+    }
+    SimulationRequest request;
+    request.station = s->name;
+    request.pattern = kind;
+    request.step = opt.step;
+    for (const SimulationInput& in : simulation_inputs(design, request, inertia)) {
+      if (!in.unusable.empty()) {
+        all_ok = false;
+        runs.push_back({{"station", s->name}, {"reference", in.reference_name}, {"status", "not_simulated"},
+                        {"reason", in.unusable}});
+        if (!opt.json) std::cout << s->name << "  " << in.reference_name << ": not simulated, " << in.unusable << "\n";
+        continue;
+      }
+      const SimulationResult r = simulate(in, so);
+      const std::filesystem::path csv = dir / (s->name + "-" + in.reference_name + ".csv");
+      AtomicFile file(csv);
+      write_time_series_csv(file.stream(), r);
+      file.commit();
+      files.push_back(csv.generic_string());
+      Json j = to_json(in, r);
+      j["csv"] = csv.generic_string();
+      runs.push_back(j);
+      all_ok = all_ok && r.ok();
+      if (!opt.json) print_run(in, r, csv.generic_string());
+    }
+  }
+  if (opt.json) {
+    print_json({{"command", "simulate"},
+                {"design", design.name},
+                {"integrator", "CVODE BDF, Newton, dense"},
+                {"rtol", so.rtol},
+                {"mass", mass},
+                {"runs", runs},
+                {"files", files}});
+  } else {
+    for (const auto& [station, mechs] : mass.items()) {
+      for (const auto& [name, m] : mechs.items()) {
+        std::cout << "mass properties " << station << "/" << name << ": " << m["note"].get<std::string>() << "\n";
+      }
+    }
+  }
+  if (!all_ok) {
+    std::cerr << "fivebar simulate: a simulation did not finish or could not start (its status and reason are above)\n";
+    return kCheckFailed;
+  }
+  return kOk;
+}
+
+}  // namespace
+
+void setup_simulate(CLI::App& app) {
+  auto opt = std::make_shared<SimulateOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "simulate",
+      "Dynamics of a station's two tactors under the exported PID: motors, driver limits, ADC, skin stick/slip, "
+      "integrated by CVODE; tracking error, currents, saturation, shear force, CSV time series");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("-s,--station", opt->station, "Finger station (e.g. index); default: every station with both tactors")
+      ->type_name("NAME");
+  auto* pattern = sub->add_option("--pattern", opt->pattern, "Only this pattern: stretch, slip, twist or pivot")
+                      ->type_name("KIND");
+  sub->add_flag("--step", opt->step, "A 1 mm step of both tactors along +x from the stretch pattern's start, 0.5 s")
+      ->excludes(pattern);
+  sub->add_flag("--no-render", opt->no_render,
+                "Links' masses from the closed form (slab with bosses) instead of the parts' STL renders (openscad)");
+  sub->add_option("--rtol", opt->rtol, "CVODE relative tolerance (default 1e-6)")->type_name("R");
+  sub->add_option("--max-wall", opt->max_wall_s, "Wall-time bound of each simulation (s, default 120): beyond it the run "
+                  "stops with status wall_time_limit")
+      ->type_name("S");
+  sub->add_option("-o,--out", opt->out, "Directory for the CSV files (default: outputs/<design>/simulate)")
+      ->type_name("DIR");
+  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  sub->footer(
+      "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
+      "Without --pattern or --step, every pattern of the station's patterns: section (or all four defaults).\n"
+      "Exit status: 0 every simulation finished, 1 one did not (singular pose, step or time limit) or a part\n"
+      "failed to render, 2 bad input, 3 internal error or output not writable.");
+  sub->callback([opt]() { finish(run_simulate(*opt)); });
+}
+
+}  // namespace fivebar::cli

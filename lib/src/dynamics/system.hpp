@@ -1,0 +1,52 @@
+#pragma once
+/// The right-hand side of the simulated station (fivebar/dynamics.hpp "Model"), free of SUNDIALS:
+/// lib/src/dynamics/cvode.cpp integrates it. Private to the library.
+///
+/// State per mechanism k, at offset kStateSize k: theta1, theta2 (rad), w1, w2 (rad/s),
+/// i1, i2 (A), anchor x, y (m).
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "fivebar/dynamics.hpp"
+
+namespace fivebar::dynamics_detail {
+
+inline constexpr std::size_t kStateSize = 8;
+
+struct System {
+  const SimulationInput* input = nullptr;
+  const SimulationOptions* options = nullptr;
+  std::vector<std::array<double, 2>> duty;  ///< held over the current period, per mechanism
+  std::vector<char> slipping;               ///< contact mode per mechanism
+  double k = 0.0;      ///< N/m
+  double c = 0.0;      ///< N s/m
+  double limit = 0.0;  ///< mu N, N
+  bool last_failure_singular = false;
+  std::size_t evaluations = 0;         ///< right-hand sides evaluated by the integrator  ///< the last failed evaluation was a singular pose
+  std::size_t mechanisms() const { return input->mechanisms.size(); }
+};
+
+/// One mechanism evaluated at a state.
+struct Evaluation {
+  bool ok = false;
+  DynamicsTerms terms;
+  std::array<double, 2> voltage{0.0, 0.0};
+  std::array<bool, 2> saturated{false, false};  ///< |duty| >= 1 or the current limit acting
+  Vec2 force{0.0, 0.0};                         ///< skin force on the tactor, N
+  std::array<double, kStateSize> dy{};
+};
+
+System make_system(const SimulationInput& input, const SimulationOptions& options);
+/// Mechanism `k` of the state vector `y` (all mechanisms).
+Evaluation evaluate(System& s, std::size_t k, const double* y);
+/// dy/dt of the whole state; false when a pose is singular or unreachable (CVODE retries).
+bool rhs(System& s, const double* y, double* dy);
+/// The stick/slip switching functions, one per mechanism (contact on).
+void roots(System& s, const double* y, double* g);
+/// Root directions for the current modes: +1 (sticking: the spring force reaches mu N),
+/// -1 (sliding: the tactor turns back).
+std::vector<int> root_directions(const System& s);
+
+}  // namespace fivebar::dynamics_detail
