@@ -14,6 +14,11 @@ FIVEBAR_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libopenmpi-dev openmpi-bin
   libsundials-dev
+  # Optimisation: pagmo2 (multi-objective evolutionary search) and NLopt (derivative-free polish, tuning).
+  libpagmo-dev libnlopt-cxx-dev
+  # Tests of what users open: urdfdom's check_urdf reads the exported URDF, python3-jsonschema
+  # validates every command's --json against docs/schemas/, headless Chromium loads the HTML report.
+  liburdfdom-tools python3-jsonschema chromium
   openscad
   # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
   prusa-slicer unzip
