@@ -71,14 +71,15 @@ int run_coverage(const CoverageCliOptions& opt) {
   }
   const auto progress = terminal_progress("coverage");
 
-  Json doc;
-  doc["stations"] = Json::object();
+  Json doc = {{"command", "coverage"}, {"design", design.name}};
+  doc["target_override"] = override_target ? to_json(*override_target) : Json(nullptr);
+  doc["stations"] = Json::array();
   bool all = true;
   for (const Station& s : chosen) {
     if (progress) progress("station " + s.name);
     const StationCoverage c = station_coverage(s, override_target);
     all = all && c.covered();
-    doc["stations"][s.name] = to_json(c);
+    doc["stations"].push_back(to_json(c, s.name));
     if (!opt.json) print_station(s, override_target ? *override_target : s.target, override_target.has_value(), c);
   }
   if (opt.json) {

@@ -58,7 +58,8 @@ int run_run(const RunOptions& opt) {
   if (!opt.quiet) options.progress = terminal_progress("run");  // only for a person watching
   const SceneReport report = run_scene(design, options);
   if (opt.json) {
-    Json doc = report.to_json();
+    Json doc = {{"command", "run"}};
+    doc.update(report.to_json());
     doc["summary_md"] = report.summary_md.generic_string();
     doc["summary_json"] = report.summary_json.generic_string();
     print_json(doc);

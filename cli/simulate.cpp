@@ -98,13 +98,19 @@ int run_simulate(const SimulateOptions& opt) {
   if (opt.rtol) so.rtol = *opt.rtol;
   so.max_wall_s = opt.max_wall_s;
   Json runs = Json::array();
-  Json mass = Json::object();
+  Json mass = Json::array();  // one record per station and mechanism (docs/conventions.md "JSON documents")
   std::vector<std::string> files;
   bool all_ok = true;
   for (const Station* s : stations) {
     const auto inertia = station_inertia(design, *s, parts ? &*parts : nullptr, parts_dir);
     for (const auto& [name, in] : inertia) {
-      mass[s->name][name] = {{"source", std::string(to_string(in.source))}, {"note", in.note}};
+      double moving = in.tip_mass_kg;
+      for (const LinkInertia& l : in.links) moving += l.mass_kg;
+      mass.push_back({{"station", s->name},
+                      {"mechanism", name},
+                      {"source", std::string(to_string(in.source))},
+                      {"note", in.note},
+                      {"moving_mass_g", moving * 1e3}});
     }
     SimulationRequest request;
     request.station = s->name;
@@ -140,10 +146,9 @@ int run_simulate(const SimulateOptions& opt) {
                 {"runs", runs},
                 {"files", files}});
   } else {
-    for (const auto& [station, mechs] : mass.items()) {
-      for (const auto& [name, m] : mechs.items()) {
-        std::cout << "mass properties " << station << "/" << name << ": " << m["note"].get<std::string>() << "\n";
-      }
+    for (const Json& m : mass) {
+      std::cout << "mass properties " << m["station"].get<std::string>() << "/" << m["mechanism"].get<std::string>()
+                << ": " << m["note"].get<std::string>() << "\n";
     }
   }
   if (!all_ok) {

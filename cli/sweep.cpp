@@ -180,6 +180,7 @@ int run_sweep_cmd(const SweepCliOptions& o) {
   }
   if (o.json) {
     Json doc;
+    doc["command"] = "sweep";
     doc["design"] = design.name;
     doc["station"] = settings.station;
     doc["mechanism"] = settings.mechanism.empty() ? Json(nullptr) : Json(settings.mechanism);

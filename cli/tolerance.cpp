@@ -118,7 +118,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
   const ParameterSigmas sigma = parameter_sigmas(t);
   const auto progress = terminal_progress("tolerance");
 
-  Json doc;
+  Json doc = {{"command", "tolerance"}, {"design", design.name}};
   doc["tolerance"] = {{"source", given ? "design" : "defaults (assumptions)"},
                       {"link_length_sigma_mm", sigma[0]},
                       {"base_sigma_mm", sigma[4]},
@@ -126,7 +126,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
                       {"adc_bits", t.adc_bits},
                       {"samples", t.samples},
                       {"seed", t.seed}};
-  doc["stations"] = Json::object();
+  doc["stations"] = Json::array();
   if (!opt.json) {
     std::cout << "tolerances " << (given ? "from the design" : "by default (assumptions to replace)")
               << ": link length sigma " << fixed(sigma[0], 4) << " mm, base " << fixed(sigma[4], 4)
@@ -135,11 +135,13 @@ int run_tolerance(const ToleranceCliOptions& opt) {
   }
   for (const Station* s : stations) {
     if (progress) progress("station " + s->name);
-    Json js = Json::object();
+    Json js = {{"station", s->name}, {"mechanisms", Json::array()}};
     if (!opt.json) std::cout << "station " << s->name << "\n";
     for (const Mechanism* m : s->mechanisms()) {
       const MechanismTolerance r = analyse(*m, s->target, t);
-      js[m->name] = to_json(r);
+      Json jm = {{"mechanism", m->name}};
+      jm.update(to_json(r));
+      js["mechanisms"].push_back(std::move(jm));
       if (opt.json) continue;
       std::cout << "  " << m->name << ": at the centre " << point(s->target.center) << ": ";
       if (r.centre.status != Status::ok) {
@@ -156,7 +158,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
       if (r.not_ok > 0) std::cout << "; " << r.not_ok << " points unreachable or singular (no estimate)";
       std::cout << "\n";
     }
-    doc["stations"][s->name] = js;
+    doc["stations"].push_back(std::move(js));
   }
   if (opt.json) print_json(doc);
   return kOk;

@@ -22,6 +22,7 @@
 
 #include "cli_geometry.hpp"
 #include "cli_test.hpp"
+#include "json_records.hpp"
 
 namespace {
 
@@ -80,7 +81,7 @@ TEST_F(CliTactors, PairCollidingMovesTheLowerAndExitsOne) {
   EXPECT_GE(doc["after"]["min_clearance_mm"].get<double>(), 0.3);
   // The upper keeps its IK solution: the same angles `fivebar ik` gives.
   const json ik = parse(run({"ik", kDesign, "-s", "index", "-m", "upper", "--point", "6.25,15.5", "--json"}));
-  EXPECT_EQ(doc["upper"]["theta_deg"], ik["theta_deg"]);
+  EXPECT_EQ(ft::record(doc["mechanisms"], "mechanism", "upper")["theta_deg"], ik["theta_deg"]);
 }
 TEST_F(CliTactors, NegativeCoordinatesAndUnreachableTargets) {
   // A negative coordinate after --upper is a value, not an option; (-30, 15.5) is out of reach.

@@ -22,6 +22,7 @@
 
 #include "cli_geometry.hpp"
 #include "cli_test.hpp"
+#include "json_records.hpp"
 
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
@@ -63,8 +64,8 @@ TEST_F(CliWorkspace, CoverageJsonHasExactlyTheDocumentedShapeAndIndependentMargi
   const Outcome r = run({"coverage", kDesign, "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::ordered_json::parse(r.out);
-  EXPECT_EQ(keys(j), std::vector<std::string>{"stations"});
-  EXPECT_EQ(keys(j["stations"]), (std::vector<std::string>{"index", "thumb"}));
+  EXPECT_EQ(keys(j), (std::vector<std::string>{"command", "design", "target_override", "stations"}));
+  EXPECT_EQ(ft::record_names(j["stations"], "station"), (std::vector<std::string>{"index", "thumb"}));
   // Index: ellipse 15 x 12 at (6.25, 15.5); lower annuli 6..24 about (0,0), (12.5,0); upper about
   // y = 31. Thumb: 15 x 14 at (6.25, 17.5), annuli 8.5..26.5, upper at y = 35.
   struct Expect {
@@ -74,14 +75,18 @@ TEST_F(CliWorkspace, CoverageJsonHasExactlyTheDocumentedShapeAndIndependentMargi
   for (const Expect& e : {Expect{"index", 6.0, 24.0, 31.0, 6.25, 15.5, 7.5, 6.0},
                           Expect{"thumb", 8.5, 26.5, 35.0, 6.25, 17.5, 7.5, 7.0}}) {
     SCOPED_TRACE(e.station);
-    const auto& st = j["stations"][e.station];
-    EXPECT_EQ(keys(st), (std::vector<std::string>{"lower", "upper", "shared"}));
+    const auto& st = ft::station(j, e.station);
+    EXPECT_EQ(keys(st), (std::vector<std::string>{"station", "mechanisms", "shared"}));
+    EXPECT_EQ(ft::record_names(st["mechanisms"], "mechanism"), (std::vector<std::string>{"lower", "upper"}));
     const double lower = annuli_margin(e.r, e.R, 0, 12.5, 0, e.cx, e.cy, e.a, e.b);
     const double upper = annuli_margin(e.r, e.R, 0, 12.5, e.upper_y, e.cx, e.cy, e.a, e.b);
     EXPECT_GT(lower, 0.5);
     for (const char* part : {"lower", "upper", "shared"}) {
-      const auto& c = st[part];
-      EXPECT_EQ(keys(c), kResultKeys) << part;
+      const bool shared = std::string(part) == "shared";
+      const auto& c = shared ? st["shared"] : ft::mechanism(st, part);
+      std::vector<std::string> expected_keys = kResultKeys;
+      if (!shared) expected_keys.insert(expected_keys.begin(), "mechanism");
+      EXPECT_EQ(keys(c), expected_keys) << part;
       EXPECT_TRUE(c["covered"].get<bool>()) << part;
       EXPECT_TRUE(c["inside"].get<bool>()) << part;
       EXPECT_EQ(c["covered_fraction"].get<double>(), 1.0) << part;
@@ -105,9 +110,10 @@ TEST_F(CliWorkspace, CoverageEllipseOverrideOutsideIsExitOneWithNegativeMargin) 
   const Outcome r = run({"coverage", kDesign, "--station", "index", "--ellipse", "6.25,15.5,40,12,0", "--json"});
   EXPECT_EQ(r.code, 1) << r.err;
   const json j = parse(r);
-  EXPECT_EQ(keys(j["stations"]), std::vector<std::string>{"index"});
+  EXPECT_EQ(ft::record_names(j["stations"], "station"), std::vector<std::string>{"index"});
   for (const char* part : {"lower", "upper", "shared"}) {
-    const json& c = j["stations"]["index"][part];
+    const json& c = std::string(part) == "shared" ? ft::station(j, "index")["shared"]
+                                                  : ft::mechanism(ft::station(j, "index"), part);
     EXPECT_FALSE(c["covered"].get<bool>()) << part;
     EXPECT_LT(c["margin_mm"].get<double>(), 0.0) << part;
     EXPECT_GT(c["covered_fraction"].get<double>(), 0.0) << part;
@@ -115,7 +121,7 @@ TEST_F(CliWorkspace, CoverageEllipseOverrideOutsideIsExitOneWithNegativeMargin) 
     EXPECT_THAT(c["reason"].get<std::string>(), Not(IsEmpty())) << part;
   }
   // Independent margin of the lower mechanism against its annuli (negative: outside by that much).
-  EXPECT_NEAR(j["stations"]["index"]["lower"]["margin_mm"].get<double>(),
+  EXPECT_NEAR(ft::mechanism(ft::station(j, "index"), "lower")["margin_mm"].get<double>(),
               annuli_margin(6, 24, 0, 12.5, 0, 6.25, 15.5, 20, 6), 1e-6);
 
   const Outcome table = run({"coverage", kDesign, "--station", "index", "--ellipse", "6.25,15.5,40,12,0"});
@@ -125,7 +131,7 @@ TEST_F(CliWorkspace, CoverageEllipseOverrideOutsideIsExitOneWithNegativeMargin) 
   // A negative centre coordinate is a value, not an option; a small circle there is covered.
   const Outcome negative = run({"coverage", kDesign, "--station", "index", "--ellipse", "-1,15.5,4,4,0", "--json"});
   EXPECT_EQ(negative.code, 0) << negative.err;
-  EXPECT_TRUE(json::parse(negative.out)["stations"]["index"]["shared"]["covered"].get<bool>());
+  EXPECT_TRUE(ft::station(json::parse(negative.out), "index")["shared"]["covered"].get<bool>());
 }
 TEST_F(CliWorkspace, CoverageFailsOnTheDesignsLciThreshold) {
   // min_lci 0.9 on the index lower mechanism: inside, but conditioning too poor over the ellipse.
@@ -134,14 +140,14 @@ TEST_F(CliWorkspace, CoverageFailsOnTheDesignsLciThreshold) {
   const Outcome r = run({"coverage", design.string(), "--json"});
   EXPECT_EQ(r.code, 1) << r.err;
   const json j = parse(r);
-  const json& lower = j["stations"]["index"]["lower"];
+  const json& lower = ft::mechanism(ft::station(j, "index"), "lower");
   EXPECT_TRUE(lower["inside"].get<bool>());
   EXPECT_FALSE(lower["lci_ok"].get<bool>());
   EXPECT_FALSE(lower["covered"].get<bool>());
   EXPECT_LT(lower["min_lci"].get<double>(), 0.9);
-  EXPECT_TRUE(j["stations"]["index"]["upper"]["covered"].get<bool>());
-  EXPECT_FALSE(j["stations"]["index"]["shared"]["covered"].get<bool>());
-  EXPECT_TRUE(j["stations"]["thumb"]["shared"]["covered"].get<bool>());
+  EXPECT_TRUE(ft::mechanism(ft::station(j, "index"), "upper")["covered"].get<bool>());
+  EXPECT_FALSE(ft::station(j, "index")["shared"]["covered"].get<bool>());
+  EXPECT_TRUE(ft::station(j, "thumb")["shared"]["covered"].get<bool>());
 }
 TEST_F(CliWorkspace, CoverageOfOneMechanismJudgesItAloneWithoutTheSharedRegion) {
   // min_lci 0.9 on the index lower mechanism fails it; --mechanism upper does not look at it.
@@ -155,11 +161,11 @@ TEST_F(CliWorkspace, CoverageOfOneMechanismJudgesItAloneWithoutTheSharedRegion) 
   EXPECT_EQ(lower.code, 1) << lower.err;
   const json jb = parse(both), ju = parse(upper), jl = parse(lower);
   // Only the chosen mechanism, no shared region, and the same numbers as the full run.
-  EXPECT_FALSE(ju["stations"]["index"].contains("lower"));
-  EXPECT_FALSE(ju["stations"]["index"].contains("shared"));
-  EXPECT_EQ(ju["stations"]["index"]["upper"], jb["stations"]["index"]["upper"]);
-  EXPECT_FALSE(jl["stations"]["index"].contains("upper"));
-  EXPECT_EQ(jl["stations"]["index"]["lower"], jb["stations"]["index"]["lower"]);
+  EXPECT_EQ(ft::record_names(ft::station(ju, "index")["mechanisms"], "mechanism"), std::vector<std::string>{"upper"});
+  EXPECT_TRUE(ft::station(ju, "index")["shared"].is_null());
+  EXPECT_EQ(ft::mechanism(ft::station(ju, "index"), "upper"), ft::mechanism(ft::station(jb, "index"), "upper"));
+  EXPECT_EQ(ft::record_names(ft::station(jl, "index")["mechanisms"], "mechanism"), std::vector<std::string>{"lower"});
+  EXPECT_EQ(ft::mechanism(ft::station(jl, "index"), "lower"), ft::mechanism(ft::station(jb, "index"), "lower"));
   // A mechanism name that does not exist: exit 2 naming the option, nothing printed.
   const Outcome missing = run({"coverage", kDesign, "--mechanism", "middle"});
   EXPECT_EQ(missing.code, 2);
@@ -204,7 +210,7 @@ TEST_F(CliWorkspace, RunCoverageFailsForAStationThatIsNotCoveredAndOnlyScansTheS
   const json j = parse(r);
   ASSERT_EQ(j["built"].size(), 1u);
   EXPECT_FALSE(j["built"][0]["passed"].get<bool>());
-  EXPECT_EQ(keys(j["results"]["coverage"]["stations"]), std::vector<std::string>{"index"});
+  EXPECT_EQ(ft::record_names(j["results"]["coverage"]["stations"], "station"), std::vector<std::string>{"index"});
   const std::string md = slurp(out / "iros2022" / "summary.md");
   EXPECT_THAT(md, AllOf(HasSubstr("✗ **not covered**"), Not(HasSubstr("Station `thumb`"))));
   EXPECT_FALSE(fs::exists(out / "iros2022" / "workspace"));  // not asked for, not built

@@ -14,6 +14,7 @@
 
 #include "cli_geometry.hpp"
 #include "cli_test.hpp"
+#include "json_records.hpp"
 
 namespace {
 
@@ -46,7 +47,7 @@ TEST_F(CliSimulate, StretchOnTheIndexTracksAndItsSeriesClosesThePaperLoops) {
   const json& run0 = doc["runs"][0];
   EXPECT_EQ(run0["status"], "ok");
   EXPECT_EQ(run0["reference"], "stretch");
-  EXPECT_EQ(doc["mass"]["index"]["lower"]["source"], "closed_form");
+  EXPECT_EQ(ft::record(doc["mass"], "mechanism", "lower")["source"], "closed_form");
   const std::string text = slurp(out / "index-stretch.csv");
   const auto rows = parse_csv(text);
   ASSERT_GT(rows.size(), 3u);
@@ -101,7 +102,7 @@ TEST_F(CliSimulate, MassesFromTheRenderedParts) {
   const Outcome r = run({"simulate", design.string(), "-s", "index", "--pattern", "twist", "--json", "--out", out.string()});
   ASSERT_EQ(r.code, 0) << r.err;
   const json doc = parse(r);
-  EXPECT_EQ(doc["mass"]["index"]["upper"]["source"], "stl");
+  EXPECT_EQ(ft::record(doc["mass"], "mechanism", "upper")["source"], "stl");
   EXPECT_TRUE(fs::exists(out / "parts" / "index" / "proximal_link_9mm.stl"));
   EXPECT_EQ(doc["runs"][0]["status"], "ok");
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "cli_test.hpp"
+#include "json_records.hpp"
 
 namespace ft = fivebar::testing;
 using ft::Outcome;
@@ -42,10 +43,10 @@ TEST_F(CliTolerance, JsonShapeMirrorSymmetryAndMonteCarloAgreement) {
   const json j = parse(r);
   EXPECT_EQ(j["tolerance"]["source"], "design");
   EXPECT_EQ(j["tolerance"]["adc_bits"], 16);
-  ASSERT_TRUE(j["stations"].contains("index"));
-  ASSERT_TRUE(j["stations"].contains("thumb"));
-  const json& lo = j["stations"]["index"]["lower"];
-  const json& up = j["stations"]["index"]["upper"];
+  EXPECT_EQ(j["command"], "tolerance");
+  ASSERT_EQ(ft::record_names(j["stations"], "station"), (std::vector<std::string>{"index", "thumb"}));
+  const json& lo = ft::mechanism(ft::station(j, "index"), "lower");
+  const json& up = ft::mechanism(ft::station(j, "index"), "upper");
   for (const char* key : {"centre_3sigma_mm", "centre_3sigma_minor_mm", "centre_worst_case_mm", "centre_resolution_um",
                           "target_worst_3sigma_mm", "target_worst_case_mm"}) {
     SCOPED_TRACE(key);
@@ -59,7 +60,7 @@ TEST_F(CliTolerance, JsonShapeMirrorSymmetryAndMonteCarloAgreement) {
   for (const char* station : {"index", "thumb"}) {
     for (const char* which : {"lower", "upper"}) {
       SCOPED_TRACE(std::string(station) + " " + which);
-      const json& m = j["stations"][station][which];
+      const json& m = ft::mechanism(ft::station(j, station), which);
       EXPECT_EQ(m["centre_status"], "ok");
       EXPECT_EQ(m["target_points_not_ok"], 0);
       EXPECT_EQ(m["monte_carlo_samples_used"], 10000);
@@ -87,8 +88,8 @@ TEST_F(CliTolerance, FiguresScaleWithTolerancesAndCounts) {
   EXPECT_EQ(b["stations"].size(), 1u);
   for (const char* which : {"lower", "upper"}) {
     SCOPED_TRACE(which);
-    const json& x = a["stations"]["thumb"][which];
-    const json& y = b["stations"]["thumb"][which];
+    const json& x = ft::mechanism(ft::station(a, "thumb"), which);
+    const json& y = ft::mechanism(ft::station(b, "thumb"), which);
     for (const char* key : {"centre_3sigma_mm", "centre_worst_case_mm", "target_worst_3sigma_mm",
                             "target_worst_case_mm"}) {
       EXPECT_NEAR(y[key].get<double>(), 2.0 * x[key].get<double>(), 1e-9 * x[key].get<double>()) << key;
@@ -106,9 +107,9 @@ TEST_F(CliTolerance, ZeroTolerancesGiveZeroError) {
   const Outcome r = run({"tolerance", zero.string(), "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = parse(r);
-  for (const auto& [station, mechanisms] : j["stations"].items()) {
-    for (const auto& [which, m] : mechanisms.items()) {
-      SCOPED_TRACE(station + " " + which);
+  for (const json& st : j["stations"]) {
+    for (const json& m : st["mechanisms"]) {
+      SCOPED_TRACE(st["station"].get<std::string>() + " " + m["mechanism"].get<std::string>());
       EXPECT_EQ(m["centre_3sigma_mm"].get<double>(), 0.0);
       EXPECT_EQ(m["centre_worst_case_mm"].get<double>(), 0.0);
       EXPECT_EQ(m["target_worst_case_mm"].get<double>(), 0.0);

@@ -22,6 +22,7 @@
 
 #include "cli_geometry.hpp"
 #include "cli_test.hpp"
+#include "json_records.hpp"
 
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
@@ -69,7 +70,7 @@ TEST_F(CliWorkspace, WorkspaceJsonAreasMatchTheAnnuliOfTableOne) {
     EXPECT_EQ(st["station"], expect[s].station);
     const double area = annuli_area(expect[s].r, expect[s].R, 12.5);
     for (const char* m : {"lower", "upper"}) {
-      const json& mech = st["mechanisms"][m];
+      const json& mech = ft::mechanism(st, m);
       EXPECT_NEAR(mech["area_mm2"].get<double>(), area, 1e-9 * area) << m;
       EXPECT_EQ(mech["components"], 1) << m;
       EXPECT_EQ(mech["holes"], expect[s].holes) << m;
@@ -159,7 +160,8 @@ TEST_F(CliWorkspace, RunBuildsWorkspaceAndCoverageWithSummarySections) {
   const Outcome cov = run({"coverage", kDesign, "--json"});
   EXPECT_EQ(s["results"]["coverage"]["stations"], json::parse(cov.out)["stations"]);
   const double area = annuli_area(6, 24, 12.5);
-  EXPECT_NEAR(s["results"]["workspace"]["stations"][0]["mechanisms"]["lower"]["area_mm2"].get<double>(), area, 1e-9 * area);
+  EXPECT_NEAR(ft::mechanism(s["results"]["workspace"]["stations"][0], "lower")["area_mm2"].get<double>(), area,
+              1e-9 * area);
 
   const std::string md = slurp(scene / "summary.md");
   EXPECT_THAT(md, AllOf(HasSubstr("## Reachable workspace"), HasSubstr("## Target coverage"),

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "cli_test.hpp"
+#include "json_records.hpp"
 
 namespace fivebar::testing {
 namespace {
@@ -202,7 +203,7 @@ TEST_F(Reliability, EveryScaleGivesTheScaleFreeAnswerOrExit2) {
   write("unit.yaml", scaled_design(1.0));
   const Outcome unit = run({"coverage", "unit.yaml", "--json"});
   ASSERT_EQ(unit.code, 0) << unit.err;
-  const auto ref = parse(unit)["stations"]["index"]["shared"];
+  const auto ref = station(parse(unit), "index")["shared"];
   for (const double s : {1e-300, 1e-200, 1e-155, 1e-60, 1e-30, 1e-12, 1e-9, 1e-6, 1e-3, 1e3, 1e6, 1e10, 1e11, 1e30, 1e300}) {
     SCOPED_TRACE(s);
     write("s.yaml", scaled_design(s));
@@ -216,7 +217,7 @@ TEST_F(Reliability, EveryScaleGivesTheScaleFreeAnswerOrExit2) {
       continue;
     }
     ASSERT_EQ(r.code, 0) << r.err;
-    const auto got = parse(r)["stations"]["index"]["shared"];
+    const auto got = station(parse(r), "index")["shared"];
     EXPECT_EQ(got["covered"], true);
     // LCI is scale-free; the margin scales with the design.
     EXPECT_NEAR(got["min_lci"].get<double>(), ref["min_lci"].get<double>(), 1e-12);

@@ -704,10 +704,10 @@ TEST_F(ReportCli, StabilityJsonAndExitCode) {
   EXPECT_TRUE(j["passed"].get<bool>());
   EXPECT_EQ(j["failed"], 0);
   EXPECT_EQ(j["cases_total"].get<std::size_t>(), j["cases"].size());
-  for (const char* key : {"mechanism", "group", "case", "operation", "parameter", "status", "expected", "error", "bound",
+  for (const char* key : {"subject", "group", "case", "operation", "parameter", "status", "expected", "error", "bound",
                           "unit", "conditioning", "finite", "passed", "ill_conditioned", "explanation"})
     EXPECT_TRUE(j["cases"][0].contains(key)) << key;
-  for (const auto& c : j["cases"]) EXPECT_TRUE(c["mechanism"] == "index/lower" || c["mechanism"] == "index/upper");
+  for (const auto& c : j["cases"]) EXPECT_TRUE(c["subject"] == "index/lower" || c["subject"] == "index/upper");
 
   const Outcome text = run({"report", "stability", kDesign, "--station", "thumb"});
   EXPECT_EQ(text.code, 0);

@@ -255,7 +255,8 @@ TEST(StationWorkspace, JsonMirrorsTheResults) {
   const Json j = to_json(ws);
   EXPECT_EQ(j["station"], "index");
   EXPECT_EQ(j["grid"]["nx"], ws.grid.nx);
-  const auto& lower = j["mechanisms"]["lower"];
+  ASSERT_EQ(j["mechanisms"][0]["mechanism"], "lower");  // mechanisms are records (docs/conventions.md)
+  const auto& lower = j["mechanisms"][0];
   EXPECT_EQ(lower["area_mm2"].get<double>(), ws.mechanisms[0].region.area_mm2());
   EXPECT_EQ(lower["holes"], 2);  // the two inner disks (radius 6, centres 12.5 apart) are disjoint
   EXPECT_EQ(lower["components"], 1);

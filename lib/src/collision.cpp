@@ -633,8 +633,11 @@ Json to_json(const PriorityResult& r) {
   j["lower_target_mm"] = xy(r.lower_target);
   j["lower_point_mm"] = xy(r.lower_point);
   j["moved_mm"] = r.moved_mm;
-  j["upper"] = to_json(r.upper);
-  j["lower"] = to_json(r.lower);
+  // Mechanisms as records, lower first, as every JSON document lists them (docs/conventions.md).
+  Json lower = {{"mechanism", "lower"}}, upper = {{"mechanism", "upper"}};
+  lower.update(to_json(r.lower));
+  upper.update(to_json(r.upper));
+  j["mechanisms"] = Json::array({lower, upper});
   j["before"] = r.before ? to_json(*r.before) : Json(nullptr);
   j["after"] = r.after ? to_json(*r.after) : Json(nullptr);
   return j;

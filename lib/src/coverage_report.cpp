@@ -33,11 +33,17 @@ Json to_json(const CoverageResult& r) {
   return j;
 }
 
-Json to_json(const StationCoverage& s) {
+Json to_json(const StationCoverage& s, std::string_view station) {
   Json j = Json::object();
-  if (s.lower) j["lower"] = to_json(*s.lower);
-  if (s.upper) j["upper"] = to_json(*s.upper);
-  if (s.shared) j["shared"] = to_json(*s.shared);
+  j["station"] = station;
+  j["mechanisms"] = Json::array();
+  for (const auto& [name, r] : {std::pair{"lower", &s.lower}, std::pair{"upper", &s.upper}}) {
+    if (!r->has_value()) continue;
+    Json m = {{"mechanism", name}};
+    m.update(to_json(**r));
+    j["mechanisms"].push_back(std::move(m));
+  }
+  j["shared"] = s.shared ? to_json(*s.shared) : Json(nullptr);
   return j;
 }
 

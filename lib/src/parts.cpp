@@ -865,7 +865,17 @@ Json to_json(const PartsReport& report) {
     j["name"] = p.spec.name;
     j["station"] = p.spec.station;
     j["kind"] = std::string(to_string(p.spec.kind));
-    j["mechanisms"] = p.spec.mechanisms;
+    // The mechanisms that use the part, as names ("-", the base, uses none).
+    Json names = Json::array();
+    if (p.spec.mechanisms != "-") {
+      std::size_t from = 0;
+      while (from <= p.spec.mechanisms.size()) {
+        const std::size_t plus = std::min(p.spec.mechanisms.find('+', from), p.spec.mechanisms.size());
+        names.push_back(p.spec.mechanisms.substr(from, plus - from));
+        from = plus + 1;
+      }
+    }
+    j["mechanisms"] = names;
     j["uses"] = p.spec.uses;
     j["count"] = p.spec.count;
     j["length_mm"] = p.spec.kind == PartKind::proximal_link || p.spec.kind == PartKind::distal_link

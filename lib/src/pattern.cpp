@@ -316,6 +316,12 @@ Json spec_json(const PatternSpec& spec, const Vec2& centre) {
   return j;
 }
 
+Json with_mechanism(const char* name, const Json& rest) {
+  Json j = {{"mechanism", name}};
+  j.update(rest);
+  return j;
+}
+
 Json tactor_json(const TactorSample& s) {
   Json j;
   j["status"] = std::string(to_string(s.status));
@@ -353,8 +359,9 @@ Json to_json(const PatternResult& r, bool samples) {
     j["first_failure"] = nullptr;
   }
   Json worst;
-  worst["min_lci"] = {{"upper", r.min_lci[0]}, {"lower", r.min_lci[1]}};
-  worst["min_type1_distance_mm"] = {{"upper", r.min_type1_distance_mm[0]}, {"lower", r.min_type1_distance_mm[1]}};
+  worst["mechanisms"] = Json::array({
+      {{"mechanism", "lower"}, {"min_lci", r.min_lci[1]}, {"min_type1_distance_mm", r.min_type1_distance_mm[1]}},
+      {{"mechanism", "upper"}, {"min_lci", r.min_lci[0]}, {"min_type1_distance_mm", r.min_type1_distance_mm[0]}}});
   worst["min_clearance_mm"] = finite_or_null(r.min_clearance_mm);
   worst["min_commanded_clearance_mm"] = finite_or_null(r.min_commanded_clearance_mm);
   worst["max_moved_mm"] = r.max_moved_mm;
@@ -372,8 +379,8 @@ Json to_json(const PatternResult& r, bool samples) {
     Json list = Json::array();
     for (const PatternSample& s : r.samples) {
       list.push_back({{"time_s", s.time_s},
-                      {"upper", tactor_json(s.upper)},
-                      {"lower", tactor_json(s.lower)},
+                      {"mechanisms", Json::array({with_mechanism("lower", tactor_json(s.lower)),
+                                                  with_mechanism("upper", tactor_json(s.upper))})},
                       {"clearance_mm", s.clearance_mm ? finite_or_null(*s.clearance_mm) : Json(nullptr)},
                       {"moved_mm", s.moved_mm}});
     }

@@ -57,11 +57,12 @@ json SceneReport::to_json() const {
   }
   json j;
   j["fivebar_version"] = std::string(version());
-  j["design"] = {{"name", design_name}, {"source", design_source.generic_string()}};
+  j["design"] = design_name;
+  j["design_file"] = design_source.generic_string();
   j["out_dir"] = out_dir.generic_string();
   j["stations"] = json::array();
   for (const auto& [name, mechanisms] : stations) {
-    j["stations"].push_back({{"name", name}, {"mechanisms", mechanisms}});
+    j["stations"].push_back({{"station", name}, {"mechanisms", mechanisms}});
   }
   j["products_listed"] = products_listed;
   j["ok"] = ok();

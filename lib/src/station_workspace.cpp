@@ -127,9 +127,10 @@ Json to_json(const StationWorkspace& ws) {
                {"spacing_mm", ws.grid.spacing},
                {"nx", ws.grid.nx},
                {"ny", ws.grid.ny}};
-  Json mechanisms = Json::object();
+  Json mechanisms = Json::array();
   for (const MechanismWorkspace& w : ws.mechanisms) {
-    Json m = region_json(w.region);
+    Json m = {{"mechanism", w.mechanism.name}};
+    m.update(region_json(w.region));
     if (w.region.empty()) {
       m["bounds_mm"] = nullptr;
     } else {
@@ -145,7 +146,7 @@ Json to_json(const StationWorkspace& ws) {
     for (std::size_t k = 0; k < w.field.lci.size(); ++k)
       if (w.field.reach[k] != 0) best = std::max(best, w.field.lci[k]);
     m["max_lci_sampled"] = best;
-    mechanisms[w.mechanism.name] = m;
+    mechanisms.push_back(std::move(m));
   }
   j["mechanisms"] = mechanisms;
   j["shared"] = ws.shared ? region_json(*ws.shared) : Json(nullptr);

@@ -13,8 +13,10 @@ namespace fivebar {
 ///  min_lci_point_mm [x, y], min_force_capability (N per N*mm), lci_ok, assembly_ok, method,
 ///  reason}, in that order and nothing else.
 Json to_json(const CoverageResult& result);
-/// {"lower": {...}, "upper": {...}, "shared": {...}} with the parts the station has.
-Json to_json(const StationCoverage& station);
+/// A station record in the shape every command uses (docs/conventions.md "JSON documents"):
+/// {"station": name, "mechanisms": [{"mechanism": "lower", <result>}, {"mechanism": "upper", ...}]
+/// with the mechanisms the station has, "shared": <result> or null}.
+Json to_json(const StationCoverage& station, std::string_view station_name);
 
 
 }  // namespace fivebar

@@ -838,7 +838,7 @@ Json to_json(const StabilityReport& r) {
   Json cases = Json::array();
   for (const StabilityCase& c : r.cases) {
     Json k;
-    k["mechanism"] = c.mechanism;
+    k["subject"] = c.mechanism;  // "index/lower" or the catalogue's label: not a mechanism record
     k["group"] = c.group;
     k["case"] = c.name;
     k["operation"] = c.operation;

@@ -76,7 +76,7 @@ Product coverage_product() {
   p.unavailable = without_mechanisms;
   p.build = [](Context& ctx) {
     Built b;
-    Json stations = Json::object();
+    Json stations = Json::array();
     std::string markdown = kPreamble;
     std::vector<std::string> failed;
     std::size_t total = 0;
@@ -86,7 +86,7 @@ Product coverage_product() {
       if (s.mechanisms().empty()) continue;
       ctx.say("coverage: station " + s.name);
       const StationCoverage c = station_coverage(s);
-      stations[s.name] = to_json(c);
+      stations.push_back(to_json(c, s.name));
       markdown += station_markdown(s, c, ctx.result_of("workspace"));
       for (const auto* r : {&c.lower, &c.upper}) {
         if (!r->has_value()) continue;

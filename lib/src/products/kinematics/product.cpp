@@ -95,7 +95,8 @@ MechanismReport analyse(const Station& s, const Mechanism& m) {
 
 json mechanism_json(const Station& s, const MechanismReport& r) {
   json j;
-  j["mechanism"] = to_json(*r.m);
+  j["mechanism"] = r.m->name;
+  j["parameters"] = to_json(*r.m);
   json centre;
   centre["target_mm"] = json::array({s.target.center.x(), s.target.center.y()});
   centre["ik"] = to_json(r.centre);
@@ -238,7 +239,7 @@ Product kinematics_product() {
       ctx.say("kinematics: station " + s.name);
       std::vector<MechanismReport> reports;
       json js;
-      js["name"] = s.name;
+      js["station"] = s.name;
       js["target"] = to_json(s.target);
       js["mechanisms"] = json::array();
       for (const Mechanism* m : mechanisms) {

@@ -65,7 +65,7 @@ Product pattern_product() {
       }
       std::vector<PatternResult> results;
       Json js;
-      js["name"] = s.name;
+      js["station"] = s.name;
       js["patterns"] = Json::array();
       for (const PatternSpec& spec : specs) {
         ctx.say("pattern: station " + s.name + ", " + std::string(to_string(spec.kind)));

@@ -42,7 +42,7 @@ Product simulate_product() {
                      "peak current (A)", "rms current (A)", "saturated (s)", "peak shear (N)", "slip", "wall (s)"},
                     "llllrrrrrrlr");
     Json runs = Json::array();
-    Json mass = Json::object();
+    Json mass = Json::array();  // one record per station and mechanism (docs/conventions.md "JSON documents")
     std::size_t total = 0, failed = 0;
     double wall = 0.0;
     std::string problems;
@@ -52,7 +52,11 @@ Product simulate_product() {
       for (const auto& [name, in] : inertia) {
         double moving = in.tip_mass_kg;
         for (const LinkInertia& l : in.links) moving += l.mass_kg;
-        mass[s.name][name] = {{"source", std::string(to_string(in.source))}, {"note", in.note}, {"moving_mass_g", moving * 1e3}};
+        mass.push_back({{"station", s.name},
+                        {"mechanism", name},
+                        {"source", std::string(to_string(in.source))},
+                        {"note", in.note},
+                        {"moving_mass_g", moving * 1e3}});
       }
       SimulationRequest request;
       request.station = s.name;
@@ -92,11 +96,9 @@ Product simulate_product() {
     Built b;
     b.result = {{"integrator", "CVODE BDF, Newton, dense"}, {"rtol", SimulationOptions{}.rtol}, {"mass", mass}, {"runs", runs}};
     std::string masses;
-    for (const auto& [station, mechs] : mass.items()) {
-      for (const auto& [name, m] : mechs.items()) {
-        masses += "- " + station + "/" + name + ": moving mass " + md::fixed(m["moving_mass_g"].get<double>(), 3) +
-                  " g (" + m["note"].get<std::string>() + ")\n";
-      }
+    for (const Json& m : mass) {
+      masses += "- " + m["station"].get<std::string>() + "/" + m["mechanism"].get<std::string>() + ": moving mass " +
+                md::fixed(m["moving_mass_g"].get<double>(), 3) + " g (" + m["note"].get<std::string>() + ")\n";
     }
     b.markdown = std::string(kPreamble) + table.str() + "\n" + masses + "\n" + problems;
     b.passed = failed == 0;

@@ -1,0 +1,143 @@
+#!/usr/bin/env python3
+"""Every command's --json document against its JSON Schema in docs/schemas/ (docs/conventions.md
+"JSON documents"), validated by python3-jsonschema (Debian), an implementation independent of the
+code that writes the documents.
+
+    json_schemas.py FIVEBAR SOURCE_DIR WORK_DIR
+
+Runs each subcommand on the showcase design (and on cases that change a document's shape: an
+unreachable pose, a target that is not covered, both collision forms, the step of simulate),
+validates stdout against docs/schemas/<command>.schema.json, validates the summary.json of a
+`fivebar run`, and checks what a schema cannot say: no object anywhere is keyed by one of the
+design's station names. Before that it shows that the validator rejects the shapes the rules forbid
+(stations keyed by name, a mechanism record without its name), so a schema that accepted
+everything would fail here.
+
+Exit 0 all valid, 1 a document failed (each failure printed), 77 python3-jsonschema missing (ctest
+reports the test as skipped; ./test.sh installs it).
+"""
+import copy
+import json
+import pathlib
+import shutil
+import subprocess
+import sys
+
+try:
+    from jsonschema import Draft202012Validator, RefResolver
+except ImportError:  # pragma: no cover
+    print("SKIP: python3-jsonschema is not installed (Debian package python3-jsonschema; ./test.sh installs it)")
+    sys.exit(77)
+
+FIVEBAR, SOURCE, WORK = str(pathlib.Path(sys.argv[1]).resolve()), pathlib.Path(sys.argv[2]).resolve(), pathlib.Path(sys.argv[3]).resolve()
+SCHEMAS = SOURCE / "docs" / "schemas"
+DESIGN = str(SOURCE / "designs" / "iros2022.yaml")
+STATIONS = {"index", "thumb"}  # the showcase's station names: never keys of an object
+
+failures = []
+
+
+def validator(name):
+    schema = json.loads((SCHEMAS / f"{name}.schema.json").read_text())
+    Draft202012Validator.check_schema(schema)
+    resolver = RefResolver(base_uri=SCHEMAS.as_uri() + "/", referrer=schema)
+    return Draft202012Validator(schema, resolver=resolver)
+
+
+def keyed_by_station(node, path="$"):
+    """Paths of objects that hold an object under a station name (a station keyed by its name)."""
+    found = []
+    if isinstance(node, dict):
+        for k, v in node.items():
+            if k in STATIONS and isinstance(v, dict):
+                found.append(f"{path}.{k}")
+            found += keyed_by_station(v, f"{path}.{k}")
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            found += keyed_by_station(v, f"{path}[{i}]")
+    return found
+
+
+def check(label, schema, doc):
+    errors = sorted(validator(schema).iter_errors(doc), key=lambda e: list(e.absolute_path))
+    for e in errors[:10]:
+        failures.append(f"{label}: {'/'.join(map(str, e.absolute_path)) or '(root)'}: {e.message[:300]}")
+    for p in keyed_by_station(doc):
+        failures.append(f"{label}: {p}: an object keyed by a station name (list station records instead)")
+    if not errors:
+        print(f"ok    {label}  ({schema}.schema.json)")
+
+
+def run(label, schema, args, codes=(0,)):
+    out = subprocess.run([FIVEBAR, *args, "--json"], cwd=WORK, capture_output=True, text=True, timeout=900)
+    if out.returncode not in codes:
+        failures.append(f"{label}: exit {out.returncode} (expected {codes}); stderr: {out.stderr[-500:]}")
+        return None
+    try:
+        doc = json.loads(out.stdout)
+    except json.JSONDecodeError as e:
+        failures.append(f"{label}: stdout is not one JSON document ({e})")
+        return None
+    check(label, schema, doc)
+    return doc
+
+
+def main():
+    if WORK.exists():
+        shutil.rmtree(WORK)
+    WORK.mkdir(parents=True)
+    for f in sorted(SCHEMAS.glob("*.schema.json")):
+        Draft202012Validator.check_schema(json.loads(f.read_text()))
+
+    out = str(WORK / "out")
+    coverage = run("coverage", "coverage", ["coverage", DESIGN])
+    # The validator must reject the forbidden shapes (a check that cannot fail is no check).
+    if coverage is not None:
+        bad = copy.deepcopy(coverage)
+        bad["stations"] = {s["station"]: s for s in bad["stations"]}
+        if not list(validator("coverage").iter_errors(bad)):
+            failures.append("self-test: stations keyed by name passed the coverage schema")
+        bad = copy.deepcopy(coverage)
+        del bad["stations"][0]["mechanisms"][0]["mechanism"]
+        if not list(validator("coverage").iter_errors(bad)):
+            failures.append("self-test: a mechanism record without \"mechanism\" passed the coverage schema")
+        bad = copy.deepcopy(coverage)
+        bad["stations"][0]["mechanisms"] = {m["mechanism"]: m for m in bad["stations"][0]["mechanisms"]}
+        if not list(validator("coverage").iter_errors(bad)):
+            failures.append("self-test: mechanisms keyed by name passed the coverage schema")
+        if not keyed_by_station({"x": {"index": {"margin_mm": 1}}}) or keyed_by_station({"index": 3}):
+            failures.append("self-test: the station-key walk is wrong")
+
+    run("coverage, not covered", "coverage", ["coverage", DESIGN, "-s", "index", "--ellipse", "6.25,15.5,30,30,0"], (1,))
+    run("fk", "fk", ["fk", DESIGN, "-s", "index", "-m", "lower", "--theta", "100,80"])
+    run("fk --all", "fk", ["fk", DESIGN, "-s", "index", "-m", "lower", "--theta", "100,80", "--all"])
+    run("fk, unreachable", "fk", ["fk", DESIGN, "-s", "index", "-m", "lower", "--theta", "180,0"], (1,))
+    run("ik", "ik", ["ik", DESIGN, "-s", "index", "-m", "lower", "--point", "6.25,15.5"])
+    run("ik --all", "ik", ["ik", DESIGN, "-s", "index", "-m", "lower", "--point", "6.25,15.5", "--all"])
+    run("ik, unreachable", "ik", ["ik", DESIGN, "-s", "index", "-m", "lower", "--point", "60,15.5"], (1,))
+    run("workspace", "workspace", ["workspace", DESIGN, "--spacing", "0.5", "--out", out + "/ws"])
+    run("collision map", "collision", ["collision", DESIGN, "-s", "index", "--spacing", "1.5", "--out", out + "/col"])
+    run("collision pair", "collision", ["collision", DESIGN, "-s", "index", "--upper", "6,18", "--lower", "6,14"], (0, 1))
+    run("pattern", "pattern", ["pattern", DESIGN, "-s", "thumb", "--pattern", "twist", "--out", out + "/pat"])
+    run("sweep", "sweep", ["sweep", DESIGN, "--no-plots", "--out", out + "/sweep"])
+    run("parts", "parts", ["parts", DESIGN, "--no-render", "--out", out])
+    run("export", "export", ["export", DESIGN, "--out", out + "/export"])
+    run("report stability", "report-stability", ["report", "stability", DESIGN, "-s", "index", "-q"])
+    run("report accuracy", "report-accuracy", ["report", "accuracy", DESIGN, "-s", "index", "--quick", "-q", "--out", out])
+    run("simulate", "simulate", ["simulate", DESIGN, "-s", "index", "--pattern", "stretch", "--no-render", "--out", out + "/sim"])
+    run("simulate --step", "simulate", ["simulate", DESIGN, "-s", "index", "--step", "--no-render", "--out", out + "/sim"])
+    run("tolerance", "tolerance", ["tolerance", DESIGN])
+    doc = run("run", "run", ["run", DESIGN, "-q", "--out", out + "/run", "-P",
+                             "kinematics,workspace,coverage,collision,pattern,export"])
+    if doc is not None:
+        summary = json.loads(pathlib.Path(doc["summary_json"]).read_text())
+        check("run: summary.json", "run", summary)
+
+    for f in failures:
+        print("FAIL  " + f)
+    print(f"{len(failures)} failure(s)")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
