@@ -5,10 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <filesystem>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "common.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/io.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 
@@ -19,149 +24,112 @@ namespace {
 struct ToleranceCliOptions {
   std::string design;
   std::string station;
+  std::string out;
+  double spacing_mm = 0.25;
+  bool no_files = false;
   bool json = false;
 };
 
-/// Grid points per axis of the target ellipse's bounding box (those inside the ellipse are used).
-constexpr int kGrid = 21;
-
-/// Points of a kGrid x kGrid grid over the filled ellipse (its own frame), centre included.
-std::vector<Vec2> ellipse_grid(const Ellipse& e) {
-  std::vector<Vec2> out;
-  const double c = std::cos(e.angle);
-  const double s = std::sin(e.angle);
-  for (int i = 0; i < kGrid; ++i) {
-    for (int j = 0; j < kGrid; ++j) {
-      const double u = -1.0 + 2.0 * i / (kGrid - 1);
-      const double v = -1.0 + 2.0 * j / (kGrid - 1);
-      if (u * u + v * v > 1.0) continue;
-      const double x = 0.5 * e.axes.x() * u;
-      const double y = 0.5 * e.axes.y() * v;
-      out.push_back(e.center + Vec2(c * x - s * y, s * x + c * y));
-    }
-  }
-  return out;
-}
-
-Json point_json(const Vec2& p) { return Json::array({p.x(), p.y()}); }
 std::string point(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ")"; }
 
-struct MechanismTolerance {
-  ToleranceEstimate centre;
-  MonteCarloTolerance monte_carlo;
-  double mc_3sigma_mm = 0.0;  ///< 3 sqrt(largest eigenvalue) of the Monte Carlo covariance
-  double worst_3sigma_mm = 0.0;
-  Vec2 worst_3sigma_at{0.0, 0.0};
-  double worst_case_mm = 0.0;
-  Vec2 worst_case_at{0.0, 0.0};
-  double worst_resolution_um = 0.0;
-  std::size_t points = 0;
-  std::size_t not_ok = 0;  ///< grid points unreachable or singular (no estimate)
-};
-
-MechanismTolerance analyse(const Mechanism& m, const Ellipse& target, const ToleranceSettings& t) {
-  MechanismTolerance r;
-  const ParameterSigmas sigma = parameter_sigmas(t);
-  const double per_count = angle_per_count(t.adc_bits);
-  r.centre = tolerance_first_order(m, target.center, sigma, per_count);
-  r.monte_carlo = tolerance_monte_carlo(m, target.center, sigma, t.samples, t.seed);
-  const Eigen::Matrix2d& C = r.monte_carlo.covariance;
-  const double mid = 0.5 * (C(0, 0) + C(1, 1));
-  r.mc_3sigma_mm = 3.0 * std::sqrt(std::max(0.0, mid + std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1))));
-  for (const Vec2& p : ellipse_grid(target)) {
-    ++r.points;
-    const ToleranceEstimate e = tolerance_first_order(m, p, sigma, per_count);
-    if (e.status != Status::ok) {
-      ++r.not_ok;
-      continue;
-    }
-    if (e.ellipse_semi_axes.x() > r.worst_3sigma_mm) {
-      r.worst_3sigma_mm = e.ellipse_semi_axes.x();
-      r.worst_3sigma_at = p;
-    }
-    if (e.worst_case_mm > r.worst_case_mm) {
-      r.worst_case_mm = e.worst_case_mm;
-      r.worst_case_at = p;
-    }
-    r.worst_resolution_um = std::max(r.worst_resolution_um, e.resolution_um);
+void print_mechanism(const ToleranceMap& r) {
+  std::cout << "  " << r.mechanism << ": at the centre " << point(r.target.center) << ": ";
+  if (r.centre.status != Status::ok) {
+    std::cout << to_string(r.centre.status) << " (no first-order estimate)\n";
+  } else {
+    std::cout << "3-sigma " << fixed(r.centre.ellipse_semi_axes.x(), 4) << " mm (Monte Carlo "
+              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst case " << fixed(r.centre.worst_case_mm, 4)
+              << " mm, resolution " << fixed(r.centre.resolution_um, 3) << " um per count, play "
+              << fixed(r.centre_play.extent_mm, 4) << " mm\n";
   }
-  return r;
-}
-
-Json to_json(const MechanismTolerance& r) {
-  Json j;
-  j["centre_status"] = std::string(to_string(r.centre.status));
-  j["centre_3sigma_mm"] = r.centre.ellipse_semi_axes.x();
-  j["centre_3sigma_minor_mm"] = r.centre.ellipse_semi_axes.y();
-  j["centre_3sigma_angle_deg"] = angle_deg(r.centre.ellipse_angle);
-  j["centre_worst_case_mm"] = r.centre.worst_case_mm;
-  j["centre_resolution_um"] = r.centre.resolution_um;
-  j["centre_monte_carlo_3sigma_mm"] = r.mc_3sigma_mm;
-  j["monte_carlo_samples_used"] = r.monte_carlo.used;
-  j["monte_carlo_samples_failed"] = r.monte_carlo.failed;
-  j["target_points"] = r.points;
-  j["target_points_not_ok"] = r.not_ok;
-  j["target_worst_3sigma_mm"] = r.worst_3sigma_mm;
-  j["target_worst_3sigma_at_mm"] = point_json(r.worst_3sigma_at);
-  j["target_worst_case_mm"] = r.worst_case_mm;
-  j["target_worst_case_at_mm"] = point_json(r.worst_case_at);
-  j["target_worst_resolution_um"] = r.worst_resolution_um;
-  return j;
+  std::cout << "    over the target (" << r.target_points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)
+            << " mm at " << point(r.worst_3sigma_at) << ", worst case up to " << fixed(r.worst_case_mm, 4) << " mm at "
+            << point(r.worst_case_at) << ", resolution up to " << fixed(r.worst_resolution_um, 3)
+            << " um per count, play up to " << fixed(r.worst_play_mm, 4) << " mm at " << point(r.worst_play_at);
+  if (r.target_not_ok > 0) std::cout << "; " << r.target_not_ok << " points unreachable or singular (no estimate)";
+  std::cout << "\n";
+  const RobustCoverage& c = r.robust;
+  std::cout << "    robust coverage: margin " << fixed(c.margin_mm, 4) << " mm, sigma " << fixed(c.sigma_mm, 4)
+            << " mm per printed device: " << fixed(100.0 * c.fraction, 1) << " % of devices keep "
+            << fixed(c.robust_margin_mm, 4) << " mm -> " << (c.covered ? "covered" : "NOT covered")
+            << " at " << point(c.robust_point) << " (first order: at most " << fixed(100.0 * c.fraction_first_order, 2)
+            << " % cover; Monte Carlo "
+            << fixed(100.0 * c.fraction_monte_carlo, 2) << " % of " << c.samples << ")\n";
 }
 
 int run_tolerance(const ToleranceCliOptions& opt) {
   const Design design = load(opt.design);
   const auto stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
+  if (!(opt.spacing_mm > 0.0) || !std::isfinite(opt.spacing_mm)) throw InputError("--spacing must be > 0 mm");
   const ToleranceSettings* given = design.get<ToleranceSettings>();
   const ToleranceSettings t = given ? *given : ToleranceSettings{};
-  const ParameterSigmas sigma = parameter_sigmas(t);
   const auto progress = terminal_progress("tolerance");
 
+  // Analyse everything before writing anything.
+  std::vector<std::vector<ToleranceMap>> maps;
+  std::vector<ToleranceSources> first_sources;
+  for (const Station* s : stations) {
+    if (progress) progress("station " + s->name);
+    maps.emplace_back();
+    for (const Mechanism* m : s->mechanisms()) {
+      const ToleranceSources src = tolerance_sources(design, *s, *m);
+      if (first_sources.empty()) first_sources.push_back(src);
+      maps.back().push_back(tolerance_map(*m, s->name, s->target, src, opt.spacing_mm));
+    }
+  }
+  const ToleranceSources& src = first_sources.front();
   Json doc = {{"command", "tolerance"}, {"design", design.name}};
   doc["tolerance"] = {{"source", given ? "design" : "defaults (assumptions)"},
-                      {"link_length_sigma_mm", sigma[0]},
-                      {"base_sigma_mm", sigma[4]},
-                      {"angle_sigma_deg", t.angle_sigma_deg},
-                      {"adc_bits", t.adc_bits},
+                      {"link_length_sigma_mm", src.sigma[0]},
+                      {"base_sigma_mm", src.sigma[4]},
+                      {"angle_sigma_deg", angle_deg(src.sigma[8])},
+                      {"angle_offset_sigma_deg", t.angle_sigma_deg},
+                      {"resolution_source", src.resolution_source},
+                      {"leg_play_mm", Json::array({src.leg_play_mm[0], src.leg_play_mm[1]})},
+                      {"robust_fraction", src.robust_fraction},
                       {"samples", t.samples},
                       {"seed", t.seed}};
   doc["stations"] = Json::array();
   if (!opt.json) {
     std::cout << "tolerances " << (given ? "from the design" : "by default (assumptions to replace)")
-              << ": link length sigma " << fixed(sigma[0], 4) << " mm, base " << fixed(sigma[4], 4)
-              << " mm per axis, joint angle " << fixed(t.angle_sigma_deg, 3) << " deg, " << t.adc_bits
-              << "-bit counts per turn; Monte Carlo " << t.samples << " devices, seed " << t.seed << "\n";
+              << ": link length sigma " << fixed(src.sigma[0], 4) << " mm, base " << fixed(src.sigma[4], 4)
+              << " mm per axis, joint angle " << fixed(angle_deg(src.sigma[8]), 3)
+              << " deg (offset, potentiometer linearity, ADC), leg play " << fixed(src.leg_play_mm[0], 3) << " / "
+              << fixed(src.leg_play_mm[1], 3) << " mm; resolution from " << src.resolution_source << "; Monte Carlo "
+              << t.samples << " devices, seed " << t.seed << "\n";
   }
-  for (const Station* s : stations) {
-    if (progress) progress("station " + s->name);
+  std::vector<std::string> files;
+  std::filesystem::path dir;
+  if (!opt.no_files) {
+    dir = opt.out.empty() ? resolve_output_dir("outputs", design.name) / "tolerance" : std::filesystem::path(opt.out);
+    make_directories(dir);
+  }
+  std::optional<WriteFence> fence;  // nothing of this command lands outside its folder (fivebar/io.hpp)
+  if (!opt.no_files) fence.emplace(dir);
+  bool all_covered = true;
+  for (std::size_t k = 0; k < stations.size(); ++k) {
+    const Station* s = stations[k];
     Json js = {{"station", s->name}, {"mechanisms", Json::array()}};
     if (!opt.json) std::cout << "station " << s->name << "\n";
-    for (const Mechanism* m : s->mechanisms()) {
-      const MechanismTolerance r = analyse(*m, s->target, t);
-      Json jm = {{"mechanism", m->name}};
-      jm.update(to_json(r));
-      js["mechanisms"].push_back(std::move(jm));
-      if (opt.json) continue;
-      std::cout << "  " << m->name << ": at the centre " << point(s->target.center) << ": ";
-      if (r.centre.status != Status::ok) {
-        std::cout << to_string(r.centre.status) << " (no first-order estimate)\n";
-      } else {
-        std::cout << "3-sigma " << fixed(r.centre.ellipse_semi_axes.x(), 4) << " mm (Monte Carlo "
-                  << fixed(r.mc_3sigma_mm, 4) << " mm), worst case " << fixed(r.centre.worst_case_mm, 4)
-                  << " mm, resolution " << fixed(r.centre.resolution_um, 3) << " um per count\n";
-      }
-      std::cout << "    over the target (" << r.points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)
-                << " mm at " << point(r.worst_3sigma_at) << ", worst case up to " << fixed(r.worst_case_mm, 4)
-                << " mm at " << point(r.worst_case_at) << ", resolution up to " << fixed(r.worst_resolution_um, 3)
-                << " um per count";
-      if (r.not_ok > 0) std::cout << "; " << r.not_ok << " points unreachable or singular (no estimate)";
-      std::cout << "\n";
+    for (const ToleranceMap& r : maps[k]) {
+      js["mechanisms"].push_back(to_json(r));
+      all_covered = all_covered && r.robust.covered;
+      if (!opt.json) print_mechanism(r);
+    }
+    if (!opt.no_files) {
+      for (const auto& f : write_tolerance_files(dir, *s, maps[k])) files.push_back(f.generic_string());
     }
     doc["stations"].push_back(std::move(js));
   }
-  if (opt.json) print_json(doc);
-  return kOk;
+  doc["files"] = files;
+  doc["robust_covered"] = all_covered;
+  if (opt.json) {
+    print_json(doc);
+  } else if (!files.empty()) {
+    std::cout << "wrote " << files.size() << " files into " << dir.generic_string() << "\n";
+  }
+  return all_covered ? kOk : kCheckFailed;
 }
 
 }  // namespace
@@ -171,15 +139,23 @@ void setup_tolerance(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "tolerance",
       "How far the printed device's tactor can be from where the controller believes it is: 3-sigma and "
-      "worst-case error (mm) and resolution per ADC count at the target centre and over the target ellipse");
+      "worst-case error (mm), resolution per ADC count and clearance play at the target centre and over the target "
+      "ellipse, maps over the reachable region, and robust coverage (the target covered by a fraction of printed "
+      "devices)");
   add_design_argument(*sub, opt->design);
   sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
-  sub->add_flag("--json", opt->json,
-                "Print {\"tolerance\": {...}, \"stations\": {S: {\"lower\": ..., \"upper\": ...}}} on stdout and "
-                "nothing else");
+  sub->add_option("--spacing", opt->spacing_mm, "Grid spacing of the maps over the reachable region (mm)")
+      ->capture_default_str()
+      ->type_name("MM");
+  sub->add_option("-o,--out", opt->out, "Directory for the maps (default: outputs/<design>/tolerance)")
+      ->type_name("DIR");
+  sub->add_flag("--no-files", opt->no_files, "Print the figures only: no VTK maps, no pictures");
+  sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
   sub->footer(
       "Tolerances come from the design's tolerance: section (docs/design-file.md), else from its defaults, which are "
-      "assumptions.\nExit status: 0 success, 2 bad input, 3 internal error.");
+      "assumptions.\nFiles: <station>-<mechanism>-tolerance.vti (ParaView: three_sigma_mm, worst_case_mm, resolution_um, "
+      "play_mm, status) and <station>-tolerance.svg|.png.\nExit status: 0 every mechanism covers its target for "
+      "tolerance.robust_fraction of printed devices, 1 one does not, 2 bad input, 3 internal error.");
   sub->callback([opt]() { finish(run_tolerance(*opt)); });
 }
 

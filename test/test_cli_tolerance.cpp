@@ -10,12 +10,14 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "cli_test.hpp"
 #include "json_records.hpp"
 
+namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
 using ft::Outcome;
 using nlohmann::json;
@@ -27,22 +29,24 @@ namespace {
 class CliTolerance : public ft::CliTest {
  protected:
   CliTolerance() : CliTest("fivebar_test_cli_tol") {}
-};
 
-const char* const kSection =
-    "tolerance:\n"
-    "  link_sigma_mm: 0.05        # assumption: a resin print's pin-centre distance\n"
-    "  pin_sigma_mm: 0.025        # assumption: each pin hole's position, per axis\n"
-    "  base_sigma_mm: 0.1         # assumption: base joints placed by hand\n"
-    "  angle_sigma_deg: 0.5       # assumption: joint angle offset left after calibration\n"
-    "  adc_bits: 16 ";
+  /// The paper's design with its tolerance: section replaced by `section`.
+  fs::path design_with_tolerance(const std::string& name, const std::string& section) {
+    std::string text = ft::slurp(kDesign);
+    const auto a = text.find("tolerance:\n");
+    const auto b = text.find("# A small link-dimension sweep", a);
+    EXPECT_TRUE(a != std::string::npos && b != std::string::npos);
+    if (a != std::string::npos && b != std::string::npos) text.replace(a, b - a, section + "\n");
+    return write(name, text);
+  }
+};
 
 TEST_F(CliTolerance, JsonShapeMirrorSymmetryAndMonteCarloAgreement) {
   const Outcome r = run({"tolerance", kDesign, "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = parse(r);
   EXPECT_EQ(j["tolerance"]["source"], "design");
-  EXPECT_EQ(j["tolerance"]["adc_bits"], 16);
+  EXPECT_THAT(j["tolerance"]["resolution_source"].get<std::string>(), HasSubstr("controller"));
   EXPECT_EQ(j["command"], "tolerance");
   ASSERT_EQ(ft::record_names(j["stations"], "station"), (std::vector<std::string>{"index", "thumb"}));
   const json& lo = ft::mechanism(ft::station(j, "index"), "lower");
@@ -76,11 +80,17 @@ TEST_F(CliTolerance, JsonShapeMirrorSymmetryAndMonteCarloAgreement) {
 }
 
 TEST_F(CliTolerance, FiguresScaleWithTolerancesAndCounts) {
-  const Outcome base = run({"tolerance", kDesign, "--station", "thumb", "--json"});
-  const auto doubled = design_with("doubled.yaml", kSection,
-                                   "tolerance:\n  link_sigma_mm: 0.1\n  pin_sigma_mm: 0.05\n  base_sigma_mm: 0.2\n"
-                                   "  angle_sigma_deg: 1.0\n  adc_bits: 12 ");
-  const Outcome twice = run({"tolerance", doubled.string(), "--station", "thumb", "--json"});
+  // Linearity 0: the sigmas are exactly the ones given, so they double with the file's numbers.
+  const auto single = design_with_tolerance("single.yaml",
+                                            "tolerance:\n  link_sigma_mm: 0.05\n  pin_sigma_mm: 0.025\n"
+                                            "  base_sigma_mm: 0.1\n  angle_sigma_deg: 0.5\n  adc_bits: 16\n"
+                                            "  linearity_percent: 0");
+  const auto doubled = design_with_tolerance("doubled.yaml",
+                                             "tolerance:\n  link_sigma_mm: 0.1\n  pin_sigma_mm: 0.05\n"
+                                             "  base_sigma_mm: 0.2\n  angle_sigma_deg: 1.0\n  adc_bits: 12\n"
+                                             "  linearity_percent: 0");
+  const Outcome base = run({"tolerance", single.string(), "--station", "thumb", "--json", "--no-files"});
+  const Outcome twice = run({"tolerance", doubled.string(), "--station", "thumb", "--json", "--no-files"});
   ASSERT_EQ(base.code, 0) << base.err;
   ASSERT_EQ(twice.code, 0) << twice.err;
   const json a = parse(base);
@@ -101,10 +111,11 @@ TEST_F(CliTolerance, FiguresScaleWithTolerancesAndCounts) {
 }
 
 TEST_F(CliTolerance, ZeroTolerancesGiveZeroError) {
-  const auto zero = design_with("zero.yaml", kSection,
-                                "tolerance:\n  link_sigma_mm: 0\n  pin_sigma_mm: 0\n  base_sigma_mm: 0\n"
-                                "  angle_sigma_deg: 0\n  adc_bits: 16 ");
-  const Outcome r = run({"tolerance", zero.string(), "--json"});
+  const auto zero = design_with_tolerance("zero.yaml",
+                                          "tolerance:\n  link_sigma_mm: 0\n  pin_sigma_mm: 0\n  base_sigma_mm: 0\n"
+                                          "  angle_sigma_deg: 0\n  linearity_percent: 0\n  pin_play_mm: 0\n"
+                                          "  shaft_play_mm: 0\n  backlash_deg: 0");
+  const Outcome r = run({"tolerance", zero.string(), "--json", "--no-files"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = parse(r);
   for (const json& st : j["stations"]) {
@@ -115,6 +126,12 @@ TEST_F(CliTolerance, ZeroTolerancesGiveZeroError) {
       EXPECT_EQ(m["target_worst_case_mm"].get<double>(), 0.0);
       EXPECT_EQ(m["centre_monte_carlo_3sigma_mm"].get<double>(), 0.0);
       EXPECT_GT(m["centre_resolution_um"].get<double>(), 0.0);
+      EXPECT_EQ(m["centre_play_mm"].get<double>(), 0.0);
+      EXPECT_EQ(m["target_worst_play_mm"].get<double>(), 0.0);
+      // No spread: every printed device is the design, and the margin is the design's.
+      EXPECT_EQ(m["robust_coverage"]["margin_sigma_mm"].get<double>(), 0.0);
+      EXPECT_EQ(m["robust_coverage"]["robust_margin_mm"], m["robust_coverage"]["margin_mm"]);
+      EXPECT_EQ(m["robust_coverage"]["fraction_monte_carlo"].get<double>(), 1.0);
     }
   }
 }
@@ -132,7 +149,7 @@ TEST_F(CliTolerance, TextSaysWhereTheTolerancesComeFrom) {
 }
 
 TEST_F(CliTolerance, BadInputIsExitTwoNamingFileLineAndKey) {
-  const auto bad = design_with("bad.yaml", "  adc_bits: 16 ", "  adc_bits: 40 ");
+  const auto bad = design_with("bad.yaml", "  samples: 10000 ", "  adc_bits: 40\n  samples: 10000 ");
   const Outcome r = run({"tolerance", bad.string()});
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.out, IsEmpty());

@@ -3,6 +3,7 @@
 // small tolerances, determinism for a seed, and a status on a type II singularity.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -11,6 +12,8 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/print.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 #include "paper.hpp"
@@ -217,11 +220,14 @@ TEST(ToleranceSection, DefaultsRoundTripAndSigmas) {
   const Design d = load_design_from_string(std::string(kStation) + "tolerance:\n", "defaults.yaml");
   const ToleranceSettings* t = d.get<ToleranceSettings>();
   ASSERT_NE(t, nullptr);
-  EXPECT_EQ(t->adc_bits, 16);
+  EXPECT_FALSE(t->adc_bits.has_value());  // the controller's ADC decides, or 2^16 per turn
+  EXPECT_FALSE(t->pin_play_mm.has_value());  // print.pin_clearance
+  EXPECT_EQ(t->robust_fraction, 0.997);
   const Design given = load_design_from_string(
       std::string(kStation) +
           "tolerance: {link_sigma_mm: 0.03, pin_sigma_mm: 0.04, base_sigma_mm: 0.2, angle_sigma_deg: 1.5,\n"
-          "            adc_bits: 12, samples: 500, seed: 9}\n",
+          "            adc_bits: 12, pin_play_mm: 0.12, shaft_play_mm: 0.03, backlash_deg: 2,\n"
+          "            linearity_percent: 0.5, pot_travel_deg: 340, robust_fraction: 0.99, samples: 500, seed: 9}\n",
       "given.yaml");
   const ToleranceSettings* g = given.get<ToleranceSettings>();
   ASSERT_NE(g, nullptr);
@@ -236,6 +242,12 @@ TEST(ToleranceSection, DefaultsRoundTripAndSigmas) {
   EXPECT_EQ(r->base_sigma_mm, 0.2);
   EXPECT_EQ(r->angle_sigma_deg, 1.5);
   EXPECT_EQ(r->adc_bits, 12);
+  EXPECT_EQ(r->pin_play_mm, 0.12);
+  EXPECT_EQ(r->shaft_play_mm, 0.03);
+  EXPECT_EQ(r->backlash_deg, 2.0);
+  EXPECT_EQ(r->linearity_percent, 0.5);
+  EXPECT_EQ(r->pot_travel_deg, 340.0);
+  EXPECT_EQ(r->robust_fraction, 0.99);
   EXPECT_EQ(r->samples, 500u);
   EXPECT_EQ(r->seed, 9u);
   // Link length: 0.03 mm of length and two holes of 0.04 mm along it: sqrt(0.0009 + 0.0032).
@@ -255,6 +267,10 @@ TEST(ToleranceSection, BadValuesNameFileLineAndKey) {
       {"tolerance:\n  link_sigma_mm: -1\n", "bad.yaml:8: tolerance.link_sigma_mm"},
       {"tolerance:\n  angle_sigma_deg: 20\n", "bad.yaml:8: tolerance.angle_sigma_deg"},
       {"tolerance:\n  adc_bits: 40\n", "bad.yaml:8: tolerance.adc_bits"},
+      {"tolerance:\n  pin_play_mm: -0.1\n", "bad.yaml:8: tolerance.pin_play_mm"},
+      {"tolerance:\n  backlash_deg: 45\n", "bad.yaml:8: tolerance.backlash_deg"},
+      {"tolerance:\n  pot_travel_deg: 0\n", "bad.yaml:8: tolerance.pot_travel_deg"},
+      {"tolerance:\n  robust_fraction: 1\n", "bad.yaml:8: tolerance.robust_fraction"},
       {"tolerance:\n  samples: 1.5\n", "bad.yaml:8: tolerance.samples"},
       {"tolerance:\n  sigma: 1\n", "bad.yaml:8: tolerance.sigma"},
   };
@@ -267,6 +283,215 @@ TEST(ToleranceSection, BadValuesNameFileLineAndKey) {
       EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
     }
   }
+}
+
+// --- Play set -------------------------------------------------------------------------------------
+
+/// A uniform point of the disc of radius r.
+Vec2 in_disc(std::mt19937_64& rng, double r) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const double rho = r * std::sqrt(u(rng));
+  const double phi = 2.0 * std::numbers::pi * u(rng);
+  return {rho * std::cos(phi), rho * std::sin(phi)};
+}
+
+TEST(TolerancePlay, EveryDeviceWithPlayPutsItsTactorInTheSetAndReachesItsCorners) {
+  // An independent formulation of a device with play: shaft centres, elbows and the tactor joint
+  // displaced within their clearances and the proximal links turned within the backlash; the
+  // tactor is the intersection of its two distal circles, found here by the law of cosines.
+  const std::uint64_t seed = test_seed();
+  SCOPED_TRACE("FIVEBAR_TEST_SEED=" + std::to_string(seed));
+  std::mt19937_64 rng(seed);
+  const double shaft = 0.02, pin = 0.15, backlash = 1.0 * std::numbers::pi / 180.0;
+  for (const char* which : {"lower", "upper"}) {
+    const Mechanism m = paper_mechanism("index", which);
+    const std::array<double, 2> r{shaft + pin + 2.0 * m.L[0] * std::sin(backlash / 4.0),
+                                  shaft + 2.0 * pin + 2.0 * m.L[1] * std::sin(backlash / 4.0)};
+    for (const Vec2& P : {Vec2(6.25, 15.5), Vec2(2.0, which[0] == 'l' ? 12.0 : 19.0), Vec2(10.0, 15.5)}) {
+      SCOPED_TRACE(std::string(which) + " at " + std::to_string(P.x()) + "," + std::to_string(P.y()));
+      const PlaySet set = tolerance_play(m, P, r);
+      ASSERT_EQ(set.status, Status::ok);
+      ASSERT_EQ(set.corners.size(), 4u);
+      const Pose q = ik(m, P);
+      double farthest = 0.0;
+      std::uniform_real_distribution<double> turn(-0.5 * backlash, 0.5 * backlash);
+      std::bernoulli_distribution edge(0.5);
+      for (int k = 0; k < 20000; ++k) {
+        // Half the devices have every play at its edge, so that the corners are approached.
+        const bool at_edge = edge(rng);
+        const auto play = [&](double c) {
+          const Vec2 d = in_disc(rng, c);
+          return at_edge && d.norm() > 0.0 ? Vec2(d * (c / d.norm())) : d;
+        };
+        const double d1 = at_edge ? (edge(rng) ? 0.5 : -0.5) * backlash : turn(rng);
+        const double d2 = at_edge ? (edge(rng) ? 0.5 : -0.5) * backlash : turn(rng);
+        const Vec2 A1 = m.O1 + play(shaft) + m.L[0] * Vec2(std::cos(q.theta1 + d1), std::sin(q.theta1 + d1)) + play(pin);
+        const Vec2 A2 = m.O2 + play(shaft) + m.L[1] * Vec2(std::cos(q.theta2 + d2), std::sin(q.theta2 + d2)) +
+                        play(pin) - play(pin);
+        // Law of cosines for the tactor on the nominal side of A1 -> A2.
+        const Vec2 c = A2 - A1;
+        const double d = c.norm();
+        const double cos_a = (m.L[2] * m.L[2] + d * d - m.L[3] * m.L[3]) / (2.0 * m.L[2] * d);
+        ASSERT_LT(std::abs(cos_a), 1.0);
+        const double side = (q.A2 - q.A1).x() * (q.P - q.A1).y() - (q.A2 - q.A1).y() * (q.P - q.A1).x() > 0 ? 1.0 : -1.0;
+        const double a = std::atan2(c.y(), c.x()) + side * std::acos(cos_a);
+        const Vec2 X = A1 + m.L[2] * Vec2(std::cos(a), std::sin(a));
+        EXPECT_TRUE(in_play_set(m, P, r, X, 1e-9)) << k;
+        farthest = std::max(farthest, (X - P).norm());
+      }
+      // No device leaves the set's extent; the devices at the edges come close to its corners.
+      EXPECT_LE(farthest, set.extent_mm * (1.0 + 1e-9));
+      EXPECT_GT(farthest, 0.6 * set.extent_mm);
+    }
+  }
+}
+
+TEST(TolerancePlay, FirstOrderAgreesForSmallPlayAndOverstatesNearTypeTwo) {
+  const Mechanism m = paper_mechanism("index", "lower");
+  const Vec2 P(6.25, 15.5);
+  EXPECT_EQ(tolerance_play(m, P, {0.0, 0.0}).extent_mm, 0.0);
+  // Small play: the exact corners approach the parallelogram's, the gap shrinking like r^2.
+  double previous_gap = 0.0;
+  for (const double r : {1e-1, 1e-2, 1e-3}) {
+    const PlaySet s = tolerance_play(m, P, {r, r});
+    ASSERT_EQ(s.status, Status::ok);
+    const double gap = std::abs(s.extent_mm - s.linear_extent_mm) / s.linear_extent_mm;
+    if (previous_gap > 0.0) EXPECT_LT(gap, 0.2 * previous_gap) << r;
+    previous_gap = gap;
+    EXPECT_NEAR(s.extent_mm / r, s.linear_extent_mm / r, 0.05 * s.linear_extent_mm / r);
+  }
+  // Near a type II singularity: down the symmetry axis the tactor nears the elbows' line, where
+  // the distal links align; stop where the tactor angle's sine drops below 0.05.
+  Vec2 Q = P;
+  for (double y = 15.5; y > 0.0; y -= 1e-3) {
+    const Pose q = ik(m, Vec2(6.25, y));
+    if (q.status != Status::ok) break;
+    Q = Vec2(6.25, y);
+    if (q.type2_sin < 0.05) break;
+  }
+  const Pose near = ik(m, Q);
+  ASSERT_EQ(near.status, Status::ok);
+  ASSERT_LT(near.type2_sin, 0.05);
+  const PlaySet s = tolerance_play(m, Q, {0.05, 0.05});
+  // The linearisation grows like 1 / sin; the exact set stays smaller (or is flagged).
+  EXPECT_GT(s.linear_extent_mm, 1.2 * s.extent_mm);
+}
+
+// --- Robust coverage -----------------------------------------------------------------------------
+
+TEST(ToleranceRobust, NormalQuantileInvertsTheNormalDistribution) {
+  EXPECT_NEAR(normal_quantile(0.975), 1.959963984540054, 1e-12);
+  EXPECT_NEAR(normal_quantile(0.5), 0.0, 1e-14);
+  for (const double p : {1e-12, 1e-6, 0.003, 0.2, 0.8, 0.997, 1.0 - 1e-9}) {
+    const double z = normal_quantile(p);
+    EXPECT_NEAR(0.5 * std::erfc(-z / std::numbers::sqrt2), p, 1e-13 * std::max(p, 1e-3)) << p;
+  }
+  EXPECT_THROW((void)normal_quantile(0.0), InputError);
+  EXPECT_THROW((void)normal_quantile(1.0), InputError);
+}
+
+TEST(ToleranceRobust, FirstOrderAgreesWithMonteCarloWhereOnePointLimitsTheMargin) {
+  // A small target near the lower mechanism's outer reach on one side only: one boundary point
+  // sets the margin, so the first order (a normal margin) should match the sampled devices.
+  const Mechanism m = paper_mechanism("index", "lower");
+  Ellipse e;
+  // Centre 22.9 mm from O2 = (12.5, 0), radius 1: 0.1 mm inside leg 2's reach L2 + L4 = 24.
+  const Vec2 dir = Vec2(-0.8192, 0.5735).normalized();
+  e.center = Vec2(12.5, 0.0) + 22.9 * dir;
+  e.axes = {2.0, 2.0};
+  ParameterSigmas sigma{};
+  for (std::size_t j = 0; j < 8; ++j) sigma[j] = 0.05;
+  const RobustCoverage r = robust_coverage(m, e, sigma, 0.9, 20000, 5);
+  ASSERT_GT(r.margin_mm, 0.0);
+  ASSERT_GT(r.sigma_mm, 0.0);
+  SCOPED_TRACE("margin " + std::to_string(r.margin_mm) + " sigma " + std::to_string(r.sigma_mm));
+  // Not trivially covered or uncovered: the comparison means something.
+  ASSERT_GT(r.fraction_monte_carlo, 0.3);
+  ASSERT_LT(r.fraction_monte_carlo, 0.999);
+  EXPECT_NEAR(r.fraction_first_order, r.fraction_monte_carlo, 4.0 * r.monte_carlo_stderr + 0.01);
+  EXPECT_NEAR(r.robust_margin_mm, r.quantile_margin_mm, 0.05 * r.sigma_mm + 0.002);
+  // One dominant point: |g|^2 of the outer reach R = |b - O| against L1 + L3 (both +1) and the
+  // base's unit vector: sigma = 0.05 sqrt(1 + 1 + 1) over those three parameters.
+  EXPECT_NEAR(r.sigma_mm, 0.05 * std::sqrt(3.0), 1e-3);
+}
+
+TEST(ToleranceRobust, ZeroSigmaKeepsTheMarginAndSamplesAreDeterministic) {
+  const Mechanism m = paper_mechanism("index", "upper");
+  Ellipse e;
+  e.center = {6.25, 15.5};
+  e.axes = {15.0, 12.0};
+  const RobustCoverage zero = robust_coverage(m, e, ParameterSigmas{}, 0.997, 100, 1);
+  EXPECT_EQ(zero.sigma_mm, 0.0);
+  EXPECT_NEAR(zero.robust_margin_mm, zero.margin_mm, 1e-9);
+  EXPECT_EQ(zero.fraction_monte_carlo, 1.0);
+  ParameterSigmas sigma{};
+  sigma.fill(0.1);
+  const RobustCoverage a = robust_coverage(m, e, sigma, 0.997, 3000, 11);
+  const RobustCoverage b = robust_coverage(m, e, sigma, 0.997, 3000, 11);
+  EXPECT_EQ(a.quantile_margin_mm, b.quantile_margin_mm);
+  EXPECT_EQ(a.samples_covering, b.samples_covering);
+}
+
+// --- Sources and maps ------------------------------------------------------------------------------
+
+TEST(ToleranceSources, ResolutionFromTheControllersAdcAndLinearityInQuadrature) {
+  Design d;
+  d.name = "t";
+  Station s;
+  s.name = "index";
+  s.lower = paper_mechanism("index", "lower");
+  d.stations.push_back(s);
+  ToleranceSettings t;
+  t.angle_sigma_deg = 0.3;
+  t.linearity_percent = 0.5;
+  t.pot_travel_deg = 300.0;
+  d.set(t);
+  ControllerSettings c;  // 16 bits over 20 V, 60 deg per volt
+  d.set(c);
+  PrintSettings print;
+  print.pin_clearance = 0.1;
+  d.set(print);
+  const ToleranceSources src = tolerance_sources(d, d.stations[0], *d.stations[0].lower);
+  const double deg = std::numbers::pi / 180.0;
+  EXPECT_NEAR(src.rad_per_count[0], 20.0 / 65536.0 * 60.0 * deg, 1e-15);
+  // 0.5 % of 300 deg is a +-1.5 deg band: sigma 1.5 / sqrt(3) deg, with 0.3 deg in quadrature.
+  EXPECT_NEAR(src.sigma[8], std::sqrt(0.09 + 2.25 / 3.0) * deg, 1e-15);
+  const Mechanism& m = *d.stations[0].lower;
+  EXPECT_NEAR(src.leg_play_mm[0], 0.02 + 0.1 + 2.0 * m.L[0] * std::sin(0.25 * deg), 1e-15);
+  EXPECT_NEAR(src.leg_play_mm[1], 0.02 + 0.2 + 2.0 * m.L[1] * std::sin(0.25 * deg), 1e-15);
+}
+
+TEST(ToleranceMaps, TheFieldIsTheFirstOrderAtEachPointAndZeroWithoutTolerances) {
+  const Mechanism m = paper_mechanism("thumb", "lower");
+  Ellipse e;
+  e.center = {6.25, 17.5};
+  e.axes = {15.0, 14.0};
+  ToleranceSources src;
+  src.sigma.fill(0.02);
+  src.rad_per_count = {1e-4, 2e-4};
+  src.leg_play_mm = {0.1, 0.2};
+  src.samples = 200;
+  const ToleranceMap map = tolerance_map(m, "thumb", e, src, 1.0);
+  ASSERT_GT(map.nx, 10);
+  std::size_t ok = 0;
+  for (std::size_t k = 0; k < map.field_status.size(); k += 37) {
+    const Vec2 p(map.x0 + map.spacing_mm * static_cast<double>(k % static_cast<std::size_t>(map.nx)),
+                 map.y0 + map.spacing_mm * static_cast<double>(k / static_cast<std::size_t>(map.nx)));
+    const ToleranceEstimate est = tolerance_first_order(m, p, src.sigma, 2e-4);
+    EXPECT_EQ(map.field_status[k], static_cast<std::uint8_t>(est.status));
+    if (est.status != Status::ok) continue;
+    ++ok;
+    EXPECT_EQ(map.field_3sigma_mm[k], est.ellipse_semi_axes.x());
+    EXPECT_EQ(map.field_resolution_um[k], est.resolution_um);
+    EXPECT_EQ(map.field_play_mm[k], tolerance_play(m, p, src.leg_play_mm).extent_mm);
+  }
+  EXPECT_GT(ok, 10u);
+  ToleranceSources none;
+  none.samples = 10;
+  const ToleranceMap zero = tolerance_map(m, "thumb", e, none, 1.0);
+  EXPECT_EQ(zero.worst_3sigma_mm, 0.0);
+  EXPECT_EQ(zero.worst_play_mm, 0.0);
+  EXPECT_EQ(zero.robust.robust_margin_mm, zero.robust.margin_mm);
 }
 
 }  // namespace

@@ -98,7 +98,8 @@ void limit_simulate(std::vector<std::string>& args) {
   args.insert(args.begin() + 1, {"--no-render", "--max-wall", "0.5"});
 }
 
-/// `run` builds only the cheap products: report (a timing study by design), sweep (a grid of any
+/// `run` builds only the cheap products: report (a timing study by design), tolerance (Monte Carlo of
+/// as many devices as the design asks), sweep (a grid of any
 /// size), parts and simulate (OpenSCAD processes) and workspace (sampled fields and pictures: ~6 s per design in
 /// this build, against a 10 s timeout per input) are left to their own tests and to the
 /// hostile-input suite. Names of those four in a --products list
@@ -106,7 +107,7 @@ void limit_simulate(std::vector<std::string>& args) {
 /// `products:` cannot ask for them either.
 void limit_run_products(std::vector<std::string>& args) {
   if (args.empty() || args[0] != "run") return;
-  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace", "simulate"};
+  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace", "simulate", "tolerance"};
   const auto filtered = [&](const std::string& list) {
     std::vector<std::string> kept;
     std::size_t start = 0;

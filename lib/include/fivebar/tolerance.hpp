@@ -25,15 +25,50 @@
 /// every parameter at the edge of its +-3 sigma band with the worst sign,
 /// sum_j |S_j| 3 sigma_j, which bounds the 3-sigma ellipse's major semi-axis (triangle inequality).
 /// The resolution is the tactor step of one ADC count on one joint: max_i |J_i| dtheta_count.
+///
+/// Clearance as a set (tolerance_play()). A pin of diameter d in a hole of d + 2c lets the joint
+/// centre move anywhere within c; gear backlash b lets a proximal link turn within +-b/2, which
+/// moves its elbow within a disc of radius 2 L_i sin(b/4) (the arc's chord bound, a superset).
+/// Leg 1 (O1, A1) and leg 2 (O2, A2, and the tactor joint P: the tactor rides on L3) then start
+/// their distal link anywhere within r_1, r_2 of the nominal elbow, so with the motors at their
+/// nominal angles the tactor lies exactly in
+///   S = { X : L3 - r1 <= |X - A1| <= L3 + r1,  L4 - r2 <= |X - A2| <= L4 + r2 }
+/// on the nominal assembly side: the intersection of two thin annuli, a curvilinear quadrilateral
+/// whose four corners are circle-circle intersections. The distance from P along each bounding arc
+/// is unimodal with its maximum on the far side of the arc's centre, so the largest displacement
+/// max |X - P| over S is at a corner (exact, not a linearisation). The first-order set is the
+/// parallelogram P + M^{-1} [+-r1, +-r2] (M as above): it agrees for small play and grows like
+/// 1/det M near a type II singularity, where S instead stays bounded until the inner circles stop
+/// meeting (then the set is not a quadrilateral and the status says singular_type2).
+///
+/// Robust coverage (robust_coverage()). A printed device's own reachable region is the design's
+/// with its perturbed lengths and base positions; it covers the target when its certified margin
+/// (fivebar/coverage.hpp containment()) is >= 0. At each of 72 points b of the ellipse's boundary
+/// the signed distance to the region's boundary is, to first order, d(b) + g(b) . dq with
+/// g = dd/dq (central differences, step 1 % of each sigma), so its standard deviation is
+/// sigma(b) = sqrt(sum_j g_j(b)^2 sigma_j^2) and the robust margin is the signed margin minus the
+/// error at each boundary point: min_b d(b) - z_p sigma(b), z_p = Phi^{-1}(p), capped by the
+/// certified margin. A device covers only if every point does, so min_b Phi(d(b) / sigma(b)) is
+/// an upper bound of the fraction of devices that cover (the points' errors are correlated, and
+/// where two boundary points are nearly as close the true fraction is lower). The Monte Carlo
+/// reference evaluates containment() on each sampled device: the fraction that covers, and the
+/// (1 - p) quantile of their margins to set beside the robust margin. Joint angle offsets and
+/// play do not move the reachable region (play only widens it), so they do not enter.
 
 #include <Eigen/Core>
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/rendered_plot.hpp"
 #include "fivebar/sections/tolerance.hpp"
 
 namespace fivebar {
@@ -96,5 +131,121 @@ struct MonteCarloTolerance {
 };
 MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
                                           std::size_t samples, std::uint64_t seed);
+
+// --- Sources from a design ----------------------------------------------------------------------
+
+/// What the analyses of one mechanism take from the design (`tolerance:`, `print:`, `controller:`).
+struct ToleranceSources {
+  /// parameter_sigmas(), the joint angle sigma combining the calibration offset and the
+  /// potentiometer's linearity (uniform over +-linearity_percent of its travel: sigma = half band
+  /// / sqrt(3)) in quadrature. The ADC's quantisation is the resolution, reported on its own.
+  ParameterSigmas sigma{};
+  std::array<double, 2> rad_per_count{0.0, 0.0};  ///< joint angle of one count, joints 1 and 2
+  std::string resolution_source;                   ///< where rad_per_count comes from
+  std::array<double, 2> leg_play_mm{0.0, 0.0};     ///< r1, r2 of the play set (header above)
+  double robust_fraction = 0.997;
+  std::uint64_t samples = 10000;
+  std::uint64_t seed = 1;
+};
+/// The sources of `mechanism` of `station`: the design's `tolerance:` (or its defaults, all
+/// assumptions), the pin play from print.pin_clearance unless tolerance.pin_play_mm is set, the
+/// resolution from tolerance.adc_bits when set, else from the controller's ADC (range / 2^bits
+/// volts per count times the joint's potentiometer scale), else 2^16 counts per turn.
+ToleranceSources tolerance_sources(const Design& design, const Station& station, const Mechanism& mechanism);
+
+// --- Clearance (play) as a set -------------------------------------------------------------------
+
+struct PlaySet {
+  /// ok; unreachable or singular as ik() at P; singular_type2 also when the annuli do not give the
+  /// four corners (the set reaches across the distal-link line): extent_mm is then a lower bound.
+  Status status = Status::unreachable;
+  double extent_mm = 0.0;         ///< max |X - P| over the set (exact: at its corners), mm
+  double linear_extent_mm = 0.0;  ///< the same over the first-order parallelogram, mm
+  std::vector<Vec2> corners;      ///< the corners found (mm), up to four
+};
+/// The tactor's play set at P for legs' radial play r = {r1, r2} (mm, >= 0; derivation above).
+PlaySet tolerance_play(const Mechanism& m, const Vec2& P, const std::array<double, 2>& leg_play_mm);
+
+/// True when X lies in the play set of P (the two annuli, on P's assembly side), within `slack` mm.
+bool in_play_set(const Mechanism& m, const Vec2& P, const std::array<double, 2>& leg_play_mm, const Vec2& X,
+                 double slack);
+
+// --- Robust coverage -------------------------------------------------------------------------------
+
+struct RobustCoverage {
+  double fraction = 0.997;         ///< of printed devices that must cover
+  double margin_mm = 0.0;          ///< the design's certified margin (containment())
+  bool decided = true;             ///< containment() decided the nominal verdict
+  double sigma_mm = 0.0;           ///< sigma(b) at the boundary point that sets the robust margin
+  double z = 0.0;                  ///< Phi^{-1}(fraction)
+  double robust_margin_mm = 0.0;   ///< margin - z sigma: what `fraction` of printed devices keep
+  double fraction_first_order = 0.0;  ///< min_b Phi(d(b) / sigma(b)): an upper bound of the covering fraction
+  bool covered = false;            ///< robust_margin_mm >= 0
+  std::array<double, kToleranceParameters> gradient{};  ///< g(b) there (mm per mm, mm per rad)
+  Vec2 robust_point{0.0, 0.0};     ///< that boundary point
+  Vec2 worst_point{0.0, 0.0};      ///< where the nominal margin is smallest
+  // Monte Carlo reference (samples = 0: not run).
+  std::size_t samples = 0;
+  std::size_t samples_covering = 0;
+  double fraction_monte_carlo = 0.0;
+  double quantile_margin_mm = 0.0;  ///< the (1 - fraction) quantile of the sampled margins
+  double monte_carlo_stderr = 0.0;  ///< binomial standard error of fraction_monte_carlo
+};
+/// Robust coverage of `target` by `m` under `sigma` for a `fraction` of printed devices, with a
+/// Monte Carlo check of `samples` devices (0: none; OpenMP over devices, the draws made in order
+/// from `seed` first, so the answer does not depend on the thread count).
+RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+                               double fraction, std::size_t samples, std::uint64_t seed);
+
+/// Phi^{-1}(p) of the standard normal, p in (0, 1) (Newton on std::erfc, to rounding).
+double normal_quantile(double p);
+
+// --- Maps ----------------------------------------------------------------------------------------
+
+/// The tolerance figures of one mechanism on a grid over its reachable region's bounding box
+/// (x fastest), and their worst values over the filled target ellipse.
+struct ToleranceMap {
+  std::string station, mechanism;
+  Ellipse target;
+  double x0 = 0.0, y0 = 0.0, spacing_mm = 0.0;
+  int nx = 0, ny = 0;
+  std::vector<std::uint8_t> field_status;      ///< Status per grid point
+  std::vector<double> field_3sigma_mm;         ///< major 3-sigma semi-axis (0 where not ok)
+  std::vector<double> field_worst_case_mm;
+  std::vector<double> field_resolution_um;     ///< tactor step of one count on the worse joint
+  std::vector<double> field_play_mm;           ///< play set extent
+  // Over the filled target (a 21 x 21 grid of its bounding box, points inside):
+  ToleranceEstimate centre;
+  MonteCarloTolerance centre_monte_carlo;
+  double centre_monte_carlo_3sigma_mm = 0.0;
+  PlaySet centre_play;
+  std::size_t target_points = 0, target_not_ok = 0;
+  double worst_3sigma_mm = 0.0, worst_case_mm = 0.0, worst_resolution_um = 0.0, worst_play_mm = 0.0;
+  Vec2 worst_3sigma_at{0.0, 0.0}, worst_case_at{0.0, 0.0}, worst_resolution_at{0.0, 0.0}, worst_play_at{0.0, 0.0};
+  std::vector<Vec2> target_points_mm;                  ///< the target grid's points
+  std::vector<ToleranceEstimate> target_estimates;     ///< first order at each of them
+  RobustCoverage robust;
+};
+/// The map of one mechanism with `spacing_mm` (> 0; the grid is capped at 1000 x 1000 points).
+ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const Ellipse& target,
+                           const ToleranceSources& sources, double spacing_mm);
+
+/// JSON with units at the edges: the figures at the centre and over the target, the play set and
+/// the robust coverage (no grid: that is the .vti file's).
+Json to_json(const ToleranceMap& map);
+
+/// Picture of a station's maps (one row per mechanism): 3-sigma error over the target with error
+/// ellipses at a grid of poses, and the play set's extent.
+RenderedPlot plot_tolerance(const Station& station, const std::vector<ToleranceMap>& maps);
+
+/// The files of a station's maps, name and bytes: `<station>-<mechanism>-tolerance.vti` per map
+/// (ParaView: three_sigma_mm, worst_case_mm, resolution_um, play_mm, status) and
+/// `<station>-tolerance.svg`, `.png`.
+std::vector<std::pair<std::string, std::string>> tolerance_files(const Station& station,
+                                                                 const std::vector<ToleranceMap>& maps);
+/// Writes `<station>-<mechanism>-tolerance.vti` per map and `<station>-tolerance.svg|.png` into
+/// `dir` (atomically); returns the paths written.
+std::vector<std::filesystem::path> write_tolerance_files(const std::filesystem::path& dir, const Station& station,
+                                                         const std::vector<ToleranceMap>& maps);
 
 }  // namespace fivebar

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fivebar/station_workspace.hpp"
@@ -35,6 +36,17 @@ const char* to_string(CurveKind kind);
 std::string regions_vtp(const StationWorkspace& workspace);
 /// The `.vti` document of one field.
 std::string field_vti(const WorkspaceField& field);
+
+/// A scalar field of any study on a regular grid (x fastest, then y), for ParaView: VTK XML image
+/// data with one double point array per entry of `arrays`, the first one active.
+struct ImageField {
+  double x0 = 0.0, y0 = 0.0;  ///< origin, mm
+  double spacing = 1.0;       ///< mm
+  int nx = 0, ny = 0;
+  std::vector<std::pair<std::string, std::vector<double>>> arrays;  ///< name, nx * ny values
+};
+/// The `.vti` document of an ImageField (InputError when an array has not nx * ny values).
+std::string image_vti(const ImageField& field);
 
 /// Writes regions_vtp() / field_vti() to `path` atomically; IoError when it cannot.
 void write_regions_vtp(const std::filesystem::path& path, const StationWorkspace& workspace);

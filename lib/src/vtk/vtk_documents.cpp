@@ -16,9 +16,11 @@
 #include <vtkXMLImageDataWriter.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
+#include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/workspace_io.hpp"
 
@@ -161,6 +163,25 @@ std::string field_vti(const WorkspaceField& f) {
   for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
     status_names->InsertNextValue(std::string(to_string(s)));
   image->GetFieldData()->AddArray(status_names);
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  return write_document(writer.Get(), ".vti");
+}
+
+std::string image_vti(const ImageField& f) {
+  const std::size_t n = static_cast<std::size_t>(std::max(f.nx, 0)) * static_cast<std::size_t>(std::max(f.ny, 0));
+  for (const auto& [name, values] : f.arrays) {
+    if (values.size() != n) {
+      throw InputError("image field '" + name + "': " + std::to_string(values.size()) + " values for a " +
+                       std::to_string(f.nx) + " x " + std::to_string(f.ny) + " grid");
+    }
+  }
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(f.nx, f.ny, 1);
+  image->SetOrigin(f.x0, f.y0, 0.0);
+  image->SetSpacing(f.spacing, f.spacing, f.spacing);
+  for (const auto& [name, values] : f.arrays) add_point_array<vtkDoubleArray>(image, name.c_str(), values);
+  if (!f.arrays.empty()) image->GetPointData()->SetActiveScalars(f.arrays.front().first.c_str());
   vtkNew<vtkXMLImageDataWriter> writer;
   writer->SetInputData(image);
   return write_document(writer.Get(), ".vti");

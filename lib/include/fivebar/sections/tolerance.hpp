@@ -6,6 +6,7 @@
 /// per-parameter standard deviations.
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 namespace fivebar {
@@ -19,7 +20,22 @@ struct ToleranceSettings {
   double pin_sigma_mm = 0.025;   ///< each pin hole's position, per axis, mm (assumption)
   double base_sigma_mm = 0.1;    ///< each base joint's placement, per axis, mm (assumption: by hand)
   double angle_sigma_deg = 0.5;  ///< joint angle offset after calibration, deg (assumption)
-  int adc_bits = 16;             ///< counts resolve one full joint turn into 2^bits (paper: 16-bit DAQ)
+  /// Counts per full joint turn are 2^bits (e.g. an encoder). Unset: the resolution comes from
+  /// the `controller:` section's ADC range and bits and the potentiometer's scale of each joint,
+  /// or 2^16 per turn without one (the paper's 16-bit DAQ).
+  std::optional<int> adc_bits;
+  /// Radial play of each pin joint (elbows A1, A2 and the tactor joint P): a pin of diameter d in
+  /// a hole of d + 2 c lets the joint centre move anywhere within c. Unset: print.pin_clearance.
+  std::optional<double> pin_play_mm;
+  double shaft_play_mm = 0.02;   ///< radial play of a motor shaft in its hub, mm (assumption)
+  double backlash_deg = 1.0;     ///< gear backlash at the output shaft, whole band, deg (assumption)
+  /// Independent linearity of the potentiometer, +- % of its electrical travel: a sensing error
+  /// left after a two-point calibration, taken as uniform over the band (assumption: a
+  /// conductive-plastic part's datasheet gives 0.25 ... 2 %; replace with yours).
+  double linearity_percent = 0.25;
+  double pot_travel_deg = 300.0; ///< electrical travel of the potentiometer, deg (assumption)
+  /// Robust coverage: the fraction of printed devices that must cover the target (0.997: 3 sigma).
+  double robust_fraction = 0.997;
   std::uint64_t samples = 10000; ///< Monte Carlo devices
   std::uint64_t seed = 1;        ///< Monte Carlo seed
   void validate() const;
