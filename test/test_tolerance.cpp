@@ -9,6 +9,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "fivebar/error.hpp"
 #include "fivebar/kinematics.hpp"
@@ -283,6 +284,23 @@ TEST(ToleranceSection, BadValuesNameFileLineAndKey) {
       EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << e.what();
     }
   }
+}
+
+TEST(ToleranceMonteCarlo, ManyPointsAtOnceEqualOnePointAtATime) {
+  const Mechanism m = paper_mechanism("thumb", "upper");
+  ParameterSigmas sigma{};
+  sigma.fill(0.03);
+  const std::vector<Vec2> points{{6.25, 17.5}, {2.0, 20.0}, {11.0, 14.0}, {100.0, 100.0}};
+  const auto many = tolerance_monte_carlo(m, points, sigma, 3000, 42);
+  ASSERT_EQ(many.size(), points.size());
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    const MonteCarloTolerance one = tolerance_monte_carlo(m, points[k], sigma, 3000, 42);
+    EXPECT_EQ(many[k].status, one.status) << k;
+    EXPECT_EQ(many[k].used, one.used) << k;
+    EXPECT_EQ(many[k].failed, one.failed) << k;
+    EXPECT_NEAR((many[k].covariance - one.covariance).norm(), 0.0, 1e-15) << k;
+  }
+  EXPECT_EQ(many[3].status, Status::unreachable);
 }
 
 // --- Play set -------------------------------------------------------------------------------------

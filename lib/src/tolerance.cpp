@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <vector>
 
 namespace fivebar {
 namespace {
@@ -141,6 +142,55 @@ MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, con
   if (out.used > 1) {
     out.covariance = comoment / static_cast<double>(out.used - 1);
     out.covariance(0, 1) = out.covariance(1, 0) = 0.5 * (out.covariance(0, 1) + out.covariance(1, 0));
+  }
+  return out;
+}
+
+std::vector<MonteCarloTolerance> tolerance_monte_carlo(const Mechanism& m, const std::vector<Vec2>& points,
+                                                       const ParameterSigmas& sigma, std::size_t samples,
+                                                       std::uint64_t seed) {
+  // One table of draws for every point (common random numbers), in tolerance_monte_carlo()'s order.
+  std::vector<double> draws(samples * kToleranceParameters);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (std::size_t k = 0; k < samples; ++k)
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) draws[k * kToleranceParameters + j] = sigma[j] * normal(rng);
+  std::vector<MonteCarloTolerance> out(points.size());
+  const auto n = static_cast<std::ptrdiff_t>(points.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const Vec2& P = points[static_cast<std::size_t>(i)];
+    MonteCarloTolerance& r = out[static_cast<std::size_t>(i)];
+    const Pose nominal = ik(m, P);
+    r.status = nominal.status;
+    if (nominal.status != Status::ok) continue;
+    Mechanism printed = m;
+    printed.joint_limits.reset();
+    printed.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+    Vec2 mean{0.0, 0.0};
+    Eigen::Matrix2d comoment = Eigen::Matrix2d::Zero();
+    for (std::size_t k = 0; k < samples; ++k) {
+      const double* dq = &draws[k * kToleranceParameters];
+      for (std::size_t l = 0; l < 4; ++l) printed.L[l] = m.L[l] + dq[l];
+      printed.O1 = m.O1 + Vec2(dq[4], dq[5]);
+      printed.O2 = m.O2 + Vec2(dq[6], dq[7]);
+      const bool lengths_ok = std::all_of(printed.L.begin(), printed.L.end(), [](double l) { return l > 0.0; });
+      const PointResult p = lengths_ok ? fk_point(printed, nominal.theta1 + dq[8], nominal.theta2 + dq[9]) : PointResult{};
+      if (p.status != Status::ok) {
+        ++r.failed;
+        continue;
+      }
+      const Vec2 err = p.P - P;
+      ++r.used;
+      const Vec2 delta = err - mean;
+      mean += delta / static_cast<double>(r.used);
+      comoment += delta * (err - mean).transpose();
+    }
+    r.mean_error = mean;
+    if (r.used > 1) {
+      r.covariance = comoment / static_cast<double>(r.used - 1);
+      r.covariance(0, 1) = r.covariance(1, 0) = 0.5 * (r.covariance(0, 1) + r.covariance(1, 0));
+    }
   }
   return out;
 }

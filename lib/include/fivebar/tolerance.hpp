@@ -132,6 +132,14 @@ struct MonteCarloTolerance {
 MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
                                           std::size_t samples, std::uint64_t seed);
 
+/// The Monte Carlo reference at many tactor points at once: the same `samples` printed devices
+/// (drawn in order from `seed`, as tolerance_monte_carlo() draws them) at every point, the points
+/// shared out over OpenMP threads (the answer does not depend on the thread count). Element k is
+/// tolerance_monte_carlo(m, points[k], sigma, samples, seed) up to the summation order.
+std::vector<MonteCarloTolerance> tolerance_monte_carlo(const Mechanism& m, const std::vector<Vec2>& points,
+                                                       const ParameterSigmas& sigma, std::size_t samples,
+                                                       std::uint64_t seed);
+
 // --- Sources from a design ----------------------------------------------------------------------
 
 /// What the analyses of one mechanism take from the design (`tolerance:`, `print:`, `controller:`).
