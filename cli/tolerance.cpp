@@ -95,7 +95,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
     std::cout << "tolerances " << (given ? "from the design" : "by default (assumptions to replace)")
               << ": link length sigma " << fixed(src.sigma[0], 4) << " mm, base " << fixed(src.sigma[4], 4)
               << " mm per axis, joint angle " << fixed(angle_deg(src.sigma[8]), 3)
-              << " deg (offset, potentiometer linearity, ADC), leg play " << fixed(src.leg_play_mm[0], 3) << " / "
+              << " deg (calibration offset and potentiometer linearity), leg play " << fixed(src.leg_play_mm[0], 3) << " / "
               << fixed(src.leg_play_mm[1], 3) << " mm; resolution from " << src.resolution_source << "; Monte Carlo "
               << t.samples << " devices, seed " << t.seed << "\n";
   }
