@@ -265,7 +265,7 @@ void setup_sweep(CLI::App& app) {
   sub->add_option("--collision-spacing", opt->collision_spacing,
                   "Grid spacing (mm) of the per-design collision fraction when the design has geometry: (0: off; default 2)")
       ->type_name("MM");
-  sub->add_option("--objective", opt->objectives, "margin, min_lci, force, footprint, collision; repeatable, in priority order")
+  sub->add_option("--objective", opt->objectives, "margin, min_lci, force, footprint, collision, robust (the margin robust_fraction of printed devices keep: tolerance:); repeatable, in priority order")
       ->delimiter(',');
   sub->add_option("-o,--out", opt->out, "Output directory (default outputs/<name>/sweep)")->type_name("DIR");
   sub->add_option("--shard", opt->shard, "Run shard K of N (0-based K/N): contiguous blocks of the designs")->type_name("K/N");

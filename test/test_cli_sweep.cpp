@@ -101,10 +101,14 @@ TEST_F(CliSweep, CollisionFractionColumnForCoveredDesigns) {
   std::istringstream csv(slurp(dir_ / "on" / "sweep.csv"));
   std::string line;
   std::getline(csv, line);
-  ASSERT_TRUE(line.ends_with(",footprint_mm2,collision_fraction")) << line;
+  ASSERT_TRUE(line.ends_with(",footprint_mm2,collision_fraction,robust_margin_mm")) << line;
   int covered = 0;
   while (std::getline(csv, line)) {
-    const std::string last = line.substr(line.rfind(',') + 1);
+    // The collision fraction is the last column but one (robust_margin_mm, empty without the
+    // `robust` objective, is the last).
+    ASSERT_TRUE(line.ends_with(",")) << line;
+    const std::string body = line.substr(0, line.size() - 1);
+    const std::string last = body.substr(body.rfind(',') + 1);
     if (line.find(",covered,1,") != std::string::npos) {
       ++covered;
       const double f = std::stod(last);
@@ -118,7 +122,7 @@ TEST_F(CliSweep, CollisionFractionColumnForCoveredDesigns) {
   ASSERT_EQ(sweep("off", "0").code, 0);
   const std::string off = slurp(dir_ / "off" / "sweep.csv");
   std::istringstream rows(off.substr(off.find('\n') + 1));
-  while (std::getline(rows, line)) EXPECT_TRUE(line.ends_with(",")) << line;
+  while (std::getline(rows, line)) EXPECT_TRUE(line.ends_with(",,")) << line;
   const Outcome bad = sweep("bad", "-1");
   EXPECT_EQ(bad.code, 2);
   EXPECT_THAT(bad.err, HasSubstr("collision_spacing_mm"));

@@ -19,6 +19,7 @@
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/collision.hpp"
 #include "fivebar/coverage.hpp"
+#include "fivebar/sections/tolerance.hpp"
 #include "fivebar/sweep.hpp"
 #include "paper.hpp"
 
@@ -148,6 +149,49 @@ TEST(Evaluation, RowsAgreeWithSingleDesignCoverage) {
   }
   EXPECT_GT(covered, 3);
   EXPECT_GT(not_covered, 3);
+}
+
+TEST(Evaluation, RobustObjectiveIsTheMarginLessTheTolerancesShare) {
+  // The `robust` objective: with every tolerance zero the robust margin is the margin itself; with
+  // tolerances it is smaller, and halving them (sigma is linear in the tolerances) about halves
+  // the loss.
+  SweepSettings s = grid({{"L34", 14, 17, 4}});
+  s.objectives = {"margin", "robust"};
+  s.collision_spacing_mm = 0.0;
+  const auto with_tolerance = [&](double scale) {
+    Design d = with_sweep(s);
+    ToleranceSettings t;
+    t.link_sigma_mm = 0.05 * scale;
+    t.pin_sigma_mm = 0.025 * scale;
+    t.base_sigma_mm = 0.1 * scale;
+    d.set(t);
+    return d;
+  };
+  const Design none = with_tolerance(0.0), full = with_tolerance(1.0), half = with_tolerance(0.5);
+  int covered = 0;
+  for (std::uint64_t i = 0; i < sweep_size(s); ++i) {
+    const SweepRow a = evaluate_sweep_design(none, s, i), b = evaluate_sweep_design(full, s, i),
+                   c = evaluate_sweep_design(half, s, i);
+    SCOPED_TRACE(::testing::Message() << "design " << i << ": " << b.status);
+    if (!b.covered) {
+      EXPECT_TRUE(std::isnan(b.robust_margin_mm));
+      continue;
+    }
+    ++covered;
+    const double margin = std::fmin(b.margin_lower_mm, b.margin_upper_mm);
+    EXPECT_NEAR(a.robust_margin_mm, margin, 1e-9);
+    EXPECT_LT(b.robust_margin_mm, margin - 0.05);
+    // min_b (d(b) - s z sigma(b)) is concave in the scale s: halving the tolerances loses at most
+    // half, and about half where one boundary point stays the worst.
+    EXPECT_LE(margin - c.robust_margin_mm, 0.5 * (margin - b.robust_margin_mm) + 1e-9);
+    EXPECT_GT(margin - c.robust_margin_mm, 0.45 * (margin - b.robust_margin_mm));
+    EXPECT_EQ(b.score("robust"), b.robust_margin_mm);
+  }
+  EXPECT_GT(covered, 1);
+  // Without the objective the column stays empty.
+  SweepSettings plain = s;
+  plain.objectives = {"margin"};
+  EXPECT_TRUE(std::isnan(evaluate_sweep_design(with_sweep(plain), plain, 1).robust_margin_mm));
 }
 
 TEST(Evaluation, InvalidDesignsAreRowsNotErrors) {

@@ -39,6 +39,10 @@ struct SweepRow {
   double min_lci, min_force_capability;
   double footprint_w_mm, footprint_h_mm, footprint_mm2;
   double collision_fraction;  ///< see collision_fraction(); NaN without geometry or one mechanism
+  /// The smallest robust margin of the swept mechanisms (fivebar/tolerance.hpp robust_coverage(),
+  /// first order, the design's tolerance: sources): the margin a robust_fraction of printed
+  /// devices keeps. NaN unless the objectives ask for `robust`.
+  double robust_margin_mm;
   SweepRow();
   /// Objective value oriented so that larger is better (footprint, collision negated); NaN if missing.
   double score(const std::string& objective) const;

@@ -19,7 +19,7 @@ const std::vector<std::string>& sweep_variable_names() {
 }
 
 const std::vector<std::string>& sweep_objective_names() {
-  static const std::vector<std::string> names{"margin", "min_lci", "force", "footprint", "collision"};
+  static const std::vector<std::string> names{"margin", "min_lci", "force", "footprint", "collision", "robust"};
   return names;
 }
 
