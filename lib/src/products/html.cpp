@@ -189,7 +189,7 @@ class Renderer {
     std::string cell;
     for (std::size_t i = 0; i < line.size(); ++i) {
       if (line[i] == '\\' && i + 1 < line.size() && line[i + 1] == '|') {
-        cell += "\\|";
+        cell += '|';  // an escaped pipe is text, also inside code
         ++i;
       } else if (line[i] == '|') {
         out.emplace_back(trim(cell));
