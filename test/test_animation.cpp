@@ -239,7 +239,7 @@ TEST(HtmlPage, RendersTheSummaryMarkdownWithEveryTextEscaped) {
       "Some **bold** text & a [link](patterns/a.csv), a [bad one](javascript:alert(1)).\n\n"
       "## Products\n\n"
       "| product | value | note |\n|---|---:|:---:|\n| `a\\|b` | 1.5 | <script>alert(1)</script> |\n\n"
-      "- one\n- two\n\n"
+      "- one\n- two: `pics/p.svg` and `pics/none.csv`\n\n"
       "![picture](pics/p.png)\n\n"
       "![movie](animations/m.svg)\n\n"
       "## Products\n";
@@ -259,7 +259,8 @@ TEST(HtmlPage, RendersTheSummaryMarkdownWithEveryTextEscaped) {
   EXPECT_THAT(page, HasSubstr("<td><code>a|b</code></td><td class=\"r\">1.5</td>"));
   EXPECT_THAT(page, HasSubstr("&lt;script&gt;alert(1)&lt;/script&gt;"));
   EXPECT_THAT(page, Not(HasSubstr("<script>alert")));
-  EXPECT_THAT(page, HasSubstr("<ul>\n<li>one</li>\n<li>two</li>\n</ul>"));
+  EXPECT_THAT(page, HasSubstr("<ul>\n<li>one</li>\n<li>two: <a href=\"pics/p.svg\"><code>pics/p.svg</code></a> and "
+                              "<code>pics/none.csv</code></li>\n</ul>"));  // a file beside the page is linked
   // The SVG beside the PNG is shown; the animation is inline (its script would not run in an <img>).
   EXPECT_THAT(page, HasSubstr("<img src=\"pics/p.svg\" alt=\"picture\">"));
   EXPECT_THAT(page, HasSubstr("<figure><svg id=\"m\"><script>go()</script></svg>\n<figcaption>movie</figcaption>"));

@@ -141,7 +141,12 @@ class Renderer {
           ++i;
           continue;
         }
-        out += "<code>" + html_escape(s.substr(i + 1, end - i - 1)) + "</code>";
+        const std::string_view code = s.substr(i + 1, end - i - 1);
+        // A file of the scene named in code (the products' file lists) links to it.
+        const bool file = code.find('.') != std::string_view::npos && local_file(code) && files_.exists &&
+                          files_.exists(std::string(code));
+        const std::string html = "<code>" + html_escape(code) + "</code>";
+        out += file ? "<a href=\"" + html_escape(code) + "\">" + html + "</a>" : html;
         i = end + 1;
       } else if (c == '*' && i + 1 < s.size() && s[i + 1] == '*') {
         const std::size_t end = s.find("**", i + 2);
