@@ -24,7 +24,7 @@ struct AnimateOptions {
   std::string pattern;
   std::string out;
   std::string simulated;
-  double width_px = 760.0;
+  double width_px = 1100.0;
   bool json = false;
 };
 
@@ -121,7 +121,7 @@ void setup_animate(CLI::App& app) {
                   "A time series CSV of `fivebar simulate` for this station and pattern: the simulated tactor is "
                   "drawn beside the reference")
       ->type_name("CSV");
-  sub->add_option("--width", opt->width_px, "Width of the picture in pixels (default 760)")->type_name("PX");
+  sub->add_option("--width", opt->width_px, "Width of the picture in pixels (default 1100)")->type_name("PX");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->footer(
       "The pattern's parameters come from the design's patterns: section, as in `fivebar run`.\n"

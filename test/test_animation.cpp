@@ -132,8 +132,9 @@ TEST_F(Animation, TheStaticPictureDrawsTheFirstFrameThroughTheView) {
   const PatternResult r = pattern("index", PatternKind::twist);
   const std::string svg = animate_pattern_svg(s, r);
   const json d = frames_of(svg);
-  const double xmin = d["view"]["xmin_mm"].get<double>(), ymax = d["view"]["ymax_mm"].get<double>();
-  const double scale = d["view"]["px_per_mm"].get<double>();
+  const json& view = d["views"][0];  // the station's panel, drawn first
+  const double xmin = view["xmin_mm"].get<double>(), ymax = view["ymax_mm"].get<double>();
+  const double scale = view["px_per_mm"].get<double>();
   // The first <polyline class="fivebar-link"> is the upper linkage: O1 A1 P A2 O2 in panel pixels.
   std::istringstream points(attribute(svg, "fivebar-link", "points"));
   std::vector<Vec2> px;
@@ -149,6 +150,16 @@ TEST_F(Animation, TheStaticPictureDrawsTheFirstFrameThroughTheView) {
   for (std::size_t i = 0; i < 5; ++i) {
     const Vec2 back(xmin + px[i].x() / scale, ymax - px[i].y() / scale);  // pixels back to mm
     EXPECT_LT((back - mm[i]).norm(), 0.006 / scale + 1e-4) << "joint " << i;
+  }
+  // The second panel shows every tactor point, enlarged.
+  const json& detail = d["views"][1];
+  EXPECT_GT(detail["px_per_mm"].get<double>(), 2.0 * scale);
+  for (const json& m : d["mechanisms"]) {
+    for (const json& f : m["frames"]) {
+      const double u = (f[2].get<double>() - detail["xmin_mm"].get<double>()) * detail["px_per_mm"].get<double>();
+      const double v = (detail["ymax_mm"].get<double>() - f[3].get<double>()) * detail["px_per_mm"].get<double>();
+      EXPECT_TRUE(u > 0.0 && u < detail["width_px"].get<double>() && v > 0.0 && v < detail["height_px"].get<double>());
+    }
   }
   // A self-contained document: no reference to another file or site.
   EXPECT_THAT(svg, Not(HasSubstr("href")));

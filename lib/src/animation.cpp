@@ -79,12 +79,26 @@ std::string sanitise_id(std::string_view s) {
   return out;
 }
 
-/// Station millimetres to the panel's pixels (y up to y down).
+/// One panel: where it sits on the page and how it maps station millimetres to its own pixels
+/// (y up to y down).
 struct View {
+  double x_px = 0.0, y_px = 0.0, width_px = 0.0, height_px = 0.0;  ///< on the page
   double xmin = 0.0, ymax = 0.0, scale = 1.0;
   double u(double x) const { return (x - xmin) * scale; }
   double v(double y) const { return (ymax - y) * scale; }
   std::string pt(const Vec2& p) const { return num(u(p.x())) + "," + num(v(p.y())); }
+  /// The bounds [x0, x1] x [y0, y1] (mm) fitted into the panel with equal aspect, centred.
+  static View fit(double x_px, double y_px, double w, double h, double x0, double x1, double y0, double y1) {
+    View view{x_px, y_px, w, h, 0.0, 0.0, 1.0};
+    view.scale = std::min(w / (x1 - x0), h / (y1 - y0));
+    view.xmin = 0.5 * (x0 + x1) - 0.5 * w / view.scale;
+    view.ymax = 0.5 * (y0 + y1) + 0.5 * h / view.scale;
+    return view;
+  }
+  Json to_json() const {
+    return {{"x_px", x_px},       {"y_px", y_px},        {"width_px", width_px}, {"height_px", height_px},
+            {"xmin_mm", xmin},    {"ymax_mm", ymax},     {"px_per_mm", scale}};
+  }
 };
 
 // The player: reads the frames, draws frame k, runs at true speed, seeks from the slider and the
@@ -95,19 +109,25 @@ constexpr const char* kScript = R"JS(
   if (!root || root.getAttribute('data-fivebar-ready')) return;
   root.setAttribute('data-fivebar-ready', '1');
   var D = JSON.parse(root.querySelector('.fivebar-animation-data').textContent);
-  var T = D.t_s, n = T.length, dur = T[n - 1], V = D.view;
-  function u(x) { return ((x - V.xmin_mm) * V.px_per_mm).toFixed(2); }
-  function v(y) { return ((V.ymax_mm - y) * V.px_per_mm).toFixed(2); }
-  var mechs = D.mechanisms.map(function (m) {
-    var g = root.querySelector('.fivebar-mechanism-' + m.name);
-    var pts = m.frames.map(function (f) { return f ? u(f[2]) + ',' + v(f[3]) : null; });
-    var sim = m.simulated ? m.simulated.map(function (p) { return p ? u(p[0]) + ',' + v(p[1]) : null; }) : null;
-    return { d: m, g: g, pts: pts, sim: sim, link: g.querySelector('.fivebar-link'),
-             e1: g.querySelector('.fivebar-elbow1'), e2: g.querySelector('.fivebar-elbow2'),
-             tactor: g.querySelector('.fivebar-tactor'), target: g.querySelector('.fivebar-target'),
-             trail: g.querySelector('.fivebar-trail'), simDot: g.querySelector('.fivebar-sim'),
-             simTrail: g.querySelector('.fivebar-sim-trail') };
-  });
+  var T = D.t_s, n = T.length, dur = T[n - 1];
+  var layers = [];
+  var panels = root.querySelectorAll('.fivebar-panel');
+  for (var p = 0; p < panels.length && p < D.views.length; ++p) {
+    (function (panel, V) {
+      function u(x) { return ((x - V.xmin_mm) * V.px_per_mm).toFixed(2); }
+      function v(y) { return ((V.ymax_mm - y) * V.px_per_mm).toFixed(2); }
+      D.mechanisms.forEach(function (m) {
+        var g = panel.querySelector('.fivebar-mechanism-' + m.name);
+        layers.push({ d: m, g: g, u: u, v: v,
+                      pts: m.frames.map(function (f) { return f ? u(f[2]) + ',' + v(f[3]) : null; }),
+                      sim: m.simulated ? m.simulated.map(function (q) { return q ? u(q[0]) + ',' + v(q[1]) : null; }) : null,
+                      link: g.querySelector('.fivebar-link'), e1: g.querySelector('.fivebar-elbow1'),
+                      e2: g.querySelector('.fivebar-elbow2'), tactor: g.querySelector('.fivebar-tactor'),
+                      target: g.querySelector('.fivebar-target'), trail: g.querySelector('.fivebar-trail'),
+                      simDot: g.querySelector('.fivebar-sim'), simTrail: g.querySelector('.fivebar-sim-trail') });
+      });
+    })(panels[p], D.views[p]);
+  }
   var knob = root.querySelector('.fivebar-knob'), fill = root.querySelector('.fivebar-progress');
   var track = root.querySelector('.fivebar-track'), label = root.querySelector('.fivebar-time');
   var playIcon = root.querySelector('.fivebar-play-icon'), pauseIcon = root.querySelector('.fivebar-pause-icon');
@@ -118,26 +138,26 @@ constexpr const char* kScript = R"JS(
     while (lo < hi) { var mid = (lo + hi + 1) >> 1; if (T[mid] <= time + 1e-9) lo = mid; else hi = mid - 1; }
     return lo;
   }
-  function setCircle(c, x, y) { if (c) { c.setAttribute('cx', u(x)); c.setAttribute('cy', v(y)); } }
   function upTo(list, k) { var out = []; for (var i = 0; i <= k; ++i) if (list[i] !== null) out.push(list[i]); return out.join(' '); }
   function draw(k) {
-    mechs.forEach(function (m) {
-      var f = m.d.frames[k];
-      m.g.setAttribute('data-frame', k);
+    layers.forEach(function (L) {
+      function at(c, x, y) { if (c) { c.setAttribute('cx', L.u(x)); c.setAttribute('cy', L.v(y)); } }
+      var f = L.d.frames[k], m = L.d;
+      L.g.setAttribute('data-frame', k);
       var vis = f ? 'visible' : 'hidden';
-      [m.link, m.e1, m.e2, m.tactor].forEach(function (el) { el.setAttribute('visibility', vis); });
+      [L.link, L.e1, L.e2, L.tactor].forEach(function (el) { el.setAttribute('visibility', vis); });
       if (f) {
-        m.link.setAttribute('points', [u(m.d.O1[0]) + ',' + v(m.d.O1[1]), u(f[0]) + ',' + v(f[1]), u(f[2]) + ',' + v(f[3]),
-                                       u(f[4]) + ',' + v(f[5]), u(m.d.O2[0]) + ',' + v(m.d.O2[1])].join(' '));
-        setCircle(m.e1, f[0], f[1]); setCircle(m.e2, f[4], f[5]); setCircle(m.tactor, f[2], f[3]);
+        L.link.setAttribute('points', [L.u(m.O1[0]) + ',' + L.v(m.O1[1]), L.u(f[0]) + ',' + L.v(f[1]), L.u(f[2]) + ',' + L.v(f[3]),
+                                       L.u(f[4]) + ',' + L.v(f[5]), L.u(m.O2[0]) + ',' + L.v(m.O2[1])].join(' '));
+        at(L.e1, f[0], f[1]); at(L.e2, f[4], f[5]); at(L.tactor, f[2], f[3]);
       }
-      setCircle(m.target, m.d.targets[k][0], m.d.targets[k][1]);
-      m.trail.setAttribute('points', upTo(m.pts, k));
-      if (m.sim && m.simDot) {
-        var s = m.d.simulated[k];
-        m.simDot.setAttribute('visibility', s ? 'visible' : 'hidden');
-        if (s) setCircle(m.simDot, s[0], s[1]);
-        m.simTrail.setAttribute('points', upTo(m.sim, k));
+      at(L.target, m.targets[k][0], m.targets[k][1]);
+      L.trail.setAttribute('points', upTo(L.pts, k));
+      if (L.sim && L.simDot) {
+        var q = m.simulated[k];
+        L.simDot.setAttribute('visibility', q ? 'visible' : 'hidden');
+        if (q) at(L.simDot, q[0], q[1]);
+        L.simTrail.setAttribute('points', upTo(L.sim, k));
       }
     });
   }
@@ -171,9 +191,9 @@ constexpr const char* kScript = R"JS(
     window.requestAnimationFrame(step);
   }
   function toSvgX(evt) {
-    var p = root.createSVGPoint(); p.x = evt.clientX; p.y = evt.clientY;
+    var q = root.createSVGPoint(); q.x = evt.clientX; q.y = evt.clientY;
     var m = root.getScreenCTM();
-    return m ? p.matrixTransform(m.inverse()).x : p.x;
+    return m ? q.matrixTransform(m.inverse()).x : q.x;
   }
   var dragging = false;
   function seekTo(evt) {
@@ -346,14 +366,42 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
   xmax += pad;
   ymin -= pad;
   ymax += pad;
-  const double width = std::max(options.width_px, 360.0);
-  const double panel_w = width - 2.0 * kSide;
-  View view{xmin, ymax, panel_w / (xmax - xmin)};
-  double panel_h = (ymax - ymin) * view.scale;
-  if (panel_h > 1.2 * width) {  // a tall view: fit the height instead
-    view.scale *= 1.2 * width / panel_h;
-    panel_h = 1.2 * width;
+  // The detail: every tactor point, target and simulated point, enlarged (at least 4 mm across).
+  double dx0 = std::numeric_limits<double>::infinity(), dy0 = dx0, dx1 = -dx0, dy1 = -dx0;
+  const auto grow_detail = [&](const Vec2& p) {
+    dx0 = std::min(dx0, p.x());
+    dx1 = std::max(dx1, p.x());
+    dy0 = std::min(dy0, p.y());
+    dy1 = std::max(dy1, p.y());
+  };
+  for (const AnimationFrame& f : frames) {
+    for (const auto& l : f.linkage) {
+      if (l.drawn) grow_detail(l.P);
+    }
+    grow_detail(result.samples[f.sample].upper.target);
+    grow_detail(result.samples[f.sample].lower.target);
   }
+  for (const auto& list : simulated) {
+    for (const auto& p : list) {
+      if (p) grow_detail(*p);
+    }
+  }
+  for (double* lo_hi : {&dx0, &dy0}) {
+    double& lo = *lo_hi;
+    double& hi = lo_hi == &dx0 ? dx1 : dy1;
+    const double grow_by = std::max(0.0, 4.0 - (hi - lo));
+    lo -= 0.5 * grow_by;
+    hi += 0.5 * grow_by;
+  }
+  const double dpad = 0.1 * std::max(dx1 - dx0, dy1 - dy0) + 0.5 * options.tactor_diameter_mm + 0.5;
+  const double width = std::max(options.width_px, 360.0);
+  const double inner = width - 3.0 * kSide;
+  const double main_w = std::round(0.52 * inner);
+  const double detail_w = inner - main_w;
+  const double panel_h = std::round(std::min((ymax - ymin) * main_w / (xmax - xmin), 1.3 * main_w));
+  const std::array<View, 2> views{
+      View::fit(kSide, kHeader, main_w, panel_h, xmin, xmax, ymin, ymax),
+      View::fit(2.0 * kSide + main_w, kHeader, detail_w, panel_h, dx0 - dpad, dx1 + dpad, dy0 - dpad, dy1 + dpad)};
   const double height = kHeader + panel_h + kFooter;
   const std::string id = options.id.empty() ? sanitise_id("fivebar-animation-" + station.name + "-" + pattern)
                                             : sanitise_id(options.id);
@@ -363,7 +411,8 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
   data["station"] = station.name;
   data["pattern"] = pattern;
   data["rate_hz"] = result.spec.rate_hz;
-  data["view"] = {{"xmin_mm", r4(view.xmin)}, {"ymax_mm", r4(view.ymax)}, {"px_per_mm", view.scale}};
+  data["tactor_diameter_mm"] = options.tactor_diameter_mm;
+  data["views"] = Json::array({views[0].to_json(), views[1].to_json()});
   Json times = Json::array();
   for (const AnimationFrame& f : frames) times.push_back(f.time_s);
   data["t_s"] = times;
@@ -422,79 +471,95 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
   }
   o << "<text x=\"" << kSide << "\" y=\"44\" font-size=\"12\" fill=\"" << (result.passed ? "#1a8033" : "#bf1a1a") << "\">"
     << xml_escape(std::to_string(result.samples.size()) + " samples at " + format::shortest(result.spec.rate_hz) +
-                  " Hz over " + num(duration) + " s, shown at true speed; " + verdict)
+                  " Hz over " + num(duration) + " s at true speed; left the station, right the target region enlarged; " + verdict)
     << "</text>\n";
 
-  // The panel: a nested viewport, so that whatever lies outside the view is clipped.
-  o << "<svg class=\"fivebar-panel\" x=\"" << kSide << "\" y=\"" << kHeader << "\" width=\"" << num(panel_w) << "\" height=\""
-    << num(panel_h) << "\" viewBox=\"0 0 " << num(panel_w) << " " << num(panel_h) << "\" overflow=\"hidden\">\n";
-  o << "<rect width=\"100%\" height=\"100%\" fill=\"#fbfbfb\" stroke=\"#d9d9d9\"/>\n";
-  for (std::size_t i = 0; i < 2; ++i) {
-    o << "<path class=\"fivebar-region\" d=\"" << region_path_d(reachable_region(*mechs[i]), view) << "\" fill=\""
-      << colours[i] << "\" fill-opacity=\"0.07\" fill-rule=\"evenodd\" stroke=\"" << colours[i]
-      << "\" stroke-opacity=\"0.45\" stroke-width=\"1\"/>\n";
-  }
-  {
-    std::string d;
-    const std::vector<Vec2> e = ellipse_polyline(station.target, 180);
-    for (std::size_t k = 0; k < e.size(); ++k) d += (k == 0 ? "M" : "L") + view.pt(e[k]);
-    o << "<path class=\"fivebar-target-ellipse\" d=\"" << d << "Z\" fill=\"none\" stroke=\"" << kInk
-      << "\" stroke-opacity=\"0.8\" stroke-width=\"1.3\" stroke-dasharray=\"6 4\"/>\n";
-  }
-  // The whole target path, faint, so that one sees where the tactors are going.
-  for (std::size_t i = 0; i < 2; ++i) {
-    std::string pts;
-    for (const AnimationFrame& f : frames) {
-      const TactorSample& ts = i == 0 ? result.samples[f.sample].upper : result.samples[f.sample].lower;
-      pts += (pts.empty() ? "" : " ") + view.pt(ts.target);
-    }
-    o << "<polyline class=\"fivebar-target-path\" points=\"" << pts << "\" fill=\"none\" stroke=\"" << colours[i]
-      << "\" stroke-opacity=\"0.25\" stroke-width=\"1.5\" stroke-dasharray=\"2 3\"/>\n";
-  }
-  const double tactor_r = options.tactor_diameter_mm > 0.0 ? 0.5 * options.tactor_diameter_mm * view.scale : 6.0;
+  // The panels: nested viewports, so that whatever lies outside a view is clipped.
+  const std::array<Region, 2> regions{reachable_region(*mechs[0]), reachable_region(*mechs[1])};
   const AnimationFrame& first = frames.front();
-  for (std::size_t i = 0; i < 2; ++i) {
-    const Mechanism& m = *mechs[i];
-    const auto& l = first.linkage[i];
-    const std::string vis = l.drawn ? "visible" : "hidden";
-    const std::string c = colours[i];
-    o << "<g class=\"fivebar-mechanism fivebar-mechanism-" << m.name << "\" data-frame=\"0\">\n";
-    if (has_sim[i]) {
-      o << "<polyline class=\"fivebar-sim-trail\" points=\"\" fill=\"none\" stroke=\"" << kSimColour
-        << "\" stroke-width=\"1.6\" stroke-dasharray=\"4 2\"/>\n";
+  for (std::size_t panel = 0; panel < 2; ++panel) {
+    const View& view = views[panel];
+    o << "<svg class=\"fivebar-panel\" x=\"" << num(view.x_px) << "\" y=\"" << num(view.y_px) << "\" width=\""
+      << num(view.width_px) << "\" height=\"" << num(view.height_px) << "\" viewBox=\"0 0 " << num(view.width_px) << " "
+      << num(view.height_px) << "\" overflow=\"hidden\">\n";
+    o << "<rect width=\"100%\" height=\"100%\" fill=\"#fbfbfb\" stroke=\"#d9d9d9\"/>\n";
+    for (std::size_t i = 0; i < 2; ++i) {
+      o << "<path class=\"fivebar-region\" d=\"" << region_path_d(regions[i], view) << "\" fill=\"" << colours[i]
+        << "\" fill-opacity=\"0.07\" fill-rule=\"evenodd\" stroke=\"" << colours[i]
+        << "\" stroke-opacity=\"0.45\" stroke-width=\"1\"/>\n";
     }
-    o << "<polyline class=\"fivebar-link\" visibility=\"" << vis << "\" points=\""
-      << (l.drawn ? view.pt(m.O1) + " " + view.pt(l.A1) + " " + view.pt(l.P) + " " + view.pt(l.A2) + " " + view.pt(m.O2) : "")
-      << "\" fill=\"none\" stroke=\"" << c << "\" stroke-opacity=\"0.85\" stroke-width=\"4\" stroke-linejoin=\"round\" "
-      << "stroke-linecap=\"round\"/>\n";
-    for (const Vec2& base : {m.O1, m.O2}) {
-      o << "<rect class=\"fivebar-base\" x=\"" << num(view.u(base.x()) - 6.0) << "\" y=\"" << num(view.v(base.y()) - 6.0)
-        << "\" width=\"12\" height=\"12\" fill=\"" << kInk << "\" fill-opacity=\"0.8\"/>\n";
+    {
+      std::string d;
+      const std::vector<Vec2> e = ellipse_polyline(station.target, 180);
+      for (std::size_t k = 0; k < e.size(); ++k) d += (k == 0 ? "M" : "L") + view.pt(e[k]);
+      o << "<path class=\"fivebar-target-ellipse\" d=\"" << d << "Z\" fill=\"none\" stroke=\"" << kInk
+        << "\" stroke-opacity=\"0.8\" stroke-width=\"1.3\" stroke-dasharray=\"6 4\"/>\n";
     }
-    const auto joint = [&](const char* cls, const Vec2& p, double r, const std::string& fill, const std::string& stroke) {
-      o << "<circle class=\"" << cls << "\" visibility=\"" << vis << "\" cx=\"" << num(view.u(p.x())) << "\" cy=\""
-        << num(view.v(p.y())) << "\" r=\"" << num(r) << "\" fill=\"" << fill << "\" stroke=\"" << stroke
+    // The whole target path, faint, so that one sees where the tactors are going.
+    for (std::size_t i = 0; i < 2; ++i) {
+      std::string pts;
+      for (const AnimationFrame& f : frames) {
+        const TactorSample& ts = i == 0 ? result.samples[f.sample].upper : result.samples[f.sample].lower;
+        pts += (pts.empty() ? "" : " ") + view.pt(ts.target);
+      }
+      o << "<polyline class=\"fivebar-target-path\" points=\"" << pts << "\" fill=\"none\" stroke=\"" << colours[i]
+        << "\" stroke-opacity=\"0.3\" stroke-width=\"1.5\" stroke-dasharray=\"2 3\"/>\n";
+    }
+    const double tactor_r = options.tactor_diameter_mm > 0.0 ? 0.5 * options.tactor_diameter_mm * view.scale : 6.0;
+    for (std::size_t i = 0; i < 2; ++i) {
+      const Mechanism& m = *mechs[i];
+      const auto& l = first.linkage[i];
+      const std::string vis = l.drawn ? "visible" : "hidden";
+      const std::string c = colours[i];
+      o << "<g class=\"fivebar-mechanism fivebar-mechanism-" << m.name << "\" data-frame=\"0\">\n";
+      if (has_sim[i]) {
+        o << "<polyline class=\"fivebar-sim-trail\" points=\"\" fill=\"none\" stroke=\"" << kSimColour
+          << "\" stroke-width=\"1.6\" stroke-dasharray=\"4 2\"/>\n";
+      }
+      o << "<polyline class=\"fivebar-link\" visibility=\"" << vis << "\" points=\""
+        << (l.drawn ? view.pt(m.O1) + " " + view.pt(l.A1) + " " + view.pt(l.P) + " " + view.pt(l.A2) + " " + view.pt(m.O2) : "")
+        << "\" fill=\"none\" stroke=\"" << c << "\" stroke-opacity=\"0.85\" stroke-width=\"4\" stroke-linejoin=\"round\" "
+        << "stroke-linecap=\"round\"/>\n";
+      for (const Vec2& base : {m.O1, m.O2}) {
+        o << "<rect class=\"fivebar-base\" x=\"" << num(view.u(base.x()) - 6.0) << "\" y=\"" << num(view.v(base.y()) - 6.0)
+          << "\" width=\"12\" height=\"12\" fill=\"" << kInk << "\" fill-opacity=\"0.8\"/>\n";
+      }
+      const auto joint = [&](const char* cls, const Vec2& p) {
+        o << "<circle class=\"" << cls << "\" visibility=\"" << vis << "\" cx=\"" << num(view.u(p.x())) << "\" cy=\""
+          << num(view.v(p.y())) << "\" r=\"4\" fill=\"#ffffff\" stroke=\"" << c << "\" stroke-width=\"1.5\"/>\n";
+      };
+      joint("fivebar-elbow1", l.A1);
+      joint("fivebar-elbow2", l.A2);
+      o << "<circle class=\"fivebar-tactor\" visibility=\"" << vis << "\" cx=\"" << num(view.u(l.P.x())) << "\" cy=\""
+        << num(view.v(l.P.y())) << "\" r=\"" << num(tactor_r) << "\" fill=\"" << c << "\" fill-opacity=\"0.15\" stroke=\"" << c
         << "\" stroke-width=\"1.5\"/>\n";
-    };
-    joint("fivebar-elbow1", l.A1, 4.0, "#ffffff", c);
-    joint("fivebar-elbow2", l.A2, 4.0, "#ffffff", c);
-    o << "<circle class=\"fivebar-tactor\" visibility=\"" << vis << "\" cx=\"" << num(view.u(l.P.x())) << "\" cy=\""
-      << num(view.v(l.P.y())) << "\" r=\"" << num(tactor_r) << "\" fill=\"" << c << "\" fill-opacity=\"0.15\" stroke=\"" << c
-      << "\" stroke-width=\"1.5\"/>\n";
-    o << "<polyline class=\"fivebar-trail\" points=\"" << (l.drawn ? view.pt(l.P) : "") << "\" fill=\"none\" stroke=\"" << c
-      << "\" stroke-width=\"3\" stroke-linejoin=\"round\" stroke-linecap=\"round\"/>\n";
-    const TactorSample& ts0 = i == 0 ? result.samples[first.sample].upper : result.samples[first.sample].lower;
-    o << "<circle class=\"fivebar-target\" cx=\"" << num(view.u(ts0.target.x())) << "\" cy=\"" << num(view.v(ts0.target.y()))
-      << "\" r=\"2.2\" fill=\"" << kInk << "\"/>\n";
-    if (has_sim[i]) {
-      const auto& p = simulated[i].front();
-      o << "<circle class=\"fivebar-sim\" visibility=\"" << (p ? "visible" : "hidden") << "\" cx=\""
-        << (p ? num(view.u(p->x())) : "0") << "\" cy=\"" << (p ? num(view.v(p->y())) : "0") << "\" r=\""
-        << num(std::max(3.5, 0.6 * tactor_r)) << "\" fill=\"none\" stroke=\"" << kSimColour << "\" stroke-width=\"2\"/>\n";
+      o << "<polyline class=\"fivebar-trail\" points=\"" << (l.drawn ? view.pt(l.P) : "") << "\" fill=\"none\" stroke=\"" << c
+        << "\" stroke-width=\"3\" stroke-linejoin=\"round\" stroke-linecap=\"round\"/>\n";
+      const TactorSample& ts0 = i == 0 ? result.samples[first.sample].upper : result.samples[first.sample].lower;
+      o << "<circle class=\"fivebar-target\" cx=\"" << num(view.u(ts0.target.x())) << "\" cy=\"" << num(view.v(ts0.target.y()))
+        << "\" r=\"2.2\" fill=\"" << kInk << "\"/>\n";
+      if (has_sim[i]) {
+        const auto& p = simulated[i].front();
+        o << "<circle class=\"fivebar-sim\" visibility=\"" << (p ? "visible" : "hidden") << "\" cx=\""
+          << (p ? num(view.u(p->x())) : "0") << "\" cy=\"" << (p ? num(view.v(p->y())) : "0") << "\" r=\""
+          << num(std::max(3.5, 0.6 * tactor_r)) << "\" fill=\"none\" stroke=\"" << kSimColour << "\" stroke-width=\"2\"/>\n";
+      }
+      o << "</g>\n";
     }
-    o << "</g>\n";
+    // A scale bar of a round length near 80 px, and what the panel shows.
+    double bar_mm = 0.1;
+    for (const double len : {0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0}) {
+      if (std::abs(len * view.scale - 80.0) < std::abs(bar_mm * view.scale - 80.0)) bar_mm = len;
+    }
+    const double by = view.height_px - 12.0;
+    o << "<line x1=\"10\" y1=\"" << num(by) << "\" x2=\"" << num(10.0 + bar_mm * view.scale) << "\" y2=\"" << num(by)
+      << "\" stroke=\"" << kInk << "\" stroke-width=\"2\"/><text x=\"10\" y=\"" << num(by - 6.0)
+      << "\" font-size=\"11\" fill=\"" << kInk << "\">" << format::shortest(bar_mm) << " mm</text>\n";
+    const std::string what = panel == 0 ? "the station"
+                                        : "the target region, " + num(views[1].scale / views[0].scale, 1) + "× enlarged";
+    o << "<text x=\"10\" y=\"18\" font-size=\"11\" fill=\"" << kGrey << "\">" << xml_escape(what) << "</text>\n";
+    o << "</svg>\n";
   }
-  o << "</svg>\n";
 
   // Controls: play/pause, the slider, the time.
   const double cy = kHeader + panel_h + 24.0;

@@ -1,8 +1,9 @@
 #pragma once
 /// Animations of a station's two linkages through a skin-deformation pattern (fivebar/pattern.hpp):
-/// one self-contained SVG document (plain SVG and a little JavaScript, no external resource) that
-/// shows, behind everything, both mechanisms' reachable regions and the fingertip target ellipse,
-/// and in front both linkages O1-A1-P-A2-O2 moving through the pattern's samples at true speed
+/// one self-contained SVG document (plain SVG and a little JavaScript, no external resource) with
+/// two panels, the whole station and its tactor region enlarged, that show, behind everything, both
+/// mechanisms' reachable regions and the fingertip target ellipse, and in front both linkages
+/// O1-A1-P-A2-O2 moving through the pattern's samples at true speed
 /// (the sample times of the pattern), the tactor paths drawn as they go, and, when the `simulate`
 /// product's time series are given, the simulated tactor beside the reference (a hollow marker and
 /// its own trace). A play/pause button and a time slider drive it; a URL fragment `#t=SECONDS`
@@ -16,8 +17,10 @@
 ///
 /// The frames are stored in the document as JSON in a `<metadata class="fivebar-animation-data">`
 /// element (units at the edges: `t_s`, points in mm), which the script reads and which tests and
-/// other tools can read back: per mechanism `O1`, `O2`, `links_mm` and per frame `[A1x, A1y, Px, Py,
-/// A2x, A2y]` or null, the pattern target per frame, and the simulated point per frame or null.
+/// other tools can read back: `views` (per panel its place on the page in pixels and its mapping,
+/// page x = x_px + (x - xmin_mm) px_per_mm, page y = y_px + (ymax_mm - y) px_per_mm), per mechanism
+/// `O1`, `O2`, `links_mm` and per frame `[A1x, A1y, Px, Py, A2x, A2y]` or null, the pattern target
+/// per frame, and the simulated point per frame or null.
 /// The static picture (no script run, e.g. through an <img>) shows the first frame.
 
 #include <array>
@@ -44,7 +47,7 @@ struct SimulatedTrack {
 std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_view name);
 
 struct AnimationOptions {
-  double width_px = 760.0;            ///< width of the picture; the height follows the view
+  double width_px = 1100.0;           ///< width of the picture (both panels); the height follows the view
   double tactor_diameter_mm = 0.0;    ///< > 0: the tactor disks at their true size (geometry:)
   std::size_t max_frames = 1500;      ///< longer patterns are shown every k-th sample (k as small as fits)
   std::vector<SimulatedTrack> simulated;  ///< empty: the reference motion only
