@@ -206,6 +206,32 @@ TEST_F(Animation, TheSimulatedTactorIsTheLastSimulatedSampleAtEachFrame) {
   }
 }
 
+TEST_F(Animation, UnreachableSamplesHaveNoLinkageInTheirFrames) {
+  const Station& s = *design_.station("index");
+  PatternSpec spec;
+  spec.kind = PatternKind::stretch;
+  spec.amplitude_mm = 40.0;  // far beyond both workspaces at the end
+  spec.separation_mm = 8.0;
+  spec.duration_s = 1.0;
+  spec.rate_hz = 20.0;
+  const PatternResult r = check_pattern(s, geometry_, spec, settings_.max_joint_speed);
+  ASSERT_FALSE(r.passed);
+  const json d = frames_of(animate_pattern_svg(s, r));
+  std::size_t missing = 0;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& m = d["mechanisms"][i];
+    for (std::size_t k = 0; k < r.samples.size(); ++k) {
+      const TactorSample& ts = i == 0 ? r.samples[k].upper : r.samples[k].lower;
+      const bool reachable = ts.pose.status != Status::unreachable;
+      EXPECT_EQ(m["frames"][k].is_array(), reachable) << m["name"] << " frame " << k;
+      missing += reachable ? 0 : 1;
+      EXPECT_LT((vec(m["targets"][k]) - ts.target).norm(), 1e-4);  // the target is shown all the same
+    }
+  }
+  EXPECT_GT(missing, 0u);
+  EXPECT_THAT(animate_pattern_svg(s, r), HasSubstr("NOT renderable"));
+}
+
 TEST(AnimationInput, BadTimeSeriesNameFileAndLine) {
   std::istringstream no_column("t_s,mechanism,x_mm\n0,lower,1\n");
   try {

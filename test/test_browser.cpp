@@ -53,6 +53,7 @@ class Browser : public ft::CliTest {
                                   "--disable-component-update",
                                   "--disable-sync",
                                   "--disable-extensions",
+                                  "--disable-dev-shm-usage",
                                   "--hide-scrollbars",
                                   "--force-device-scale-factor=1",
                                   "--user-data-dir=" + profile.string(),

@@ -471,7 +471,7 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
   }
   o << "<text x=\"" << kSide << "\" y=\"44\" font-size=\"12\" fill=\"" << (result.passed ? "#1a8033" : "#bf1a1a") << "\">"
     << xml_escape(std::to_string(result.samples.size()) + " samples at " + format::shortest(result.spec.rate_hz) +
-                  " Hz over " + num(duration) + " s at true speed; left the station, right the target region enlarged; " + verdict)
+                  " Hz over " + num(duration) + " s at true speed; left the station, right the tactors' region; " + verdict)
     << "</text>\n";
 
   // The panels: nested viewports, so that whatever lies outside a view is clipped.
@@ -555,8 +555,10 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
     o << "<line x1=\"10\" y1=\"" << num(by) << "\" x2=\"" << num(10.0 + bar_mm * view.scale) << "\" y2=\"" << num(by)
       << "\" stroke=\"" << kInk << "\" stroke-width=\"2\"/><text x=\"10\" y=\"" << num(by - 6.0)
       << "\" font-size=\"11\" fill=\"" << kInk << "\">" << format::shortest(bar_mm) << " mm</text>\n";
-    const std::string what = panel == 0 ? "the station"
-                                        : "the target region, " + num(views[1].scale / views[0].scale, 1) + "× enlarged";
+    const double zoom = views[1].scale / views[0].scale;
+    const std::string what = panel == 0   ? "the station"
+                             : zoom >= 1.0 ? "the tactors' region, " + num(zoom, 1) + "× enlarged"
+                                           : "the tactors' region, at " + num(zoom, 1) + "× the station's scale";
     o << "<text x=\"10\" y=\"18\" font-size=\"11\" fill=\"" << kGrey << "\">" << xml_escape(what) << "</text>\n";
     o << "</svg>\n";
   }
