@@ -38,7 +38,8 @@ void print_report(const SceneReport& report) {
   }
   std::fflush(stdout);
   std::cout << "\nsummary: " << report.summary_md.generic_string() << "\n"
-            << "         " << report.summary_json.generic_string() << "\n";
+            << "         " << report.summary_json.generic_string() << "\n"
+            << "         " << report.index_html.generic_string() << " (open it in a browser)\n";
   const auto missing = report.missing();
   if (!missing.empty()) {
     std::cerr << "fivebar run: requested but not built:";
@@ -62,6 +63,7 @@ int run_run(const RunOptions& opt) {
     doc.update(report.to_json());
     doc["summary_md"] = report.summary_md.generic_string();
     doc["summary_json"] = report.summary_json.generic_string();
+    doc["index_html"] = report.index_html.generic_string();
     print_json(doc);
   } else {
     print_report(report);
@@ -74,7 +76,7 @@ int run_run(const RunOptions& opt) {
 void setup_run(CLI::App& app) {
   auto opt = std::make_shared<RunOptions>();
   CLI::App* sub = app.add_subcommand(
-      "run", "Build the products a scene lists (default: all it has data for) into OUT/<name>/ with summary.md/.json");
+      "run", "Build the products a scene lists (default: all it has data for) into OUT/<name>/ with summary.md/.json and index.html");
   add_design_argument(*sub, opt->design);
   sub->add_option("-o,--out", opt->out, "Output root; the scene writes OUT/<design name>/")
       ->capture_default_str()

@@ -43,7 +43,7 @@ class Cli : public ft::CliTest {
 
 // --- run ------------------------------------------------------------------------------------------
 
-TEST_F(Cli, RunWritesTheTwoSummariesAndNothingElse) {
+TEST_F(Cli, RunWritesTheSummariesAndThePageAndNothingElse) {
   const fs::path out = dir_ / "out";
   // Only kinematics, which writes no files of its own (other products write theirs beside).
   const Outcome r = run({"run", kDesign, "--out", out.string(), "--products", "kinematics"});
@@ -55,8 +55,8 @@ TEST_F(Cli, RunWritesTheTwoSummariesAndNothingElse) {
   EXPECT_TRUE(s["ok"].get<bool>());
   ASSERT_GE(s["built"].size(), 1u);
   EXPECT_EQ(s["built"][0]["name"], "kinematics");
-  // Nothing but the summaries and the files the built products list (and their folders).
-  std::set<std::string> expected{"iros2022", "iros2022/summary.json", "iros2022/summary.md"};
+  // Nothing but the summaries, the page and the files the built products list (and their folders).
+  std::set<std::string> expected{"iros2022", "iros2022/summary.json", "iros2022/summary.md", "iros2022/index.html"};
   for (const auto& product : s["built"]) {
     for (const auto& f : product["files"]) {
       for (fs::path p = fs::path("iros2022") / f.get<std::string>(); p != "iros2022"; p = p.parent_path()) {
@@ -87,6 +87,7 @@ TEST_F(Cli, RunJsonAndDefaultOutputRoot) {
   const json j = parse(r);
   EXPECT_EQ(j["built"][0]["name"], "kinematics");
   EXPECT_EQ(j["summary_md"], "outputs/iros2022/summary.md");
+  EXPECT_EQ(j["index_html"], "outputs/iros2022/index.html");
   EXPECT_TRUE(fs::exists(dir_ / "outputs" / "iros2022" / "summary.json"));
 }
 TEST_F(Cli, RunProductsOptionAndSceneList) {

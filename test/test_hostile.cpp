@@ -354,6 +354,14 @@ std::vector<Case> cases() {
                {"rate_hz = 1000000000 Hz"}});
   c.push_back({"PatternAmplitudeNaN", sub({"pattern"}, {"-s", "index", "--pattern", "stretch", "--amplitude", "nan"}),
                {both}, {"amplitude_mm = nan"}});
+  c.push_back({"AnimateUnknownKind", {"animate", "both.yaml", "-s", "index", "--pattern", "wiggle", "--out", "out/a.svg"},
+               {both}, {"--pattern 'wiggle'", "stretch"}});
+  c.push_back({"AnimateGif", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.gif"}, {both},
+               {"SVG only"}});
+  c.push_back({"AnimateWithoutPatterns", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg"},
+               {both}, {"no patterns: section"}});
+  c.push_back({"AnimateWidthHuge", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg",
+                                    "--width", "1e300"}, {both}, {"--width"}});
   c.push_back({"PartsNoJobs", sub({"parts"}, {"--jobs", "0"}), {both}, {"--jobs", "0"}});
   c.push_back({"SweepBillionSteps", sub({"sweep"}, {"-s", "index", "--vary", "L1=1:2:1000000000"}), {both},
                {"--vary 'L1=1:2:1000000000'"}});

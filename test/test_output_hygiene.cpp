@@ -251,7 +251,7 @@ TEST(InterruptedRun, LeavesOnlyCompleteFilesWheneverTheSignalLands) {
   const ft::Outcome full = ft::run(FIVEBAR_BINARY, args, reference_dir.path(), io.path(), ft::child_timeout_s(60));
   ASSERT_EQ(full.code, 0) << full.err;
   const auto reference = files_under(reference_dir.path() / "out");
-  ASSERT_EQ(reference.size(), 2u);  // summary.md and summary.json
+  ASSERT_EQ(reference.size(), 3u);  // summary.md, summary.json and index.html
   const double full_s = full.seconds;
 
   // Signals at moments spread over the whole run, from before main() to after the last rename:

@@ -145,7 +145,7 @@ TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
   std::vector<std::string> files;
   for (const auto& e : fs::directory_iterator(r.out_dir)) files.push_back(e.path().filename().string());
   std::sort(files.begin(), files.end());
-  std::set<std::string> expected{"summary.json", "summary.md"};
+  std::set<std::string> expected{"summary.json", "summary.md", "index.html"};
   for (const auto& p : r.products) {
     for (const auto& f : p.files) expected.insert(f.begin()->string());
   }
@@ -157,6 +157,20 @@ TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
   EXPECT_EQ(json["results"]["kinematics"]["stations"].size(), 2u);
   EXPECT_EQ(slurp(r.summary_md), r.to_markdown());
   EXPECT_THAT(r.to_markdown(), HasSubstr("## Kinematics at the target"));
+
+  // index.html: the same sections and tables as summary.md, every pattern's animation inline.
+  EXPECT_EQ(r.index_html, r.out_dir / "index.html");
+  const std::string html = slurp(r.index_html);
+  const std::string md = r.to_markdown();
+  const auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count(html, "<h2 id="), count(md, "\n## "));
+  EXPECT_EQ(count(html, "<table>"), count(md, "\n|---") + count(md, "\n|:---"));
+  EXPECT_EQ(count(html, "<svg xmlns=\"http://www.w3.org/2000/svg\" id=\"fivebar-animation-"), 8u);  // 2 stations x 4 patterns
+  EXPECT_THAT(html, HasSubstr("<h2 id=\"kinematics-at-the-target-kinematics\">Kinematics at the target (<code>kinematics</code>)</h2>"));
 }
 
 TEST_F(Scene, AnExplicitListBuildsOnlyWhatItNames) {

@@ -2,6 +2,8 @@
 #include "fivebar/scene.hpp"
 
 #include <algorithm>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <set>
 
@@ -10,6 +12,7 @@
 #include "fivebar/io.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/version.hpp"
+#include "products/html.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -204,7 +207,24 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
   report.summary_md = report.out_dir / "summary.md";
   report.summary_json = report.out_dir / "summary.json";
   write_file_atomic(report.summary_json, report.to_json().dump(2) + "\n");
-  write_file_atomic(report.summary_md, report.to_markdown());
+  const std::string markdown = report.to_markdown();
+  write_file_atomic(report.summary_md, markdown);
+  // The same text as a page: pictures by relative link, animations inline (products/html.hpp).
+  md::HtmlFiles files;
+  const std::filesystem::path dir = report.out_dir;
+  files.exists = [dir](const std::string& rel) {
+    std::error_code ec;
+    return std::filesystem::is_regular_file(dir / rel, ec);
+  };
+  files.read = [dir](const std::string& rel) -> std::optional<std::string> {
+    std::ifstream in(dir / rel, std::ios::binary);
+    if (!in) return std::nullopt;
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+  };
+  report.index_html = report.out_dir / "index.html";
+  write_file_atomic(report.index_html, md::to_html_page(markdown, "fivebar: " + design.name, files));
   return report;
 }
 

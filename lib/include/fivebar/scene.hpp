@@ -1,8 +1,8 @@
 #pragma once
 /// The scene runner (docs/architecture.md "Products"): a design file is also a scene. run_scene() builds the
 /// products the scene asks for (default: every product the file has data for) plus their
-/// prerequisites, and nothing else, then writes `<out_root>/<design name>/summary.md` and
-/// `summary.json` (atomically) listing what was built, what was left out and why, and each
+/// prerequisites, and nothing else, then writes `<out_root>/<design name>/summary.md`,
+/// `summary.json` and `index.html` (summary.md as a page, atomically) listing what was built, what was left out and why, and each
 /// product's results.
 
 #include <nlohmann/json.hpp>
@@ -55,6 +55,9 @@ struct SceneReport {
   std::vector<ProductOutcome> products;  ///< every known product, in build order
   std::filesystem::path summary_md;      ///< paths of the two summaries written
   std::filesystem::path summary_json;
+  /// summary.md as a page that opens offline, with the products' pictures and the pattern
+  /// animations (products/html.hpp)
+  std::filesystem::path index_html;
 
   /// Every built product passed its check and every explicitly requested product was built.
   bool ok() const;
