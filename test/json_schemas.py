@@ -126,7 +126,8 @@ def main():
     run("report accuracy", "report-accuracy", ["report", "accuracy", DESIGN, "-s", "index", "--quick", "-q", "--out", out])
     run("simulate", "simulate", ["simulate", DESIGN, "-s", "index", "--pattern", "stretch", "--no-render", "--out", out + "/sim"])
     run("simulate --step", "simulate", ["simulate", DESIGN, "-s", "index", "--step", "--no-render", "--out", out + "/sim"])
-    run("tolerance", "tolerance", ["tolerance", DESIGN])
+    run("tolerance", "tolerance", ["tolerance", DESIGN, "--out", out + "/tol"])
+    run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/twist.svg"])
     doc = run("run", "run", ["run", DESIGN, "-q", "--out", out + "/run", "-P",
                              "kinematics,workspace,coverage,collision,pattern,export"])
     if doc is not None:
