@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "fivebar/tolerance.hpp"
 #include "fivebar/coverage.hpp"
 #include "fivebar/coverage_report.hpp"
 #include "fivebar/error.hpp"
@@ -20,6 +21,7 @@ struct CoverageCliOptions {
   std::string mechanism;  ///< "lower" / "upper": that one alone (no shared region); empty: both
   std::string ellipse;  ///< "CX,CY,AX,AY,ANGLE"
   bool ellipse_given = false;
+  bool robust = false;  ///< also: covered by tolerance.robust_fraction of printed devices
   bool json = false;
 };
 
@@ -79,8 +81,30 @@ int run_coverage(const CoverageCliOptions& opt) {
     if (progress) progress("station " + s.name);
     const StationCoverage c = station_coverage(s, override_target);
     all = all && c.covered();
-    doc["stations"].push_back(to_json(c, s.name));
-    if (!opt.json) print_station(s, override_target ? *override_target : s.target, override_target.has_value(), c);
+    Json js = to_json(c, s.name);
+    const Ellipse& target = override_target ? *override_target : s.target;
+    if (!opt.json) print_station(s, target, override_target.has_value(), c);
+    if (opt.robust) {
+      // Robust coverage (fivebar/tolerance.hpp): the margin that tolerance.robust_fraction of
+      // printed devices keep, with the Monte Carlo of tolerance.samples devices beside it.
+      for (Json& jm : js["mechanisms"]) {
+        const Mechanism* m = s.mechanism(jm["mechanism"].get<std::string>());
+        const ToleranceSources src = tolerance_sources(design, s, *m);
+        const RobustCoverage r = robust_coverage(*m, target, src.sigma, src.robust_fraction, src.samples, src.seed);
+        all = all && r.covered;
+        jm["robust"] = to_json(r);
+        if (!opt.json) {
+          std::cout << "  " << m->name << " robust: " << fixed(100.0 * r.fraction, 1) << " % of printed devices keep "
+                    << fixed(r.robust_margin_mm, 4) << " mm at " << point(r.robust_point) << " -> "
+                    << (r.covered ? "covered" : "NOT COVERED") << " (Monte Carlo: "
+                    << fixed(100.0 * r.fraction_monte_carlo, 2) << " % of " << r.samples << " devices cover; "
+                    << fixed(100.0 - 100.0 * r.fraction, 1) << " % quantile of their margins "
+                    << fixed(r.quantile_margin_mm, 4) << " mm)\n";
+        }
+      }
+      if (!opt.json) std::cout << "\n";
+    }
+    doc["stations"].push_back(std::move(js));
   }
   if (opt.json) {
     print_json(doc);
@@ -107,11 +131,17 @@ void setup_coverage(CLI::App& app) {
                   "Target instead of the design's: centre CX,CY (mm), full axis lengths AX,AY (mm) and rotation "
                   "ANGLE (deg), e.g. --ellipse 6.25,15.5,15,12,0; applies to every station checked")
       ->type_name("CX,CY,AX,AY,ANGLE");
+  sub->add_flag("--robust", opt->robust,
+                "Also require the target covered by tolerance.robust_fraction of printed devices (the design's "
+                "tolerance: section, or its assumed defaults): the margin less the tolerances' error at each boundary "
+                "point, with a Monte Carlo of tolerance.samples devices");
   sub->add_flag("--json", opt->json,
-                "Print {\"stations\": {S: {\"lower\": ..., \"upper\": ..., \"shared\": ...}}} on stdout and nothing else");
+                "Print {\"command\", \"design\", \"stations\": [{\"station\", \"mechanisms\": [{\"mechanism\", ...}], "
+                "\"shared\"}]} on stdout and nothing else");
   sub->footer(
       "The margin is the signed distance from the ellipse to the region boundary (negative: outside by that much).\n"
-      "Exit status: 0 every mechanism covers the target (inside, assembly side kept, LCI >= min_lci), 1 otherwise, "
+      "Exit status: 0 every mechanism covers the target (inside, assembly side kept, LCI >= min_lci; with --robust also "
+      "for the printed devices), 1 otherwise, "
       "2 bad input, 3 internal error.");
   sub->callback([opt, ellipse]() {
     opt->ellipse_given = ellipse->count() > 0;

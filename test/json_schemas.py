@@ -108,6 +108,7 @@ def main():
         if not keyed_by_station({"x": {"index": {"margin_mm": 1}}}) or keyed_by_station({"index": 3}):
             failures.append("self-test: the station-key walk is wrong")
 
+    run("coverage --robust", "coverage", ["coverage", DESIGN, "-s", "thumb", "--robust"])
     run("coverage, not covered", "coverage", ["coverage", DESIGN, "-s", "index", "--ellipse", "6.25,15.5,30,30,0"], (1,))
     run("fk", "fk", ["fk", DESIGN, "-s", "index", "-m", "lower", "--theta", "100,80"])
     run("fk --all", "fk", ["fk", DESIGN, "-s", "index", "-m", "lower", "--theta", "100,80", "--all"])

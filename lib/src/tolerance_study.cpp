@@ -351,6 +351,27 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
 
 // --- Outputs ----------------------------------------------------------------------------------
 
+Json to_json(const RobustCoverage& r) {
+  const auto xy = [](const Vec2& p) { return Json::array({p.x(), p.y()}); };
+  Json robust;
+  robust["fraction"] = r.fraction;
+  robust["margin_mm"] = r.margin_mm;
+  robust["decided"] = r.decided;
+  robust["margin_sigma_mm"] = r.sigma_mm;
+  robust["z"] = r.z;
+  robust["robust_margin_mm"] = r.robust_margin_mm;
+  robust["covered"] = r.covered;
+  robust["fraction_first_order_at_most"] = r.fraction_first_order;
+  robust["robust_point_mm"] = xy(r.robust_point);
+  robust["worst_point_mm"] = xy(r.worst_point);
+  robust["monte_carlo_samples"] = r.samples;
+  robust["monte_carlo_covering"] = r.samples_covering;
+  robust["fraction_monte_carlo"] = r.fraction_monte_carlo;
+  robust["fraction_monte_carlo_stderr"] = r.monte_carlo_stderr;
+  robust["monte_carlo_quantile_margin_mm"] = r.quantile_margin_mm;
+  return robust;
+}
+
 Json to_json(const ToleranceMap& map) {
   const auto xy = [](const Vec2& p) { return Json::array({p.x(), p.y()}); };
   Json j;
@@ -377,24 +398,7 @@ Json to_json(const ToleranceMap& map) {
   j["target_worst_resolution_at_mm"] = xy(map.worst_resolution_at);
   j["target_worst_play_mm"] = map.worst_play_mm;
   j["target_worst_play_at_mm"] = xy(map.worst_play_at);
-  const RobustCoverage& r = map.robust;
-  Json robust;
-  robust["fraction"] = r.fraction;
-  robust["margin_mm"] = r.margin_mm;
-  robust["decided"] = r.decided;
-  robust["margin_sigma_mm"] = r.sigma_mm;
-  robust["z"] = r.z;
-  robust["robust_margin_mm"] = r.robust_margin_mm;
-  robust["covered"] = r.covered;
-  robust["fraction_first_order_at_most"] = r.fraction_first_order;
-  robust["robust_point_mm"] = xy(r.robust_point);
-  robust["worst_point_mm"] = xy(r.worst_point);
-  robust["monte_carlo_samples"] = r.samples;
-  robust["monte_carlo_covering"] = r.samples_covering;
-  robust["fraction_monte_carlo"] = r.fraction_monte_carlo;
-  robust["fraction_monte_carlo_stderr"] = r.monte_carlo_stderr;
-  robust["monte_carlo_quantile_margin_mm"] = r.quantile_margin_mm;
-  j["robust_coverage"] = robust;
+  j["robust_coverage"] = to_json(map.robust);
   j["grid"] = {{"origin_mm", xy(Vec2(map.x0, map.y0))}, {"spacing_mm", map.spacing_mm}, {"nx", map.nx}, {"ny", map.ny}};
   return j;
 }

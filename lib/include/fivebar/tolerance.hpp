@@ -238,6 +238,11 @@ struct ToleranceMap {
 ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const Ellipse& target,
                            const ToleranceSources& sources, double spacing_mm);
 
+/// JSON of a robust coverage: fraction, margin_mm, decided, margin_sigma_mm, z, robust_margin_mm,
+/// covered, fraction_first_order_at_most, robust_point_mm, worst_point_mm and the Monte Carlo
+/// reference (monte_carlo_samples, _covering, fraction_monte_carlo, its stderr, the quantile margin).
+Json to_json(const RobustCoverage& robust);
+
 /// JSON with units at the edges: the figures at the centre and over the target, the play set and
 /// the robust coverage (no grid: that is the .vti file's).
 Json to_json(const ToleranceMap& map);
