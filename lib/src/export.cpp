@@ -560,6 +560,12 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
   for (ExportFormat f : formats) {
     documents.emplace_back(dir / (stem + std::string(file_extension(f))), render(f, result.parameters));
   }
+  if (options.urdf && d.has<Geometry>()) {  // the links' outlines and masses (fivebar/urdf.hpp)
+    for (const std::string& name : result.gate.stations) {
+      const Station& s = *d.station(name);
+      documents.emplace_back(dir / urdf_file_name(d, s), render_urdf(d, s, options.urdf_options));
+    }
+  }
   // A target that cannot be replaced (a directory of that name) fails before anything is written.
   for (const auto& [path, text] : documents) {
     std::error_code ec;

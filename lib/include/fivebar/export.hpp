@@ -58,6 +58,7 @@
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/json.hpp"
+#include "fivebar/urdf.hpp"
 
 namespace fivebar {
 
@@ -79,6 +80,11 @@ struct ExportOptions {
   int boundary_samples = 720;
   /// Called with one line per step of the gate ("coverage of station index"); may be empty.
   std::function<void(std::string_view)> progress;
+  /// Also write `<design>_<station>.urdf` per exported station (fivebar/urdf.hpp) when the design
+  /// has `geometry:` (the links' outlines and masses), with these
+  /// options (the parts' renders for masses and meshes, when there are).
+  bool urdf = true;
+  UrdfOptions urdf_options;
 };
 
 /// One check of the export gate.
@@ -170,7 +176,8 @@ struct ExportResult {
 /// `<design>_controller` + `_<station>` for a one-station export of a several-station design.
 std::string export_stem(const Design& design, const std::vector<std::string>& stations);
 
-/// Runs the gate; only when it passes, renders every requested format in memory, creates `dir`
+/// Runs the gate; only when it passes, renders every requested format (and, with options.urdf,
+/// the URDF of every exported station) in memory, creates `dir`
 /// and writes each file atomically (all temporaries written before the first rename; a target
 /// that is not a regular file is refused before anything is written). A failed gate creates and
 /// writes nothing. IoError when the files cannot be written.

@@ -38,6 +38,13 @@ Product export_product() {
     const Design& d = ctx.design;
     ExportOptions options;
     options.progress = ctx.progress;
+    // The URDF's masses and meshes from the parts' STL renders when the scene built them (the
+    // parts product comes first in products.def); the closed form otherwise (fivebar/urdf.hpp).
+    if (const Json* parts = ctx.result_of("parts")) {
+      options.urdf_options.parts = parts;
+      options.urdf_options.parts_dir = ctx.dir / "parts";
+      options.urdf_options.mesh_prefix = "../parts";
+    }
     const ExportResult r = export_controller(d, all_export_formats(), ctx.dir / "export", options);
     for (const auto& f : r.files) ctx.record(std::filesystem::path("export") / f.filename());
 
