@@ -421,6 +421,7 @@ TEST(Urdf, ExportWritesOneUrdfPerStationAtomicallyAndOnlyWhenAsked) {
   TempDir dir;
   ExportOptions options;
   options.stations = {"thumb"};
+  options.urdf = true;
   const ExportResult r = export_controller(d, {ExportFormat::ros2}, dir.path / "out", options);
   ASSERT_TRUE(r.gate.passed());
   ASSERT_EQ(r.files.size(), 2u);

@@ -83,7 +83,7 @@ struct ExportOptions {
   /// Also write `<design>_<station>.urdf` per exported station (fivebar/urdf.hpp) when the design
   /// has `geometry:` (the links' outlines and masses), with these
   /// options (the parts' renders for masses and meshes, when there are).
-  bool urdf = true;
+  bool urdf = false;
   UrdfOptions urdf_options;
 };
 

@@ -38,6 +38,7 @@ Product export_product() {
     const Design& d = ctx.design;
     ExportOptions options;
     options.progress = ctx.progress;
+    options.urdf = true;
     // The URDF's masses and meshes from the parts' STL renders when the scene built them (the
     // parts product comes first in products.def); the closed form otherwise (fivebar/urdf.hpp).
     if (const Json* parts = ctx.result_of("parts")) {
