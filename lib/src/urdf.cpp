@@ -107,7 +107,7 @@ class Writer {
   std::ostringstream out;
   void line(int indent, const std::string& text) { out << std::string(static_cast<std::size_t>(2 * indent), ' ') << text << "\n"; }
   void comment(int indent, const std::string& text) { line(indent, "<!-- " + comment_text(text) + " -->"); }
-  void link(const std::string& name, const Body* body, const std::string& visual_box) {
+  void link_element(const std::string& name, const Body* body, const std::string& visual_box) {
     if (body == nullptr && visual_box.empty()) {
       line(1, "<link name=\"" + escaped(name) + "\"/>");
       return;
@@ -200,7 +200,7 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
     w.line(2, "</visual>");
     w.line(1, "</link>");
   } else {
-    w.link(base, nullptr, "");
+    w.link_element(base, nullptr, "");
   }
 
   struct MotorJoint {
@@ -259,9 +259,9 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
       return "<origin xyz=\"" + m(0.5 * L) + " 0 " + m(0.5 * t) + "\" rpy=\"0 0 0\"/><geometry><box size=\"" + m(L) +
              " " + m(g.link_width[i]) + " " + m(t) + "\"/></geometry>";
     };
-    for (std::size_t i = 0; i < 4; ++i) w.link(prefix + "_L" + std::to_string(i + 1), &bodies[i], box(i));
-    w.link(prefix + "_tip", &tip, "");
-    w.link(prefix + "_P", nullptr, "");
+    for (std::size_t i = 0; i < 4; ++i) w.link_element(prefix + "_L" + std::to_string(i + 1), &bodies[i], box(i));
+    w.link_element(prefix + "_tip", &tip, "");
+    w.link_element(prefix + "_P", nullptr, "");
 
     // Motor joints.
     for (int j = 1; j <= 2; ++j) {
