@@ -25,8 +25,9 @@ struct ExportCliOptions {
 
 std::vector<ExportFormat> formats_of(const std::string& text) {
   if (text == "all") return all_export_formats();
+  if (text == "urdf") return {};
   if (const auto f = parse_export_format(text)) return {*f};
-  throw InputError("--format '" + text + "': expected ros2, json, header or all");
+  throw InputError("--format '" + text + "': expected ros2, json, header, urdf or all");
 }
 
 void print_gate(const ExportGate& gate) {
@@ -97,6 +98,7 @@ int run_export(const ExportCliOptions& opt) {
   const std::vector<ExportFormat> formats = formats_of(opt.format);
   const Design design = load(opt.design);
   ExportOptions options;
+  options.urdf = opt.format == "all" || opt.format == "urdf";  // fivebar/urdf.hpp: closed-form masses here
   if (!opt.station.empty()) options.stations = {opt.station};
   options.progress = terminal_progress("export");
   // The directory is created only once the gate has passed.
@@ -143,7 +145,8 @@ void setup_export(CLI::App& app) {
       "design passes the export gate (coverage, singularities, joint limits, calibration, patterns)");
   add_design_argument(*sub, opt->design);
   sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
-  sub->add_option("--format", opt->format, "ros2, json, header or all (default: all)")->type_name("FORMAT");
+  sub->add_option("--format", opt->format,
+                  "ros2, json, header, urdf or all (default: all; urdf: one URDF with ros2_control per station)")->type_name("FORMAT");
   sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/export)")
       ->type_name("DIR");
   sub->add_option("--check", opt->check,
@@ -151,7 +154,9 @@ void setup_export(CLI::App& app) {
       ->type_name("FILE");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->footer(
-      "Files: <design>_controller[_<station>].yaml|.json|.hpp, SI units; joints <station>_<mechanism>_theta<1|2>.\n"
+      "Files: <design>_controller[_<station>].yaml|.json|.hpp and <design>_<station>.urdf (with geometry:), SI\n"
+      "units; joints <station>_<mechanism>_theta<1|2>, their limits the usable range of each joint (potentiometer\n"
+      "travel, hard stops, joint_limits).\n"
       "Exit status: 0 exported (or --check: the file matches), 1 export refused by the gate (nothing written) or\n"
       "--check found differences, 2 bad input (design without controller: section, unknown station, ...), "
       "3 internal error or the files could not be written.");

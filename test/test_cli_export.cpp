@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -51,14 +53,19 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
                            HasSubstr("design hash fnv1a64:"), HasSubstr("index/lower"), HasSubstr("thumb pivot")));
   EXPECT_THAT(r.out, Not(HasSubstr("FAILED")));
   EXPECT_EQ(listing(dir_ / "ctl"), (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
-                                                             "iros2022_controller.yaml"}));
+                                                             "iros2022_controller.yaml", "iros2022_index.urdf",
+                                                             "iros2022_thumb.urdf"}));
   // The ROS file with yaml-cpp: the paper's numbers in SI units, doubles as doubles.
   const YAML::Node p = YAML::LoadFile((dir_ / "ctl" / "iros2022_controller.yaml").string())["fivebar_controller"]["ros__parameters"];
   EXPECT_EQ(p["loop_rate_hz"].Scalar(), "100.0");
   EXPECT_EQ(p["pwm_hz"].Scalar(), "1000.0");
   EXPECT_EQ(p["adc"]["bits"].Scalar(), "16");
   EXPECT_EQ(p["stations"]["thumb"]["lower"]["link_lengths_m"][3].as<double>(), 0.0175);
-  EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["has_position_limits"].as<bool>(), false);
+  // The usable range from the hardware: the potentiometer's end (4.75 V at 0 deg, 60 deg/V, 300 deg
+  // of travel: -285 deg) and the boss of the other motor (acos(212.25 / 225) = 19.38 deg from 180).
+  EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["has_position_limits"].as<bool>(), true);
+  EXPECT_NEAR(p["joint_limits"]["index_upper_theta1"]["min_position"].as<double>(), -285.0 * std::numbers::pi / 180, 1e-12);
+  EXPECT_NEAR(p["joint_limits"]["index_upper_theta1"]["max_position"].as<double>(), -std::acos(212.25 / 225.0), 1e-12);
   EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["max_velocity"].Scalar(), "6.283185307179586");  // 360 deg/s
   EXPECT_EQ(p["gains"]["index_upper_theta1"]["p"].Scalar(), "5.0");
   EXPECT_EQ(p["collision"]["priority"].as<std::string>(), "upper");
@@ -126,7 +133,7 @@ TEST_F(CliExport, ARefusedExportWritesNothingAndListsEveryReason) {
   const std::string before = slurp(dir_ / "kept" / "iros2022_controller.yaml");
   EXPECT_EQ(run({"export", bad.string(), "--out", "kept"}).code, 1);
   EXPECT_EQ(slurp(dir_ / "kept" / "iros2022_controller.yaml"), before);
-  EXPECT_EQ(listing(dir_ / "kept").size(), 3u);
+  EXPECT_EQ(listing(dir_ / "kept").size(), 5u);  // three formats and two URDFs
 }
 
 TEST_F(CliExport, BadInputIsExitTwo) {
@@ -186,8 +193,9 @@ TEST_F(CliExport, RunBuildsTheExportProduct) {
   const json doc = parse(r);
   EXPECT_EQ(doc["results"]["export"]["exported"], true);
   EXPECT_EQ(doc["results"]["export"]["files"],
-            json({"export/iros2022_controller.yaml", "export/iros2022_controller.json", "export/iros2022_controller.hpp"}));
-  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 3u);
+            json({"export/iros2022_controller.yaml", "export/iros2022_controller.json", "export/iros2022_controller.hpp",
+                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf"}));
+  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 5u);
   EXPECT_EQ(run({"export", "--check", (dir_ / "scene" / "iros2022" / "export" / "iros2022_controller.json").string(), kDesign}).code, 0);
   EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"), AllOf(HasSubstr("## Controller export (`export`)"),
                                                                        HasSubstr("Files:")));

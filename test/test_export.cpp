@@ -173,10 +173,13 @@ TEST(Parameters, HoldThePapersDeviceInSiUnits) {
   EXPECT_EQ(index.at("lower").at("working_mode"), "-+");
   EXPECT_EQ(index.at("upper").at("working_mode"), "+-");
   EXPECT_EQ(index.at("upper").at("assembly_mode"), "-");
-  // The showcase: no joint limits; 360 deg/s; pots 5 V over 300 deg; mid-travel offsets.
+  // The showcase: limits from the hardware (below the boss of O1 at 180 deg + acos(212.25 / 225),
+  // above the potentiometer's end: 3.25 V at 0 deg, 60 deg/V over 0 ... 5 V); 360 deg/s; pots 5 V
+  // over 300 deg; mid-travel offsets.
   const Json& lim = p.at("joint_limits").at("thumb_upper_theta2");
-  EXPECT_EQ(lim.at("has_position_limits"), false);
-  EXPECT_FALSE(lim.contains("min_position"));
+  EXPECT_EQ(lim.at("has_position_limits"), true);
+  EXPECT_NEAR(lim.at("min_position").get<double>(), -kPi + std::acos(212.25 / 225.0), 1e-12);
+  EXPECT_NEAR(lim.at("max_position").get<double>(), deg(105), 1e-12);
   EXPECT_EQ(lim.at("has_velocity_limits"), true);
   EXPECT_DOUBLE_EQ(lim.at("max_velocity").get<double>(), 2.0 * kPi);
   EXPECT_EQ(p.at("gains").at("index_lower_theta1"), Json({{"p", 5.0}, {"i", 1.0}, {"d", 0.05}, {"i_clamp", 0.2}}));

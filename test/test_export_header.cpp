@@ -13,6 +13,7 @@
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/export.hpp"
+#include "fivebar/joint_limits.hpp"
 #include "fivebar/version.hpp"
 #include "header_values.hpp"
 
@@ -80,7 +81,8 @@ TEST(ExportedHeader, EveryCompiledValueEqualsTheDesign) {
     EXPECT_EQ(hj.i_clamp, jc.pid.i_clamp);
     EXPECT_EQ(hj.volts_at_zero, jc.potentiometer.volts_at_zero);
     EXPECT_EQ(hj.rad_per_volt, jc.potentiometer.rad_per_volt);
-    EXPECT_EQ(hj.has_position_limits, d.station(hm.station)->mechanism(hm.name)->joint_limits.has_value());
+    EXPECT_EQ(hj.has_position_limits,
+              with_usable_limits(d, *d.station(hm.station)).mechanism(hm.name)->joint_limits.has_value());
     EXPECT_TRUE(hj.has_velocity_limits);
     EXPECT_EQ(hj.max_velocity, c.max_velocity);
   }

@@ -17,6 +17,7 @@
 #include "fivebar/coverage.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/pattern.hpp"
 #include "fivebar/version.hpp"
@@ -278,7 +279,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
   }
 
   for (const std::string& name : gate.stations) {
-    const Station& s = *d.station(name);
+    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/joint_limits.hpp)
     say(options, "export gate: coverage of station " + name);
     const StationCoverage sc = station_coverage(s, std::nullopt, options.coverage);
     for (const Mechanism* m : s.mechanisms()) {
@@ -358,6 +359,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
           r.covered ? "both tactors reach the whole target, margin " + fixed(r.margin_mm, 3) + " mm"
                     : "the shared region does not cover the target: " + r.reason);
     }
+    for (GateCheck& check : hardware_limit_checks(d, *d.station(name), options)) gate.checks.push_back(std::move(check));
   }
 
   // Patterns declared for the exported stations.
@@ -365,7 +367,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
     add("pattern", "design", true, "no patterns: section: nothing to check");
   } else {
     for (const std::string& name : gate.stations) {
-      const Station& s = *d.station(name);
+      const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/joint_limits.hpp)
       const std::vector<PatternSpec> specs = d.get<PatternSettings>()->for_station(name);
       if (specs.empty() || !(s.lower && s.upper)) continue;  // patterns move both tactors
       for (const PatternSpec& spec : specs) {
@@ -462,7 +464,7 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
   Json station_tree = Json::object();
   Json limits = Json::object(), gains = Json::object(), pots = Json::object();
   for (const std::string& name : stations) {
-    const Station& s = *d.station(name);
+    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/joint_limits.hpp)
     Json st = Json::object();
     st["target"] = {{"center_m", pair_m(s.target.center)},
                     {"axes_m", pair_m(s.target.axes)},
@@ -557,6 +559,12 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
   const std::string stem = export_stem(d, result.gate.stations);
   for (ExportFormat f : formats) {
     documents.emplace_back(dir / (stem + std::string(file_extension(f))), render(f, result.parameters));
+  }
+  if (options.urdf && d.has<Geometry>()) {  // the links' outlines and masses (fivebar/urdf.hpp)
+    for (const std::string& name : result.gate.stations) {
+      const Station& s = *d.station(name);
+      documents.emplace_back(dir / urdf_file_name(d, s), render_urdf(d, s, options.urdf_options));
+    }
   }
   // A target that cannot be replaced (a directory of that name) fails before anything is written.
   for (const auto& [path, text] : documents) {

@@ -42,7 +42,7 @@ static_assert(same(fc::fivebar::design, "iros2022"));
 static_assert(same(fc::collision::priority, "upper"));
 static_assert(count(fc::joint_names) == 8 && count(fc::station_names) == 2);
 static_assert(same(fc::joint_names[0], "index_lower_theta1") && same(fc::joint_names[7], "thumb_upper_theta2"));
-static_assert(!fc::joint_limits::thumb_upper_theta2::has_position_limits);
+static_assert(fc::joint_limits::thumb_upper_theta2::has_position_limits);  // potentiometer travel, hard stops
 static_assert(fc::collision::layers[0] == 0 && fc::collision::layers[3] == 1);
 
 }  // namespace

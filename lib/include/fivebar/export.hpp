@@ -22,7 +22,8 @@
 ///     link_thickness_m, layers, layer_gap_m, pin_diameter_m, boss_diameter_m, tactor_diameter_m,
 ///     tactor_height_m, motor_shaft_diameter_m}
 ///   joint_limits.<joint>: ros2_control layout: has_position_limits, min_position, max_position
-///     (only with limits: the design's ccw arc, max = min + span), has_velocity_limits,
+///     (only with limits: the joint's usable range of fivebar/joint_limits.hpp, i.e. the design's
+///     ccw arc cut by the potentiometer's travel and the hard stops, max = min + span), has_velocity_limits,
 ///     max_velocity (rad/s), has_acceleration_limits, has_jerk_limits, has_effort_limits (false)
 ///   gains.<joint>: {p, i, d, i_clamp} (duty per rad, see PidGains)
 ///   potentiometers.<joint>: {volts_at_zero, rad_per_volt}: theta = rad_per_volt (V - volts_at_zero)
@@ -57,6 +58,7 @@
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/json.hpp"
+#include "fivebar/urdf.hpp"
 
 namespace fivebar {
 
@@ -78,6 +80,11 @@ struct ExportOptions {
   int boundary_samples = 720;
   /// Called with one line per step of the gate ("coverage of station index"); may be empty.
   std::function<void(std::string_view)> progress;
+  /// Also write `<design>_<station>.urdf` per exported station (fivebar/urdf.hpp) when the design
+  /// has `geometry:` (the links' outlines and masses), with these
+  /// options (the parts' renders for masses and meshes, when there are).
+  bool urdf = false;
+  UrdfOptions urdf_options;
 };
 
 /// One check of the export gate.
@@ -117,7 +124,11 @@ struct ExportGate {
 ///                (the exact containment of coverage() already covers the joint-limited region);
 ///   calibration  the joint's range (its limits, else its angles over the ellipse) reads within
 ///                the ADC's input range through its potentiometer;
+///   hardware_limits, joint_margin  the usable range of every joint from its potentiometer's travel
+///                and the hard stops (fivebar/joint_limits.hpp), and the target and every pattern at
+///                least controller.joint_margin inside it, the proximal links clear of the other leg's;
 ///   pattern      every pattern of `patterns:` for the station passes check_pattern().
+/// Every check runs on the stations with their usable ranges as joint limits (with_usable_limits()).
 /// Throws InputError for a design without `controller:` or an unknown station in options.
 ExportGate export_gate(const Design& design, const ExportOptions& options = {});
 
@@ -165,7 +176,8 @@ struct ExportResult {
 /// `<design>_controller` + `_<station>` for a one-station export of a several-station design.
 std::string export_stem(const Design& design, const std::vector<std::string>& stations);
 
-/// Runs the gate; only when it passes, renders every requested format in memory, creates `dir`
+/// Runs the gate; only when it passes, renders every requested format (and, with options.urdf,
+/// the URDF of every exported station) in memory, creates `dir`
 /// and writes each file atomically (all temporaries written before the first rename; a target
 /// that is not a regular file is refused before anything is written). A failed gate creates and
 /// writes nothing. IoError when the files cannot be written.

@@ -48,6 +48,13 @@ void require_rad_per_volt(const std::string& key, double v) {
   }
 }
 
+void require_travel(const std::string& key, double v) {
+  // A potentiometer turns at most once: 360 deg is an endless (or continuous-rotation) one.
+  if (!(v > 0.0) || !(v <= 2.0 * std::numbers::pi * (1.0 + 1e-15))) {
+    throw ValidationError(key, "= " + format_degrees(v) + " deg: must be in (0, 360] deg (the potentiometer's electrical travel)");
+  }
+}
+
 }  // namespace
 
 void PidGains::validate() const {
@@ -60,6 +67,7 @@ void PidGains::validate() const {
 void Potentiometer::validate() const {
   require_volts_at_zero("volts_at_zero", volts_at_zero);
   require_rad_per_volt("rad_per_volt", rad_per_volt);
+  if (travel) require_travel("travel_deg", *travel);
 }
 
 std::string ControlOverride::key() const {
@@ -84,6 +92,7 @@ JointControl ControllerSettings::joint(std::string_view station, std::string_vie
     if (o.i_clamp) out.pid.i_clamp = *o.i_clamp;
     if (o.volts_at_zero) out.potentiometer.volts_at_zero = *o.volts_at_zero;
     if (o.rad_per_volt) out.potentiometer.rad_per_volt = *o.rad_per_volt;
+    if (o.travel) out.potentiometer.travel = *o.travel;
   };
   // Widest scope first, so that the narrower keys win whatever the order of the list.
   for (int level = 0; level <= 4; ++level) {
@@ -142,6 +151,9 @@ void ControllerSettings::validate() const {
   if (!(min_lci >= 0.0) || !(min_lci <= 1.0)) {
     throw ValidationError("min_lci", "= " + plain_number(min_lci) + ": must be in [0, 1]");
   }
+  if (!(joint_margin >= 0.0) || !(joint_margin < std::numbers::pi)) {
+    throw ValidationError("joint_margin_deg", "= " + format_degrees(joint_margin) + " deg: must be >= 0 and < 180 deg");
+  }
   rules::validate_nested("pid", [&] { pid.validate(); });
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
   for (const ControlOverride& o : overrides) {
@@ -162,6 +174,7 @@ void ControllerSettings::validate() const {
     if (o.i_clamp) require_i_clamp(at("pid.i_clamp"), *o.i_clamp);
     if (o.volts_at_zero) require_volts_at_zero(at("potentiometer.volts_at_zero"), *o.volts_at_zero);
     if (o.rad_per_volt) require_rad_per_volt(at("potentiometer.rad_per_volt"), *o.rad_per_volt);
+    if (o.travel) require_travel(at("potentiometer.travel_deg"), *o.travel);
   }
 }
 
@@ -177,9 +190,10 @@ void control_keys(const std::vector<Value>& all, ControlOverride& o) {
     }
   }
   if (const Value* pot = find(all, "potentiometer")) {
-    const auto keys = pot->entries({"volts_at_zero", "volts_per_rad", "rad_per_volt"},
-                                   "(volts_at_zero, and volts_per_rad or rad_per_volt)");
+    const auto keys = pot->entries({"volts_at_zero", "volts_per_rad", "rad_per_volt", "travel_deg"},
+                                   "(volts_at_zero, volts_per_rad or rad_per_volt, travel_deg)");
     if (const Value* v0 = find(keys, "volts_at_zero")) o.volts_at_zero = v0->number("V");
+    if (const Value* t = find(keys, "travel_deg")) o.travel = kRadPerDeg * t->number("deg");
     const Value* vpr = find(keys, "volts_per_rad");
     const Value* rpv = find(keys, "rad_per_volt");
     if (vpr != nullptr && rpv != nullptr) rpv->fail("give volts_per_rad or rad_per_volt, not both (one is 1 / the other)");
@@ -198,9 +212,9 @@ void load(const Value& v, Design& design) {
   ControllerSettings& c = design.set(ControllerSettings{});
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                              "min_lci", "pid", "potentiometer", "mechanisms", "stations"},
+                              "min_lci", "joint_margin_deg", "pid", "potentiometer", "mechanisms", "stations"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                             "pid, potentiometer, mechanisms, stations)");
+                             "joint_margin_deg, pid, potentiometer, mechanisms, stations)");
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -215,6 +229,7 @@ void load(const Value& v, Design& design) {
   if (const Value* speed = find(all, "max_velocity_deg_s")) c.max_velocity = kRadPerDeg * speed->number("deg/s");
   if (const Value* p = find(all, "collision_priority")) c.collision_priority = p->text("must be upper");
   c.min_lci = number_or(all, "min_lci", c.min_lci, "");
+  if (const Value* m = find(all, "joint_margin_deg")) c.joint_margin = kRadPerDeg * m->number("deg");
   ControlOverride defaults;
   control_keys(all, defaults);
   if (defaults.kp) c.pid.kp = *defaults.kp;
@@ -223,6 +238,7 @@ void load(const Value& v, Design& design) {
   if (defaults.i_clamp) c.pid.i_clamp = *defaults.i_clamp;
   if (defaults.volts_at_zero) c.potentiometer.volts_at_zero = *defaults.volts_at_zero;
   if (defaults.rad_per_volt) c.potentiometer.rad_per_volt = *defaults.rad_per_volt;
+  if (defaults.travel) c.potentiometer.travel = *defaults.travel;
 
   // One mechanism's scope (of a station, or of every station when `station` is empty) and its joints.
   const auto mechanism_scope = [&](const Value& m, const std::string& station) {
@@ -235,7 +251,7 @@ void load(const Value& v, Design& design) {
     for (const Value& j : mech_keys) {
       if (j.name() != "theta1" && j.name() != "theta2") continue;
       ControlOverride jo = mo;
-      jo.kp = jo.ki = jo.kd = jo.i_clamp = jo.volts_at_zero = jo.rad_per_volt = std::nullopt;
+      jo.kp = jo.ki = jo.kd = jo.i_clamp = jo.volts_at_zero = jo.rad_per_volt = jo.travel = std::nullopt;
       jo.joint = j.name() == "theta1" ? 1 : 2;
       control_keys(j.entries({"pid", "potentiometer"}, "(pid, potentiometer)"), jo);
       c.overrides.push_back(jo);
@@ -286,7 +302,7 @@ ControlOverride merged(const std::vector<const ControlOverride*>& scope) {
   for (const ControlOverride* o : scope) {
     for (auto [to, from] : {std::pair{&m.kp, &o->kp}, std::pair{&m.ki, &o->ki}, std::pair{&m.kd, &o->kd},
                             std::pair{&m.i_clamp, &o->i_clamp}, std::pair{&m.volts_at_zero, &o->volts_at_zero},
-                            std::pair{&m.rad_per_volt, &o->rad_per_volt}}) {
+                            std::pair{&m.rad_per_volt, &o->rad_per_volt}, std::pair{&m.travel, &o->travel}}) {
       if (*from) *to = *from;
     }
   }
@@ -294,7 +310,7 @@ ControlOverride merged(const std::vector<const ControlOverride*>& scope) {
 }
 
 bool has_keys(const ControlOverride& o) {
-  return o.kp || o.ki || o.kd || o.i_clamp || o.volts_at_zero || o.rad_per_volt;
+  return o.kp || o.ki || o.kd || o.i_clamp || o.volts_at_zero || o.rad_per_volt || o.travel;
 }
 
 /// `pid:` and `potentiometer:` of one scope, only the keys it gives.
@@ -306,10 +322,11 @@ void control_keys_out(Out& out, const ControlOverride& o) {
     if (o.kd) pid.add("kd", Out::number(*o.kd));
     if (o.i_clamp) pid.add("i_clamp", Out::number(*o.i_clamp));
   }
-  if (o.volts_at_zero || o.rad_per_volt) {
+  if (o.volts_at_zero || o.rad_per_volt || o.travel) {
     Out& pot = out.add("potentiometer", Out::map(/*flow=*/true));
     if (o.volts_at_zero) pot.add("volts_at_zero", Out::number(*o.volts_at_zero));
     if (o.rad_per_volt) pot.add("rad_per_volt", Out::number(*o.rad_per_volt));
+    if (o.travel) pot.add("travel_deg", Out::degrees(*o.travel));
   }
 }
 
@@ -329,9 +346,11 @@ void write(const Design& d, Out& top) {
   out.add("max_velocity_deg_s", Out::degrees(c.max_velocity));
   out.add("collision_priority", Out::quoted(c.collision_priority));
   out.add("min_lci", Out::number(c.min_lci));
+  out.add("joint_margin_deg", Out::degrees(c.joint_margin));
   ControlOverride defaults;
   defaults.kp = c.pid.kp, defaults.ki = c.pid.ki, defaults.kd = c.pid.kd, defaults.i_clamp = c.pid.i_clamp;
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;
+  defaults.travel = c.potentiometer.travel;
   control_keys_out(out, defaults);
 
   // Overrides in canonical form: every station's mechanisms, then by station (design order), then

@@ -30,9 +30,16 @@ struct PidGains {
 /// Potentiometer on a motor shaft, read through the ADC (`controller.potentiometer`):
 /// theta = rad_per_volt * (V - volts_at_zero), theta in the station frame (docs/conventions.md "Frames": from +x,
 /// counter-clockwise). The file takes volts_per_rad (the datasheet's sensitivity) or rad_per_volt.
+///
+/// Electrical travel (`travel_deg`, optional): the potentiometer is a voltage divider that reads
+/// 0 V at one end of its travel and travel / |rad_per_volt| volts at the other, so the joint reads
+/// only on the arc theta in [rad_per_volt (0 - volts_at_zero), rad_per_volt (travel/|rad_per_volt|
+/// - volts_at_zero)] (ends swapped when wired reversed); potentiometer_window() in
+/// fivebar/joint_limits.hpp. Without it the potentiometer is taken to read on every angle.
 struct Potentiometer {
   double volts_at_zero = 2.5;                   ///< reading at theta = 0, V
   double rad_per_volt = 1.0471975511965976;     ///< 5 V over 300 deg: 60 deg/V; negative when wired reversed
+  std::optional<double> travel;                 ///< electrical travel, rad in (0, 2 pi] (file: travel_deg)
   void validate() const;
 };
 
@@ -53,6 +60,7 @@ struct ControlOverride {
   int joint = 0;          ///< 1 or 2 (theta1, theta2), or 0: both joints
   std::optional<double> kp, ki, kd, i_clamp;
   std::optional<double> volts_at_zero, rad_per_volt;
+  std::optional<double> travel;  ///< rad (potentiometer.travel_deg)
   /// Key path of this scope relative to `controller` ("stations.index.lower.theta1",
   /// "mechanisms.upper").
   std::string key() const;
@@ -80,6 +88,10 @@ struct ControllerSettings {
   /// Export gate: LCI over every target ellipse must be at least max(min_lci, the mechanism's
   /// min_lci): the ellipse keeps this far from singularities.
   double min_lci = 0.05;
+  /// Export gate: the target ellipse and every pattern keep at least this far (rad) inside each
+  /// joint's usable range (fivebar/joint_limits.hpp; file: joint_margin_deg, default 5 deg, an
+  /// assumption: room for the PID's overshoot before a hard stop or the end of a potentiometer).
+  double joint_margin = 0.08726646259971647;
   PidGains pid;                   ///< every joint, unless overridden
   Potentiometer potentiometer;    ///< every joint, unless overridden
   std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first

@@ -20,9 +20,12 @@ constexpr const char* kPreamble =
     "The configuration of the device's ROS controller (paper Sec. II-D: an IK module per mechanism, FK of the "
     "measured joints for collision checks with the upper mechanism's priority, a PID per motor), written only "
     "when the export gate passes: every mechanism covers its target, the LCI over the target stays above the "
-    "threshold, the joint limits hold over the whole target, each joint's range reads within the ADC range and "
-    "the declared patterns are renderable. The three files hold the same values (SI units); "
-    "`fivebar export --check FILE DESIGN` confirms a file still matches the design.\n\n";
+    "threshold, the joint limits hold over the whole target, each joint's range reads within the ADC range, "
+    "the target and the patterns keep a margin inside each joint's usable range (the potentiometers' travel and "
+    "the links' hard stops: docs/urdf.md) and the declared patterns are renderable. The three files hold the same "
+    "values (SI units); `fivebar export --check FILE DESIGN` confirms a file still matches the design. Each "
+    "station also gets a URDF with a `<ros2_control>` block (masses and meshes from the parts' STL renders when "
+    "the scene built them).\n\n";
 
 }  // namespace
 
@@ -38,6 +41,14 @@ Product export_product() {
     const Design& d = ctx.design;
     ExportOptions options;
     options.progress = ctx.progress;
+    options.urdf = true;
+    // The URDF's masses and meshes from the parts' STL renders when the scene built them (the
+    // parts product comes first in products.def); the closed form otherwise (fivebar/urdf.hpp).
+    if (const Json* parts = ctx.result_of("parts")) {
+      options.urdf_options.parts = parts;
+      options.urdf_options.parts_dir = ctx.dir / "parts";
+      options.urdf_options.mesh_prefix = "../parts";
+    }
     const ExportResult r = export_controller(d, all_export_formats(), ctx.dir / "export", options);
     for (const auto& f : r.files) ctx.record(std::filesystem::path("export") / f.filename());
 

@@ -11,6 +11,7 @@
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/tolerances.hpp"
+#include "fivebar/joint_limits.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -223,6 +224,22 @@ constexpr const char* kPreamble =
 
 }  // namespace
 
+/// The usable range of every joint from the hardware (fivebar/joint_limits.hpp), when any joint
+/// of the station has one.
+std::string usable_ranges_markdown(const Design& d, const Station& s) {
+  md::Table table({"joint", "usable range", "angle at the target centre (deg)"}, "llr");
+  bool any = false;
+  for (const Mechanism* m : s.mechanisms()) {
+    for (const UsableRange& r : usable_ranges(d, s, *m)) {
+      any = any || r.limited || !r.usable;
+      table.row({md::code(r.joint), describe(r), r.usable ? md::fixed(angle_deg(r.reference), 2) : "-"});
+    }
+  }
+  if (!any) return "";
+  return "**Usable joint ranges** (the potentiometers' travel, the links' hard stops and the declared limits; "
+         "docs/urdf.md)\n\n" + table.str() + "\n";
+}
+
 Product kinematics_product() {
   Product p;
   p.name = "kinematics";
@@ -250,6 +267,7 @@ Product kinematics_product() {
       }
       stations.push_back(js);
       markdown += station_markdown(s, reports);
+      markdown += usable_ranges_markdown(ctx.design, s);
     }
     b.result = {{"stations", stations}};
     b.markdown = markdown;

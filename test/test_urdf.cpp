@@ -1,0 +1,445 @@
+// Tests of the URDF (fivebar/urdf.hpp): urdfdom's check_urdf accepts the showcase's files; the
+// document read back by a small XML reader written here has the tree, joint limits, masses and
+// ros2_control block the design gives, compared with hand values (the hard stop's angle, the
+// potentiometer's end, the stall torque) and with an independent closed-form mass of a slab; with
+// a parts report of box-shaped STL files written here, masses, centres and inertias are the
+// boxes' and the meshes are the visuals; export_controller writes one URDF per station.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "fivebar/design.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/export.hpp"
+#include "fivebar/joint_limits.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/urdf.hpp"
+
+namespace fivebar {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const fs::path kSource = FIVEBAR_SOURCE_DIR;
+constexpr double kPi = std::numbers::pi;
+double deg(double d) { return d * kPi / 180.0; }
+const char* const kCheckUrdf = "/usr/bin/check_urdf";
+
+Design paper() { return load_design(kSource / "designs" / "iros2022.yaml"); }
+
+// --- A minimal XML reader: elements, attributes, text; comments, declarations skipped -----------
+
+struct Element {
+  std::string name;
+  std::map<std::string, std::string> attributes;
+  std::vector<std::unique_ptr<Element>> children;
+  std::string text;
+  const Element* child(const std::string& n) const {
+    for (const auto& c : children)
+      if (c->name == n) return c.get();
+    return nullptr;
+  }
+  std::vector<const Element*> all(const std::string& n) const {
+    std::vector<const Element*> out;
+    for (const auto& c : children)
+      if (c->name == n) out.push_back(c.get());
+    return out;
+  }
+  const std::string& at(const std::string& key) const {
+    const auto it = attributes.find(key);
+    if (it == attributes.end()) throw std::runtime_error("<" + name + "> has no attribute " + key);
+    return it->second;
+  }
+};
+
+class XmlReader {
+ public:
+  explicit XmlReader(std::string text) : s_(std::move(text)) {}
+  std::unique_ptr<Element> document() {
+    skip_misc();
+    auto root = element();
+    skip_misc();
+    if (i_ != s_.size()) fail("content after the root element");
+    return root;
+  }
+
+ private:
+  std::string s_;
+  std::size_t i_ = 0;
+  [[noreturn]] void fail(const std::string& why) { throw std::runtime_error("XML at " + std::to_string(i_) + ": " + why); }
+  bool starts(const char* p) const { return s_.compare(i_, std::strlen(p), p) == 0; }
+  void space() {
+    while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
+  }
+  void skip_misc() {
+    for (;;) {
+      space();
+      if (starts("<!--")) {
+        const std::size_t end = s_.find("-->", i_ + 4);
+        if (end == std::string::npos) fail("unterminated comment");
+        if (s_.substr(i_ + 4, end - i_ - 4).find("--") != std::string::npos) fail("-- inside a comment");
+        i_ = end + 3;
+      } else if (starts("<?")) {
+        const std::size_t end = s_.find("?>", i_);
+        if (end == std::string::npos) fail("unterminated declaration");
+        i_ = end + 2;
+      } else {
+        return;
+      }
+    }
+  }
+  std::string name() {
+    const std::size_t b = i_;
+    while (i_ < s_.size() && (std::isalnum(static_cast<unsigned char>(s_[i_])) || s_[i_] == '_' || s_[i_] == ':' || s_[i_] == '-')) ++i_;
+    if (b == i_) fail("expected a name");
+    return s_.substr(b, i_ - b);
+  }
+  static std::string unescape(const std::string& t) {
+    std::string out;
+    for (std::size_t k = 0; k < t.size(); ++k) {
+      if (t[k] != '&') {
+        out += t[k];
+        continue;
+      }
+      const std::size_t e = t.find(';', k);
+      const std::string ent = t.substr(k, e - k + 1);
+      out += ent == "&amp;" ? "&" : ent == "&lt;" ? "<" : ent == "&gt;" ? ">" : ent == "&quot;" ? "\"" : "'";
+      k = e;
+    }
+    return out;
+  }
+  std::unique_ptr<Element> element() {
+    if (!starts("<")) fail("expected <");
+    ++i_;
+    auto e = std::make_unique<Element>();
+    e->name = name();
+    for (;;) {
+      space();
+      if (starts("/>")) {
+        i_ += 2;
+        return e;
+      }
+      if (starts(">")) {
+        ++i_;
+        break;
+      }
+      const std::string key = name();
+      space();
+      if (!starts("=")) fail("expected =");
+      ++i_;
+      space();
+      const char q = s_[i_];
+      if (q != '"' && q != '\'') fail("expected a quoted value");
+      const std::size_t end = s_.find(q, i_ + 1);
+      if (!e->attributes.emplace(key, unescape(s_.substr(i_ + 1, end - i_ - 1))).second) fail("duplicate attribute " + key);
+      i_ = end + 1;
+    }
+    for (;;) {
+      skip_misc();
+      if (starts("</")) {
+        i_ += 2;
+        if (name() != e->name) fail("mismatched end tag of " + e->name);
+        space();
+        if (!starts(">")) fail("expected >");
+        ++i_;
+        return e;
+      }
+      if (starts("<")) {
+        e->children.push_back(element());
+      } else {
+        const std::size_t b = i_;
+        while (i_ < s_.size() && s_[i_] != '<') ++i_;
+        e->text += unescape(s_.substr(b, i_ - b));
+      }
+    }
+  }
+};
+
+double number(const std::string& t) { return std::stod(t); }
+std::array<double, 3> triple(const std::string& t) {
+  std::istringstream in(t);
+  std::array<double, 3> v{};
+  in >> v[0] >> v[1] >> v[2];
+  return v;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("fivebar_urdf_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+std::string run(const std::string& command) {
+  std::string out;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return out;
+  std::array<char, 4096> buffer{};
+  std::size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) out.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  out += "\n[exit " + std::to_string(WEXITSTATUS(status)) + "]";
+  return out;
+}
+
+const Element* find_named(const Element& robot, const std::string& tag, const std::string& name) {
+  for (const Element* e : robot.all(tag))
+    if (e->at("name") == name) return e;
+  return nullptr;
+}
+
+// --- Tests -------------------------------------------------------------------------------------
+
+TEST(Urdf, CheckUrdfAcceptsTheShowcase) {
+  if (!fs::exists(kCheckUrdf)) GTEST_SKIP() << "check_urdf not installed (Debian package liburdfdom-tools): not run";
+  const Design d = paper();
+  TempDir dir;
+  for (const Station& s : d.stations) {
+    const fs::path file = dir.path / urdf_file_name(d, s);
+    std::ofstream(file) << render_urdf(d, s);
+    const std::string out = run(std::string(kCheckUrdf) + " '" + file.string() + "' 2>&1");
+    SCOPED_TRACE(out);
+    EXPECT_THAT(out, HasSubstr("robot name is: iros2022_" + s.name));
+    EXPECT_THAT(out, HasSubstr("Successfully Parsed XML"));
+    EXPECT_THAT(out, HasSubstr("root Link: " + s.name + "_base has 4 child(ren)"));
+    EXPECT_THAT(out, HasSubstr("[exit 0]"));
+  }
+}
+
+TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
+  const Design d = paper();
+  const Station& s = *d.station("index");
+  const std::string text = render_urdf(d, s);
+  const auto robot = XmlReader(text).document();
+  ASSERT_EQ(robot->name, "robot");
+  EXPECT_EQ(robot->at("name"), "iros2022_index");
+
+  // A tree: every link but the root is the child of exactly one joint; 4 motor joints, 4 elbows,
+  // 2 tactor joints (the cut), 2 fixed tips.
+  std::map<std::string, int> parents;
+  for (const Element* l : robot->all("link")) parents[l->at("name")] = 0;
+  EXPECT_EQ(parents.size(), 1u + 2 * 6);  // base + per mechanism L1..L4, tip, P
+  std::map<std::string, int> types;
+  for (const Element* j : robot->all("joint")) {
+    ++types[j->at("type")];
+    ASSERT_TRUE(parents.count(j->child("child")->at("link")));
+    ASSERT_TRUE(parents.count(j->child("parent")->at("link")));
+    ++parents[j->child("child")->at("link")];
+  }
+  for (const auto& [link, n] : parents) EXPECT_EQ(n, link == "index_base" ? 0 : 1) << link;
+  EXPECT_EQ(types["revolute"], 4);
+  EXPECT_EQ(types["continuous"], 6);
+  EXPECT_EQ(types["fixed"], 2);
+
+  // Motor joints: limits = the usable ranges, by hand: the boss of the other motor 19.38 deg
+  // (cos = 212.25 / 225) and the potentiometer's end 285 deg (0.25 V offset, 60 deg/V, 300 deg).
+  const double stop = std::acos(212.25 / 225.0);
+  const Element* t1 = find_named(*robot, "joint", "index_lower_theta1");
+  ASSERT_NE(t1, nullptr);
+  EXPECT_EQ(t1->at("type"), "revolute");
+  const Element* lim = t1->child("limit");
+  EXPECT_NEAR(number(lim->at("lower")), stop, 1e-15);
+  EXPECT_NEAR(number(lim->at("upper")), deg(285), 1e-15);
+  EXPECT_DOUBLE_EQ(number(lim->at("velocity")), 2 * kPi);  // controller.max_velocity_deg_s 360
+  // Stall torque at the output: eta N k_t min(V / R, I_max) = 0.7 x 200 x 5 mN m/A x min(6/5, 1) A.
+  EXPECT_NEAR(number(lim->at("effort")), 0.7 * 200 * 0.005 * 1.0, 1e-15);
+  EXPECT_EQ(triple(t1->child("origin")->at("xyz"))[0], 0.0);
+  EXPECT_EQ(triple(find_named(*robot, "joint", "index_lower_theta2")->child("origin")->at("xyz"))[0], 0.0125);
+  for (const Mechanism* m : s.mechanisms()) {
+    const auto ranges = usable_ranges(d, s, *m);
+    for (const UsableRange& r : ranges) {
+      const Element* j = find_named(*robot, "joint", r.joint);
+      ASSERT_NE(j, nullptr) << r.joint;
+      EXPECT_EQ(number(j->child("limit")->at("lower")), r.lo);
+      EXPECT_EQ(number(j->child("limit")->at("upper")), r.hi);
+    }
+  }
+  const Element* elbow = find_named(*robot, "joint", "index_upper_elbow2");
+  ASSERT_NE(elbow, nullptr);
+  EXPECT_EQ(elbow->at("type"), "continuous");
+  EXPECT_EQ(elbow->child("parent")->at("link"), "index_upper_L2");
+  // From L2's frame: 9 mm along x, one plane up (2.5 mm plate + 0.4 mm gap).
+  const auto e = triple(elbow->child("origin")->at("xyz"));
+  EXPECT_DOUBLE_EQ(e[0], 0.009);
+  EXPECT_NEAR(e[2], 0.0029, 1e-15);
+  EXPECT_THAT(text, HasSubstr("fills the passive joints from forward kinematics"));
+
+  // Masses: the distal link without the post (L4) is a 15 x 4 x 2.5 mm slab with a half disc of
+  // 2.5 mm at each end, less two pin holes of 2 + 2 x 0.15 mm, at 1.15 g/cm^3.
+  const double slab_mm3 = 15.0 * 4.0 * 2.5 + kPi * 2.5 * 2.5 * 2.5 - 2.0 * kPi * 1.15 * 1.15 * 2.5;
+  const Element* l4 = find_named(*robot, "link", "index_lower_L4");
+  ASSERT_NE(l4, nullptr);
+  EXPECT_NEAR(number(l4->child("inertial")->child("mass")->at("value")), 1.15e-6 * slab_mm3, 1e-15);
+  // Its centre of mass is midway (symmetric), in the plate's mid-plane.
+  const auto com = triple(l4->child("inertial")->child("origin")->at("xyz"));
+  EXPECT_NEAR(com[0], 0.0075, 1e-15);
+  EXPECT_NEAR(com[2], 0.00125, 1e-15);
+  // Every inertia is a physical one: positive, and each principal moment at most the sum of the others.
+  for (const Element* l : robot->all("link")) {
+    const Element* in = l->child("inertial");
+    if (in == nullptr) continue;
+    const Element* I = in->child("inertia");
+    const double xx = number(I->at("ixx")), yy = number(I->at("iyy")), zz = number(I->at("izz"));
+    EXPECT_GT(number(in->child("mass")->at("value")), 0.0);
+    EXPECT_GT(xx, 0.0);
+    EXPECT_LE(zz, xx + yy) << l->at("name");
+    EXPECT_LE(xx, yy + zz) << l->at("name");
+  }
+  EXPECT_THAT(text, HasSubstr("closed_form_inertia()"));  // no parts report: says so
+
+  // ros2_control: one system, the four motor joints, position command (min/max = the limits),
+  // position and velocity states.
+  const Element* rc = robot->child("ros2_control");
+  ASSERT_NE(rc, nullptr);
+  EXPECT_EQ(rc->at("type"), "system");
+  EXPECT_EQ(rc->child("hardware")->child("plugin")->text, "mock_components/GenericSystem");
+  const auto joints = rc->all("joint");
+  ASSERT_EQ(joints.size(), 4u);
+  EXPECT_EQ(joints[0]->at("name"), "index_lower_theta1");
+  EXPECT_EQ(joints[3]->at("name"), "index_upper_theta2");
+  for (const Element* j : joints) {
+    const Element* command = j->child("command_interface");
+    ASSERT_NE(command, nullptr);
+    EXPECT_EQ(command->at("name"), "position");
+    const Element* motor = find_named(*robot, "joint", j->at("name"));
+    const auto params = command->all("param");
+    ASSERT_EQ(params.size(), 2u);
+    EXPECT_EQ(number(params[0]->text), number(motor->child("limit")->at("lower")));
+    EXPECT_EQ(number(params[1]->text), number(motor->child("limit")->at("upper")));
+    const auto states = j->all("state_interface");
+    ASSERT_EQ(states.size(), 2u);
+    EXPECT_EQ(states[0]->at("name"), "position");
+    EXPECT_EQ(states[1]->at("name"), "velocity");
+    const double initial = number(states[0]->child("param")->text);
+    EXPECT_GT(initial, number(params[0]->text));
+    EXPECT_LT(initial, number(params[1]->text));
+  }
+}
+
+/// A binary STL of the box [x0, x0 + a] x [y0, y0 + b] x [z0, z0 + c], outward normals.
+void write_box(const fs::path& file, double x0, double y0, double z0, double a, double b, double c) {
+  const std::array<std::array<double, 3>, 8> v{{{x0, y0, z0}, {x0 + a, y0, z0}, {x0 + a, y0 + b, z0}, {x0, y0 + b, z0},
+                                                {x0, y0, z0 + c}, {x0 + a, y0, z0 + c}, {x0 + a, y0 + b, z0 + c}, {x0, y0 + b, z0 + c}}};
+  const std::array<std::array<int, 3>, 12> f{{{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                                              {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}}};
+  std::ofstream out(file, std::ios::binary);
+  const std::string header(80, ' ');
+  out.write(header.data(), 80);
+  const std::uint32_t n = 12;
+  out.write(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : f) {
+    const float zero[3] = {0, 0, 0};
+    out.write(reinterpret_cast<const char*>(zero), 12);
+    for (int k : t) {
+      const float p[3] = {float(v[std::size_t(k)][0]), float(v[std::size_t(k)][1]), float(v[std::size_t(k)][2])};
+      out.write(reinterpret_cast<const char*>(p), 12);
+    }
+    const std::uint16_t attr = 0;
+    out.write(reinterpret_cast<const char*>(&attr), 2);
+  }
+}
+
+TEST(Urdf, FromStlRendersMassesAreTheBoxesAndMeshesAreVisuals) {
+  const Design d = paper();
+  const Station& s = *d.station("index");
+  TempDir dir;
+  fs::create_directories(dir.path / "parts" / "index");
+  // Boxes with exactly representable corners (floats): 8 x 4 x 2 mm links, a 2 x 2 x 1 mm tip.
+  write_box(dir.path / "parts/index/link.stl", 0.5, -2.0, 0.0, 8.0, 4.0, 2.0);
+  write_box(dir.path / "parts/index/tip.stl", -1.0, -1.0, 0.0, 2.0, 2.0, 1.0);
+  Json parts = {{"parts", Json::array()}};
+  parts["parts"].push_back({{"station", "index"}, {"uses", {"lower/L1", "lower/L2", "lower/L3", "lower/L4", "upper/L1",
+                                                             "upper/L2", "upper/L3", "upper/L4"}},
+                            {"stl", "index/link.stl"}});
+  parts["parts"].push_back({{"station", "index"}, {"uses", {"lower/tactor", "upper/tactor"}}, {"stl", "index/tip.stl"}});
+  UrdfOptions options;
+  options.parts = &parts;
+  options.parts_dir = dir.path / "parts";
+  const std::string text = render_urdf(d, s, options);
+  const auto robot = XmlReader(text).document();
+  const Element* l1 = find_named(*robot, "link", "index_upper_L1");
+  ASSERT_NE(l1, nullptr);
+  const double rho = 1.15e-6;  // kg/mm^3
+  const double mass = rho * 8.0 * 4.0 * 2.0;
+  EXPECT_NEAR(number(l1->child("inertial")->child("mass")->at("value")), mass, 1e-12 * mass);
+  const auto com = triple(l1->child("inertial")->child("origin")->at("xyz"));
+  EXPECT_NEAR(com[0], 0.0045, 1e-15);
+  EXPECT_NEAR(com[1], 0.0, 1e-15);
+  EXPECT_NEAR(com[2], 0.001, 1e-15);
+  // Box about its centre: m (b^2 + c^2) / 12 etc., kg mm^2 -> kg m^2.
+  const Element* I = l1->child("inertial")->child("inertia");
+  EXPECT_NEAR(number(I->at("ixx")), mass * (16.0 + 4.0) / 12.0 * 1e-6, 1e-9 * mass * 1e-6);
+  EXPECT_NEAR(number(I->at("iyy")), mass * (64.0 + 4.0) / 12.0 * 1e-6, 1e-9 * mass * 1e-6);
+  EXPECT_NEAR(number(I->at("izz")), mass * (64.0 + 16.0) / 12.0 * 1e-6, 1e-9 * mass * 1e-6);
+  EXPECT_NEAR(number(I->at("ixy")), 0.0, 1e-12 * mass * 1e-6);
+  const Element* tip = find_named(*robot, "link", "index_lower_tip");
+  EXPECT_NEAR(number(tip->child("inertial")->child("mass")->at("value")), rho * 4.0, 1e-12);
+  const Element* mesh = l1->child("visual")->child("geometry")->child("mesh");
+  EXPECT_EQ(mesh->at("filename"), "../parts/index/link.stl");
+  EXPECT_EQ(mesh->at("scale"), "0.001 0.001 0.001");
+  EXPECT_THAT(text, HasSubstr("STL renders"));
+
+  // A report without every piece (no tip): the closed form, and the URDF says why.
+  parts["parts"].erase(1);
+  const std::string fallback = render_urdf(d, s, options);
+  EXPECT_THAT(fallback, HasSubstr("The parts report could not be used"));
+  EXPECT_THAT(fallback, HasSubstr("closed_form_inertia()"));
+}
+
+TEST(Urdf, ExportWritesOneUrdfPerStationAtomicallyAndOnlyWhenAsked) {
+  const Design d = paper();
+  TempDir dir;
+  ExportOptions options;
+  options.stations = {"thumb"};
+  options.urdf = true;
+  const ExportResult r = export_controller(d, {ExportFormat::ros2}, dir.path / "out", options);
+  ASSERT_TRUE(r.gate.passed());
+  ASSERT_EQ(r.files.size(), 2u);
+  EXPECT_EQ(r.files[1].filename(), "iros2022_thumb.urdf");
+  const std::string text = slurp(r.files[1]);
+  EXPECT_NO_THROW(XmlReader(text).document());
+  EXPECT_EQ(text, render_urdf(d, *d.station("thumb")));
+  for (const auto& entry : fs::directory_iterator(dir.path / "out")) {
+    EXPECT_NE(entry.path().filename().string().front(), '.') << "temporary left: " << entry.path();
+  }
+  options.urdf = false;
+  const ExportResult none = export_controller(d, {ExportFormat::ros2}, dir.path / "out2", options);
+  ASSERT_EQ(none.files.size(), 1u);
+  // No geometry: no URDF (and the controller files still go out for a one-mechanism station).
+  Design bare = d;
+  bare.reset<Geometry>();
+  EXPECT_THROW(render_urdf(bare, *bare.station("index")), InputError);
+}
+
+}  // namespace
+}  // namespace fivebar
