@@ -161,4 +161,21 @@ TEST_F(CliTolerance, BadInputIsExitTwoNamingFileLineAndKey) {
   EXPECT_THAT(s.err, HasSubstr("pinky"));
 }
 
+TEST_F(CliTolerance, ExportRefusesATargetThatPrintedDevicesLose) {
+  // tolerance.export_gate (on in the showcase): a 17 x 14 mm index target is covered by the
+  // design (0.0165 mm) but not by 99.7 % of printed devices, so export refuses, naming the
+  // mechanism and the figure, and writes nothing; without the gate the same design exports.
+  const fs::path out = dir_ / "exp";
+  const auto big = design_with("big.yaml", "axes: [15, 12]", "axes: [17, 14]");
+  const Outcome r = run({"export", big.string(), "--station", "index", "--out", out.string()});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.out + r.err, HasSubstr("robust_coverage"));
+  EXPECT_THAT(r.out + r.err, HasSubstr("index/lower"));
+  EXPECT_THAT(r.out + r.err, HasSubstr("printed devices lose the target"));
+  EXPECT_FALSE(fs::exists(out));
+  const auto off = design_with("off.yaml", {{"axes: [15, 12]", "axes: [17, 14]"}, {"export_gate: true", "export_gate: false"}});
+  const Outcome ok = run({"export", off.string(), "--station", "index", "--out", out.string()});
+  EXPECT_THAT(ok.out + ok.err, ::testing::Not(HasSubstr("robust_coverage")));
+}
+
 }  // namespace

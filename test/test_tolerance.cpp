@@ -272,6 +272,7 @@ TEST(ToleranceSection, BadValuesNameFileLineAndKey) {
       {"tolerance:\n  backlash_deg: 45\n", "bad.yaml:8: tolerance.backlash_deg"},
       {"tolerance:\n  pot_travel_deg: 0\n", "bad.yaml:8: tolerance.pot_travel_deg"},
       {"tolerance:\n  robust_fraction: 1\n", "bad.yaml:8: tolerance.robust_fraction"},
+      {"tolerance:\n  export_gate: maybe\n", "bad.yaml:8: tolerance.export_gate"},
       {"tolerance:\n  samples: 1.5\n", "bad.yaml:8: tolerance.samples"},
       {"tolerance:\n  sigma: 1\n", "bad.yaml:8: tolerance.sigma"},
   };

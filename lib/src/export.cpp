@@ -4,6 +4,8 @@
 
 #include "fivebar/format.hpp"
 #include "fivebar/export.hpp"
+#include "fivebar/sections/tolerance.hpp"
+#include "fivebar/tolerance.hpp"
 
 #include <algorithm>
 #include <array>
@@ -360,6 +362,19 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
                     : "the shared region does not cover the target: " + r.reason);
     }
     for (GateCheck& check : hardware_limit_checks(d, *d.station(name), options)) gate.checks.push_back(std::move(check));
+    // Robust coverage (fivebar/tolerance.hpp) when tolerance.export_gate asks for it: the target
+    // covered by tolerance.robust_fraction of printed devices (first order, at every boundary point).
+    if (const ToleranceSettings* t = d.get<ToleranceSettings>(); t != nullptr && t->export_gate) {
+      for (const Mechanism* m : s.mechanisms()) {
+        say(options, "export gate: robust coverage of " + name + "/" + m->name);
+        const ToleranceSources src = tolerance_sources(d, s, *m);
+        const RobustCoverage r = robust_coverage(*m, s.target, src.sigma, src.robust_fraction, 0, src.seed);
+        add("robust_coverage", name + "/" + m->name, r.covered,
+            fixed(100.0 * r.fraction, 1) + " % of printed devices keep a margin of " + fixed(r.robust_margin_mm, 3) +
+                " mm (design " + fixed(r.margin_mm, 3) + " mm, sigma " + fixed(r.sigma_mm, 3) + " mm at " +
+                point_text(r.robust_point) + ")" + (r.covered ? "" : ": printed devices lose the target"));
+      }
+    }
   }
 
   // Patterns declared for the exported stations.

@@ -57,10 +57,10 @@ void load(const Value& v, Design& design) {
   if (v.is_null()) return;
   const auto all = v.entries({"link_sigma_mm", "pin_sigma_mm", "base_sigma_mm", "angle_sigma_deg", "adc_bits",
                               "pin_play_mm", "shaft_play_mm", "backlash_deg", "linearity_percent", "pot_travel_deg",
-                              "robust_fraction", "samples", "seed"},
+                              "robust_fraction", "export_gate", "samples", "seed"},
                              "of tolerances (link_sigma_mm, pin_sigma_mm, base_sigma_mm, angle_sigma_deg, "
                              "adc_bits, pin_play_mm, shaft_play_mm, backlash_deg, linearity_percent, pot_travel_deg, "
-                             "robust_fraction, samples, seed)");
+                             "robust_fraction, export_gate, samples, seed)");
   t.link_sigma_mm = number_or(all, "link_sigma_mm", t.link_sigma_mm, "mm");
   t.pin_sigma_mm = number_or(all, "pin_sigma_mm", t.pin_sigma_mm, "mm");
   t.base_sigma_mm = number_or(all, "base_sigma_mm", t.base_sigma_mm, "mm");
@@ -72,6 +72,11 @@ void load(const Value& v, Design& design) {
   t.linearity_percent = number_or(all, "linearity_percent", t.linearity_percent, "%");
   t.pot_travel_deg = number_or(all, "pot_travel_deg", t.pot_travel_deg, "deg");
   t.robust_fraction = number_or(all, "robust_fraction", t.robust_fraction, "");
+  if (const Value* gate = find(all, "export_gate")) {
+    const std::string word = gate->text("a boolean: true or false");
+    if (word != "true" && word != "false") gate->fail_value("must be true or false");
+    t.export_gate = word == "true";
+  }
   if (const Value* n = find(all, "samples")) t.samples = n->whole(2, 1e8);
   if (const Value* seed = find(all, "seed")) t.seed = seed->whole(0, 9007199254740992.0);
 }
@@ -97,6 +102,7 @@ void write(const Design& design, Out& top) {
   o.add("linearity_percent", Out::number(t->linearity_percent));
   o.add("pot_travel_deg", Out::number(t->pot_travel_deg));
   o.add("robust_fraction", Out::number(t->robust_fraction));
+  o.add("export_gate", Out::plain(t->export_gate ? "true" : "false"));
   o.add("samples", Out::integer(static_cast<long long>(t->samples)));
   o.add("seed", Out::integer(static_cast<long long>(t->seed)));
 }

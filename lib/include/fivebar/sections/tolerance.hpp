@@ -36,6 +36,8 @@ struct ToleranceSettings {
   double pot_travel_deg = 300.0; ///< electrical travel of the potentiometer, deg (assumption)
   /// Robust coverage: the fraction of printed devices that must cover the target (0.997: 3 sigma).
   double robust_fraction = 0.997;
+  /// `fivebar export` refuses a design whose target some mechanism does not cover robustly.
+  bool export_gate = false;
   std::uint64_t samples = 10000; ///< Monte Carlo devices
   std::uint64_t seed = 1;        ///< Monte Carlo seed
   void validate() const;
