@@ -27,6 +27,7 @@ struct ToleranceCliOptions {
   std::string out;
   double spacing_mm = 0.25;
   bool no_files = false;
+  bool devices = false;
   bool json = false;
 };
 
@@ -120,6 +121,16 @@ int run_tolerance(const ToleranceCliOptions& opt) {
     if (!opt.no_files) {
       for (const auto& f : write_tolerance_files(dir, *s, maps[k])) files.push_back(f.generic_string());
     }
+    if (opt.devices) {
+      for (const Mechanism* m : s->mechanisms()) {
+        const ToleranceSources mech = tolerance_sources(design, *s, *m);
+        const std::filesystem::path csv = dir / (s->name + "-" + m->name + "-devices.csv");
+        AtomicFile file(csv);
+        write_devices_csv(file.stream(), tolerance_devices(*m, s->target, mech.sigma, mech.samples, mech.seed));
+        file.commit();
+        files.push_back(csv.generic_string());
+      }
+    }
     doc["stations"].push_back(std::move(js));
   }
   doc["files"] = files;
@@ -150,6 +161,10 @@ void setup_tolerance(CLI::App& app) {
   sub->add_option("-o,--out", opt->out, "Directory for the maps (default: outputs/<design>/tolerance)")
       ->type_name("DIR");
   sub->add_flag("--no-files", opt->no_files, "Print the figures only: no VTK maps, no pictures");
+  sub->add_flag("--devices", opt->devices,
+                "Also write the Monte Carlo's printed devices, a CSV per mechanism (<station>-<mechanism>-devices.csv: "
+                "parameter errors, tactor error at the target centre, the device's own coverage margin)")
+      ->excludes("--no-files");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
   sub->footer(
       "Tolerances come from the design's tolerance: section (docs/design-file.md), else from its defaults, which are "

@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <sstream>
+#include <fstream>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -176,6 +178,39 @@ TEST_F(CliTolerance, ExportRefusesATargetThatPrintedDevicesLose) {
   const auto off = design_with("off.yaml", {{"axes: [15, 12]", "axes: [17, 14]"}, {"export_gate: true", "export_gate: false"}});
   const Outcome ok = run({"export", off.string(), "--station", "index", "--out", out.string()});
   EXPECT_THAT(ok.out + ok.err, ::testing::Not(HasSubstr("robust_coverage")));
+}
+
+TEST_F(CliTolerance, DevicesCsvHoldsTheMonteCarlosPrintedDevices) {
+  // --devices: a row per sampled device. The devices are the Monte Carlo's (same seed and draws),
+  // so the spread of their tactor errors, computed here from the CSV, is the JSON's Monte Carlo
+  // 3-sigma, and every device whose own margin is >= 0 is counted as covering.
+  const fs::path out = dir_ / "dev";
+  const Outcome r = run({"tolerance", kDesign, "--station", "thumb", "--devices", "--json", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  std::ifstream in(out / "thumb-lower-devices.csv");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "device,dL1_mm,dL2_mm,dL3_mm,dL4_mm,dO1x_mm,dO1y_mm,dO2x_mm,dO2y_mm,dtheta1_deg,dtheta2_deg,status,"
+                  "error_x_mm,error_y_mm,margin_mm,covers");
+  double n = 0, sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0, covering = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) f.push_back(cell);
+    ASSERT_EQ(f.size(), 16u) << line;
+    ASSERT_EQ(f[11], "ok") << line;
+    const double x = std::stod(f[12]), y = std::stod(f[13]);
+    n += 1, sx += x, sy += y, sxx += x * x, syy += y * y, sxy += x * y;
+    covering += std::stod(f[15]);
+    EXPECT_EQ(f[15] == "1", std::stod(f[14]) >= 0.0) << line;
+  }
+  ASSERT_EQ(n, 10000.0);
+  const double cxx = (sxx - sx * sx / n) / (n - 1), cyy = (syy - sy * sy / n) / (n - 1), cxy = (sxy - sx * sy / n) / (n - 1);
+  const double major = 3.0 * std::sqrt(0.5 * (cxx + cyy) + std::hypot(0.5 * (cxx - cyy), cxy));
+  const json& m = ft::mechanism(ft::station(j, "thumb"), "lower");
+  EXPECT_NEAR(major, m["centre_monte_carlo_3sigma_mm"].get<double>(), 1e-9);
+  EXPECT_EQ(covering / n, m["robust_coverage"]["fraction_monte_carlo"].get<double>());
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <ostream>
 #include <random>
 
 #include "fivebar/coverage.hpp"
@@ -271,6 +272,47 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   const double quantile = margins[q];
   out.quantile_margin_mm = std::isfinite(quantile) ? quantile : -std::numeric_limits<double>::max();
   return out;
+}
+
+std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+                                            std::size_t samples, std::uint64_t seed) {
+  std::vector<DeviceSample> out(samples);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (DeviceSample& d : out)
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) d.dq[j] = sigma[j] * normal(rng);
+  const Pose nominal = ik(m, target.center);
+  Mechanism free = m;
+  free.joint_limits.reset();
+  if (nominal.status == Status::ok) free.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  const auto n = static_cast<std::ptrdiff_t>(samples);
+#pragma omp parallel for schedule(dynamic, 64)
+  for (std::ptrdiff_t k = 0; k < n; ++k) {
+    DeviceSample& d = out[static_cast<std::size_t>(k)];
+    const Mechanism p = perturbed(m, d.dq);
+    if (!lengths_positive(p)) {
+      d.margin_mm = -std::numeric_limits<double>::max();
+      continue;
+    }
+    d.margin_mm = containment(p, target).margin_mm;
+    if (nominal.status != Status::ok) continue;
+    const PointResult r = fk_point(perturbed(free, d.dq), nominal.theta1 + d.dq[8], nominal.theta2 + d.dq[9]);
+    d.status = r.status;
+    if (r.status == Status::ok) d.error_mm = r.P - target.center;
+  }
+  return out;
+}
+
+void write_devices_csv(std::ostream& out, const std::vector<DeviceSample>& devices) {
+  out << "device,dL1_mm,dL2_mm,dL3_mm,dL4_mm,dO1x_mm,dO1y_mm,dO2x_mm,dO2y_mm,dtheta1_deg,dtheta2_deg,status,"
+         "error_x_mm,error_y_mm,margin_mm,covers\n";
+  for (std::size_t k = 0; k < devices.size(); ++k) {
+    const DeviceSample& d = devices[k];
+    out << k;
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) out << ',' << format::shortest(j >= 8 ? d.dq[j] / kDeg : d.dq[j]);
+    out << ',' << to_string(d.status) << ',' << format::shortest(d.error_mm.x()) << ',' << format::shortest(d.error_mm.y()) << ','
+        << format::shortest(d.margin_mm) << ',' << (d.margin_mm >= 0.0 ? 1 : 0) << '\n';
+  }
 }
 
 // --- Maps -----------------------------------------------------------------------------------------

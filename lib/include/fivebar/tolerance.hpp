@@ -205,6 +205,22 @@ struct RobustCoverage {
 RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
                                double fraction, std::size_t samples, std::uint64_t seed);
 
+/// One sampled printed device: its parameter errors (ToleranceParameter order: mm, rad), where its
+/// tactor lands when commanded to the target centre, and its own coverage margin.
+struct DeviceSample {
+  std::array<double, kToleranceParameters> dq{};
+  Status status = Status::unreachable;  ///< of its FK at the nominal IK angles of the centre
+  Vec2 error_mm{0.0, 0.0};              ///< P_printed - P at the centre (zero unless ok)
+  double margin_mm = 0.0;               ///< containment() of the target by the device's region
+};
+/// The devices of robust_coverage()'s Monte Carlo (the same draws from `seed`), each with its
+/// tactor error at the target centre and its margin: the rows of `fivebar tolerance --devices`.
+std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+                                            std::size_t samples, std::uint64_t seed);
+/// CSV (a row per device, for pandas): device, dL1_mm ... dO2y_mm, dtheta1_deg, dtheta2_deg,
+/// status, error_x_mm, error_y_mm, margin_mm, covers.
+void write_devices_csv(std::ostream& out, const std::vector<DeviceSample>& devices);
+
 /// Phi^{-1}(p) of the standard normal, p in (0, 1) (Newton on std::erfc, to rounding).
 double normal_quantile(double p);
 
