@@ -389,6 +389,32 @@ TEST(Accuracy, RestrictedAreasAgainstTheSixteenTimesFinerGrid) {
   }
 }
 
+TEST(Accuracy, ToleranceEstimatesAgainstManyDevicesAndTheExactPlaySet) {
+  const MechanismAccuracy& a = index_lower_accuracy();
+  ASSERT_GT(a.tolerance_reference_samples, 0u);
+  const double ref = a.tolerance_reference_3sigma_mm;
+  const double ref_se = ref / std::sqrt(2.0 * double(a.tolerance_reference_samples));
+  // The first order agrees with 2e5 devices to their sampling error plus the linearisation's
+  // second-order term (0.05 mm on 9-15 mm links: well under 1 %).
+  const WorkSeries& fo = series(a.tolerance, "first-order 3-sigma");
+  ASSERT_EQ(fo.points.size(), 1u);
+  EXPECT_LT(fo.points[0].error, 4.0 * ref_se + 0.005 * ref);
+  // The Monte Carlo's error falls like N^-1/2 and its own estimate tracks it.
+  const WorkSeries& mc = series(a.tolerance, "Monte Carlo 3-sigma");
+  ASSERT_GE(mc.points.size(), 3u);
+  for (const WorkPoint& p : mc.points) {
+    ASSERT_TRUE(p.estimate);
+    EXPECT_LT(p.error, 4.0 * *p.estimate + 4.0 * ref_se) << p.resolution;
+  }
+  // Sampled devices never leave the exact play set and creep up on its extent; the first-order
+  // parallelogram is close to the exact set for 0.1 mm of play far from singularities.
+  const WorkSeries& sampled = series(a.tolerance, "play: sampled devices");
+  for (const WorkPoint& p : sampled.points) EXPECT_LE(p.value, a.play_extent_mm * (1.0 + 1e-12)) << p.resolution;
+  EXPECT_LT(sampled.points.back().error, sampled.points.front().error);
+  const WorkSeries& lin = series(a.tolerance, "play: first order");
+  EXPECT_LT(lin.points[0].error, 0.02 * a.play_extent_mm);
+}
+
 TEST(Accuracy, JointLimitsUseTheExactRegionAndNoQuadShortcut) {
   Mechanism m = paper("index", "lower");
   m.joint_limits = std::array<JointRange, 2>{JointRange{kPi / 3, 2.6}, JointRange{0.0, 2.6}};
@@ -646,7 +672,7 @@ TEST_F(Output, JsonTextAndPlotsOfTheAccuracyReport) {
                           HasSubstr("long double"), HasSubstr("ik_batch()")));
 
   const auto files = write_accuracy_plots(r, dir_ / "plots");
-  ASSERT_EQ(files.size(), 12u);  // area, margin, min LCI, restricted for index; FK; IK; SVG + PNG each
+  ASSERT_EQ(files.size(), 14u);  // area, margin, min LCI, restricted, tolerance for index; FK; IK; SVG + PNG each
   for (const auto& f : files) {
     std::ifstream in(dir_ / "plots" / f, std::ios::binary);
     std::string head(8, '\0');
@@ -724,9 +750,9 @@ TEST_F(ReportCli, AccuracyQuickJsonWritesThePlots) {
   EXPECT_TRUE(j["quick"].get<bool>());
   ASSERT_EQ(j["mechanisms"].size(), 2u);
   EXPECT_EQ(j["mechanisms"][0]["station"], "index");
-  for (const char* key : {"area", "coverage", "restricted"}) EXPECT_TRUE(j["mechanisms"][0].contains(key)) << key;
+  for (const char* key : {"area", "coverage", "restricted", "tolerance"}) EXPECT_TRUE(j["mechanisms"][0].contains(key)) << key;
   EXPECT_EQ(j["fk"]["strata"].size(), 5u);
-  ASSERT_EQ(j["files"].size(), 12u);
+  ASSERT_EQ(j["files"].size(), 14u);
   for (const auto& f : j["files"]) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;
   EXPECT_TRUE(fs::exists(dir_ / "o" / "iros2022" / "report" / "accuracy_index_area.png"));
 }

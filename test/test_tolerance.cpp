@@ -304,6 +304,34 @@ TEST(ToleranceMonteCarlo, ManyPointsAtOnceEqualOnePointAtATime) {
   EXPECT_EQ(many[3].status, Status::unreachable);
 }
 
+TEST(ToleranceMonteCarlo, FirstOrderIsFlaggedAndDisagreesNearTypeTwo) {
+  // Down the symmetry axis the tactor nears the elbows' line (type II). Far from it the first
+  // order matches the Monte Carlo; near it the estimate says it is not to be trusted, and the
+  // sampled devices do disagree (some cannot even assemble).
+  const Mechanism m = paper_mechanism("index", "lower");
+  ParameterSigmas sigma{};
+  for (std::size_t j = 0; j < 8; ++j) sigma[j] = 0.05;
+  sigma[8] = sigma[9] = 0.5 * std::numbers::pi / 180.0;
+  const ToleranceEstimate far = tolerance_first_order(m, Vec2(6.25, 15.5), sigma, 1e-4);
+  EXPECT_FALSE(far.near_singular);
+  Vec2 Q(6.25, 15.5);
+  for (double y = 15.5; y > 0.0; y -= 1e-3) {
+    const Pose q = ik(m, Vec2(6.25, y));
+    if (q.status != Status::ok) break;
+    Q = Vec2(6.25, y);
+    if (q.type2_sin < 0.02) break;
+  }
+  const ToleranceEstimate near = tolerance_first_order(m, Q, sigma, 1e-4);
+  ASSERT_EQ(near.status, Status::ok);
+  EXPECT_TRUE(near.near_singular);
+  const MonteCarloTolerance mc = tolerance_monte_carlo(m, Q, sigma, 20000, 3);
+  const Eigen::Matrix2d& C = mc.covariance;
+  const double mc3 = 3.0 * std::sqrt(0.5 * (C(0, 0) + C(1, 1)) + std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1)));
+  const bool disagrees = std::abs(mc3 - near.ellipse_semi_axes.x()) > 0.1 * near.ellipse_semi_axes.x() || mc.failed > 0;
+  EXPECT_TRUE(disagrees) << "first order " << near.ellipse_semi_axes.x() << " mm, Monte Carlo " << mc3 << " mm, "
+                         << mc.failed << " devices failed";
+}
+
 // --- Play set -------------------------------------------------------------------------------------
 
 /// A uniform point of the disc of radius r.

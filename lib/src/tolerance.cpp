@@ -96,6 +96,7 @@ ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const
     worst += s.S.col(static_cast<Eigen::Index>(j)).norm() * 3.0 * sigma[j];
   }
   out.worst_case_mm = worst;
+  out.near_singular = worst > 0.25 * std::min(m.L[2], m.L[3]) * s.pose.type2_sin;
   const double step = std::max(s.pose.J.col(0).norm(), s.pose.J.col(1).norm()) * rad_per_count;
   out.resolution_um = 1000.0 * step;
   if (!out.covariance.allFinite() || !std::isfinite(worst) || !std::isfinite(out.resolution_um)) {

@@ -98,6 +98,11 @@ struct ToleranceEstimate {
   double ellipse_angle = 0.0;        ///< direction of the major axis, rad, in (-pi/2, pi/2]
   double worst_case_mm = 0.0;        ///< sum_j |S_j| * 3 sigma_j, mm
   double resolution_um = 0.0;        ///< tactor step of one count on the worse joint, micrometres
+  /// The linearisation is not to be trusted here: the worst-case displacement reaches a quarter of
+  /// the way to the type II singularity (min(L3, L4) |sin| of the tactor angle, the distance a
+  /// distal link's end must move to align the links), where the error is no longer linear in the
+  /// tolerances (the Monte Carlo then disagrees, and some printed devices cannot assemble).
+  bool near_singular = false;
 };
 
 /// Closed-form sensitivity of the tactor to the ten parameters at P (derivation above).

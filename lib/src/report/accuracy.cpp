@@ -14,6 +14,7 @@
 #include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/report.hpp"
+#include "fivebar/tolerance.hpp"
 #include "fivebar/workspace.hpp"
 #include "report/precision.hpp"
 #include "report/quad.hpp"
@@ -637,6 +638,84 @@ std::optional<double> fit_log_slope(const std::vector<double>& x, const std::vec
   return (n * sxy - sx * sy) / den;
 }
 
+// --- tolerance estimates -------------------------------------------------------------------------
+
+/// 3 sqrt(largest eigenvalue) of a 2 x 2 covariance.
+static double major_3sigma(const Eigen::Matrix2d& C) {
+  const double mid = 0.5 * (C(0, 0) + C(1, 1));
+  return 3.0 * std::sqrt(std::max(0.0, mid + std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1))));
+}
+
+static void tolerance_study(const Mechanism& m, const Ellipse& target, const AccuracyOptions& o, MechanismAccuracy& out) {
+  const Timing tm = timing_for(o.quick);
+  // Illustrative tolerances: 0.05 mm on lengths and base positions, 0.5 deg on the joint angles;
+  // 0.1 mm of play on each leg.
+  ParameterSigmas sigma{};
+  for (std::size_t j = 0; j < 8; ++j) sigma[j] = 0.05;
+  sigma[8] = sigma[9] = 0.5 * std::numbers::pi / 180.0;
+  const std::array<double, 2> play{0.1, 0.1};
+  const Vec2 P = target.center;
+  if (ik(m, P).status != Status::ok) return;
+  out.tolerance_reference_samples = o.quick ? 200000 : 1000000;
+  out.tolerance_reference_3sigma_mm =
+      major_3sigma(tolerance_monte_carlo(m, std::vector<Vec2>{P}, sigma, out.tolerance_reference_samples, o.seed + 7)[0].covariance);
+  const double ref = out.tolerance_reference_3sigma_mm;
+
+  WorkSeries mc{"Monte Carlo 3-sigma", "samples", "mm", {}, {}, {},
+                "tolerance_monte_carlo() of N printed devices; estimate = its standard error 3 sigma / sqrt(2 N)"};
+  for (std::size_t n : {std::size_t(100), std::size_t(1000), std::size_t(10000), std::size_t(100000)}) {
+    if (o.quick && n > 10000) break;
+    MonteCarloTolerance r;
+    const double t = median_time(tm, [&] { r = tolerance_monte_carlo(m, P, sigma, n, o.seed); });
+    const double v = major_3sigma(r.covariance);
+    mc.points.push_back({double(n), t, v, std::abs(v - ref), v / std::sqrt(2.0 * double(n))});
+  }
+  // Order in N (about -1/2), above the reference's own standard error.
+  fit(mc, 2.0 * ref / std::sqrt(2.0 * double(out.tolerance_reference_samples)), kAllPoints);
+  out.tolerance.push_back(std::move(mc));
+  ToleranceEstimate fo;
+  const double t_fo = median_time(tm, [&] { fo = tolerance_first_order(m, P, sigma, 1e-4); });
+  out.tolerance.push_back({"first-order 3-sigma", "samples", "mm",
+                           {{0.0, t_fo, fo.ellipse_semi_axes.x(), std::abs(fo.ellipse_semi_axes.x() - ref), {}}},
+                           {}, {}, "tolerance_first_order(): closed-form sensitivity, one evaluation"});
+
+  // Play: the exact set's extent against devices with play drawn uniformly in their clearances
+  // (sampling approaches the corners slowly) and against the first-order parallelogram.
+  PlaySet exact;
+  const double t_exact = median_time(tm, [&] { exact = tolerance_play(m, P, play); });
+  out.play_extent_mm = exact.extent_mm;
+  if (exact.status != Status::ok) return;
+  const Pose q = ik(m, P);
+  WorkSeries sampled{"play: sampled devices", "samples", "mm", {}, {}, {},
+                     "largest |P' - P| over N devices whose legs start their distal links uniformly within the play "
+                     "(the set's corners are reached only in the limit)"};
+  for (std::size_t n : {std::size_t(100), std::size_t(1000), std::size_t(10000), std::size_t(100000)}) {
+    if (o.quick && n > 10000) break;
+    double far = 0.0;
+    const double t = median_time(tm, [&] {
+      std::mt19937_64 rng(o.seed + 11);
+      std::uniform_real_distribution<double> u(0.0, 1.0);
+      far = 0.0;
+      for (std::size_t k = 0; k < n; ++k) {
+        const auto disc = [&](double r) {
+          const double rho = r * std::sqrt(u(rng)), phi = 2.0 * std::numbers::pi * u(rng);
+          return Vec2(rho * std::cos(phi), rho * std::sin(phi));
+        };
+        const Vec2 a1 = q.A1 + disc(play[0]), a2 = q.A2 + disc(play[1]);
+        const int side = (q.A2 - q.A1).x() * (q.P - q.A1).y() - (q.A2 - q.A1).y() * (q.P - q.A1).x() >= 0.0 ? 1 : -1;
+        const CircleIntersection c = intersect_circles(a1, m.L[2], a2, m.L[3], side);
+        if (c.status != Status::unreachable) far = std::max(far, (c.point - P).norm());
+      }
+    });
+    sampled.points.push_back({double(n), t, far, std::abs(exact.extent_mm - far), {}});
+  }
+  fit(sampled, 0.0, kAllPoints);
+  out.tolerance.push_back(std::move(sampled));
+  out.tolerance.push_back({"play: first order", "samples", "mm",
+                           {{0.0, t_exact, exact.linear_extent_mm, std::abs(exact.linear_extent_mm - exact.extent_mm), {}}},
+                           {}, {}, "the parallelogram P + M^-1 [+-r1, +-r2] against the exact set (two thin annuli)"});
+}
+
 MechanismAccuracy mechanism_accuracy(const Mechanism& m, const Ellipse& target, const AccuracyOptions& o) {
   MechanismAccuracy out;
   out.mechanism = m.name;
@@ -648,6 +727,8 @@ MechanismAccuracy mechanism_accuracy(const Mechanism& m, const Ellipse& target, 
   coverage_study(m, region, target, o, out);
   say(o, "accuracy:   restricted regions");
   restricted_study(m, region, o, out);
+  say(o, "accuracy:   tolerance estimates");
+  tolerance_study(m, target, o, out);
   return out;
 }
 

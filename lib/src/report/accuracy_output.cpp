@@ -81,12 +81,14 @@ std::string label(const MechanismAccuracy& m) { return m.station + "/" + m.mecha
 void series_table(std::ostringstream& out, const std::vector<WorkSeries>& series) {
   if (series.empty()) return;
   const std::string u = series.front().unit == "mm2" ? "mm²" : series.front().unit;
-  out << "  " << pad("method", 26) << pad("h (mm)", 10, true) << pad("time (s)", 11, true)
+  const bool samples = series.front().resolution == "samples";
+  out << "  " << pad("method", 26) << pad(samples ? "N" : "h (mm)", 10, true) << pad("time (s)", 11, true)
       << pad("value" + (u == "1" ? std::string() : " (" + u + ")"), 18, true)
       << pad("error" + (u == "1" ? std::string() : " (" + u + ")"), 14, true) << pad("own estimate", 14, true) << "\n";
   for (const WorkSeries& s : series) {
     for (const WorkPoint& p : s.points) {
-      out << "  " << pad(s.method, 26) << pad(p.resolution > 0 ? fixed(p.resolution, 4) : "—", 10, true)
+      const std::string res = p.resolution > 0 ? (samples ? fixed(p.resolution, 0) : fixed(p.resolution, 4)) : "—";
+      out << "  " << pad(s.method, 26) << pad(res, 10, true)
           << pad(sci(p.time_s, 2), 11, true) << pad(fixed(p.value, s.unit == "1" ? 8 : 6), 18, true)
           << pad(sci(p.error, 2), 14, true) << pad(sci(p.estimate, 2), 14, true) << "\n";
     }
@@ -140,9 +142,13 @@ plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station,
   spec.x_label = "run time (s), median of repeats after a warm-up";
   for (const MechanismAccuracy& m : r.mechanisms) {
     if (m.station != station) continue;
-    const std::vector<WorkSeries>* list = kind == "area" ? &m.area : kind == "restricted" ? &m.restricted : &m.coverage;
+    const std::vector<WorkSeries>* list = kind == "area"         ? &m.area
+                                          : kind == "restricted" ? &m.restricted
+                                          : kind == "tolerance"  ? &m.tolerance
+                                                                 : &m.coverage;
     for (const WorkSeries& s : *list) {
-      const bool wanted = kind == "area" || kind == "restricted" || (kind == "margin" ? s.unit == "mm" : s.unit == "1");
+      const bool wanted = kind == "area" || kind == "restricted" || kind == "tolerance" ||
+                          (kind == "margin" ? s.unit == "mm" : s.unit == "1");
       if (!wanted || s.points.empty()) continue;
       plot::PlotSeries ps;
       ps.label = legend(m.mechanism, s);
@@ -161,6 +167,12 @@ plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station,
     spec.y_label = "|area - area on a 16x finer grid| (mm²)";
     spec.footnote = "restricted_area (adaptive marching squares) of the assembly- and LCI-restricted regions and of a "
                     "thin island (LCI within 2 % of its largest value); the grid spacing halves along each line.";
+  } else if (kind == "tolerance") {
+    spec.title = "Tolerance estimates at the target centre, station " + station;
+    spec.y_label = "|estimate - reference| (mm)";
+    spec.footnote = "3-sigma tactor error (0.05 mm, 0.5 deg): Monte Carlo of N devices (N x10 along the line) and the "
+                    "first order against 1e6 devices; play (0.1 mm a leg): sampled devices and first order against "
+                    "the exact set.";
   } else if (kind == "margin") {
     spec.title = "Coverage margin, station " + station;
     spec.y_label = "|margin - coverage() margin| (mm)";
@@ -249,6 +261,13 @@ Json to_json(const AccuracyReport& r) {
     rs["series"] = Json::array();
     for (const WorkSeries& s : m.restricted) rs["series"].push_back(series_json(s));
     a["restricted"] = rs;
+    Json tol;
+    tol["reference_3sigma_mm"] = m.tolerance_reference_3sigma_mm;
+    tol["reference_samples"] = m.tolerance_reference_samples;
+    tol["play_extent_mm"] = m.play_extent_mm;
+    tol["series"] = Json::array();
+    for (const WorkSeries& s : m.tolerance) tol["series"].push_back(series_json(s));
+    a["tolerance"] = tol;
     ms.push_back(a);
   }
   j["mechanisms"] = ms;
@@ -286,6 +305,10 @@ std::string to_text(const AccuracyReport& r) {
         << "); reference: h = " << fixed(m.reference_spacing_mm, 4) << " mm, assembly "
         << fixed(m.assembly_area_reference_mm2, 6) << " mm², LCI " << fixed(m.lci_area_reference_mm2, 6) << " mm²\n";
     series_table(out, m.restricted);
+    out << "Tolerance estimates at the target centre: Monte Carlo reference 3-sigma "
+        << fixed(m.tolerance_reference_3sigma_mm, 6) << " mm (" << m.tolerance_reference_samples
+        << " devices), exact play set " << fixed(m.play_extent_mm, 6) << " mm\n";
+    series_table(out, m.tolerance);
   }
   study_table(out, r.fk);
   study_table(out, r.ik);
@@ -299,7 +322,7 @@ std::vector<std::filesystem::path> write_accuracy_plots(const AccuracyReport& r,
   for (const MechanismAccuracy& m : r.mechanisms)
     if (std::find(stations.begin(), stations.end(), m.station) == stations.end()) stations.push_back(m.station);
   for (const std::string& s : stations) {
-    for (const char* kind : {"area", "margin", "min_lci", "restricted"}) {
+    for (const char* kind : {"area", "margin", "min_lci", "restricted", "tolerance"}) {
       plots.push_back({"accuracy_" + s + "_" + kind, station_plot(r, s, kind)});
     }
   }

@@ -69,6 +69,14 @@ struct MechanismAccuracy {
   std::vector<WorkSeries> restricted;      ///< assembly-restricted, LCI-restricted and thin LCI areas
   double thin_lci_threshold = 0.0;         ///< LCI threshold of the thin series (98 % of the largest)
   double thin_lci_area_reference_mm2 = 0.0;
+  // Tolerance estimates at the target centre (fivebar/tolerance.hpp), with illustrative tolerances
+  // (kAccuracyToleranceSigmas): the first order and the Monte Carlo 3-sigma against a Monte Carlo
+  // of many more devices (another seed), and the play set's extent: first order and sampled
+  // devices against the exact set.
+  double tolerance_reference_3sigma_mm = 0.0;
+  std::size_t tolerance_reference_samples = 0;
+  double play_extent_mm = 0.0;             ///< the exact set's
+  std::vector<WorkSeries> tolerance;
 };
 
 /// Error statistics of one method over one stratum of singularity distance.
