@@ -25,6 +25,9 @@ struct SimulateOptions {
   bool step = false;
   bool no_render = false;
   std::optional<double> rtol;
+  std::string integrator = "bdf";
+  std::string pwm = "averaged";
+  std::optional<double> dense_dt_s;
   double max_wall_s = 120.0;
   std::string out;
   bool json = false;
@@ -56,6 +59,13 @@ int run_simulate(const SimulateOptions& opt) {
     throw InputError("--rtol must be within [1e-14, 1e-2]");
   }
   if (!(opt.max_wall_s > 0.0) || !(opt.max_wall_s <= 1e6)) throw InputError("--max-wall must be > 0 and <= 1e6 s");
+  const std::optional<Integrator> integrator = parse_integrator(opt.integrator);
+  if (!integrator) throw InputError("--integrator '" + opt.integrator + "': expected bdf or erk");
+  const std::optional<PwmModel> pwm = parse_pwm_model(opt.pwm);
+  if (!pwm) throw InputError("--pwm '" + opt.pwm + "': expected averaged or switched");
+  if (opt.dense_dt_s && (!(*opt.dense_dt_s >= 1e-6) || !(*opt.dense_dt_s <= 1.0))) {
+    throw InputError("--dense must be within [1e-6, 1] s");
+  }
   const Design design = load(opt.design);
   std::vector<const Station*> stations;
   if (!opt.station.empty()) {
@@ -97,6 +107,9 @@ int run_simulate(const SimulateOptions& opt) {
   SimulationOptions so;
   if (opt.rtol) so.rtol = *opt.rtol;
   so.max_wall_s = opt.max_wall_s;
+  so.integrator = *integrator;
+  so.pwm = *pwm;
+  if (opt.dense_dt_s) so.dense_dt_s = *opt.dense_dt_s;
   Json runs = Json::array();
   Json mass = Json::object();
   std::vector<std::string> files;
@@ -126,6 +139,17 @@ int run_simulate(const SimulateOptions& opt) {
       files.push_back(csv.generic_string());
       Json j = to_json(in, r);
       j["csv"] = csv.generic_string();
+      if (opt.dense_dt_s) {
+        SimulationResult dense_only;
+        dense_only.samples = r.dense;
+        dense_only.summary = r.summary;  // the mechanisms' names
+        const std::filesystem::path dense_csv = dir / (s->name + "-" + in.reference_name + "-dense.csv");
+        AtomicFile dense_file(dense_csv);
+        write_time_series_csv(dense_file.stream(), dense_only);
+        dense_file.commit();
+        files.push_back(dense_csv.generic_string());
+        j["dense_csv"] = dense_csv.generic_string();
+      }
       runs.push_back(j);
       all_ok = all_ok && r.ok();
       if (!opt.json) print_run(in, r, csv.generic_string());
@@ -134,7 +158,9 @@ int run_simulate(const SimulateOptions& opt) {
   if (opt.json) {
     print_json({{"command", "simulate"},
                 {"design", design.name},
-                {"integrator", "CVODE BDF, Newton, dense"},
+                {"integrator", so.integrator == Integrator::erk ? "ARKODE ERK, Dormand-Prince 5(4)"
+                                                                : "CVODE BDF, Newton, dense"},
+                {"pwm", std::string(to_string(so.pwm))},
                 {"rtol", so.rtol},
                 {"mass", mass},
                 {"runs", runs},
@@ -170,7 +196,18 @@ void setup_simulate(CLI::App& app) {
       ->excludes(pattern);
   sub->add_flag("--no-render", opt->no_render,
                 "Links' masses from the closed form (slab with bosses) instead of the parts' STL renders (openscad)");
-  sub->add_option("--rtol", opt->rtol, "CVODE relative tolerance (default 1e-6)")->type_name("R");
+  sub->add_option("--rtol", opt->rtol, "The integrator's relative tolerance (default 1e-6)")->type_name("R");
+  sub->add_option("--integrator", opt->integrator,
+                  "bdf (CVODE BDF, Newton; the default) or erk (ARKODE explicit Runge-Kutta, Dormand-Prince 5(4), "
+                  "the comparison)")
+      ->type_name("KIND");
+  sub->add_option("--pwm", opt->pwm,
+                  "averaged (V = duty x supply; the default) or switched (the 1 kHz sign-magnitude waveform, every "
+                  "edge a stop time)")
+      ->type_name("MODEL");
+  sub->add_option("--dense", opt->dense_dt_s,
+                  "Also write <station>-<reference>-dense.csv: the integrator's dense output every S seconds")
+      ->type_name("S");
   sub->add_option("--max-wall", opt->max_wall_s, "Wall-time bound of each simulation (s, default 120): beyond it the run "
                   "stops with status wall_time_limit")
       ->type_name("S");

@@ -16,6 +16,7 @@ System make_system(const SimulationInput& input, const SimulationOptions& option
   s.options = &options;
   s.duty.assign(input.mechanisms.size(), {0.0, 0.0});
   s.slipping.assign(input.mechanisms.size(), 0);
+  s.on.assign(input.mechanisms.size(), {false, false});
   s.k = input.contact.shear_stiffness_N_per_mm * 1e3;
   s.c = input.contact.damping_N_s_per_mm * 1e3;
   s.limit = input.contact.friction_coefficient * input.contact.normal_preload_N;
@@ -62,11 +63,27 @@ Evaluation evaluate(System& s, std::size_t k, const double* yall) {
       i = 0.0;
     } else {
       const double duty = s.duty[k][static_cast<std::size_t>(j)];
-      double v = std::clamp(duty, -1.0, 1.0) * mp.supply_voltage_V;
-      const double lo = back_emf - mp.resistance() * mp.current_limit_A;
-      const double hi = back_emf + mp.resistance() * mp.current_limit_A;
-      const bool limited = v < lo || v > hi;
-      v = std::clamp(v, lo, hi);
+      const double r_limit = mp.resistance() * mp.current_limit_A;
+      double v = 0.0;
+      bool limited = false;
+      if (o.pwm == PwmModel::switched) {
+        // Sign-magnitude bridge; on the on-phase the limiter holds the current at I_max once it
+        // gets there (V = R I_max + back EMF: di/dt = 0 at the limit, the current relaxes back to
+        // it from beyond), else the full supply.
+        const double sign = duty > 0.0 ? 1.0 : duty < 0.0 ? -1.0 : 0.0;
+        if (s.on[k][static_cast<std::size_t>(j)] && sign != 0.0) {
+          v = sign * mp.supply_voltage_V;
+          if (sign * i >= mp.current_limit_A) {
+            v = sign * r_limit + back_emf;
+            limited = true;
+          }
+        }
+      } else {
+        v = std::clamp(duty, -1.0, 1.0) * mp.supply_voltage_V;
+        const double lo = back_emf - r_limit, hi = back_emf + r_limit;
+        limited = v < lo || v > hi;
+        v = std::clamp(v, lo, hi);
+      }
       v = std::clamp(v, -mp.supply_voltage_V, mp.supply_voltage_V);
       ev.voltage[static_cast<std::size_t>(j)] = v;
       ev.saturated[static_cast<std::size_t>(j)] = limited || std::abs(duty) >= 1.0;

@@ -20,11 +20,14 @@ struct System {
   const SimulationOptions* options = nullptr;
   std::vector<std::array<double, 2>> duty;  ///< held over the current period, per mechanism
   std::vector<char> slipping;               ///< contact mode per mechanism
+  /// Switched PWM (SimulationOptions::pwm): per mechanism and joint, the bridge on (sign(duty)
+  /// V_supply) or off (0 V) over the current segment between two switching instants.
+  std::vector<std::array<bool, 2>> on;
   double k = 0.0;      ///< N/m
   double c = 0.0;      ///< N s/m
   double limit = 0.0;  ///< mu N, N
-  bool last_failure_singular = false;
-  std::size_t evaluations = 0;         ///< right-hand sides evaluated by the integrator  ///< the last failed evaluation was a singular pose
+  bool last_failure_singular = false;  ///< the last failed evaluation was a singular pose
+  std::size_t evaluations = 0;  ///< right-hand sides evaluated by the integrator
   std::size_t mechanisms() const { return input->mechanisms.size(); }
 };
 
