@@ -163,7 +163,7 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
       return result;
     }
   }
-  const int n_roots = options.contact ? static_cast<int>(nm) : 0;
+  const int n_roots = dynamics_detail::root_count(sys);
   const std::unique_ptr<Stepper> stepper = options.integrator == Integrator::erk
                                                ? dynamics_detail::make_erk(sys, n, options.rtol, atol, n_roots)
                                                : dynamics_detail::make_bdf(sys, n, options.rtol, atol, n_roots);
@@ -249,7 +249,10 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
       }
       pending[k] = fresh;
     }
-    if (switched) set_pwm_levels(sys, tk, tk + std::min(T, pwm_period) * 1e-3, pwm_period);
+    if (switched) {
+      set_pwm_levels(sys, tk, tk + std::min(T, pwm_period) * 1e-3, pwm_period);
+      dynamics_detail::reset_limiters(sys, y);
+    }
     if (s == 0) record_dense(0, 0.0, 0.0);
     // Record the sample.
     TimeSample sample;
@@ -281,7 +284,10 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
     t = tk;
     for (std::size_t c = 0; c + 1 < cuts.size() && result.status == SimStatus::ok; ++c) {
       const double t_end = cuts[c + 1];
-      if (switched) set_pwm_levels(sys, cuts[c], t_end, pwm_period);
+      if (switched) {
+        set_pwm_levels(sys, cuts[c], t_end, pwm_period);
+        dynamics_detail::reset_limiters(sys, y);
+      }
       stepper->restart(cuts[c], t_end, directions());
       ++result.restarts;
       t = cuts[c];
@@ -294,8 +300,14 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
         if (outcome == StepOutcome::root) {
           std::vector<int> found;
           stepper->root_info(found);
-          for (std::size_t k = 0; k < nm; ++k) {
-            if (found[k] == 0) continue;
+          for (std::size_t r = 0; r < found.size(); ++r) {
+            if (found[r] == 0) continue;
+            const dynamics_detail::RootOwner owner = dynamics_detail::root_owner(sys, r);
+            const std::size_t k = owner.k;
+            if (owner.joint >= 0) {
+              sys.limiting[k][static_cast<std::size_t>(owner.joint)] = true;
+              continue;
+            }
             sys.slipping[k] = !sys.slipping[k];
             if (sys.slipping[k]) {
               summary[k].slipped = true;
