@@ -520,6 +520,21 @@ TEST(Stability, EveryCasePassesOnThePaperStations) {
           << mech << " " << group;
     }
   }
+  // The dynamic cases of each station: five simulations at the extremes, each finished and finite.
+  for (const char* station : {"index", "thumb"}) {
+    std::size_t n = 0;
+    for (const StabilityCase& c : r.cases) {
+      if (c.mechanism != station || c.group != "dynamics") continue;
+      ++n;
+      EXPECT_EQ(c.operation, "simulate");
+      EXPECT_TRUE(c.status == "ok" || c.status == "singular") << c.name << ": " << c.explanation;
+      EXPECT_NE(c.explanation.find(" s simulated in "), std::string::npos) << c.explanation;
+    }
+    EXPECT_EQ(n, 5u) << station;
+  }
+  const StabilityCase* stiff = find_case(r, "dynamics", "stiffness ratio 1e8 (L/R = 1e-10 s), 1 mm step", "simulate");
+  ASSERT_NE(stiff, nullptr);
+  EXPECT_EQ(stiff->status, "ok");
   // Exactly singular inputs are reported singular with the exact answer.
   const StabilityCase* t1 = find_case(r, "type I distance", "leg 1 stretched, distance 0", "ik");
   ASSERT_NE(t1, nullptr);
@@ -738,7 +753,12 @@ TEST_F(ReportCli, StabilityJsonAndExitCode) {
   for (const char* key : {"mechanism", "group", "case", "operation", "parameter", "status", "expected", "error", "bound",
                           "unit", "conditioning", "finite", "passed", "ill_conditioned", "explanation"})
     EXPECT_TRUE(j["cases"][0].contains(key)) << key;
-  for (const auto& c : j["cases"]) EXPECT_TRUE(c["mechanism"] == "index/lower" || c["mechanism"] == "index/upper");
+  for (const auto& c : j["cases"]) {
+    // The kinematic cases by mechanism, the dynamic ones (both tactors together) by station.
+    EXPECT_TRUE(c["mechanism"] == "index/lower" || c["mechanism"] == "index/upper" ||
+                (c["mechanism"] == "index" && c["group"] == "dynamics"))
+        << c["mechanism"];
+  }
 
   const Outcome text = run({"report", "stability", kDesign, "--station", "thumb"});
   EXPECT_EQ(text.code, 0);
