@@ -23,6 +23,7 @@ struct SimulateOptions {
   std::string station;
   std::string pattern;
   bool step = false;
+  bool chirp = false;
   bool no_render = false;
   std::optional<double> rtol;
   std::string integrator = "bdf";
@@ -82,6 +83,7 @@ int run_simulate(const SimulateOptions& opt) {
     probe.station = s->name;
     probe.pattern = kind;
     probe.step = opt.step;
+    probe.chirp = opt.chirp;
     std::map<std::string, MechanismInertia> none;
     for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
     (void)simulation_inputs(design, probe, none);
@@ -123,6 +125,7 @@ int run_simulate(const SimulateOptions& opt) {
     request.station = s->name;
     request.pattern = kind;
     request.step = opt.step;
+    request.chirp = opt.chirp;
     for (const SimulationInput& in : simulation_inputs(design, request, inertia)) {
       if (!in.unusable.empty()) {
         all_ok = false;
@@ -153,6 +156,32 @@ int run_simulate(const SimulateOptions& opt) {
       runs.push_back(j);
       all_ok = all_ok && r.ok();
       if (!opt.json) print_run(in, r, csv.generic_string());
+      if (opt.chirp) {
+        const BodeResult bode = chirp_bode(in, r, request);
+        const std::string stem = s->name + "-chirp-bode";
+        AtomicFile bode_csv(dir / (stem + ".csv"));
+        write_bode_csv(bode_csv.stream(), bode);
+        bode_csv.commit();
+        const std::string title = "Frequency response at the target centre, station " + s->name;
+        write_file_atomic(dir / (stem + ".svg"), bode_svg(bode, title));
+        write_file_atomic(dir / (stem + ".png"), bode_png(bode, title));
+        Json bw = Json::object();
+        for (std::size_t m = 0; m < bode.mechanisms.size(); ++m) {
+          bw[bode.mechanisms[m]] = bode.bandwidth_hz[m] ? Json(*bode.bandwidth_hz[m]) : Json(nullptr);
+          if (!opt.json) {
+            std::cout << "  " << bode.mechanisms[m] << ": -3 dB bandwidth "
+                      << (bode.bandwidth_hz[m] ? fixed(*bode.bandwidth_hz[m], 2) + " Hz"
+                                               : std::string("beyond the chirp's band"))
+                      << " (magnitude " << fixed(bode.magnitude[m].front(), 3) << " at " << fixed(bode.f_hz.front(), 2)
+                      << " Hz, " << fixed(bode.magnitude[m].back(), 3) << " at " << fixed(bode.f_hz.back(), 2)
+                      << " Hz)\n";
+          }
+        }
+        for (const char* ext : {".csv", ".svg", ".png"}) files.push_back((dir / (stem + ext)).generic_string());
+        runs.back()["bandwidth_hz"] = bw;
+        runs.back()["bode_csv"] = (dir / (stem + ".csv")).generic_string();
+        if (!opt.json) std::cout << "  Bode magnitude: " << (dir / (stem + ".csv")).generic_string() << ", .svg, .png\n";
+      }
     }
   }
   if (opt.json) {
@@ -192,8 +221,14 @@ void setup_simulate(CLI::App& app) {
       ->type_name("NAME");
   auto* pattern = sub->add_option("--pattern", opt->pattern, "Only this pattern: stretch, slip, twist or pivot")
                       ->type_name("KIND");
-  sub->add_flag("--step", opt->step, "A 1 mm step of both tactors along +x from the stretch pattern's start, 0.5 s")
-      ->excludes(pattern);
+  auto* step = sub->add_flag("--step", opt->step,
+                             "A 1 mm step of both tactors along +x from the stretch pattern's start, 0.5 s")
+                   ->excludes(pattern);
+  sub->add_flag("--chirp", opt->chirp,
+                "A 0.2 mm chirp of both tactors along x, 0.5 -> 25 Hz (a quarter of the loop rate) over 6 s: Bode "
+                "magnitude and -3 dB bandwidth (<station>-chirp-bode.csv, .svg, .png)")
+      ->excludes(pattern)
+      ->excludes(step);
   sub->add_flag("--no-render", opt->no_render,
                 "Links' masses from the closed form (slab with bosses) instead of the parts' STL renders (openscad)");
   sub->add_option("--rtol", opt->rtol, "The integrator's relative tolerance (default 1e-6)")->type_name("R");
@@ -216,7 +251,7 @@ void setup_simulate(CLI::App& app) {
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
-      "Without --pattern or --step, every pattern of the station's patterns: section (or all four defaults).\n"
+      "Without --pattern, --step or --chirp, every pattern of the station's patterns: section (or all four defaults).\n"
       "Exit status: 0 every simulation finished, 1 one did not (singular pose, step or time limit) or a part\n"
       "failed to render, 2 bad input, 3 internal error or output not writable.");
   sub->callback([opt]() { finish(run_simulate(*opt)); });

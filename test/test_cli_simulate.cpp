@@ -123,6 +123,31 @@ TEST_F(CliSimulate, ExplicitIntegratorAndSwitchedPwmWithTheDenseOutput) {
   EXPECT_GT(hi - lo, 0.1);  // A: the ripple of a 100 us winding under a 1 ms square wave
 }
 
+TEST_F(CliSimulate, ChirpGivesTheBodeMagnitudeAndBandwidth) {
+  const fs::path out = dir_ / "chirp";
+  const Outcome r = run({"simulate", kDesign, "-s", "index", "--chirp", "--no-render", "--json", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  const json& run0 = doc["runs"][0];
+  EXPECT_EQ(run0["reference"], "chirp");
+  ASSERT_EQ(run0["status"], "ok");
+  for (const char* m : {"lower", "upper"}) {
+    ASSERT_TRUE(run0["bandwidth_hz"][m].is_number()) << m;
+    const double bw = run0["bandwidth_hz"][m].get<double>();
+    EXPECT_GT(bw, 0.62);  // within the estimated band
+    EXPECT_LT(bw, 20.0);
+  }
+  const auto rows = parse_csv(slurp(out / "index-chirp-bode.csv"));
+  ASSERT_EQ(rows.size(), 41u);
+  EXPECT_EQ(rows[0][0], "f_hz");
+  // At the lowest frequency the tactor follows its command (within 10 %).
+  EXPECT_NEAR(std::stod(rows[1][1]), 1.0, 0.1);
+  EXPECT_TRUE(fs::exists(out / "index-chirp-bode.svg"));
+  EXPECT_TRUE(fs::exists(out / "index-chirp-bode.png"));
+  // --chirp excludes --step and --pattern.
+  EXPECT_EQ(run({"simulate", kDesign, "--chirp", "--step", "--no-render", "--out", (dir_ / "never").string()}).code, 2);
+}
+
 TEST_F(CliSimulate, MassesFromTheRenderedParts) {
   const fs::path design = design_with("fn24.yaml", "fn: 96", "fn: 24");
   const fs::path out = dir_ / "stl";

@@ -375,6 +375,14 @@ struct SimulationRequest {
   bool step = false;                   ///< a 1 mm step of both tactors along +x from the pattern start points
   double step_mm = 1.0;
   double step_hold_s = 0.5;
+  /// A logarithmic chirp of both tactors along x from the same start points (excludes `step`):
+  /// x_ref(t) = x0 + a sin(phi(t)), phi(t) = 2 pi f0 D (k^(t/D) - 1) / ln k, k = f1 / f0, so the
+  /// instantaneous frequency f0 k^(t/D) sweeps f0 -> f1 over D seconds.
+  bool chirp = false;
+  double chirp_amplitude_mm = 0.2;  ///< a: small, so that the skin sticks (0.2 N/mm x 0.2 mm < mu N)
+  double chirp_f0_hz = 0.5;
+  double chirp_f1_hz = 0.0;         ///< 0: a quarter of the loop rate (25 Hz at 100 Hz)
+  double chirp_duration_s = 6.0;    ///< D
 };
 
 /// The inputs of a station's simulations: one per pattern (or the step). Needs both mechanisms,
@@ -382,6 +390,30 @@ struct SimulationRequest {
 /// (`contact:` and `print:` take their defaults when absent). `inertia` per mechanism name.
 std::vector<SimulationInput> simulation_inputs(const Design& design, const SimulationRequest& request,
                                                const std::map<std::string, MechanismInertia>& inertia);
+
+// --- Frequency response --------------------------------------------------------------------------
+
+/// Bode magnitude of each tactor's x displacement per commanded x displacement, from a chirp run.
+struct BodeResult {
+  std::vector<std::string> mechanisms;
+  std::vector<double> f_hz;                      ///< log-spaced within the chirp's band
+  std::vector<std::vector<double>> magnitude;    ///< [mechanism][frequency]: |X(f) / X_ref(f)|
+  std::vector<std::optional<double>> bandwidth_hz;  ///< first -3 dB crossing (log-interpolated), per mechanism
+  std::string note;
+};
+
+/// The empirical transfer function estimate (Ljung, "System Identification", 1999: the ratio of
+/// the output's and the input's Fourier transforms) at `points` log-spaced frequencies between
+/// 1.25 f0 and f1 / 1.25, by direct DFTs of the displacements from the first sample over the
+/// controller's samples. The -3 dB bandwidth is the lowest frequency where the magnitude falls
+/// below 10^(-3/20) of its value at the lowest frequency. `request` is the chirp's.
+BodeResult chirp_bode(const SimulationInput& input, const SimulationResult& result, const SimulationRequest& request,
+                      std::size_t points = 40);
+/// CSV: f_hz, then <mechanism>_magnitude and <mechanism>_magnitude_db per mechanism.
+void write_bode_csv(std::ostream& out, const BodeResult& bode);
+/// Log-log picture of the magnitudes with the -3 dB line, in the house style: SVG and PNG bytes.
+std::string bode_svg(const BodeResult& bode, const std::string& title);
+std::string bode_png(const BodeResult& bode, const std::string& title);
 
 /// Header and rows of the time series CSV (one row per sample and mechanism):
 /// t_s,mechanism,theta1_ref_deg,theta2_ref_deg,theta1_deg,theta2_deg,w1_deg_s,w2_deg_s,i1_A,i2_A,
