@@ -47,7 +47,7 @@ void print_run(const SimulationInput& in, const SimulationResult& r, const std::
               << fixed(s.peak_shear_N, 3) << " N, " << (s.slipped ? "slipped (" + std::to_string(s.slips) + "x)" : "no slip")
               << "\n";
   }
-  std::cout << "  time series: " << file << "\n";
+  std::cout << "  time series: " << file << " (picture: .svg, .png beside it)\n";
 }
 
 int run_simulate(const SimulateOptions& opt) {
@@ -140,8 +140,15 @@ int run_simulate(const SimulateOptions& opt) {
       write_time_series_csv(file.stream(), r);
       file.commit();
       files.push_back(csv.generic_string());
+      const RenderedPlot picture = plot_simulation(*s, in, r);
+      const std::filesystem::path svg = dir / (s->name + "-" + in.reference_name + ".svg");
+      write_file_atomic(svg, picture.svg);
+      write_file_atomic(dir / (s->name + "-" + in.reference_name + ".png"), picture.png);
+      files.push_back(svg.generic_string());
+      files.push_back((dir / (s->name + "-" + in.reference_name + ".png")).generic_string());
       Json j = to_json(in, r);
       j["csv"] = csv.generic_string();
+      j["picture"] = svg.generic_string();
       if (opt.dense_dt_s) {
         SimulationResult dense_only;
         dense_only.samples = r.dense;

@@ -47,6 +47,11 @@ TEST_F(CliSimulate, StretchOnTheIndexTracksAndItsSeriesClosesThePaperLoops) {
   EXPECT_EQ(run0["status"], "ok");
   EXPECT_EQ(run0["reference"], "stretch");
   EXPECT_EQ(doc["mass"]["index"]["lower"]["source"], "closed_form");
+  // The picture beside the series: paths on the fingertip, currents and forces over time.
+  const std::string svg = slurp(out / "index-stretch.svg");
+  EXPECT_THAT(svg, HasSubstr("<svg"));
+  EXPECT_GT(fs::file_size(out / "index-stretch.png"), 10000u);
+  EXPECT_EQ(run0["picture"], (out / "index-stretch.svg").generic_string());
   const std::string text = slurp(out / "index-stretch.csv");
   const auto rows = parse_csv(text);
   ASSERT_GT(rows.size(), 3u);

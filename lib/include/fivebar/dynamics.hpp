@@ -98,6 +98,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/rendered_plot.hpp"
 #include "fivebar/sections/contact.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
@@ -414,6 +415,11 @@ void write_bode_csv(std::ostream& out, const BodeResult& bode);
 /// Log-log picture of the magnitudes with the -3 dB line, in the house style: SVG and PNG bytes.
 std::string bode_svg(const BodeResult& bode, const std::string& title);
 std::string bode_png(const BodeResult& bode, const std::string& title);
+
+/// The picture of one run (lib/src/plot/simulation_plot.cpp): the commanded and the simulated
+/// tactor paths on the station's fingertip target with the reachable regions, and the motor
+/// currents and skin shear forces over time.
+RenderedPlot plot_simulation(const Station& station, const SimulationInput& input, const SimulationResult& result);
 
 /// Header and rows of the time series CSV (one row per sample and mechanism):
 /// t_s,mechanism,theta1_ref_deg,theta2_ref_deg,theta1_deg,theta2_deg,w1_deg_s,w2_deg_s,i1_A,i2_A,
