@@ -31,7 +31,9 @@
 /// where a0_b, alpha0_b are the body accelerations at d2theta/dt2 = 0 (the second line above with
 /// dw/dt = 0): h = C(theta, w) w is the Coriolis and centrifugal term, computed exactly (no finite
 /// difference of M), so that w^T (dM/dt / 2) w = w^T h and kinetic energy is conserved by the
-/// unforced, frictionless model to the integrator's accuracy (test/test_dynamics.cpp). Gravity is
+/// unforced, frictionless model to the integrator's accuracy (test/test_dynamics.cpp); a second
+/// formulation, the four links in absolute angles closed by Lagrange multipliers as an index-1
+/// DAE under SUNDIALS IDA (test/test_dynamics_dae.cpp), gives the same joint trajectories. Gravity is
 /// left out: the design file does not give the device's orientation.
 ///   M(theta) dw/dt + h(theta, w) = tau_motor - tau_friction + J(theta)^T F_contact
 /// with J = dP/dtheta (m/rad) and F_contact the skin force on the tactor.
