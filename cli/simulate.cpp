@@ -64,8 +64,8 @@ int run_simulate(const SimulateOptions& opt) {
   if (!integrator) throw InputError("--integrator '" + opt.integrator + "': expected bdf or erk");
   const std::optional<PwmModel> pwm = parse_pwm_model(opt.pwm);
   if (!pwm) throw InputError("--pwm '" + opt.pwm + "': expected averaged or switched");
-  if (opt.dense_dt_s && (!(*opt.dense_dt_s >= 1e-6) || !(*opt.dense_dt_s <= 1.0))) {
-    throw InputError("--dense must be within [1e-6, 1] s");
+  if (opt.dense_dt_s && (!(*opt.dense_dt_s >= 1e-5) || !(*opt.dense_dt_s <= 1.0))) {
+    throw InputError("--dense must be within [1e-5, 1] s");
   }
   const Design design = load(opt.design);
   std::vector<const Station*> stations;
