@@ -1,6 +1,8 @@
 // fivebar simulate: the dynamics of a station's two tactors under the exported PID (motors,
-// driver limits, ADC, skin contact), integrated by CVODE (fivebar/dynamics.hpp); per pattern and
-// mechanism the tracking error, currents, saturation and shear force, and a CSV time series.
+// driver limits, ADC, skin contact), integrated by CVODE or ARKODE's explicit RK, with the averaged
+// or the switched PWM (fivebar/dynamics.hpp); per pattern (or step, or chirp) and mechanism the
+// tracking error, currents, saturation and shear force, a CSV time series and its picture, the
+// dense output on request, and for the chirp the Bode magnitude and bandwidth.
 
 #include <iostream>
 #include <map>
