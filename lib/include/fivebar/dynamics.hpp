@@ -270,10 +270,11 @@ struct SimulationOptions {
   double duration_s = 0.0;      ///< 0: the reference's length plus settle_s
   double settle_s = 0.2;        ///< after the reference's last sample
   /// The integrator's relative tolerance. The default 1e-6 is chosen from the work-precision study
-  /// of `fivebar report accuracy` (its "Dynamics" table): on the showcase's step, BDF's tactor
-  /// error is ~1e-6 mm there (4.6e-6 mm at 1e-5, 2.3e-7 mm at 1e-7), a thousandth of what one
-  /// level of the 16-bit ADC moves the tactor (a few micrometres), for about 1.4x the steps of
-  /// 1e-4; tighter tolerances buy accuracy the controller cannot see.
+  /// of `fivebar report accuracy` (its "Dynamics" table, a 1 mm step on the showcase): there BDF's
+  /// tactor error is 2.2e-6 mm on the averaged model (1.1e-5 mm at 1e-5, 2.3e-7 mm at 1e-7) and
+  /// 1.0e-4 mm on the switched one, at least 30x below what one level of the 16-bit ADC moves the
+  /// tactor (a few micrometres), for 1.9x the steps of 1e-4; tighter tolerances buy accuracy the
+  /// controller cannot see, looser ones let the switched model's error reach the ADC's level.
   double rtol = 1e-6;
   Integrator integrator = Integrator::bdf;
   PwmModel pwm = PwmModel::averaged;
