@@ -1,6 +1,8 @@
 // fivebar simulate: the dynamics of a station's two tactors under the exported PID (motors,
-// driver limits, ADC, skin contact), integrated by CVODE (fivebar/dynamics.hpp); per pattern and
-// mechanism the tracking error, currents, saturation and shear force, and a CSV time series.
+// driver limits, ADC, skin contact), integrated by CVODE or ARKODE's explicit RK, with the averaged
+// or the switched PWM (fivebar/dynamics.hpp); per pattern (or step, or chirp) and mechanism the
+// tracking error, currents, saturation and shear force, a CSV time series and its picture, the
+// dense output on request, and for the chirp the Bode magnitude and bandwidth.
 
 #include <iostream>
 #include <map>
@@ -23,8 +25,12 @@ struct SimulateOptions {
   std::string station;
   std::string pattern;
   bool step = false;
+  bool chirp = false;
   bool no_render = false;
   std::optional<double> rtol;
+  std::string integrator = "bdf";
+  std::string pwm = "averaged";
+  std::optional<double> dense_dt_s;
   double max_wall_s = 120.0;
   std::string out;
   bool json = false;
@@ -43,7 +49,7 @@ void print_run(const SimulationInput& in, const SimulationResult& r, const std::
               << fixed(s.peak_shear_N, 3) << " N, " << (s.slipped ? "slipped (" + std::to_string(s.slips) + "x)" : "no slip")
               << "\n";
   }
-  std::cout << "  time series: " << file << "\n";
+  std::cout << "  time series: " << file << " (picture: .svg, .png beside it)\n";
 }
 
 int run_simulate(const SimulateOptions& opt) {
@@ -56,6 +62,13 @@ int run_simulate(const SimulateOptions& opt) {
     throw InputError("--rtol must be within [1e-14, 1e-2]");
   }
   if (!(opt.max_wall_s > 0.0) || !(opt.max_wall_s <= 1e6)) throw InputError("--max-wall must be > 0 and <= 1e6 s");
+  const std::optional<Integrator> integrator = parse_integrator(opt.integrator);
+  if (!integrator) throw InputError("--integrator '" + opt.integrator + "': expected bdf or erk");
+  const std::optional<PwmModel> pwm = parse_pwm_model(opt.pwm);
+  if (!pwm) throw InputError("--pwm '" + opt.pwm + "': expected averaged or switched");
+  if (opt.dense_dt_s && (!(*opt.dense_dt_s >= 1e-5) || !(*opt.dense_dt_s <= 1.0))) {
+    throw InputError("--dense must be within [1e-5, 1] s");
+  }
   const Design design = load(opt.design);
   std::vector<const Station*> stations;
   if (!opt.station.empty()) {
@@ -72,6 +85,7 @@ int run_simulate(const SimulateOptions& opt) {
     probe.station = s->name;
     probe.pattern = kind;
     probe.step = opt.step;
+    probe.chirp = opt.chirp;
     std::map<std::string, MechanismInertia> none;
     for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
     (void)simulation_inputs(design, probe, none);
@@ -97,6 +111,9 @@ int run_simulate(const SimulateOptions& opt) {
   SimulationOptions so;
   if (opt.rtol) so.rtol = *opt.rtol;
   so.max_wall_s = opt.max_wall_s;
+  so.integrator = *integrator;
+  so.pwm = *pwm;
+  if (opt.dense_dt_s) so.dense_dt_s = *opt.dense_dt_s;
   Json runs = Json::array();
   Json mass = Json::array();  // one record per station and mechanism (docs/conventions.md "JSON documents")
   std::vector<std::string> files;
@@ -116,6 +133,7 @@ int run_simulate(const SimulateOptions& opt) {
     request.station = s->name;
     request.pattern = kind;
     request.step = opt.step;
+    request.chirp = opt.chirp;
     for (const SimulationInput& in : simulation_inputs(design, request, inertia)) {
       if (!in.unusable.empty()) {
         all_ok = false;
@@ -130,17 +148,63 @@ int run_simulate(const SimulateOptions& opt) {
       write_time_series_csv(file.stream(), r);
       file.commit();
       files.push_back(csv.generic_string());
+      const RenderedPlot picture = plot_simulation(*s, in, r);
+      const std::filesystem::path svg = dir / (s->name + "-" + in.reference_name + ".svg");
+      write_file_atomic(svg, picture.svg);
+      write_file_atomic(dir / (s->name + "-" + in.reference_name + ".png"), picture.png);
+      files.push_back(svg.generic_string());
+      files.push_back((dir / (s->name + "-" + in.reference_name + ".png")).generic_string());
       Json j = to_json(in, r);
       j["csv"] = csv.generic_string();
+      j["picture"] = svg.generic_string();
+      if (opt.dense_dt_s) {
+        SimulationResult dense_only;
+        dense_only.samples = r.dense;
+        dense_only.summary = r.summary;  // the mechanisms' names
+        const std::filesystem::path dense_csv = dir / (s->name + "-" + in.reference_name + "-dense.csv");
+        AtomicFile dense_file(dense_csv);
+        write_time_series_csv(dense_file.stream(), dense_only);
+        dense_file.commit();
+        files.push_back(dense_csv.generic_string());
+        j["dense_csv"] = dense_csv.generic_string();
+      }
       runs.push_back(j);
       all_ok = all_ok && r.ok();
       if (!opt.json) print_run(in, r, csv.generic_string());
+      if (opt.chirp) {
+        const BodeResult bode = chirp_bode(in, r, request);
+        const std::string stem = s->name + "-chirp-bode";
+        AtomicFile bode_csv(dir / (stem + ".csv"));
+        write_bode_csv(bode_csv.stream(), bode);
+        bode_csv.commit();
+        const std::string title = "Frequency response at the target centre, station " + s->name;
+        write_file_atomic(dir / (stem + ".svg"), bode_svg(bode, title));
+        write_file_atomic(dir / (stem + ".png"), bode_png(bode, title));
+        Json bw = Json::object();
+        for (std::size_t m = 0; m < bode.mechanisms.size(); ++m) {
+          bw[bode.mechanisms[m]] = bode.bandwidth_hz[m] ? Json(*bode.bandwidth_hz[m]) : Json(nullptr);
+          if (!opt.json) {
+            std::cout << "  " << bode.mechanisms[m] << ": -3 dB bandwidth "
+                      << (bode.bandwidth_hz[m] ? fixed(*bode.bandwidth_hz[m], 2) + " Hz"
+                                               : std::string("beyond the chirp's band"))
+                      << " (magnitude " << fixed(bode.magnitude[m].front(), 3) << " at " << fixed(bode.f_hz.front(), 2)
+                      << " Hz, " << fixed(bode.magnitude[m].back(), 3) << " at " << fixed(bode.f_hz.back(), 2)
+                      << " Hz)\n";
+          }
+        }
+        for (const char* ext : {".csv", ".svg", ".png"}) files.push_back((dir / (stem + ext)).generic_string());
+        runs.back()["bandwidth_hz"] = bw;
+        runs.back()["bode_csv"] = (dir / (stem + ".csv")).generic_string();
+        if (!opt.json) std::cout << "  Bode magnitude: " << (dir / (stem + ".csv")).generic_string() << ", .svg, .png\n";
+      }
     }
   }
   if (opt.json) {
     print_json({{"command", "simulate"},
                 {"design", design.name},
-                {"integrator", "CVODE BDF, Newton, dense"},
+                {"integrator", so.integrator == Integrator::erk ? "ARKODE ERK, Dormand-Prince 5(4)"
+                                                                : "CVODE BDF, Newton, dense"},
+                {"pwm", std::string(to_string(so.pwm))},
                 {"rtol", so.rtol},
                 {"mass", mass},
                 {"runs", runs},
@@ -171,11 +235,28 @@ void setup_simulate(CLI::App& app) {
       ->type_name("NAME");
   auto* pattern = sub->add_option("--pattern", opt->pattern, "Only this pattern: stretch, slip, twist or pivot")
                       ->type_name("KIND");
-  sub->add_flag("--step", opt->step, "A 1 mm step of both tactors along +x from the stretch pattern's start, 0.5 s")
-      ->excludes(pattern);
+  auto* step = sub->add_flag("--step", opt->step,
+                             "A 1 mm step of both tactors along +x from the stretch pattern's start, 0.5 s")
+                   ->excludes(pattern);
+  sub->add_flag("--chirp", opt->chirp,
+                "A 0.2 mm chirp of both tactors along x, 0.5 -> 25 Hz (a quarter of the loop rate) over 6 s: Bode "
+                "magnitude and -3 dB bandwidth (<station>-chirp-bode.csv, .svg, .png)")
+      ->excludes(pattern)
+      ->excludes(step);
   sub->add_flag("--no-render", opt->no_render,
                 "Links' masses from the closed form (slab with bosses) instead of the parts' STL renders (openscad)");
-  sub->add_option("--rtol", opt->rtol, "CVODE relative tolerance (default 1e-6)")->type_name("R");
+  sub->add_option("--rtol", opt->rtol, "The integrator's relative tolerance (default 1e-6)")->type_name("R");
+  sub->add_option("--integrator", opt->integrator,
+                  "bdf (CVODE BDF, Newton; the default) or erk (ARKODE explicit Runge-Kutta, Dormand-Prince 5(4), "
+                  "the comparison)")
+      ->type_name("KIND");
+  sub->add_option("--pwm", opt->pwm,
+                  "averaged (V = duty x supply; the default) or switched (the 1 kHz sign-magnitude waveform, every "
+                  "edge a stop time)")
+      ->type_name("MODEL");
+  sub->add_option("--dense", opt->dense_dt_s,
+                  "Also write <station>-<reference>-dense.csv: the integrator's dense output every S seconds")
+      ->type_name("S");
   sub->add_option("--max-wall", opt->max_wall_s, "Wall-time bound of each simulation (s, default 120): beyond it the run "
                   "stops with status wall_time_limit")
       ->type_name("S");
@@ -184,7 +265,7 @@ void setup_simulate(CLI::App& app) {
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
-      "Without --pattern or --step, every pattern of the station's patterns: section (or all four defaults).\n"
+      "Without --pattern, --step or --chirp, every pattern of the station's patterns: section (or all four defaults).\n"
       "Exit status: 0 every simulation finished, 1 one did not (singular pose, step or time limit) or a part\n"
       "failed to render, 2 bad input, 3 internal error or output not writable.");
   sub->callback([opt]() { finish(run_simulate(*opt)); });

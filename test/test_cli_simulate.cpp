@@ -48,6 +48,11 @@ TEST_F(CliSimulate, StretchOnTheIndexTracksAndItsSeriesClosesThePaperLoops) {
   EXPECT_EQ(run0["status"], "ok");
   EXPECT_EQ(run0["reference"], "stretch");
   EXPECT_EQ(ft::record(doc["mass"], "mechanism", "lower")["source"], "closed_form");
+  // The picture beside the series: paths on the fingertip, currents and forces over time.
+  const std::string svg = slurp(out / "index-stretch.svg");
+  EXPECT_THAT(svg, HasSubstr("<svg"));
+  EXPECT_GT(fs::file_size(out / "index-stretch.png"), 10000u);
+  EXPECT_EQ(run0["picture"], (out / "index-stretch.svg").generic_string());
   const std::string text = slurp(out / "index-stretch.csv");
   const auto rows = parse_csv(text);
   ASSERT_GT(rows.size(), 3u);
@@ -96,6 +101,59 @@ TEST_F(CliSimulate, StepMovesTheReferenceByOneMillimetreAndPrintsTheSummary) {
   EXPECT_LT(std::abs(std::stod(rows[3][10])), 1e-2);
 }
 
+TEST_F(CliSimulate, ExplicitIntegratorAndSwitchedPwmWithTheDenseOutput) {
+  // The step under ARKODE's explicit RK and the 1 kHz switched PWM; the dense CSV every 0.1 ms
+  // sees the PWM ripple the 100 Hz series cannot: the current changes within each 10 ms sample.
+  const fs::path out = dir_ / "erk";
+  const Outcome r = run({"simulate", kDesign, "-s", "index", "--step", "--no-render", "--integrator", "erk", "--pwm",
+                         "switched", "--dense", "1e-4", "--json", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  EXPECT_EQ(doc["pwm"], "switched");
+  EXPECT_THAT(doc["integrator"].get<std::string>(), HasSubstr("ARKODE"));
+  ASSERT_EQ(doc["runs"][0]["status"], "ok");
+  const std::string text = slurp(out / "index-step-dense.csv");
+  EXPECT_EQ(text.substr(0, text.find('\n')), kHeader);
+  const auto rows = parse_csv(text);
+  // 0.7 s (0.5 s held + 0.2 s settling) every 0.1 ms: 7001 instants, two rows each.
+  ASSERT_EQ(rows.size() - 1, 2u * 7001u);
+  // The step is read at t = 0.01 s and its duty applied a period later: within (0.02, 0.03) s the
+  // lower joint 1's current ripples.
+  double lo = 1e9, hi = -1e9;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    const double t = std::stod(rows[i][0]);
+    if (rows[i][1] != "lower" || t <= 0.0205 || t >= 0.0295) continue;
+    lo = std::min(lo, std::stod(rows[i][8]));
+    hi = std::max(hi, std::stod(rows[i][8]));
+  }
+  EXPECT_GT(hi - lo, 0.1);  // A: the ripple of a 100 us winding under a 1 ms square wave
+}
+
+TEST_F(CliSimulate, ChirpGivesTheBodeMagnitudeAndBandwidth) {
+  const fs::path out = dir_ / "chirp";
+  const Outcome r = run({"simulate", kDesign, "-s", "index", "--chirp", "--no-render", "--json", "--out", out.string()});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  const json& run0 = doc["runs"][0];
+  EXPECT_EQ(run0["reference"], "chirp");
+  ASSERT_EQ(run0["status"], "ok");
+  for (const char* m : {"lower", "upper"}) {
+    ASSERT_TRUE(run0["bandwidth_hz"][m].is_number()) << m;
+    const double bw = run0["bandwidth_hz"][m].get<double>();
+    EXPECT_GT(bw, 0.62);  // within the estimated band
+    EXPECT_LT(bw, 20.0);
+  }
+  const auto rows = parse_csv(slurp(out / "index-chirp-bode.csv"));
+  ASSERT_EQ(rows.size(), 41u);
+  EXPECT_EQ(rows[0][0], "f_hz");
+  // At the lowest frequency the tactor follows its command (within 10 %).
+  EXPECT_NEAR(std::stod(rows[1][1]), 1.0, 0.1);
+  EXPECT_TRUE(fs::exists(out / "index-chirp-bode.svg"));
+  EXPECT_TRUE(fs::exists(out / "index-chirp-bode.png"));
+  // --chirp excludes --step and --pattern.
+  EXPECT_EQ(run({"simulate", kDesign, "--chirp", "--step", "--no-render", "--out", (dir_ / "never").string()}).code, 2);
+}
+
 TEST_F(CliSimulate, MassesFromTheRenderedParts) {
   const fs::path design = design_with("fn24.yaml", "fn: 96", "fn: 24");
   const fs::path out = dir_ / "stl";
@@ -126,6 +184,14 @@ TEST_F(CliSimulate, BadInputIsExitTwoAndWritesNothing) {
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("wobble"));
   r = run({"simulate", kDesign, "--rtol", "0", "--no-render", "--out", out.string()});
+  EXPECT_EQ(r.code, 2);
+  r = run({"simulate", kDesign, "--integrator", "euler", "--no-render", "--out", out.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--integrator 'euler'"));
+  r = run({"simulate", kDesign, "--pwm", "pulsed", "--no-render", "--out", out.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--pwm 'pulsed'"));
+  r = run({"simulate", kDesign, "--dense", "0", "--no-render", "--out", out.string()});
   EXPECT_EQ(r.code, 2);
   EXPECT_FALSE(fs::exists(out));
 }

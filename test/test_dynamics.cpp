@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cmath>
+#include <complex>
 #include <cstdint>
 #include <map>
 #include <numbers>
@@ -21,6 +22,7 @@
 
 #include "fivebar/dynamics.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/parts.hpp"
 #include "fivebar/sections/controller.hpp"
@@ -642,6 +644,214 @@ TEST(Dynamics, LowFrictionMakesTheTactorSlipAndHighFrictionDoesNot) {
     }
   }
   EXPECT_GT(sliding, 10u);
+}
+
+
+// --- The explicit comparison integrator and the switched PWM -------------------------------------
+
+SimulationInput paper_pattern(PatternKind kind) {
+  const Design& d = paper();
+  SimulationRequest request;
+  request.station = "index";
+  request.pattern = kind;
+  return simulation_inputs(d, request, station_inertia(d, d.require_station("index"), nullptr, {})).front();
+}
+
+double max_path_difference_mm(const SimulationResult& a, const SimulationResult& b) {
+  double e = 0.0;
+  EXPECT_EQ(a.samples.size(), b.samples.size());
+  for (std::size_t s = 0; s < std::min(a.samples.size(), b.samples.size()); ++s) {
+    for (std::size_t k = 0; k < a.samples[s].mechanisms.size(); ++k) {
+      e = std::max(e, (a.samples[s].mechanisms[k].P_mm - b.samples[s].mechanisms[k].P_mm).norm());
+    }
+  }
+  return e;
+}
+
+TEST(Dynamics, ExplicitRungeKuttaAndBdfAgreeOnAPattern) {
+  // Two integrators of different families (ARKODE's Dormand-Prince 5(4), CVODE's BDF) on the same
+  // model, the twist with slip roots and restarts at every sample (ADC off, as in the convergence
+  // test: a flipped quantisation level is not an integration error). Each is within ~1e-7 mm of
+  // the exact path at rtol 1e-8 (the BDF convergence test above), so they agree within 1e-5 mm.
+  const SimulationInput in = paper_pattern(PatternKind::twist);
+  SimulationOptions o;
+  o.quantise = false;
+  o.rtol = 1e-8;
+  const SimulationResult bdf = simulate(in, o);
+  o.integrator = Integrator::erk;
+  const SimulationResult erk = simulate(in, o);
+  ASSERT_TRUE(bdf.ok()) << bdf.reason;
+  ASSERT_TRUE(erk.ok()) << erk.reason;
+  const double diff = max_path_difference_mm(bdf, erk);
+  RecordProperty("bdf_erk", format::shortest(diff) + " mm; steps " + std::to_string(bdf.steps) + " / " +
+                                std::to_string(erk.steps));
+  EXPECT_LT(diff, 1e-5);
+  for (std::size_t k = 0; k < 2; ++k) EXPECT_EQ(bdf.summary[k].slips, erk.summary[k].slips);
+  // Stiffer: the motors' L/R from 100 us to 0.1 us. The explicit method's steps are bounded by its
+  // stability region (h < ~3.3 L/R for Dormand-Prince on the decay of the current), so its step
+  // count grows ~1000-fold; BDF's (A(alpha)-stable) barely moves.
+  // Started 1 deg off its reference, so that the motors work from the first sample on.
+  SimulationInput stiff = in;
+  for (SimulatedMechanism& m : stiff.mechanisms) {
+    for (MotorParams& mp : m.model.motors) mp.inductance_mH *= 1e-3;
+    m.theta0[0] += 1.0 / format::kDegPerRad;
+  }
+  o.duration_s = 0.02;
+  o.rtol = 1e-6;
+  o.integrator = Integrator::bdf;
+  const SimulationResult stiff_bdf = simulate(stiff, o);
+  o.integrator = Integrator::erk;
+  const SimulationResult stiff_erk = simulate(stiff, o);
+  ASSERT_TRUE(stiff_bdf.ok()) << stiff_bdf.reason;
+  ASSERT_TRUE(stiff_erk.ok()) << stiff_erk.reason;
+  const double tau = stiff.mechanisms[0].model.motors[0].inductance() / stiff.mechanisms[0].model.motors[0].resistance();
+  // At least one explicit step per ~10 L/R (quiet stretches at zero duty, where nothing excites
+  // the current, let it stride further than its stability bound of ~3.3 L/R).
+  EXPECT_GT(double(stiff_erk.steps), 0.02 / (10.0 * tau));
+  EXPECT_GT(stiff_erk.steps, 20 * stiff_bdf.steps);
+  EXPECT_LT(max_path_difference_mm(stiff_bdf, stiff_erk), 1e-3);
+}
+
+TEST(Dynamics, SwitchedPwmRipplesAsAnRlCircuitUnderASquareWave) {
+  // Locked rotor, constant duty D: each PWM period applies V for D T_pwm, then 0 V. The periodic
+  // solution of L di/dt = V - R i (closed form in fivebar/dynamics.hpp) peaks at the end of the
+  // on-phase and bottoms at the period start. Both instants are stop times of the integrator;
+  // stepping over them would round the corners.
+  MechanismModel model = paper_model("index", "lower");
+  for (MotorParams& mp : model.motors) mp.current_limit_A = 2.0;  // V/R = 1.2 A: no clamp
+  const Station& s = paper().stations.front();
+  const AnglesResult start = ik_angles(*s.lower, s.target.center);
+  for (const Integrator integrator : {Integrator::bdf, Integrator::erk}) {
+    for (const double duty : {0.3, -0.65}) {
+      SCOPED_TRACE(std::string(to_string(integrator)) + " duty " + std::to_string(duty));
+      const SimulationInput in = single(model, {start.theta1, start.theta2});
+      SimulationOptions o;
+      o.drive = Drive::constant_duty;
+      o.duty = duty;
+      o.lock_joints = true;
+      o.contact = false;
+      o.pwm = PwmModel::switched;
+      o.integrator = integrator;
+      o.duration_s = 0.02;  // 200 L/R: periodic to 1e-80
+      o.rtol = 1e-10;
+      o.dense_dt_s = 5e-6;  // the on-phase ends (0.3 ms, 0.65 ms) are on this grid
+      const SimulationResult r = simulate(in, o);
+      ASSERT_TRUE(r.ok()) << r.reason;
+      const MotorParams& mp = model.motors[0];
+      const double tau = mp.inductance() / mp.resistance(), T = 1e-3, D = std::abs(duty);
+      const double v_over_r = (duty > 0 ? 1.0 : -1.0) * mp.supply_voltage_V / mp.resistance();
+      const double i_max = v_over_r * (1.0 - std::exp(-D * T / tau)) / (1.0 - std::exp(-T / tau));
+      const double i_min = i_max * std::exp(-(1.0 - D) * T / tau);
+      // The last full period [19 ms, 20 ms].
+      double hi = -1e9, lo = 1e9;
+      std::size_t n = 0;
+      for (const TimeSample& t : r.dense) {
+        if (t.t < 0.019 - 1e-12) continue;
+        ++n;
+        hi = std::max(hi, t.mechanisms[0].current[0]);
+        lo = std::min(lo, t.mechanisms[0].current[0]);
+      }
+      ASSERT_GE(n, 200u);
+      EXPECT_NEAR(duty > 0 ? hi : lo, i_max, 1e-6 * std::abs(v_over_r));
+      EXPECT_NEAR(duty > 0 ? lo : hi, i_min, 1e-6 * std::abs(v_over_r));
+      // The controller's samples (period starts) see the trough; its mean is the averaged D V / R.
+      EXPECT_NEAR(r.samples.back().mechanisms[0].current[1], i_min, 1e-6 * std::abs(v_over_r));
+      double mean = 0.0;  // trapezoid over the last period on the 5 us grid
+      std::vector<double> last;
+      for (const TimeSample& t : r.dense)
+        if (t.t >= 0.019 - 1e-12) last.push_back(t.mechanisms[0].current[0]);
+      for (std::size_t i = 0; i + 1 < last.size(); ++i) mean += 0.5 * (last[i] + last[i + 1]) / double(last.size() - 1);
+      EXPECT_NEAR(mean, duty * mp.supply_voltage_V / mp.resistance(), 2e-3 * std::abs(v_over_r));
+    }
+  }
+}
+
+TEST(Dynamics, SwitchedAndAveragedPwmAgreeOnTheSlowMotion) {
+  // The switched waveform adds a 1 kHz torque ripple of at most eta N k_t V / R peak to peak; on the
+  // joints' inertia (smallest eigenvalue of M) a zero-mean square wave of that swing moves them by
+  // at most a T^2 / 8 (twice integrated), and the tactor by |J| times that. The tactor paths agree
+  // within a few times this bound; the mean current is the same (linear winding). The drivers'
+  // current limit is raised out of the way: a cycle-by-cycle limiter cuts the ripple's peaks (1.2 A
+  // at 6 V / 5 ohm against 1 A) where the average is far below the limit, a real difference of
+  // the two models, not an integration error.
+  SimulationInput in = paper_pattern(PatternKind::stretch);
+  for (SimulatedMechanism& m : in.mechanisms)
+    for (MotorParams& mp : m.model.motors) mp.current_limit_A = 3.0;
+  SimulationOptions o;
+  o.quantise = false;
+  o.rtol = 1e-7;
+  o.duration_s = 0.4;  // the stretch's first 3 mm
+  const SimulationResult averaged = simulate(in, o);
+  o.pwm = PwmModel::switched;
+  const SimulationResult switched = simulate(in, o);
+  ASSERT_TRUE(averaged.ok()) << averaged.reason;
+  ASSERT_TRUE(switched.ok()) << switched.reason;
+  double bound = 0.0;
+  for (const SimulatedMechanism& m : in.mechanisms) {
+    const MotorParams& mp = m.model.motors[0];
+    const DynamicsTerms t = dynamics_terms(m.model, Eigen::Vector2d(m.theta0[0], m.theta0[1]), Eigen::Vector2d::Zero());
+    const double lambda = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(t.M).eigenvalues().minCoeff();
+    const double torque = mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.supply_voltage_V / mp.resistance();
+    const double sigma = Eigen::JacobiSVD<Eigen::Matrix2d>(t.J).singularValues()[0];
+    bound = std::max(bound, 1e3 * sigma * torque / lambda * 1e-6 / 8.0);  // mm
+  }
+  const double diff = max_path_difference_mm(averaged, switched);
+  RecordProperty("averaged_switched", format::shortest(diff) + " mm against the ripple bound " + format::shortest(bound) +
+                                          " mm; steps " + std::to_string(averaged.steps) + " / " +
+                                          std::to_string(switched.steps));
+  EXPECT_LT(diff, 4.0 * bound);
+  EXPECT_GT(switched.restarts, 10 * averaged.restarts);  // every edge a restart
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_NEAR(switched.summary[k].max_error_mm, averaged.summary[k].max_error_mm, 4.0 * bound);
+    EXPECT_GT(switched.summary[k].peak_current_A, averaged.summary[k].peak_current_A);  // the ripple's peaks
+  }
+}
+
+TEST(Dynamics, ChirpBodeRecoversAFirstOrderLowPass) {
+  // The estimator alone, on a record made here: the commanded chirp through a first-order low-pass
+  // discretised exactly with the controller's zero-order hold, y_k+1 = e y_k + (1 - e) u_k with
+  // e = exp(-T / tau), whose magnitude is |(1 - e) / (z - e)| at z = exp(i 2 pi f T). The estimate
+  // follows it within 10 % over the band and its -3 dB frequency within 5 %.
+  SimulationRequest request;
+  request.chirp = true;
+  const double rate = 100.0, T = 1.0 / rate, fc = 6.0, tau = 1.0 / (2.0 * std::numbers::pi * fc);
+  const double e = std::exp(-T / tau);
+  SimulationInput in;
+  in.controller.loop_rate_hz = rate;
+  SimulatedMechanism sm;
+  sm.name = "lower";
+  in.mechanisms.push_back(sm);
+  SimulationResult r;
+  const double f0 = request.chirp_f0_hz, f1 = 0.25 * rate, D = request.chirp_duration_s, k = f1 / f0;
+  double y = 0.0;
+  for (std::size_t n = 0; n <= static_cast<std::size_t>(D * rate) + 50; ++n) {
+    const double t = double(n) * T;
+    const double tt = std::min(t, D);
+    const double u = 0.2 * std::sin(2.0 * std::numbers::pi * f0 * D * (std::pow(k, tt / D) - 1.0) / std::log(k));
+    TimeSample ts;
+    ts.t = t;
+    MechanismSample ms;
+    ms.P_ref_mm = Vec2(u, 0.0);
+    ms.P_mm = Vec2(y, 0.0);
+    ts.mechanisms.push_back(ms);
+    r.samples.push_back(ts);
+    y = e * y + (1.0 - e) * u;
+  }
+  const BodeResult bode = chirp_bode(in, r, request);
+  ASSERT_EQ(bode.magnitude.size(), 1u);
+  const auto exact = [&](double f) {
+    const std::complex<double> z = std::polar(1.0, 2.0 * std::numbers::pi * f * T);
+    return std::abs((1.0 - e) / (z - e));
+  };
+  for (std::size_t i = 0; i < bode.f_hz.size(); ++i) {
+    EXPECT_NEAR(bode.magnitude[0][i], exact(bode.f_hz[i]), 0.1 * exact(bode.f_hz[i])) << bode.f_hz[i] << " Hz";
+  }
+  // The exact -3 dB point relative to the lowest frequency's magnitude, by bisection.
+  const double level = exact(bode.f_hz.front()) * std::pow(10.0, -3.0 / 20.0);
+  double lo = bode.f_hz.front(), hi = bode.f_hz.back();
+  for (int n = 0; n < 60; ++n) (exact(0.5 * (lo + hi)) > level ? lo : hi) = 0.5 * (lo + hi);
+  ASSERT_TRUE(bode.bandwidth_hz[0]);
+  EXPECT_NEAR(*bode.bandwidth_hz[0], lo, 0.05 * lo);
 }
 
 }  // namespace

@@ -336,6 +336,37 @@ TEST(Accuracy, AreaErrorsShrinkAtTheMethodsOrders) {
   EXPECT_LT(*ms.time_slope, 0.0);
 }
 
+TEST(Accuracy, DynamicsErrorFallsWithTheToleranceAndExplicitRkPaysForStiffness) {
+  AccuracyOptions o;
+  o.quick = true;
+  const DynamicsAccuracy d = dynamics_accuracy(load_design(ft::CliTest::kDesign), o);
+  ASSERT_TRUE(d.skipped.empty()) << d.skipped;
+  ASSERT_EQ(d.series.size(), 6u);  // BDF, ERK x averaged S = 1e2, averaged S = 1e4, switched S = 1e2
+  for (const DynamicsSeries& s : d.series) {
+    SCOPED_TRACE(s.integrator + " " + s.pwm + " S = " + std::to_string(s.stiffness_ratio));
+    ASSERT_GE(s.points.size(), 3u);
+    for (const DynamicsPoint& p : s.points) EXPECT_EQ(p.status, "ok");
+    // Against BDF at rtol 1e-12: six decades of tolerance buy at least four of error.
+    EXPECT_LT(s.points.back().error_mm, 1e-4 * s.points.front().error_mm + 1e-9);
+    EXPECT_GT(s.points.back().steps, s.points.front().steps);
+  }
+  // BDF's steps per simulated second stay within a factor 3 from S = 1e2 to 1e6; the explicit
+  // method's grow at least 100-fold (stability, not accuracy, sets its step), and overtake BDF's.
+  ASSERT_GE(d.stiffness.size(), 5u);
+  double bdf_lo = 1e300, bdf_hi = 0.0;
+  for (const StiffnessPoint& p : d.stiffness) {
+    bdf_lo = std::min(bdf_lo, p.steps_per_s[0]);
+    bdf_hi = std::max(bdf_hi, p.steps_per_s[0]);
+    EXPECT_EQ(p.status[0], "ok");
+  }
+  EXPECT_LT(bdf_hi, 3.0 * bdf_lo);
+  EXPECT_GT(d.stiffness.back().steps_per_s[1], 100.0 * d.stiffness.front().steps_per_s[1]);
+  ASSERT_TRUE(d.crossover_ratio);
+  EXPECT_GE(*d.crossover_ratio, d.stiffness.front().stiffness_ratio);
+  EXPECT_LT(*d.crossover_ratio, d.stiffness.back().stiffness_ratio);
+  EXPECT_NEAR(d.stiffness.front().stiffness_ratio, 100.0, 1e-9);  // the showcase's motors
+}
+
 TEST(Accuracy, CoverageSamplingConvergesToTheExactValues) {
   const MechanismAccuracy& a = index_lower_accuracy();
   const Mechanism m = paper("index", "lower");
@@ -515,6 +546,21 @@ TEST(Stability, EveryCasePassesOnThePaperStations) {
           << mech << " " << group;
     }
   }
+  // The dynamic cases of each station: five simulations at the extremes, each finished and finite.
+  for (const char* station : {"index", "thumb"}) {
+    std::size_t n = 0;
+    for (const StabilityCase& c : r.cases) {
+      if (c.mechanism != station || c.group != "dynamics") continue;
+      ++n;
+      EXPECT_EQ(c.operation, "simulate");
+      EXPECT_TRUE(c.status == "ok" || c.status == "singular") << c.name << ": " << c.explanation;
+      EXPECT_NE(c.explanation.find(" s simulated in "), std::string::npos) << c.explanation;
+    }
+    EXPECT_EQ(n, 5u) << station;
+  }
+  const StabilityCase* stiff = find_case(r, "dynamics", "stiffness ratio 1e8 (L/R = 1e-10 s), 1 mm step", "simulate");
+  ASSERT_NE(stiff, nullptr);
+  EXPECT_EQ(stiff->status, "ok");
   // Exactly singular inputs are reported singular with the exact answer.
   const StabilityCase* t1 = find_case(r, "type I distance", "leg 1 stretched, distance 0", "ik");
   ASSERT_NE(t1, nullptr);
@@ -733,7 +779,12 @@ TEST_F(ReportCli, StabilityJsonAndExitCode) {
   for (const char* key : {"subject", "group", "case", "operation", "parameter", "status", "expected", "error", "bound",
                           "unit", "conditioning", "finite", "passed", "ill_conditioned", "explanation"})
     EXPECT_TRUE(j["cases"][0].contains(key)) << key;
-  for (const auto& c : j["cases"]) EXPECT_TRUE(c["subject"] == "index/lower" || c["subject"] == "index/upper");
+  for (const auto& c : j["cases"]) {
+    // The kinematic cases by mechanism, the dynamic ones (both tactors together) by station.
+    EXPECT_TRUE(c["subject"] == "index/lower" || c["subject"] == "index/upper" ||
+                (c["subject"] == "index" && c["group"] == "dynamics"))
+        << c["subject"];
+  }
 
   const Outcome text = run({"report", "stability", kDesign, "--station", "thumb"});
   EXPECT_EQ(text.code, 0);
@@ -752,9 +803,12 @@ TEST_F(ReportCli, AccuracyQuickJsonWritesThePlots) {
   EXPECT_EQ(j["mechanisms"][0]["station"], "index");
   for (const char* key : {"area", "coverage", "restricted", "tolerance"}) EXPECT_TRUE(j["mechanisms"][0].contains(key)) << key;
   EXPECT_EQ(j["fk"]["strata"].size(), 5u);
-  ASSERT_EQ(j["files"].size(), 14u);
+  ASSERT_EQ(j["files"].size(), 18u);  // 5 per station, FK, IK, dynamics, stiffness; SVG and PNG
   for (const auto& f : j["files"]) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;
   EXPECT_TRUE(fs::exists(dir_ / "o" / "iros2022" / "report" / "accuracy_index_area.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "o" / "iros2022" / "report" / "accuracy_dynamics_stiffness.svg"));
+  EXPECT_EQ(j["dynamics"]["station"], "index");
+  EXPECT_GT(j["dynamics"]["crossover_stiffness_ratio"].get<double>(), 1.0);
 }
 
 TEST_F(ReportCli, BadInputExitsTwoAndAnUnwritableOutputThree) {

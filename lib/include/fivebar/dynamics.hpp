@@ -2,7 +2,8 @@
 /// Dynamics of the device (issue 15): each five-bar as a 2-DOF closed chain driven by two DC
 /// gearmotors under the exported PID, the tactor on a skin spring with Coulomb stick/slip, both
 /// mechanisms of a station together, integrated by SUNDIALS CVODE (BDF, Newton, dense direct
-/// solver; lib/src/dynamics/cvode.cpp is the only file that sees SUNDIALS).
+/// solver) or, for comparison, ARKODE's explicit Runge-Kutta (lib/src/dynamics/cvode.cpp and
+/// arkode.cpp are the only files that see SUNDIALS).
 ///
 /// Units inside: SI (m, kg, s, rad, N, V, A); the results carry mm, deg, N, A at the edges.
 ///
@@ -30,7 +31,9 @@
 /// where a0_b, alpha0_b are the body accelerations at d2theta/dt2 = 0 (the second line above with
 /// dw/dt = 0): h = C(theta, w) w is the Coriolis and centrifugal term, computed exactly (no finite
 /// difference of M), so that w^T (dM/dt / 2) w = w^T h and kinetic energy is conserved by the
-/// unforced, frictionless model to the integrator's accuracy (test/test_dynamics.cpp). Gravity is
+/// unforced, frictionless model to the integrator's accuracy (test/test_dynamics.cpp); a second
+/// formulation, the four links in absolute angles closed by Lagrange multipliers as an index-1
+/// DAE under SUNDIALS IDA (test/test_dynamics_dae.cpp), gives the same joint trajectories. Gravity is
 /// left out: the design file does not give the device's orientation.
 ///   M(theta) dw/dt + h(theta, w) = tau_motor - tau_friction + J(theta)^T F_contact
 /// with J = dP/dtheta (m/rad) and F_contact the skin force on the tactor.
@@ -60,12 +63,26 @@
 ///   sticking: F = -k (P - a) - c dP/dt, da/dt = 0, until k |P - a| = mu N_preload (a root);
 ///   sliding:  F = -k (P - a), with |P - a| = mu N / k kept by da/dt = (u . dP/dt) u,
 ///             u = (P - a)/|P - a|, until u . dP/dt = 0 (a root: the tactor turns back).
-/// Both switches are located by CVODE's root finding; the integration restarts there.
+/// Both switches are located by the integrator's root finding; the integration restarts there.
+///
+/// Switched PWM (on request, SimulationOptions::pwm): instead of its average the bridge applies
+/// sign(duty) V_supply during the first |duty| T_pwm of each PWM period and 0 V for the rest
+/// (sign-magnitude drive). With a locked rotor the current of the RL winding (tau = L/R) then
+/// settles into the periodic ripple of a square wave (the first-order exponential response in each
+/// phase, i -> V/R on and i -> 0 off, made periodic by i(p + T_pwm) = i(p)):
+///   i_max = (V/R) (1 - exp(-D T_pwm / tau)) / (1 - exp(-T_pwm / tau)),
+///   i_min = i_max exp(-(1 - D) T_pwm / tau),
+/// whose mean is D V / R, the averaged model's current (test/test_dynamics.cpp checks both). The
+/// limiter's onset at |i| = I_max is located as a root too (a kink left to error control made the
+/// error at one tolerance jump by 1e-2 mm: BDF's Newton iteration straddled it).
 ///
 /// Integration: CVODE BDF (variable order 1-5) with Newton iterations and a dense direct linear
-/// solver (difference-quotient Jacobian), restarted at every controller sample (the ZOH input is
-/// discontinuous there: each sample time is a stop time, never stepped over) and at every
-/// stick/slip switch. Bounded by a step count and a wall time: exceeding either is a status.
+/// solver (difference-quotient Jacobian) by default; ARKODE's explicit Runge-Kutta (ERKStep,
+/// Dormand-Prince 5(4)) as the comparison (SimulationOptions::integrator). Either is restarted at
+/// every controller sample (the ZOH input is discontinuous there: each sample time is a stop
+/// time, never stepped over), at every switching instant of the switched PWM (likewise stop
+/// times) and at every stick/slip switch (located by the integrator's root finding). Bounded by
+/// a step count and a wall time: exceeding either is a status.
 
 #include <Eigen/Core>
 
@@ -83,6 +100,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/rendered_plot.hpp"
 #include "fivebar/sections/contact.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
@@ -224,10 +242,46 @@ enum class Drive : std::uint8_t {
   open_circuit,   ///< driver off, windings open: i = 0, no torque (free motion)
 };
 
+/// The integrator (both SUNDIALS, both restarted at every sample, PWM edge and stick/slip root).
+enum class Integrator : std::uint8_t {
+  bdf,  ///< CVODE BDF, variable order 1-5, Newton iterations, dense direct solver (the default)
+  erk,  ///< ARKODE ERKStep, Dormand-Prince 5(4) (the explicit comparison; stability-limited when stiff)
+};
+std::string_view to_string(Integrator integrator);
+std::optional<Integrator> parse_integrator(std::string_view text);  ///< "bdf" or "erk"
+
+/// How the driver's PWM reaches the winding.
+enum class PwmModel : std::uint8_t {
+  averaged,  ///< V = duty V_supply, continuous (the default)
+  /// Sign-magnitude drive: within each PWM period [p, p + T_pwm) (p a multiple of T_pwm from t = 0)
+  /// the bridge applies sign(duty) V_supply for the first |duty| T_pwm and 0 V (the winding
+  /// shorted through the bridge, the current recirculating) for the rest; the duty is the one the
+  /// controller holds at that instant. Every switching instant is a stop time of the integrator.
+  /// Sign-magnitude (not locked-antiphase) because it draws no ripple at zero duty. The current
+  /// limit acts cycle by cycle: once |i| reaches I_max in an on-phase the driver holds it there
+  /// (V = R I_max + back EMF) until the phase ends. Unlike the averaged clamp it cuts the ripple's
+  /// peaks, so with a small L/R it acts at duties whose average current is well below I_max.
+  switched,
+};
+std::string_view to_string(PwmModel pwm);
+std::optional<PwmModel> parse_pwm_model(std::string_view text);  ///< "averaged" or "switched"
+
 struct SimulationOptions {
   double duration_s = 0.0;      ///< 0: the reference's length plus settle_s
   double settle_s = 0.2;        ///< after the reference's last sample
-  double rtol = 1e-6;           ///< CVODE relative tolerance
+  /// The integrator's relative tolerance. The default 1e-6 is chosen from the work-precision study
+  /// of `fivebar report accuracy` (its "Dynamics" table, a 1 mm step on the showcase): there BDF's
+  /// tactor error is 2.2e-6 mm on the averaged model (1.1e-5 mm at 1e-5, 2.3e-7 mm at 1e-7) and
+  /// 1.0e-4 mm on the switched one, at least 30x below what one level of the 16-bit ADC moves the
+  /// tactor (a few micrometres), for 1.9x the steps of 1e-4; tighter tolerances buy accuracy the
+  /// controller cannot see, looser ones let the switched model's error reach the ADC's level.
+  double rtol = 1e-6;
+  Integrator integrator = Integrator::bdf;
+  PwmModel pwm = PwmModel::averaged;
+  double pwm_frequency_hz = 1000.0;  ///< the switched model's PWM frequency (the issue's 1 kHz, an assumption)
+  /// > 0: also record the integrator's dense output (its interpolant within each step) at the
+  /// multiples of this spacing, in SimulationResult::dense; 0: not.
+  double dense_dt_s = 0.0;
   /// Absolute tolerances are rtol x these scales (rad, rad/s, A, m).
   double angle_scale = 1.0, rate_scale = 1.0, current_scale = 0.1, anchor_scale = 1e-3;
   Drive drive = Drive::pid;
@@ -236,7 +290,7 @@ struct SimulationOptions {
   bool lock_joints = false;     ///< rotors held still (locked-rotor test): w = 0
   bool quantise = true;         ///< ADC quantisation
   bool delay = true;            ///< one period of computation delay
-  std::size_t max_steps = 5'000'000;  ///< CVODE steps in all
+  std::size_t max_steps = 5'000'000;  ///< integrator steps in all
   double max_wall_s = 120.0;          ///< wall time in all
   bool record = true;           ///< keep the time series (at the loop rate)
 };
@@ -246,7 +300,7 @@ enum class SimStatus : std::uint8_t {
   singular,        ///< the state reached a type II singularity or left the workspace
   step_limit,      ///< max_steps exceeded
   wall_time_limit, ///< max_wall_s exceeded
-  solver_failure,  ///< CVODE failed (error test or convergence failures at the minimum step)
+  solver_failure,  ///< the integrator failed (error test or convergence failures at the minimum step)
 };
 std::string_view to_string(SimStatus status);
 
@@ -300,16 +354,19 @@ struct SimulationResult {
   SimStatus status = SimStatus::ok;
   std::string reason;            ///< empty when ok: the time, state and cause otherwise
   double t_end = 0.0;            ///< s reached
-  std::size_t steps = 0;         ///< CVODE steps
+  std::size_t steps = 0;         ///< integrator steps (CVODE or ARKODE)
   std::size_t rhs_evaluations = 0;
   std::size_t restarts = 0;      ///< at samples and switches
   double wall_s = 0.0;
   std::vector<TimeSample> samples;
+  /// The integrator's dense output at multiples of SimulationOptions::dense_dt_s (empty when 0).
+  std::vector<TimeSample> dense;
   std::vector<MechanismSummary> summary;
   bool ok() const { return status == SimStatus::ok; }
 };
 
-/// Runs the simulation (CVODE). Never throws on non-convergence: the status says why and where.
+/// Runs the simulation (CVODE or ARKODE as options.integrator says). Never throws on
+/// non-convergence: the status says why and where.
 /// Throws InputError for an input without mechanisms or with an empty reference.
 SimulationResult simulate(const SimulationInput& input, const SimulationOptions& options = {});
 
@@ -322,6 +379,14 @@ struct SimulationRequest {
   bool step = false;                   ///< a 1 mm step of both tactors along +x from the pattern start points
   double step_mm = 1.0;
   double step_hold_s = 0.5;
+  /// A logarithmic chirp of both tactors along x from the same start points (excludes `step`):
+  /// x_ref(t) = x0 + a sin(phi(t)), phi(t) = 2 pi f0 D (k^(t/D) - 1) / ln k, k = f1 / f0, so the
+  /// instantaneous frequency f0 k^(t/D) sweeps f0 -> f1 over D seconds.
+  bool chirp = false;
+  double chirp_amplitude_mm = 0.2;  ///< a: small, so that the skin sticks (0.2 N/mm x 0.2 mm < mu N)
+  double chirp_f0_hz = 0.5;
+  double chirp_f1_hz = 0.0;         ///< 0: a quarter of the loop rate (25 Hz at 100 Hz)
+  double chirp_duration_s = 6.0;    ///< D
 };
 
 /// The inputs of a station's simulations: one per pattern (or the step). Needs both mechanisms,
@@ -329,6 +394,35 @@ struct SimulationRequest {
 /// (`contact:` and `print:` take their defaults when absent). `inertia` per mechanism name.
 std::vector<SimulationInput> simulation_inputs(const Design& design, const SimulationRequest& request,
                                                const std::map<std::string, MechanismInertia>& inertia);
+
+// --- Frequency response --------------------------------------------------------------------------
+
+/// Bode magnitude of each tactor's x displacement per commanded x displacement, from a chirp run.
+struct BodeResult {
+  std::vector<std::string> mechanisms;
+  std::vector<double> f_hz;                      ///< log-spaced within the chirp's band
+  std::vector<std::vector<double>> magnitude;    ///< [mechanism][frequency]: |X(f) / X_ref(f)|
+  std::vector<std::optional<double>> bandwidth_hz;  ///< first -3 dB crossing (log-interpolated), per mechanism
+  std::string note;
+};
+
+/// The empirical transfer function estimate (Ljung, "System Identification", 1999: the ratio of
+/// the output's and the input's Fourier transforms) at `points` log-spaced frequencies between
+/// 1.25 f0 and f1 / 1.25, by direct DFTs of the displacements from the first sample over the
+/// controller's samples. The -3 dB bandwidth is the lowest frequency where the magnitude falls
+/// below 10^(-3/20) of its value at the lowest frequency. `request` is the chirp's.
+BodeResult chirp_bode(const SimulationInput& input, const SimulationResult& result, const SimulationRequest& request,
+                      std::size_t points = 40);
+/// CSV: f_hz, then <mechanism>_magnitude and <mechanism>_magnitude_db per mechanism.
+void write_bode_csv(std::ostream& out, const BodeResult& bode);
+/// Log-log picture of the magnitudes with the -3 dB line, in the house style: SVG and PNG bytes.
+std::string bode_svg(const BodeResult& bode, const std::string& title);
+std::string bode_png(const BodeResult& bode, const std::string& title);
+
+/// The picture of one run (lib/src/plot/simulation_plot.cpp): the commanded and the simulated
+/// tactor paths on the station's fingertip target with the reachable regions, and the motor
+/// currents and skin shear forces over time.
+RenderedPlot plot_simulation(const Station& station, const SimulationInput& input, const SimulationResult& result);
 
 /// Header and rows of the time series CSV (one row per sample and mechanism):
 /// t_s,mechanism,theta1_ref_deg,theta2_ref_deg,theta1_deg,theta2_deg,w1_deg_s,w2_deg_s,i1_A,i2_A,

@@ -83,6 +83,44 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
     }
   }
   std::vector<SimulationInput> out;
+  if (request.chirp) {
+    double separation = PatternSpec{}.separation_mm;
+    for (const PatternSpec& s : specs)
+      if (s.kind == PatternKind::stretch) separation = s.separation_mm;
+    const double f0 = request.chirp_f0_hz;
+    const double f1 = request.chirp_f1_hz > 0.0 ? request.chirp_f1_hz : 0.25 * rate;
+    const double D = request.chirp_duration_s;
+    if (!(f0 > 0.0) || !(f1 > f0) || !(f1 <= 0.5 * rate) || !(D > 0.0) || !(request.chirp_amplitude_mm > 0.0)) {
+      throw InputError("simulate: the chirp needs 0 < f0 < f1 <= half the loop rate, a duration and an amplitude > 0");
+    }
+    SimulationInput in = make("chirp");
+    const Vec2 c = station.target.center;
+    const std::array<Vec2, 2> start{c - Vec2(0.0, 0.5 * separation), c + Vec2(0.0, 0.5 * separation)};
+    const auto n = static_cast<std::size_t>(std::floor(D * rate + tol::kSamplePeriodsRel)) + 1;
+    const double k = f1 / f0;
+    for (std::size_t m = 0; m < 2; ++m) {
+      SimulatedMechanism& sm = in.mechanisms[m];
+      std::array<double, 2> previous{0.0, 0.0};
+      for (std::size_t s = 0; s < n; ++s) {
+        const double t = double(s) / rate;
+        const double phase = 2.0 * std::numbers::pi * f0 * D * (std::pow(k, t / D) - 1.0) / std::log(k);
+        const Vec2 p = start[m] + Vec2(request.chirp_amplitude_mm * std::sin(phase), 0.0);
+        const AnglesResult a = ik_angles(sm.model.mechanism, p);
+        if (a.status != Status::ok) {
+          throw InputError("simulate: the chirp of the " + sm.name + " tactor reaches (" + format::fixed(p.x(), 3) + ", " +
+                           format::fixed(p.y(), 3) + ") mm, which is " + std::string(to_string(a.status)));
+        }
+        std::array<double, 2> th{a.theta1, a.theta2};
+        if (s > 0) th = {unwrap(th[0], previous[0]), unwrap(th[1], previous[1])};
+        previous = th;
+        sm.reference.push_back(th);
+        sm.reference_point_mm.push_back(p);
+      }
+      sm.theta0 = sm.reference.front();
+    }
+    out.push_back(std::move(in));
+    return out;
+  }
   if (request.step) {
     double separation = PatternSpec{}.separation_mm;
     for (const PatternSpec& s : specs)

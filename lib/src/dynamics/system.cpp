@@ -16,6 +16,10 @@ System make_system(const SimulationInput& input, const SimulationOptions& option
   s.options = &options;
   s.duty.assign(input.mechanisms.size(), {0.0, 0.0});
   s.slipping.assign(input.mechanisms.size(), 0);
+  s.on.assign(input.mechanisms.size(), {false, false});
+  s.limiting.assign(input.mechanisms.size(), {false, false});
+  s.contact_roots = options.contact;
+  s.limit_roots = options.pwm == PwmModel::switched && options.drive != Drive::open_circuit;
   s.k = input.contact.shear_stiffness_N_per_mm * 1e3;
   s.c = input.contact.damping_N_s_per_mm * 1e3;
   s.limit = input.contact.friction_coefficient * input.contact.normal_preload_N;
@@ -62,11 +66,26 @@ Evaluation evaluate(System& s, std::size_t k, const double* yall) {
       i = 0.0;
     } else {
       const double duty = s.duty[k][static_cast<std::size_t>(j)];
-      double v = std::clamp(duty, -1.0, 1.0) * mp.supply_voltage_V;
-      const double lo = back_emf - mp.resistance() * mp.current_limit_A;
-      const double hi = back_emf + mp.resistance() * mp.current_limit_A;
-      const bool limited = v < lo || v > hi;
-      v = std::clamp(v, lo, hi);
+      const double r_limit = mp.resistance() * mp.current_limit_A;
+      double v = 0.0;
+      bool limited = false;
+      if (o.pwm == PwmModel::switched) {
+        // Sign-magnitude bridge; on the on-phase the limiter holds the current at I_max once it
+        // gets there (a root: V = R I_max + back EMF, di/dt = 0 at the limit), else the full supply.
+        const double sign = duty > 0.0 ? 1.0 : duty < 0.0 ? -1.0 : 0.0;
+        if (s.on[k][static_cast<std::size_t>(j)] && sign != 0.0) {
+          v = sign * mp.supply_voltage_V;
+          if (s.limiting[k][static_cast<std::size_t>(j)]) {
+            v = sign * r_limit + back_emf;
+            limited = true;
+          }
+        }
+      } else {
+        v = std::clamp(duty, -1.0, 1.0) * mp.supply_voltage_V;
+        const double lo = back_emf - r_limit, hi = back_emf + r_limit;
+        limited = v < lo || v > hi;
+        v = std::clamp(v, lo, hi);
+      }
       v = std::clamp(v, -mp.supply_voltage_V, mp.supply_voltage_V);
       ev.voltage[static_cast<std::size_t>(j)] = v;
       ev.saturated[static_cast<std::size_t>(j)] = limited || std::abs(duty) >= 1.0;
@@ -96,26 +115,76 @@ bool rhs(System& s, const double* y, double* dy) {
   return true;
 }
 
+int root_count(const System& s) {
+  const std::size_t per = (s.contact_roots ? 1u : 0u) + (s.limit_roots ? 2u : 0u);
+  return static_cast<int>(per * s.mechanisms());
+}
+
+RootOwner root_owner(const System& s, std::size_t r) {
+  const std::size_t per = (s.contact_roots ? 1u : 0u) + (s.limit_roots ? 2u : 0u);
+  RootOwner o;
+  o.k = r / per;
+  const std::size_t local = r % per;
+  if (s.contact_roots && local == 0) return o;
+  o.joint = static_cast<int>(local - (s.contact_roots ? 1u : 0u));
+  return o;
+}
+
+namespace {
+/// sign(duty) of joint j, 0 when the bridge is off over this segment.
+double drive_sign(const System& s, std::size_t k, std::size_t j) {
+  if (!s.on[k][j]) return 0.0;
+  const double d = s.duty[k][j];
+  return d > 0.0 ? 1.0 : d < 0.0 ? -1.0 : 0.0;
+}
+}  // namespace
+
 void roots(System& s, const double* yall, double* g) {
+  std::size_t r = 0;
   for (std::size_t k = 0; k < s.mechanisms(); ++k) {
     const double* y = yall + kStateSize * k;
     const SimulatedMechanism& sm = s.input->mechanisms[k];
-    const Eigen::Vector2d w = s.options->lock_joints ? Eigen::Vector2d::Zero() : Eigen::Vector2d(y[2], y[3]);
-    const DynamicsTerms t = dynamics_terms(sm.model, Eigen::Vector2d(y[0], y[1]), w);
-    const Vec2 stretch = t.P - Vec2(y[6], y[7]);
-    if (s.slipping[k]) {
-      const double n = stretch.norm();
-      g[k] = n > 0.0 ? stretch.dot(t.P_dot) / n : 0.0;  // m/s
-    } else {
-      g[k] = s.k * stretch.norm() - s.limit;  // N
+    if (s.contact_roots) {
+      const Eigen::Vector2d w = s.options->lock_joints ? Eigen::Vector2d::Zero() : Eigen::Vector2d(y[2], y[3]);
+      const DynamicsTerms t = dynamics_terms(sm.model, Eigen::Vector2d(y[0], y[1]), w);
+      const Vec2 stretch = t.P - Vec2(y[6], y[7]);
+      if (s.slipping[k]) {
+        const double n = stretch.norm();
+        g[r++] = n > 0.0 ? stretch.dot(t.P_dot) / n : 0.0;  // m/s
+      } else {
+        g[r++] = s.k * stretch.norm() - s.limit;  // N
+      }
+    }
+    if (s.limit_roots) {
+      for (std::size_t j = 0; j < 2; ++j) {
+        const double sign = drive_sign(s, k, j);
+        // Inactive (off, or already limiting): a constant that never crosses zero.
+        g[r++] = sign == 0.0 || s.limiting[k][j] ? -1.0 : sign * y[4 + j] - sm.model.motors[j].current_limit_A;  // A
+      }
     }
   }
 }
 
 std::vector<int> root_directions(const System& s) {
-  std::vector<int> d(s.mechanisms());
-  for (std::size_t k = 0; k < d.size(); ++k) d[k] = s.slipping[k] ? -1 : +1;
+  std::vector<int> d;
+  for (std::size_t k = 0; k < s.mechanisms(); ++k) {
+    if (s.contact_roots) d.push_back(s.slipping[k] ? -1 : +1);
+    if (s.limit_roots) {
+      d.push_back(+1);
+      d.push_back(+1);
+    }
+  }
   return d;
+}
+
+void reset_limiters(System& s, const double* yall) {
+  for (std::size_t k = 0; k < s.mechanisms(); ++k) {
+    for (std::size_t j = 0; j < 2; ++j) {
+      const double sign = drive_sign(s, k, j);
+      s.limiting[k][j] =
+          sign != 0.0 && sign * yall[kStateSize * k + 4 + j] >= s.input->mechanisms[k].model.motors[j].current_limit_A;
+    }
+  }
 }
 
 }  // namespace fivebar::dynamics_detail

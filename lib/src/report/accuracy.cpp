@@ -831,6 +831,8 @@ AccuracyReport accuracy_report(const Design& design, const AccuracyOptions& o) {
   report.fk = precision_study(all, "fk", o);
   say(o, "accuracy: IK precision study");
   report.ik = precision_study(all, "ik", o);
+  say(o, "accuracy: dynamics work-precision (BDF and explicit RK)");
+  report.dynamics = dynamics_accuracy(design, o);
   report.seconds = seconds_since(t0);
   return report;
 }

@@ -76,6 +76,85 @@ Json study_json(const PrecisionStudy& st) {
   return j;
 }
 
+Json dynamics_json(const DynamicsAccuracy& d) {
+  Json j;
+  if (!d.skipped.empty()) {
+    j["skipped"] = d.skipped;
+    return j;
+  }
+  j["station"] = d.station;
+  j["scenario"] = d.scenario;
+  j["duration_s"] = d.duration_s;
+  j["reference"] = "CVODE BDF at rtol " + report_fmt::sci(d.reference_rtol, 0) + " on the same model";
+  j["default_rtol"] = d.default_rtol;
+  j["stiffness_ratio_definition"] = "T_loop R / L";
+  Json series = Json::array();
+  for (const DynamicsSeries& s : d.series) {
+    Json a;
+    a["integrator"] = s.integrator;
+    a["pwm"] = s.pwm;
+    a["stiffness_ratio"] = s.stiffness_ratio;
+    a["error_vs_time_slope"] = opt(s.time_slope);
+    Json pts = Json::array();
+    for (const DynamicsPoint& p : s.points) {
+      pts.push_back({{"rtol", p.rtol},
+                     {"time_s", p.time_s},
+                     {"error_mm", p.error_mm},
+                     {"steps", p.steps},
+                     {"rhs_evaluations", p.rhs_evaluations},
+                     {"status", p.status}});
+    }
+    a["points"] = pts;
+    series.push_back(a);
+  }
+  j["series"] = series;
+  Json st = Json::array();
+  for (const StiffnessPoint& p : d.stiffness) {
+    st.push_back({{"stiffness_ratio", p.stiffness_ratio},
+                  {"l_over_r_s", p.l_over_r_s},
+                  {"bdf_steps_per_simulated_s", p.steps_per_s[0]},
+                  {"erk_steps_per_simulated_s", p.steps_per_s[1]},
+                  {"bdf_wall_s_per_simulated_s", p.wall_per_s[0]},
+                  {"erk_wall_s_per_simulated_s", p.wall_per_s[1]},
+                  {"bdf_status", p.status[0]},
+                  {"erk_status", p.status[1]}});
+  }
+  j["stiffness"] = st;
+  j["crossover_stiffness_ratio"] = opt(d.crossover_ratio);
+  return j;
+}
+
+void dynamics_table(std::ostringstream& out, const DynamicsAccuracy& d) {
+  out << "\nDynamics: CVODE BDF against ARKODE explicit RK (Dormand-Prince 5(4))";
+  if (!d.skipped.empty()) {
+    out << ": not studied, " << d.skipped << "\n";
+    return;
+  }
+  out << ", station " << d.station << ": " << d.scenario << "\n";
+  out << "  error: max over the samples and both tactors of |P - P_ref| (mm), P_ref from BDF at rtol "
+      << sci(d.reference_rtol, 0) << "; stiffness ratio S = T_loop R / L\n";
+  out << "  " << pad("integrator", 12) << pad("PWM", 10) << pad("S", 8, true) << pad("rtol", 9, true)
+      << pad("time (s)", 11, true) << pad("steps", 9, true) << pad("error (mm)", 12, true) << "  status\n";
+  for (const DynamicsSeries& s : d.series) {
+    for (const DynamicsPoint& p : s.points) {
+      out << "  " << pad(s.integrator, 12) << pad(s.pwm, 10) << pad(sci(s.stiffness_ratio, 0), 8, true)
+          << pad(sci(p.rtol, 0), 9, true) << pad(sci(p.time_s, 2), 11, true) << pad(std::to_string(p.steps), 9, true)
+          << pad(sci(p.error_mm, 2), 12, true) << "  " << p.status << "\n";
+    }
+  }
+  out << "  Steps per simulated second at the default rtol " << sci(d.default_rtol, 0) << " as L shrinks:\n";
+  out << "  " << pad("S", 8) << pad("L/R (s)", 10, true) << pad("BDF steps/s", 14, true) << pad("ERK steps/s", 14, true)
+      << pad("BDF wall/s", 12, true) << pad("ERK wall/s", 12, true) << "  status (BDF, ERK)\n";
+  for (const StiffnessPoint& p : d.stiffness) {
+    out << "  " << pad(sci(p.stiffness_ratio, 0), 8) << pad(sci(p.l_over_r_s, 1), 10, true)
+        << pad(sci(p.steps_per_s[0], 2), 14, true) << pad(sci(p.steps_per_s[1], 2), 14, true)
+        << pad(sci(p.wall_per_s[0], 2), 12, true) << pad(sci(p.wall_per_s[1], 2), 12, true) << "  " << p.status[0]
+        << ", " << p.status[1] << "\n";
+  }
+  out << "  crossover (ERK's steps overtake BDF's): "
+      << (d.crossover_ratio ? "S = " + sci(*d.crossover_ratio, 1) : std::string("not within the range")) << "\n";
+}
+
 std::string label(const MechanismAccuracy& m) { return m.station + "/" + m.mechanism; }
 
 void series_table(std::ostringstream& out, const std::vector<WorkSeries>& series) {
@@ -217,6 +296,43 @@ plot::PlotSpec study_plot(const PrecisionStudy& st) {
   return spec;
 }
 
+plot::PlotSpec dynamics_plot(const DynamicsAccuracy& d) {
+  plot::PlotSpec spec;
+  spec.title = "Dynamics work-precision, station " + d.station + ": BDF against explicit RK";
+  spec.x_label = "run time (s)";
+  spec.y_label = "max |P - P_ref| over the samples (mm)";
+  for (const DynamicsSeries& s : d.series) {
+    plot::PlotSeries ps;
+    ps.label = std::string(s.integrator == "bdf" ? "CVODE BDF" : "ARKODE ERK") + ", " + s.pwm + " PWM, S = " +
+               sci(s.stiffness_ratio, 0);
+    for (const DynamicsPoint& p : s.points)
+      if (p.status == "ok") ps.points.push_back({p.time_s, p.error_mm});
+    spec.series.push_back(std::move(ps));
+  }
+  spec.footnote = "rtol from " + sci(d.series.empty() || d.series[0].points.empty() ? 0.0 : d.series[0].points.front().rtol, 0) +
+                  " (first point) to " + sci(d.series.empty() || d.series[0].points.empty() ? 0.0 : d.series[0].points.back().rtol, 0) +
+                  " along each line; reference BDF at rtol " + sci(d.reference_rtol, 0) +
+                  ". S = T_loop R / L; zero errors are not drawn.";
+  return spec;
+}
+
+plot::PlotSpec stiffness_plot(const DynamicsAccuracy& d) {
+  plot::PlotSpec spec;
+  spec.title = "Integrator steps per simulated second as the motor inductance shrinks";
+  spec.x_label = "stiffness ratio S = T_loop R / L";
+  spec.y_label = "steps per simulated second";
+  for (std::size_t k = 0; k < 2; ++k) {
+    plot::PlotSeries ps;
+    ps.label = k == 0 ? "CVODE BDF" : "ARKODE ERK (Dormand-Prince 5(4))";
+    for (const StiffnessPoint& p : d.stiffness) ps.points.push_back({p.stiffness_ratio, p.steps_per_s[k]});
+    spec.series.push_back(std::move(ps));
+  }
+  spec.footnote = "rtol " + sci(d.default_rtol, 0) + "; crossover " +
+                  (d.crossover_ratio ? "at S = " + sci(*d.crossover_ratio, 1) : std::string("not within the range")) +
+                  ". Runs stopped by the step bound count their rate over the part simulated.";
+  return spec;
+}
+
 }  // namespace
 
 Json to_json(const AccuracyReport& r) {
@@ -273,6 +389,7 @@ Json to_json(const AccuracyReport& r) {
   j["mechanisms"] = ms;
   j["fk"] = study_json(r.fk);
   j["ik"] = study_json(r.ik);
+  j["dynamics"] = dynamics_json(r.dynamics);
   return j;
 }
 
@@ -312,6 +429,7 @@ std::string to_text(const AccuracyReport& r) {
   }
   study_table(out, r.fk);
   study_table(out, r.ik);
+  dynamics_table(out, r.dynamics);
   return out.str();
 }
 
@@ -328,6 +446,10 @@ std::vector<std::filesystem::path> write_accuracy_plots(const AccuracyReport& r,
   }
   if (!r.fk.methods.empty()) plots.push_back({"accuracy_fk", study_plot(r.fk)});
   if (!r.ik.methods.empty()) plots.push_back({"accuracy_ik", study_plot(r.ik)});
+  if (r.dynamics.skipped.empty() && !r.dynamics.series.empty()) {
+    plots.push_back({"accuracy_dynamics", dynamics_plot(r.dynamics)});
+    plots.push_back({"accuracy_dynamics_stiffness", stiffness_plot(r.dynamics)});
+  }
   std::vector<std::filesystem::path> written;
   for (const auto& [name, spec] : plots) {
     write_file_atomic(dir / (name + ".svg"), plot::render_svg(spec));

@@ -823,6 +823,8 @@ StabilityReport stability_report(const Design& design, const StabilityOptions& o
       StabilityReport one = stability_catalogue(*m, s->target, label_of(*s, *m));
       for (StabilityCase& c : one.cases) report.cases.push_back(std::move(c));
     }
+    if (o.progress) o.progress("stability: " + s->name + " dynamics");
+    for (StabilityCase& c : dynamics_stability_cases(design, *s)) report.cases.push_back(std::move(c));
   }
   return report;
 }
@@ -879,7 +881,7 @@ std::string to_text(const StabilityReport& r) {
     out << "  " << pad(c.name, 48) << pad(c.operation, 17) << pad(c.status, 16) << pad(sci(c.error), 10, true)
         << pad(sci(c.bound), 10, true) << pad(c.unit, 5, true) << pad(sci(c.conditioning), 11, true) << "  " << verdict
         << "\n";
-    if (!c.passed) out << "      " << c.explanation << "\n";
+    if (!c.passed || c.group == "dynamics") out << "      " << c.explanation << "\n";
   }
   out << "\n" << (r.passed() ? "all cases passed" : std::to_string(r.failed()) + " case(s) FAILED") << "\n";
   return out.str();

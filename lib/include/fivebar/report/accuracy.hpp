@@ -109,6 +109,55 @@ struct PrecisionStudy {
   std::vector<std::optional<double>> order;
 };
 
+/// One run of the dynamics at one tolerance (work-precision of fivebar/dynamics.hpp).
+struct DynamicsPoint {
+  double rtol = 0.0;
+  double time_s = 0.0;       ///< wall time of the run (median of repeats after a warm-up)
+  double error_mm = 0.0;     ///< max over the controller's samples and both tactors of |P - P_reference|
+  std::size_t steps = 0;     ///< integrator steps
+  std::size_t rhs_evaluations = 0;
+  std::string status;        ///< SimStatus; not "ok": error_mm covers the samples reached
+};
+
+/// One integrator on one model at increasing tolerance.
+struct DynamicsSeries {
+  std::string integrator;       ///< "bdf" or "erk"
+  std::string pwm;              ///< "averaged" or "switched"
+  double stiffness_ratio = 0.0; ///< S = T_loop R / L (see DynamicsAccuracy)
+  std::vector<DynamicsPoint> points;
+  std::optional<double> time_slope;  ///< slope of log(error) against log(time)
+};
+
+/// BDF against explicit RK at one stiffness ratio, both at the default rtol, on the same step
+/// started 1 deg off its reference without the computation delay (the motors work from t = 0).
+struct StiffnessPoint {
+  double stiffness_ratio = 0.0;
+  double l_over_r_s = 0.0;                        ///< the motors' electrical time constant
+  std::array<double, 2> steps_per_s{0.0, 0.0};    ///< integrator steps per simulated second: bdf, erk
+  std::array<double, 2> wall_per_s{0.0, 0.0};     ///< wall seconds per simulated second: bdf, erk
+  std::array<std::string, 2> status;              ///< bdf, erk (step_limit: the rates are over the part run)
+};
+
+/// Work-precision of the dynamics on stiff cases (fivebar/dynamics.hpp), on the first station with
+/// both mechanisms: its 1 mm step (ADC quantisation off: a rounding level flipped by a tiny
+/// difference changes the next duty, a discontinuity no tolerance removes). The stiffness ratio
+/// S = T_loop R / L is the winding's rate R/L over the controller's (the fastest mode the model
+/// carries against the slowest rate at which its input changes); the showcase's motors sit at
+/// S = 1e2 (L/R = 100 us, T_loop = 10 ms), and S grows as L shrinks.
+struct DynamicsAccuracy {
+  std::string station;
+  std::string scenario;         ///< what was simulated
+  double duration_s = 0.0;
+  double reference_rtol = 0.0;  ///< the reference: BDF at this rtol on the same model
+  double default_rtol = 0.0;    ///< SimulationOptions{}.rtol
+  std::vector<DynamicsSeries> series;
+  std::vector<StiffnessPoint> stiffness;
+  /// The smallest S where ERK takes more steps per simulated second than BDF (interpolated in log
+  /// S between the bracketing points; the first S when ERK takes more from the start).
+  std::optional<double> crossover_ratio;
+  std::string skipped;          ///< non-empty: why there is no study (no station with both mechanisms, no motor:)
+};
+
 struct AccuracyOptions {
   bool quick = false;        ///< coarser series and fewer samples (tests, `fivebar run`)
   std::string station;       ///< empty: every station
@@ -121,6 +170,7 @@ struct AccuracyReport {
   bool quick = false;
   std::vector<MechanismAccuracy> mechanisms;
   PrecisionStudy fk, ik;
+  DynamicsAccuracy dynamics;
   double seconds = 0.0;  ///< wall time of the whole report
 };
 
@@ -129,6 +179,8 @@ MechanismAccuracy mechanism_accuracy(const Mechanism& m, const Ellipse& target, 
 /// FK (`problem` "fk") or IK ("ik") precision study over the given mechanisms (samples pooled).
 PrecisionStudy precision_study(const std::vector<const Mechanism*>& mechanisms, std::string_view problem,
                                const AccuracyOptions& options = {});
+/// Work-precision of the dynamics of `design` (`station` empty: the first station with both mechanisms).
+DynamicsAccuracy dynamics_accuracy(const Design& design, const AccuracyOptions& options = {});
 /// The whole accuracy report of a design (or of one station). InputError for an unknown station.
 AccuracyReport accuracy_report(const Design& design, const AccuracyOptions& options = {});
 

@@ -20,7 +20,7 @@ namespace fivebar {
 // --- Stability -----------------------------------------------------------------------------------
 
 struct StabilityCase {
-  std::string mechanism;  ///< "index/lower", or the label given to stability_catalogue()
+  std::string mechanism;  ///< "index/lower", the label given to stability_catalogue(), or the station ("index") of a dynamic case
   std::string group;      ///< "type I distance", "type II distance", "link ratio", "scale", ...
   std::string name;       ///< the case within its group, e.g. "stretched, distance 1e-08"
   std::string operation;  ///< "ik", "fk", "jacobian", "lci", "area", "closed-form area", "margin", ...
@@ -55,7 +55,15 @@ struct StabilityOptions {
 /// only cut the workspace), with lengths rounded to a dyadic grid where exact singular points need
 /// it (no change for lengths such as the paper's), in frames that make the sensitive input exact.
 StabilityReport stability_catalogue(const Mechanism& m, const Ellipse& target, const std::string& label);
-/// The catalogue for every mechanism of the design (or of one station).
+/// The dynamic cases of a station with both mechanisms (group "dynamics", operation "simulate",
+/// labelled by the station): fivebar/dynamics.hpp's simulation with the motors' stiffness ratio
+/// T_loop R / L at 1e8, the skin 1000x stiffer, a reference ramped to within 1e-6 of the length
+/// scale of the workspace boundary, zero friction (motors and skin) and a current limit that is
+/// hit; each passes when it finishes with finite numbers and an expected status (and the limit
+/// case saturates). Empty without `motor:` and `controller:`.
+std::vector<StabilityCase> dynamics_stability_cases(const Design& design, const Station& station);
+/// The catalogue for every mechanism of the design (or of one station), then the dynamic cases of
+/// each station with both mechanisms.
 StabilityReport stability_report(const Design& design, const StabilityOptions& options = {});
 
 Json to_json(const StabilityReport& report);

@@ -21,7 +21,8 @@ constexpr const char* kPreamble =
     "Newton, dense) restarted at every sample and every stick/slip switch (lib/include/fivebar/dynamics.hpp). "
     "The motor and skin data are the design's `motor:` and `contact:` sections: assumptions until replaced by "
     "measured values. Tracking error is |P − P_ref| at the loop rate; saturation is time at full duty or at the "
-    "current limit. Time series: `simulate/<station>-<pattern>.csv`.\n\n";
+    "current limit. Time series: `simulate/<station>-<pattern>.csv`; picture (commanded and simulated tactor paths on "
+    "the fingertip, motor currents and skin forces over time): `simulate/<station>-<pattern>.svg` and `.png`.\n\n";
 
 }  // namespace
 
@@ -78,8 +79,13 @@ Product simulate_product() {
         write_time_series_csv(file.stream(), r);
         file.commit();
         ctx.record(rel);
+        const RenderedPlot picture = plot_simulation(s, in, r);
+        const std::filesystem::path svg = std::filesystem::path("simulate") / (s.name + "-" + in.reference_name + ".svg");
+        ctx.write_file(svg, picture.svg);
+        ctx.write_file(std::filesystem::path("simulate") / (s.name + "-" + in.reference_name + ".png"), picture.png);
         Json j = to_json(in, r);
         j["csv"] = rel.generic_string();
+        j["picture"] = svg.generic_string();
         runs.push_back(j);
         if (!r.ok()) {
           ++failed;
