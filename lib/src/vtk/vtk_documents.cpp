@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/control.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/workspace_io.hpp"
 
@@ -157,6 +158,26 @@ std::string field_vti(const WorkspaceField& f) {
   add_point_array<vtkDoubleArray>(image, "force_capability", f.force_capability);
   image->GetPointData()->SetActiveScalars("lci");
   vtkNew<vtkStringArray> status_names;  // index = status value
+  status_names->SetName("status_names");
+  for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
+    status_names->InsertNextValue(std::string(to_string(s)));
+  image->GetFieldData()->AddArray(status_names);
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  return write_document(writer.Get(), ".vti");
+}
+
+// The stability field of fivebar/control.hpp (declared there; VTK stays in this file).
+std::string rho_field_vti(const RhoField& f) {
+  const Grid& g = f.grid;
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(g.nx, g.ny, 1);
+  image->SetOrigin(g.x0, g.y0, 0.0);
+  image->SetSpacing(g.spacing, g.spacing, g.spacing);
+  add_point_array<vtkDoubleArray>(image, "rho", f.rho);
+  add_point_array<vtkUnsignedCharArray>(image, "status", f.status);
+  image->GetPointData()->SetActiveScalars("rho");
+  vtkNew<vtkStringArray> status_names;  // index = status value; 255: outside the joint limits
   status_names->SetName("status_names");
   for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
     status_names->InsertNextValue(std::string(to_string(s)));
