@@ -105,5 +105,6 @@ void setup_report(CLI::App& app);
 void setup_export(CLI::App& app);
 void setup_simulate(CLI::App& app);
 void setup_tolerance(CLI::App& app);
+void setup_control(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -100,6 +100,7 @@ int run(int argc, char** argv) {
   setup_export(app);
   setup_simulate(app);
   setup_tolerance(app);
+  setup_control(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -203,6 +203,15 @@ TEST(Control, DampingAndFrequencyOfTheDominantPoleComeFromItsLogarithm) {
   const double sr = std::log(r) / T, si = ang / T;
   EXPECT_NEAR(p.damping, -sr / std::hypot(sr, si), 1e-12);
   EXPECT_NEAR(p.frequency_hz, si / (2 * std::numbers::pi), 1e-9);
+  EXPECT_NEAR(p.oscillatory_damping, p.damping, 1e-12);
+  // A slower real pole (an integrator's) dominates; the oscillation is still reported.
+  phi(3, 3) = 0.95;
+  const LoopPoles q = loop_poles(phi, T);
+  EXPECT_NEAR(q.rho, 0.95, 1e-14);
+  EXPECT_NEAR(q.damping, 1.0, 1e-12);
+  EXPECT_NEAR(q.frequency_hz, 0.0, 1e-9);
+  EXPECT_NEAR(q.oscillatory_damping, -sr / std::hypot(sr, si), 1e-12);
+  EXPECT_NEAR(q.oscillatory_frequency_hz, si / (2 * std::numbers::pi), 1e-9);
 }
 
 /// A small step of one mechanism's tactor at P (mm) simulated by CVODE with `gains`: the largest

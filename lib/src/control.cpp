@@ -126,6 +126,15 @@ LoopPoles loop_poles(const LoopMatrix& phi, double period_s) {
       out.dominant = ev[i];
     }
   }
+  for (Eigen::Index i = 0; i < ev.size(); ++i) {
+    if (!(ev[i].imag() > 1e-12 * std::max(1.0, std::abs(ev[i])))) continue;
+    const std::complex<double> s = std::log(ev[i]) / period_s;
+    const double zeta = -s.real() / std::abs(s);
+    if (zeta < out.oscillatory_damping) {
+      out.oscillatory_damping = zeta;
+      out.oscillatory_frequency_hz = s.imag() / (2.0 * std::numbers::pi);
+    }
+  }
   if (out.rho > 0.0) {
     const std::complex<double> s = std::log(out.dominant) / period_s;
     const double mag = std::abs(s);
@@ -264,6 +273,11 @@ StabilityMap stability_map(const LoopModel& loop, const std::vector<Vec2>& point
       ++map.not_ok;
       continue;
     }
+    if (ok == 0 || pl.poles.oscillatory_damping < map.oscillatory_damping) {
+      map.oscillatory_damping = pl.poles.oscillatory_damping;
+      map.oscillatory_frequency_hz = pl.poles.oscillatory_frequency_hz;
+      map.oscillatory_P_mm = pl.P_mm;
+    }
     if (ok == 0 || pl.poles.rho > map.max_rho) {
       map.max_rho = pl.poles.rho;
       map.worst = map.poses.size() - 1;
@@ -334,6 +348,9 @@ Json to_json(const StabilityMap& map) {
   j["worst_pose_mm"] = Json::array({w.x(), w.y()});
   j["dominant_damping"] = map.damping;
   j["dominant_frequency_hz"] = map.frequency_hz;
+  j["oscillatory_damping"] = map.oscillatory_damping;
+  j["oscillatory_frequency_hz"] = map.oscillatory_frequency_hz;
+  j["oscillatory_pose_mm"] = Json::array({map.oscillatory_P_mm.x(), map.oscillatory_P_mm.y()});
   j["kp_margin"] = map.kp_margin;
   j["kd_margin"] = map.kd_margin;
   return j;
@@ -421,7 +438,8 @@ std::vector<std::string> summary_lines(const StationControl& study) {
             std::to_string(ok) + " poses";
     if (m.not_ok) line += ", " + std::to_string(m.not_ok) + " unreachable or singular";
     line += "); dominant pole damping " + fixed(m.damping, 3) + " at " + fixed(m.frequency_hz, 2) +
-            " Hz; margins kp x" + margin_text(m.kp_margin, cap) + ", kd x" + margin_text(m.kd_margin, cap);
+            " Hz, least-damped oscillation " + fixed(m.oscillatory_damping, 3) + " at " +
+            fixed(m.oscillatory_frequency_hz, 2) + " Hz; margins kp x" + margin_text(m.kp_margin, cap) + ", kd x" + margin_text(m.kd_margin, cap);
     out.push_back(line);
   }
   return out;

@@ -39,7 +39,9 @@
 /// so z_{k+1} = Phi z_k, and the loop is asymptotically stable iff the spectral radius
 /// rho(Phi) = max |eig(Phi)| < 1. (The integral clamp and the duty clamp are inactive for small
 /// signals.) The dominant pole z* (largest modulus) maps to s* = ln(z*) / T, its damping ratio
-/// zeta = -Re(s*) / |s*| and frequency |Im(s*)| / (2 pi).
+/// zeta = -Re(s*) / |s*| and frequency |Im(s*)| / (2 pi); the least damped
+/// complex pole is reported beside it (with an integral term the dominant pole is often the slow
+/// real pole of the integrator, ~exp(-(ki / kp) T)).
 ///
 /// Stability map: rho at every pose of a grid over the filled target ellipse (or over the whole
 /// reachable region, as a field): the verdict is max rho < 1, the worst pose is the argmax. Gain
@@ -108,6 +110,10 @@ struct LoopPoles {
   std::complex<double> dominant{0.0, 0.0};
   double damping = 1.0;                 ///< zeta of the dominant pole (1 for rho = 0; negative when rho > 1)
   double frequency_hz = 0.0;            ///< |Im ln(z*)| / (2 pi T)
+  /// The least damped of the complex poles (an oscillation; the dominant pole is often the
+  /// integrator's slow real one): its zeta and frequency; 1 and 0 when every pole is real.
+  double oscillatory_damping = 1.0;
+  double oscillatory_frequency_hz = 0.0;
 };
 LoopPoles loop_poles(const LoopMatrix& phi, double period_s);
 
@@ -162,6 +168,10 @@ struct StabilityMap {
   bool stable = false;             ///< max rho < 1 over every ok pose, and at least one ok pose
   double damping = 1.0;            ///< of the dominant pole at the worst pose
   double frequency_hz = 0.0;
+  /// The least damped oscillatory pole over the poses (LoopPoles), and where.
+  double oscillatory_damping = 1.0;
+  double oscillatory_frequency_hz = 0.0;
+  Vec2 oscillatory_P_mm{0.0, 0.0};
   /// Largest factor on both joints' kp (resp. kd) keeping max rho < 1 over the poses (the others
   /// at their values); 0 when the loop is unstable at factor 0 too; margin_cap when still stable there.
   double kp_margin = 0.0, kd_margin = 0.0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <numbers>
 
@@ -19,7 +20,6 @@ constexpr double kPanel = 470.0;  // panel width and height, pixels
 constexpr double kLeft = 50.0;
 constexpr double kTop = 92.0;
 constexpr double kGap = 70.0;
-constexpr double kRhoLow = 0.5;   // bottom of the colour scale
 constexpr Rgb kUnstable{0.80, 0.10, 0.10};
 constexpr Rgb kOutside{0.88, 0.88, 0.88};
 
@@ -29,10 +29,15 @@ std::string fmt(const char* format, double v) {
   return buf;
 }
 
-Rgb rho_colour(double rho) {
-  if (rho >= 1.0) return kUnstable;
-  return ramp_colour(std::clamp((rho - kRhoLow) / (1.0 - kRhoLow), 0.0, 1.0));
-}
+/// The colour scale: [lo, hi] of the finite rho below 1 over every field (one scale for the
+/// picture), red at and above 1.
+struct Scale {
+  double lo = 0.0, hi = 1.0;
+  Rgb operator()(double rho) const {
+    if (rho >= 1.0) return kUnstable;
+    return ramp_colour(hi > lo ? std::clamp((rho - lo) / (hi - lo), 0.0, 1.0) : 1.0);
+  }
+};
 
 }  // namespace
 
@@ -44,6 +49,15 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
   const double n = static_cast<double>(maps.size());
   const double width = kLeft + n * kPanel + (n - 1.0) * kGap + 40.0;
   const double height = kTop + kPanel + 150.0;
+  Scale colour{1.0, 0.0};
+  for (const RhoField& f : fields) {
+    for (double r : f.rho) {
+      if (!std::isfinite(r) || r >= 1.0) continue;
+      colour.lo = std::min(colour.lo, r);
+      colour.hi = std::max(colour.hi, r);
+    }
+  }
+  if (colour.lo > colour.hi) colour = {0.0, 1.0};
   Canvas canvas(width, height);
   cairo_t* cr = canvas.cr();
   text(cr, kLeft, 28.0, "Loop stability — station " + station.name, 19.0, kInk, 0.0, true);
@@ -65,23 +79,47 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
     text(cr, x0, kTop + 14.0,
          "(" + std::string(1, char('a' + k)) + ") " + map.mechanism + " mechanism: ρ over its reachable region",
          12.0, kInk, 0.0, true);
-    const double half = 0.5 * g.spacing;
-    for (int j = 0; j < g.ny; ++j) {
-      for (int i = 0; i < g.nx; ++i) {
-        const std::size_t idx = std::size_t(j) * std::size_t(g.nx) + std::size_t(i);
-        const double rho = f.rho[idx];
-        if (!std::isfinite(rho)) continue;
-        const auto p0 = panel.px(g.point(i, j) - Vec2(half, half));
-        const auto p1 = panel.px(g.point(i, j) + Vec2(half, half));
-        cairo_rectangle(cr, p0[0], p1[1], p1[0] - p0[0] + 0.3, p0[1] - p1[1] + 0.3);
-        set_colour(cr, rho_colour(rho));
-        cairo_fill(cr);
+    // The field as one raster (one pixel per grid point, drawn nearest): an SVG stays small.
+    {
+      cairo_surface_t* img = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, g.nx, g.ny);
+      cairo_surface_flush(img);
+      unsigned char* data = cairo_image_surface_get_data(img);
+      const int stride = cairo_image_surface_get_stride(img);
+      for (int j = 0; j < g.ny; ++j) {
+        auto* row = reinterpret_cast<std::uint32_t*>(data + std::ptrdiff_t(g.ny - 1 - j) * stride);
+        for (int i = 0; i < g.nx; ++i) {
+          const double rho = f.rho[std::size_t(j) * std::size_t(g.nx) + std::size_t(i)];
+          if (!std::isfinite(rho)) {
+            row[i] = 0u;  // transparent
+            continue;
+          }
+          const Rgb c = colour(rho);
+          const auto byte = [](double v) { return std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+          row[i] = 0xFF000000u | (byte(c.r) << 16) | (byte(c.g) << 8) | byte(c.b);
+        }
       }
+      cairo_surface_mark_dirty(img);
+      const auto top_left = panel.px(Vec2(b[0], b[3]));
+      const double cell = g.spacing * panel.scale();
+      cairo_save(cr);
+      cairo_rectangle(cr, panel.x(), panel.y(), panel.w(), panel.h());
+      cairo_clip(cr);
+      cairo_translate(cr, top_left[0], top_left[1]);
+      cairo_scale(cr, cell, cell);
+      cairo_set_source_surface(cr, img, 0.0, 0.0);
+      cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
+      cairo_rectangle(cr, 0.0, 0.0, g.nx, g.ny);
+      cairo_fill(cr);
+      cairo_restore(cr);
+      cairo_surface_destroy(img);
     }
     // Target ellipse, dashed.
     panel.begin();
     ellipse_path(cr, station.target);
     panel.end();
+    set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.9);  // a halo: the ramp's dark end is behind it
+    cairo_set_line_width(cr, 3.4);
+    cairo_stroke_preserve(cr);
     const double dash[2] = {6.0, 4.0};
     cairo_set_dash(cr, dash, 2, 0.0);
     set_colour(cr, kInk, 0.9);
@@ -101,7 +139,12 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
       cairo_arc(cr, w[0], w[1], 10.0, 0.0, 2.0 * std::numbers::pi);
       set_colour(cr, ink);
       cairo_stroke(cr);
-      text(cr, w[0] + 13.0, w[1] - 8.0, "worst ρ = " + fmt("%.3f", map.max_rho), 11.0, kInk, 0.0, true);
+      const std::string label = "worst ρ = " + fmt("%.4f", map.max_rho);
+      const double tw = text_width(cr, label, 11.0, true);
+      cairo_rectangle(cr, w[0] + 10.0, w[1] - 21.0, tw + 6.0, 17.0);
+      set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
+      cairo_fill(cr);
+      text(cr, w[0] + 13.0, w[1] - 8.0, label, 11.0, kInk, 0.0, true);
     }
     const double span = std::max(b[2] - b[0], b[3] - b[1]);
     axes(cr, panel, b, span > 40.0 ? 10.0 : 5.0);
@@ -109,13 +152,14 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
     const double by = kTop + kPanel + 28.0;
     for (int c = 0; c < 100; ++c) {
       cairo_rectangle(cr, x0 + 40.0 + 3.0 * c, by, 3.2, 12.0);
-      set_colour(cr, rho_colour(kRhoLow + (1.0 - kRhoLow) * c / 100.0));
+      set_colour(cr, colour(colour.lo + (colour.hi - colour.lo) * c / 99.0));
       cairo_fill(cr);
     }
     cairo_rectangle(cr, x0 + 343.0, by, 20.0, 12.0);
     set_colour(cr, kUnstable);
     cairo_fill(cr);
-    text(cr, x0 + 36.0, by + 10.0, "ρ ≤ " + fmt("%.1f", kRhoLow), 10.0, kInk, 1.0);
+    text(cr, x0 + 36.0, by + 10.0, fmt("%.4f", colour.lo), 10.0, kInk, 1.0);
+    text(cr, x0 + 340.0, by + 24.0, fmt("%.4f", colour.hi), 10.0, kInk, 1.0);
     text(cr, x0 + 368.0, by + 10.0, "≥ 1 unstable", 10.0, kInk, 0.0);
     (void)kOutside;
     const std::string verdict = map.stable ? "stable over the target" : "UNSTABLE on the target";
@@ -126,9 +170,14 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
          11.0, map.stable ? kInk : kUnstable, 0.0, true);
     text(cr, x0, by + 52.0,
          "dominant pole: damping " + fmt("%.3f", map.damping) + ", " + fmt("%.2f", map.frequency_hz) +
-             " Hz;  gain margins: kp ×" + fmt("%.3g", map.kp_margin) + ", kd ×" + fmt("%.3g", map.kd_margin),
+             " Hz; least-damped oscillation: " + fmt("%.3f", map.oscillatory_damping) + " at " +
+             fmt("%.2f", map.oscillatory_frequency_hz) + " Hz",
          11.0, kInk);
-    text(cr, x0, by + 70.0, "dashed: target ellipse; blank: unreachable, singular or outside the joint limits", 10.0,
+    text(cr, x0, by + 70.0,
+         "gain margins (factor keeping max ρ < 1): kp ×" + fmt("%.3g", map.kp_margin) + ", kd ×" +
+             fmt("%.3g", map.kd_margin),
+         11.0, kInk);
+    text(cr, x0, by + 88.0, "dashed: target ellipse; blank: unreachable, singular or outside the joint limits", 10.0,
          kGrey);
   }
   return canvas.render();
