@@ -142,6 +142,13 @@ void ControllerSettings::validate() const {
   if (!(min_lci >= 0.0) || !(min_lci <= 1.0)) {
     throw ValidationError("min_lci", "= " + plain_number(min_lci) + ": must be in [0, 1]");
   }
+  if (!(max_tracking_error_mm > 0.0) || !(max_tracking_error_mm <= 1000.0)) {
+    throw ValidationError("max_tracking_error_mm",
+                          "= " + plain_number(max_tracking_error_mm) + " mm: must be > 0 and <= 1000 mm");
+  }
+  if (!(max_saturation_fraction >= 0.0) || !(max_saturation_fraction <= 1.0)) {
+    throw ValidationError("max_saturation_fraction", "= " + plain_number(max_saturation_fraction) + ": must be in [0, 1]");
+  }
   rules::validate_nested("pid", [&] { pid.validate(); });
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
   for (const ControlOverride& o : overrides) {
@@ -198,9 +205,10 @@ void load(const Value& v, Design& design) {
   ControllerSettings& c = design.set(ControllerSettings{});
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                              "min_lci", "pid", "potentiometer", "mechanisms", "stations"},
+                              "min_lci", "max_tracking_error_mm", "max_saturation_fraction", "pid", "potentiometer",
+                              "mechanisms", "stations"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                             "pid, potentiometer, mechanisms, stations)");
+                             "max_tracking_error_mm, max_saturation_fraction, pid, potentiometer, mechanisms, stations)");
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -215,6 +223,8 @@ void load(const Value& v, Design& design) {
   if (const Value* speed = find(all, "max_velocity_deg_s")) c.max_velocity = kRadPerDeg * speed->number("deg/s");
   if (const Value* p = find(all, "collision_priority")) c.collision_priority = p->text("must be upper");
   c.min_lci = number_or(all, "min_lci", c.min_lci, "");
+  c.max_tracking_error_mm = number_or(all, "max_tracking_error_mm", c.max_tracking_error_mm, "mm");
+  c.max_saturation_fraction = number_or(all, "max_saturation_fraction", c.max_saturation_fraction, "");
   ControlOverride defaults;
   control_keys(all, defaults);
   if (defaults.kp) c.pid.kp = *defaults.kp;
@@ -329,6 +339,8 @@ void write(const Design& d, Out& top) {
   out.add("max_velocity_deg_s", Out::degrees(c.max_velocity));
   out.add("collision_priority", Out::quoted(c.collision_priority));
   out.add("min_lci", Out::number(c.min_lci));
+  out.add("max_tracking_error_mm", Out::number(c.max_tracking_error_mm));
+  out.add("max_saturation_fraction", Out::number(c.max_saturation_fraction));
   ControlOverride defaults;
   defaults.kp = c.pid.kp, defaults.ki = c.pid.ki, defaults.kd = c.pid.kd, defaults.i_clamp = c.pid.i_clamp;
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;

@@ -80,6 +80,14 @@ struct ControllerSettings {
   /// Export gate: LCI over every target ellipse must be at least max(min_lci, the mechanism's
   /// min_lci): the ellipse keeps this far from singularities.
   double min_lci = 0.05;
+  /// Export gate (with `motor:`): the tactor's tracking error |P - P_ref| in every simulated
+  /// pattern (fivebar/dynamics.hpp) must stay at most this, mm. 0.5 mm is an ASSUMPTION (a sixth
+  /// of the patterns' default 3 mm amplitude), to replace with the rendering task's requirement.
+  double max_tracking_error_mm = 0.5;
+  /// Export gate (with `motor:`): the share of a simulated pattern's time a mechanism may spend
+  /// saturated (a joint at full duty or at the driver's current limit), in [0, 1]. 0.05 is an
+  /// ASSUMPTION: brief saturation at a pattern's start is tolerated, sustained saturation is not.
+  double max_saturation_fraction = 0.05;
   PidGains pid;                   ///< every joint, unless overridden
   Potentiometer potentiometer;    ///< every joint, unless overridden
   std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first
