@@ -101,6 +101,30 @@ TEST_F(CliControl, TheVerdictFlipsAtTheReportedKpMargin) {
   }
 }
 
+TEST_F(CliControl, TuneWritesThePatchAndPrintsBeforeAndAfter) {
+  const std::string out = (dir_ / "tune").string();
+  const Outcome r = run({"control", kDesign, "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                         "--tune-evaluations", "3", "--out", out, "--json"});
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;  // 3 evaluations need not reach the constraint
+  const json j = parse(r);
+  ASSERT_EQ(j["tuning"]["mechanisms"].size(), 2u);
+  bool feasible = true;
+  for (const json& m : j["tuning"]["mechanisms"]) {
+    EXPECT_EQ(m["station"], "index");
+    EXPECT_EQ(m["evaluations"], 3);
+    EXPECT_EQ(m["before"]["gains"]["kp"], 5.0);  // the design's
+    feasible = feasible && m["feasible"].get<bool>();
+  }
+  EXPECT_EQ(r.code, feasible ? 0 : 1);
+  const std::string patch = read_text(std::filesystem::path(out) / "tuned-controller.yaml");
+  EXPECT_THAT(patch, HasSubstr("controller:\n  stations:\n    index:\n      lower: {pid: {kp: "));
+  const Outcome text = run({"control", kDesign, "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                            "--tune-evaluations", "3", "--out", out});
+  EXPECT_THAT(text.out, HasSubstr("gains before"));
+  EXPECT_THAT(text.out, HasSubstr("gains after"));
+  EXPECT_THAT(text.out, HasSubstr("index/lower    kp 5.000, ki 1.000, kd 0.0500"));
+}
+
 TEST_F(CliControl, ADesignWithoutMotorsIsBadInputAndWritesNothing) {
   std::string text = read_text(kDesign);
   const std::size_t from = text.find("\nmotor:\n");

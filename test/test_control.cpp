@@ -9,6 +9,8 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <map>
 #include <string>
 #include <vector>
@@ -304,6 +306,56 @@ TEST(Control, TheKdMarginBoundsTheDerivativeGainBothWays) {
   EXPECT_GT(max_spectral_radius(map.poses, g, true), 1.0);
   const StepResponse bad = simulate_step(loop, map.worst_P_mm(), g);
   if (bad.status == SimStatus::ok) EXPECT_GT(bad.late, 2.0 * bad.initial);
+}
+
+TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTunedGains) {
+  const Design& d = paper();
+  const Station& index = d.require_station("index");
+  TuneOptions o;
+  o.max_evaluations = 8;
+  o.max_seconds = 120.0;  // the evaluation count stops it: deterministic
+  std::map<std::string, std::map<std::string, MechanismInertia>> inertia{{"index", paper_inertia("index")}};
+  const TuneResult a = tune_controller(d, {&index}, inertia, o);
+  const TuneResult b = tune_controller(d, {&index}, inertia, o);
+  ASSERT_EQ(a.mechanisms.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const TunedMechanism& t = a.mechanisms[k];
+    SCOPED_TRACE(t.mechanism);
+    EXPECT_EQ(t.after[0].kp, b.mechanisms[k].after[0].kp);
+    EXPECT_EQ(t.after[0].ki, b.mechanisms[k].after[0].ki);
+    EXPECT_EQ(t.after[0].kd, b.mechanisms[k].after[0].kd);
+    EXPECT_EQ(t.evaluations, 8);
+    EXPECT_EQ(t.after[0].i_clamp, t.before[0].i_clamp);
+    // The figures after are those of the gains after, recomputed independently here.
+    const LoopModel loop = paper_loop("index", t.mechanism);
+    std::vector<PoseLoop> poses;
+    for (const Vec2& P : ellipse_grid(index.target, o.grid)) poses.push_back(pose_loop(loop, P));
+    EXPECT_NEAR(max_spectral_radius(poses, t.after, true), t.rho_after, 1e-12);
+    EXPECT_NEAR(max_spectral_radius(poses, t.before, true), t.rho_before, 1e-12);
+    EXPECT_EQ(t.feasible, t.rho_after <= o.rho_limit && t.saturation_after <= d.get<ControllerSettings>()->max_saturation_fraction);
+  }
+  // The patch, merged into the design file, gives each mechanism the tuned gains on both joints.
+  const std::string patch = tuned_patch_yaml(a);
+  std::ifstream in(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string design = text.str();
+  const std::size_t stations = patch.find("  stations:\n");
+  ASSERT_NE(stations, std::string::npos);
+  const std::size_t end = design.find("\n# The motors and drivers");
+  ASSERT_NE(end, std::string::npos);
+  design.insert(end + 1, patch.substr(stations));
+  const Design merged = load_design_from_string(design, "merged.yaml");
+  for (const TunedMechanism& t : a.mechanisms) {
+    for (int j = 1; j <= 2; ++j) {
+      const PidGains g = merged.get<ControllerSettings>()->joint("index", t.mechanism, j).pid;
+      EXPECT_EQ(g.kp, t.after[0].kp);
+      EXPECT_EQ(g.ki, t.after[0].ki);
+      EXPECT_EQ(g.kd, t.after[0].kd);
+    }
+    const PidGains other = merged.get<ControllerSettings>()->joint("thumb", t.mechanism, 1).pid;
+    EXPECT_EQ(other.kp, t.before[0].kp);  // the other station keeps its gains
+  }
 }
 
 TEST(Control, EllipseGridStaysInsideAndHoldsTheCentre) {

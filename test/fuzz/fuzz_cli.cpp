@@ -99,10 +99,12 @@ void limit_simulate(std::vector<std::string>& args) {
 }
 
 /// `control` runs without OpenSCAD (every --render dropped) on small grids (9 x 9 poses per target
-/// and per reach: the maps and margins of every station within a fraction of the timeout).
+/// and per reach: the maps and margins of every station within a fraction of the timeout) and
+/// never tunes (--tune dropped: seconds of simulations per input).
 void limit_control(std::vector<std::string>& args) {
   if (args.empty() || args[0] != "control") return;
   args.erase(std::remove(args.begin() + 1, args.end(), std::string("--render")), args.end());
+  args.erase(std::remove(args.begin() + 1, args.end(), std::string("--tune")), args.end());
   for (const char* option : {"--grid", "--field"}) {
     bool given = false;
     for (std::size_t i = 1; i < args.size(); ++i) {

@@ -52,6 +52,9 @@
 
 #include <array>
 #include <complex>
+#include <functional>
+#include <map>
+#include <string_view>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -232,6 +235,58 @@ Json to_json(const StationControl& study);
 /// One summary line per mechanism: "index lower: stable over the target, max rho 0.8731 at
 /// (6.25, 18.10) mm (1313 poses); dominant pole damping 0.412 at 5.21 Hz; margins kp x2.31, kd x4.50".
 std::vector<std::string> summary_lines(const StationControl& study);
+
+// --- Tuning ---------------------------------------------------------------------------------------
+//
+// Gains per mechanism (the same kp, ki, kd on both joints; i_clamp kept) that minimise the worst
+// tracking error over the station's patterns, simulated with this mechanism alone under the new
+// gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject to max rho <= rho_limit over a
+// grid of the target (the constraint) and to the saturation limit (a penalty of 10 mm per unit of
+// saturated-time fraction beyond controller.max_saturation_fraction). NLopt's COBYLA (Powell's
+// derivative-free linear-approximation method with constraints; Powell, "A direct search
+// optimization method that models the objective and constraint functions by linear
+// interpolation", 1994) over (ln kp, ln ki, ln kd) within a factor e^5 (~148) of the start, started
+// from the design's gains with an initial step of a factor 2, the constraint aimed 0.003 inside its
+// limit (COBYLA ends within its tolerance of it). Deterministic: the same design and
+// options give the same gains, unless the wall-time bound stops a run first (the result says so).
+
+struct TuneOptions {
+  double rho_limit = 0.9;       ///< max spectral radius allowed over the target
+  int grid = 9;                 ///< per axis over the target for the constraint
+  int max_evaluations = 60;     ///< objective evaluations per mechanism
+  double max_seconds = 30.0;    ///< wall time for the whole tuning, shared among the mechanisms
+  double rtol = 1e-3;           ///< CVODE tolerance of the tracking runs
+  std::function<void(std::string_view)> progress;  ///< one line per evaluation; may be empty
+};
+
+/// Before and after, for one mechanism.
+struct TunedMechanism {
+  std::string station, mechanism;
+  std::array<PidGains, 2> before, after;
+  double rho_before = 0.0, rho_after = 0.0;        ///< max over the constraint's grid
+  double error_before_mm = 0.0, error_after_mm = 0.0;  ///< worst tracking error over the patterns
+  double saturation_before = 0.0, saturation_after = 0.0;  ///< worst saturated-time fraction
+  int evaluations = 0;
+  bool feasible = false;   ///< rho_after <= rho_limit and the saturation within its limit
+  std::string stop;        ///< why the optimiser stopped
+};
+
+struct TuneResult {
+  std::vector<TunedMechanism> mechanisms;
+  double rho_limit = 0.9;
+  double wall_s = 0.0;
+};
+
+/// Tunes every mechanism of `stations` (each with both mechanisms and patterns); `inertia` per
+/// station name, then mechanism name. InputError as simulation_inputs().
+TuneResult tune_controller(const Design& design, const std::vector<const Station*>& stations,
+                           const std::map<std::string, std::map<std::string, MechanismInertia>>& inertia,
+                           const TuneOptions& options = {});
+
+/// The tuned gains as a YAML patch of the design file: `controller: {stations: {<s>: {<m>: {pid:
+/// {kp, ki, kd}}}}}` (the narrowest scope but the joints, so that it wins over the file's own).
+std::string tuned_patch_yaml(const TuneResult& result);
+Json to_json(const TuneResult& result);
 
 /// The picture of a station's maps (one panel per mechanism, `fields[k]` for `maps[k]`): rho over
 /// the reachable region on a colour ramp (red where >= 1), the target ellipse dashed, the worst
