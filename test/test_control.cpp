@@ -358,6 +358,101 @@ TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTuned
   }
 }
 
+TEST(ControlPerformance, TactorGainEqualsTheSteadyStateOfTheLoopSteppedByHand) {
+  LoopModel loop = paper_loop("index", "lower");
+  for (PidGains& g : loop.gains) g = {6.5, 40.0, 0.19, 1e9};  // a faster integrator: short transients
+  const Vec2 P = paper().require_station("index").target.center + Vec2(1.0, -2.0);
+  const AnglesResult a = ik_angles(loop.model.mechanism, P);
+  const LinearPlant plant = linear_plant(loop.model, Eigen::Vector2d(a.theta1, a.theta2), &loop.skin);
+  const DiscretePlant dp = discretise(plant, loop.period_s);
+  const double T = loop.period_s, f = 5.0, w = 2 * std::numbers::pi * f;
+  // H(:, c) from a sine on joint c's reference, stepped with DiscretePid and the one-period delay.
+  Eigen::Matrix2cd H;
+  for (int c = 0; c < 2; ++c) {
+    std::array<DiscretePid, 2> pid{DiscretePid(loop.gains[0], T), DiscretePid(loop.gains[1], T)};
+    Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Vector2d pending = Eigen::Vector2d::Zero();
+    const int n = 6000, keep = 2000;  // 100 periods kept after the transient
+    Eigen::Vector2cd acc = Eigen::Vector2cd::Zero();
+    for (int k = 0; k < n; ++k) {
+      const double r = 1e-3 * std::sin(w * k * T);
+      if (k >= n - keep) acc += x.head<2>().cast<std::complex<double>>() * std::polar(1.0, -w * k * T);
+      Eigen::Vector2d fresh;
+      for (int j = 0; j < 2; ++j) fresh[j] = pid[std::size_t(j)].update((j == c ? r : 0.0) - x[j]);
+      x = dp.Ad * x + dp.Bd * pending;
+      pending = fresh;
+    }
+    // sin has the complex amplitude -j: X = H (-j) 1e-3.
+    H.col(c) = (2.0 / keep) * acc / (std::complex<double>(0.0, -1.0) * 1e-3);
+  }
+  const Eigen::Matrix2cd Ht = plant.J.cast<std::complex<double>>() * H * plant.J.inverse().cast<std::complex<double>>();
+  const Eigen::JacobiSVD<Eigen::Matrix2cd> svd(Ht);
+  const std::array<double, 2> g = tactor_gain(dp, loop.gains, true, plant.J, f);
+  EXPECT_NEAR(g[0], svd.singularValues()[1], 1e-6);
+  EXPECT_NEAR(g[1], svd.singularValues()[0], 1e-6);
+  // At zero frequency the integral makes the loop exact: unit gain in every direction.
+  const std::array<double, 2> dc = tactor_gain(dp, loop.gains, true, plant.J, 0.0);
+  EXPECT_NEAR(dc[0], 1.0, 1e-9);
+  EXPECT_NEAR(dc[1], 1.0, 1e-9);
+}
+
+TEST(ControlPerformance, ResolutionForceAndZWidthAgreeWithFiniteDifferencesOfTheKinematics) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("index", "upper");
+  const ControllerSettings& c = *d.get<ControllerSettings>();
+  const std::array<Potentiometer, 2> pots{c.joint("index", "upper", 1).potentiometer, c.joint("index", "upper", 2).potentiometer};
+  const Vec2 P = d.require_station("index").target.center + Vec2(-1.5, 1.0);
+  const PoseFigures f = pose_figures(loop, P, c.adc_bits, c.adc_range_v, pots);
+  ASSERT_EQ(f.status, Status::ok);
+  const AnglesResult a = ik_angles(loop.model.mechanism, P);
+  // J by central differences of FK (mm/rad -> m/rad).
+  Eigen::Matrix2d J;
+  const double h = 1e-6;
+  for (int j = 0; j < 2; ++j) {
+    const double d1 = j == 0 ? h : 0.0, d2 = j == 1 ? h : 0.0;
+    const Vec2 p = fk_point(loop.model.mechanism, a.theta1 + d1, a.theta2 + d2).P;
+    const Vec2 m = fk_point(loop.model.mechanism, a.theta1 - d1, a.theta2 - d2).P;
+    J.col(j) = 1e-3 * (p - m) / (2 * h);
+  }
+  // Resolution: the tactor's move for one count on the worse joint, by FK.
+  double step_um = 0.0;
+  for (int j = 0; j < 2; ++j) {
+    const double count = std::abs(pots[std::size_t(j)].rad_per_volt) * (c.adc_range_v[1] - c.adc_range_v[0]) / 65536.0;
+    const Vec2 p0 = fk_point(loop.model.mechanism, a.theta1, a.theta2).P;
+    const Vec2 p1 = fk_point(loop.model.mechanism, a.theta1 + (j == 0 ? count : 0.0), a.theta2 + (j == 1 ? count : 0.0)).P;
+    step_um = std::max(step_um, 1e3 * (p1 - p0).norm());
+  }
+  EXPECT_NEAR(f.resolution_um, step_um, 1e-3 * step_um);
+  // Force in every direction: the worst of 3600 directions of min_j tau_j / |J_j . u|.
+  double worst = 1e300;
+  for (int k = 0; k < 3600; ++k) {
+    const Vec2 u(std::cos(k * std::numbers::pi / 3600), std::sin(k * std::numbers::pi / 3600));
+    double fu = 1e300;
+    for (int j = 0; j < 2; ++j) {
+      const MotorParams& mp = loop.model.motors[std::size_t(j)];
+      const double tau = mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.current_limit_A;
+      fu = std::min(fu, tau / std::abs(J.col(j).dot(u)));
+    }
+    worst = std::min(worst, fu);
+  }
+  EXPECT_NEAR(f.force_N, worst, 1e-4 * worst);
+  // Z-width: the least tactor damping over 3600 directions, b(u) = min over F . u for unit speed along u.
+  double bmin = 1e300;
+  Eigen::Matrix2d Bj = Eigen::Matrix2d::Zero();
+  for (int j = 0; j < 2; ++j) {
+    const MotorParams& mp = loop.model.motors[std::size_t(j)];
+    Bj(j, j) = mp.viscous_friction() + mp.gearbox_efficiency * mp.gear_ratio * mp.gear_ratio * mp.torque_constant() *
+                                           mp.back_emf_constant() / mp.resistance();
+  }
+  for (int k = 0; k < 3600; ++k) {
+    const Vec2 u(std::cos(k * std::numbers::pi / 3600), std::sin(k * std::numbers::pi / 3600));
+    const Eigen::Vector2d wdot = J.inverse() * u;           // joint rates for unit tactor speed along u
+    bmin = std::min(bmin, wdot.dot(Bj * wdot));             // power dissipated = b(u)
+  }
+  EXPECT_NEAR(f.damping_N_s_per_mm, 1e-3 * bmin, 1e-4 * 1e-3 * bmin);
+  EXPECT_NEAR(f.zwidth_N_per_mm, 2.0 * f.damping_N_s_per_mm / loop.period_s, 1e-9);
+}
+
 TEST(Control, EllipseGridStaysInsideAndHoldsTheCentre) {
   Ellipse e;
   e.center = {3.0, -2.0};

@@ -204,11 +204,67 @@ Json to_json(const StabilityMap& map);
 /// The `.vti` document (ParaView image data) of a field: point data `rho` and `status`.
 std::string rho_field_vti(const RhoField& field);
 
+// --- Performance over the target -------------------------------------------------------------------
+//
+// Bandwidth: the closed loop from the reference to the joint angles, H(z) = C (zI - Phi)^-1 G, with
+// the reference entering the PID as the measurement does (the error r - theta feeds the duty, the
+// integral and the previous error); for the tactor, J H J^-1 (reference and response mapped through
+// the Jacobian). The -3 dB bandwidth is the lowest frequency at which the gain in the worst tactor
+// direction, sigma_min(J H(e^{jwT}) J^-1), falls below 1/sqrt(2) (a log scan up to Nyquist refined by
+// bisection); Nyquist when it never does.
+// Resolution: the tactor step of one ADC count on one joint, max_j |J_j| dtheta_j with dtheta_j =
+// |rad_per_volt_j| (range_v high - low) / 2^bits (the potentiometer through the ADC).
+// Force: the largest shear force the motors hold continuously in every direction: with joint
+// torques |tau_j| <= eta_j N_j k_t,j I_max,j and J^T F = tau, a force f u needs |J_j . u| f <= tau_j,
+// so the direction-wise bound is min_j tau_j / |J_j . u| and its worst direction (u along a column)
+// gives min_j tau_j / |J_j| (N).
+// Z-width (Colgate & Schenkel, "Passivity of a class of sampled-data systems: application to haptic
+// interfaces", J. Robotic Systems 14(1), 1997): a virtual wall K, B renders passively when
+// b > K T / 2 + |B|, b the device's own damping. Here b is the joint damping mapped to the tactor,
+// B_x = J^-T diag(b_j + eta_j N_j^2 k_t,j k_e,j / R_j) J^-1 (viscous friction plus the back-EMF damping of
+// the voltage-driven motor), in the direction where it is least (its smallest eigenvalue): K_max =
+// 2 (b_min - |B|) / T, and the loop rate a stiffness K needs is K / (2 (b_min - |B|)). Coulomb friction
+// and the ADC quantisation (Abbott & Okamura's refinement) are not in this bound.
+
+struct PoseFigures {
+  Vec2 P_mm{0.0, 0.0};
+  Status status = Status::unreachable;
+  double bandwidth_hz = 0.0;
+  double resolution_um = 0.0;     ///< tactor step of one ADC count, worst joint
+  double force_N = 0.0;           ///< continuous force in every direction
+  double damping_N_s_per_mm = 0.0;  ///< least tactor damping b_min
+  double zwidth_N_per_mm = 0.0;   ///< 2 b_min / T (no virtual damping)
+};
+
+/// The closed-loop gain from the tactor reference to the tactor at frequency f (Hz): the
+/// singular values of J H(e^{j 2 pi f T}) J^-1, smallest first.
+std::array<double, 2> tactor_gain(const DiscretePlant& plant, const std::array<PidGains, 2>& gains, bool delay,
+                                  const Eigen::Matrix2d& J, double frequency_hz);
+
+/// The figures at tactor point P (mm); `adc_bits`, `adc_range_v` and the joints' potentiometers
+/// from the controller of the design.
+PoseFigures pose_figures(const LoopModel& loop, const Vec2& P_mm, int adc_bits, const std::array<double, 2>& adc_range_v,
+                         const std::array<Potentiometer, 2>& pots);
+
+/// Worst over a set of poses: the lowest bandwidth, the coarsest resolution, the weakest force,
+/// the lowest Z-width, each with its pose.
+struct PerformanceMap {
+  std::string station, mechanism;
+  std::vector<PoseFigures> poses;
+  PoseFigures worst_bandwidth, worst_resolution, worst_force, worst_zwidth;
+};
+PerformanceMap performance_map(const Design& design, const LoopModel& loop, const std::vector<Vec2>& points);
+Json to_json(const PerformanceMap& map);
+/// "index lower: bandwidth >= 6.2 Hz (at ...), resolution <= 0.9 um/count, force >= 1.9 N in every
+/// direction, Z-width >= 120 N/mm (hard surface 0.8-1.0 N/mm)".
+std::string performance_line(const PerformanceMap& map);
+
 // --- A station's study (the `control` subcommand and product) ----------------------------------
 
 struct ControlOptions {
   StabilityOptions stability;
   int field_cells = 81;  ///< per axis over each mechanism's reach, for the field
+  int performance_grid = 15;  ///< per axis over the target, for the bandwidth, resolution, force, Z-width
 };
 
 /// Every mechanism of a station: its map over the target and its field over the reachable region.
@@ -216,6 +272,7 @@ struct StationControl {
   std::string station;
   std::vector<StabilityMap> maps;  ///< lower first
   std::vector<RhoField> fields;    ///< as maps
+  std::vector<PerformanceMap> performance;  ///< as maps
   bool stable() const;             ///< every map stable
 };
 
@@ -229,11 +286,12 @@ StationControl station_control(const Design& design, const Station& station,
 std::vector<std::pair<std::string, std::string>> control_files(const StationControl& study, const Station& station,
                                                                const std::string& subtitle);
 
-/// {"station", "stable", "mechanisms": [to_json(map) ...]}.
+/// {"station", "stable", "mechanisms": [to_json(map) ...], "performance": [to_json(performance) ...]}.
 Json to_json(const StationControl& study);
 
 /// One summary line per mechanism: "index lower: stable over the target, max rho 0.8731 at
-/// (6.25, 18.10) mm (1313 poses); dominant pole damping 0.412 at 5.21 Hz; margins kp x2.31, kd x4.50".
+/// (6.25, 18.10) mm (1313 poses); dominant pole damping 0.412 at 5.21 Hz; margins kp x2.31, kd x4.50",
+/// then one performance_line() per mechanism.
 std::vector<std::string> summary_lines(const StationControl& study);
 
 // --- Tuning ---------------------------------------------------------------------------------------

@@ -21,6 +21,13 @@ constexpr const char* kPreamble =
     "so over the whole target. Small-signal figures: the driver's limits, Coulomb friction and the ADC "
     "quantisation are in the `simulate` product, not here.\n\n";
 
+constexpr const char* kPerformance =
+    "The worst over each target of: the −3 dB bandwidth of tactor displacement (the discrete closed loop's "
+    "frequency response in the tactor's worst direction), the tactor step of one ADC count, the largest "
+    "continuous shear force the motors hold in every direction (fingertip devices are compared at ≥ 1.5 N) and "
+    "the Z-width, the stiffest virtual wall the loop renders passively from the device's own damping "
+    "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm).\n\n";
+
 }  // namespace
 
 Product control_product() {
@@ -36,9 +43,12 @@ Product control_product() {
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
     const Json* parts = ctx.result_of("parts");
-    md::Table table({"station", "mechanism", "verdict", "max ρ", "worst pose (mm)", "damping", "frequency (Hz)",
-                     "kp margin", "kd margin"},
+    md::Table table({"station", "mechanism", "verdict", "max ρ", "worst pose (mm)", "dominant pole ζ / Hz",
+                     "least-damped oscillation ζ / Hz", "kp margin", "kd margin"},
                     "lllrlrrrr");
+    md::Table performance({"station", "mechanism", "bandwidth ≥ (Hz)", "resolution ≤ (µm/count)",
+                           "force in every direction ≥ (N)", "Z-width ≥ (N/mm)"},
+                          "llrrrr");
     Json studies = Json::array();
     bool stable = true;
     std::size_t maps = 0;
@@ -57,14 +67,21 @@ Product control_product() {
         ++maps;
         const Vec2 w = m.worst_P_mm();
         table.row({s.name, m.mechanism, m.stable ? "stable" : "**unstable**", md::fixed(m.max_rho, 4),
-                   "(" + md::fixed(w.x(), 2) + ", " + md::fixed(w.y(), 2) + ")", md::fixed(m.damping, 3),
-                   md::fixed(m.frequency_hz, 2), md::fixed(m.kp_margin, 2), md::fixed(m.kd_margin, 2)});
+                   "(" + md::fixed(w.x(), 2) + ", " + md::fixed(w.y(), 2) + ")",
+                   md::fixed(m.damping, 3) + " / " + md::fixed(m.frequency_hz, 2),
+                   md::fixed(m.oscillatory_damping, 3) + " / " + md::fixed(m.oscillatory_frequency_hz, 2),
+                   md::fixed(m.kp_margin, 2), md::fixed(m.kd_margin, 2)});
+      }
+      for (const PerformanceMap& m : study.performance) {
+        performance.row({s.name, m.mechanism, md::fixed(m.worst_bandwidth.bandwidth_hz, 2),
+                         md::fixed(m.worst_resolution.resolution_um, 3), md::fixed(m.worst_force.force_N, 2),
+                         md::fixed(m.worst_zwidth.zwidth_N_per_mm, 1)});
       }
       studies.push_back(to_json(study));
     }
     Built b;
     b.result = {{"stations", studies}, {"stable", stable}};
-    b.markdown = std::string(kPreamble) + table.str() + "\n" + files;
+    b.markdown = std::string(kPreamble) + table.str() + "\n" + kPerformance + performance.str() + "\n" + files;
     b.passed = stable;
     b.check = stable ? "stable over every target (" + std::to_string(maps) + " mechanisms)"
                      : "the loop is unstable somewhere on a target";
