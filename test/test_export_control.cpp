@@ -57,6 +57,8 @@ TEST(ExportLoopGate, TheShowcasePassesAndItsFilesCarryTheFigures) {
     const Json& f = v.at("index").at(m);
     EXPECT_LT(f.at("max_rho").get<double>(), 1.0);
     EXPECT_GT(f.at("kp_margin").get<double>(), 1.0);
+    EXPECT_GT(f.at("min_bandwidth_hz").get<double>(), 0.0);
+    EXPECT_LE(f.at("min_bandwidth_hz").get<double>(), 50.0);  // Nyquist of the 100 Hz loop
     EXPECT_GT(f.at("max_tracking_error_m").get<double>(), 0.0);
     EXPECT_LE(f.at("max_tracking_error_m").get<double>(), 1e-3 * d.get<ControllerSettings>()->max_tracking_error_mm);
   }

@@ -27,6 +27,8 @@ std::string point(const Vec2& p) { return "(" + fixed(p.x(), 2) + ", " + fixed(p
 
 /// Grid per axis over a target for the gate's map: ~310 poses, every 0.5 mm on the paper's ellipse.
 constexpr int kGateGrid = 21;
+/// Grid per axis for the bandwidth carried in the files (~70 poses).
+constexpr int kGatePerformanceGrid = 9;
 /// CVODE tolerance of the gate's simulations: measured on the paper's device, its tracking errors
 /// are those at the default 1e-6 to 1 um, in half the time.
 constexpr double kGateRtol = 1e-4;
@@ -75,6 +77,8 @@ ControlGate control_gate(const Design& d, const std::vector<std::string>& statio
       f["worst_pose_m"] = Json::array({1e-3 * w.x(), 1e-3 * w.y()});
       f["oscillatory_damping"] = m.oscillatory_damping;
       f["oscillatory_frequency_hz"] = m.oscillatory_frequency_hz;
+      const PerformanceMap perf = performance_map(d, loop, ellipse_grid(s.target, kGatePerformanceGrid));
+      f["min_bandwidth_hz"] = perf.worst_bandwidth.bandwidth_hz;
     }
     if (!(s.lower && s.upper)) continue;  // patterns move both tactors
     SimulationRequest request;

@@ -17,7 +17,7 @@ struct ControlGate {
   std::vector<GateCheck> checks;
   /// The figures the export was validated with, per station and mechanism (SI units, as the
   /// exported files): {<station>: {<mechanism>: {max_rho, kp_margin, kd_margin, worst_pose_m,
-  /// oscillatory_damping, oscillatory_frequency_hz, max_tracking_error_m, max_saturation_fraction}}}.
+  /// oscillatory_damping, oscillatory_frequency_hz, min_bandwidth_hz, max_tracking_error_m, max_saturation_fraction}}}.
   Json figures = Json::object();
 };
 

@@ -128,7 +128,7 @@ struct ExportGate {
 ///                controller.max_saturation_fraction of the time.
 /// The figures of those checks go into the exported files under fivebar.validation (SI units):
 /// `<station>.<mechanism>: {max_rho, kp_margin, kd_margin, worst_pose_m, oscillatory_damping,
-/// oscillatory_frequency_hz, max_tracking_error_m, max_saturation_fraction}`; check_export()
+/// oscillatory_frequency_hz, min_bandwidth_hz, max_tracking_error_m, max_saturation_fraction}`; check_export()
 /// leaves that block out of its comparison (measured figures, not design values).
 /// Throws InputError for a design without `controller:` or an unknown station in options.
 ExportGate export_gate(const Design& design, const ExportOptions& options = {});
