@@ -311,8 +311,9 @@ RhoField rho_field(const LoopModel& loop, int cells_per_axis) {
   const double ymin = std::max(m.O1.y() - r1, m.O2.y() - r2);
   const double ymax = std::min(m.O1.y() + r1, m.O2.y() + r2);
   const int n = std::max(cells_per_axis, 2);
-  const double spacing = std::max(xmax - xmin, ymax - ymin) / (n - 1);
   RhoField f;
+  if (!(xmax > xmin) || !(ymax > ymin)) return f;  // the legs' discs do not meet: nothing reachable
+  const double spacing = std::max(xmax - xmin, ymax - ymin) / (n - 1);
   f.grid = Grid::covering({xmin, ymin, xmax, ymax}, spacing, spacing);
   f.rho.assign(f.grid.size(), std::numeric_limits<double>::quiet_NaN());
   f.status.assign(f.grid.size(), static_cast<std::uint8_t>(Status::unreachable));

@@ -72,15 +72,20 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
     const RhoField& f = fields[k];
     const double x0 = kLeft + double(k) * (kPanel + kGap);
     const Grid& g = f.grid;
-    const std::array<double, 4> b{g.x0 - 0.5 * g.spacing, g.y0 - 0.5 * g.spacing,
-                                  g.x0 + (g.nx - 0.5) * g.spacing, g.y0 + (g.ny - 0.5) * g.spacing};
+    std::array<double, 4> b{g.x0 - 0.5 * g.spacing, g.y0 - 0.5 * g.spacing, g.x0 + (g.nx - 0.5) * g.spacing,
+                            g.y0 + (g.ny - 0.5) * g.spacing};
+    if (g.nx == 0 || g.ny == 0) {  // nothing reachable: the target's box
+      const double r = 0.5 * std::max(station.target.axes.x(), station.target.axes.y()) + 1.0;
+      b = {station.target.center.x() - r, station.target.center.y() - r, station.target.center.x() + r,
+           station.target.center.y() + r};
+    }
     const Panel panel(cr, x0, kTop + 22.0, kPanel, kPanel - 22.0, b);
     const Rgb ink = map.mechanism == "upper" ? kUpperColour : kLowerColour;
     text(cr, x0, kTop + 14.0,
          "(" + std::string(1, char('a' + k)) + ") " + map.mechanism + " mechanism: ρ over its reachable region",
          12.0, kInk, 0.0, true);
     // The field as one raster (one pixel per grid point, drawn nearest): an SVG stays small.
-    {
+    if (g.nx > 0 && g.ny > 0) {
       cairo_surface_t* img = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, g.nx, g.ny);
       cairo_surface_flush(img);
       unsigned char* data = cairo_image_surface_get_data(img);
@@ -127,7 +132,7 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
     cairo_stroke(cr);
     cairo_set_dash(cr, nullptr, 0, 0.0);
     // Worst pose on the target.
-    if (!map.poses.empty()) {
+    if (map.poses.size() > map.not_ok) {
       const auto w = panel.px(map.worst_P_mm());
       cairo_set_line_width(cr, 2.2);
       set_colour(cr, kInk);
