@@ -58,7 +58,7 @@ TEST_F(CliControl, JsonFilesAndMirrorSymmetryOfTheIndexStation) {
   EXPECT_NEAR(lo["worst_pose_mm"][0].get<double>(), up["worst_pose_mm"][0].get<double>(), 1e-9);
   EXPECT_NEAR(lo["worst_pose_mm"][1].get<double>() + up["worst_pose_mm"][1].get<double>(), 31.0, 1e-9);
   for (const char* f : {"index-stability.svg", "index-stability.png", "index-lower-rho.vti", "index-upper-rho.vti",
-                        "index-stability.csv"}) {
+                        "index-stability.csv", "index-performance.csv"}) {
     SCOPED_TRACE(f);
     EXPECT_TRUE(std::filesystem::is_regular_file(std::filesystem::path(out) / f));
   }
@@ -67,6 +67,18 @@ TEST_F(CliControl, JsonFilesAndMirrorSymmetryOfTheIndexStation) {
   EXPECT_THAT(vti, HasSubstr("Name=\"rho\""));
   const std::string csv = read_text(std::filesystem::path(out) / "index-stability.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')), "station,mechanism,x_mm,y_mm,status,rho,damping,frequency_hz");
+  const std::string perf = read_text(std::filesystem::path(out) / "index-performance.csv");
+  EXPECT_EQ(perf.substr(0, perf.find('\n')),
+            "station,mechanism,x_mm,y_mm,status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,"
+            "tactor_damping_N_s_per_mm,zwidth_N_per_mm");
+  const json& pl = st["performance"][0];
+  const json& pu = st["performance"][1];
+  for (const char* key : {"min_bandwidth_hz", "max_resolution_um_per_count", "min_force_every_direction_N",
+                          "min_zwidth_N_per_mm"}) {
+    SCOPED_TRACE(key);
+    EXPECT_GT(pl[key].get<double>(), 0.0);
+    EXPECT_NEAR(pl[key].get<double>(), pu[key].get<double>(), 1e-6 * pl[key].get<double>());
+  }
 }
 
 TEST_F(CliControl, TheVerdictFlipsAtTheReportedKpMargin) {

@@ -412,6 +412,19 @@ std::vector<std::pair<std::string, std::string>> control_files(const StationCont
     }
   }
   files.emplace_back(study.station + "-stability.csv", csv);
+  std::string perf =
+      "station,mechanism,x_mm,y_mm,status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,"
+      "tactor_damping_N_s_per_mm,zwidth_N_per_mm\n";
+  for (const PerformanceMap& m : study.performance) {
+    for (const PoseFigures& f : m.poses) {
+      const bool ok = f.status == Status::ok;
+      const auto v = [&](double x) { return ok ? num(x) : std::string(); };
+      perf += study.station + "," + m.mechanism + "," + num(f.P_mm.x()) + "," + num(f.P_mm.y()) + "," +
+              std::string(to_string(f.status)) + "," + v(f.bandwidth_hz) + "," + v(f.resolution_um) + "," +
+              v(f.force_N) + "," + v(f.damping_N_s_per_mm) + "," + v(f.zwidth_N_per_mm) + "\n";
+    }
+  }
+  files.emplace_back(study.station + "-performance.csv", perf);
   return files;
 }
 

@@ -282,7 +282,10 @@ StationControl station_control(const Design& design, const Station& station,
 
 /// The files of a station's study, as (name, bytes): `<station>-stability.svg` and `.png` (the
 /// picture), `<station>-<mechanism>-rho.vti` (the field, ParaView), `<station>-stability.csv`
-/// (every target pose: station,mechanism,x_mm,y_mm,status,rho,damping,frequency_hz).
+/// (every target pose: station,mechanism,x_mm,y_mm,status,rho,damping,frequency_hz) and
+/// `<station>-performance.csv` (every pose of the performance grid: station,mechanism,x_mm,y_mm,
+/// status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,tactor_damping_N_s_per_mm,
+/// zwidth_N_per_mm).
 std::vector<std::pair<std::string, std::string>> control_files(const StationControl& study, const Station& station,
                                                                const std::string& subtitle);
 
