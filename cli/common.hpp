@@ -106,5 +106,6 @@ void setup_export(CLI::App& app);
 void setup_simulate(CLI::App& app);
 void setup_tolerance(CLI::App& app);
 void setup_animate(CLI::App& app);
+void setup_control(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -101,6 +101,7 @@ int run(int argc, char** argv) {
   setup_simulate(app);
   setup_tolerance(app);
   setup_animate(app);
+  setup_control(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

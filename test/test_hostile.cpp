@@ -362,6 +362,11 @@ std::vector<Case> cases() {
                {both}, {"no patterns: section"}});
   c.push_back({"AnimateWidthHuge", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg",
                                     "--width", "1e300"}, {both}, {"--width"}});
+  c.push_back({"ControlGridHuge", sub({"control"}, {"--grid", "1000000"}), {both}, {"--grid must be within [3, 401]"}});
+  c.push_back({"ControlFieldNotANumber", sub({"control"}, {"--field", "abc"}), {both}, {"--field", "abc"}});
+  c.push_back({"ControlTuneSecondsNegative", sub({"control"}, {"--tune", "--tune-seconds", "-1"}), {both},
+               {"--tune-seconds must be > 0"}});
+  c.push_back({"ControlWithoutMotorSection", sub({"control"}, {}), {both}, {"both.yaml", "no `motor:` section"}});
   c.push_back({"PartsNoJobs", sub({"parts"}, {"--jobs", "0"}), {both}, {"--jobs", "0"}});
   c.push_back({"SweepBillionSteps", sub({"sweep"}, {"-s", "index", "--vary", "L1=1:2:1000000000"}), {both},
                {"--vary 'L1=1:2:1000000000'"}});

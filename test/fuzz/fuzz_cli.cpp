@@ -98,16 +98,38 @@ void limit_simulate(std::vector<std::string>& args) {
   args.insert(args.begin() + 1, {"--no-render", "--max-wall", "0.5"});
 }
 
+/// `control` runs without OpenSCAD (every --render dropped) on small grids (9 x 9 poses per target
+/// and per reach: the maps and margins of every station within a fraction of the timeout) and
+/// never tunes (--tune dropped: seconds of simulations per input).
+void limit_control(std::vector<std::string>& args) {
+  if (args.empty() || args[0] != "control") return;
+  args.erase(std::remove(args.begin() + 1, args.end(), std::string("--render")), args.end());
+  args.erase(std::remove(args.begin() + 1, args.end(), std::string("--tune")), args.end());
+  for (const char* option : {"--grid", "--field"}) {
+    bool given = false;
+    for (std::size_t i = 1; i < args.size(); ++i) {
+      if (args[i] == option && i + 1 < args.size()) {
+        args[i + 1] = "9";
+        given = true;
+      } else if (args[i].starts_with(std::string(option) + "=")) {
+        args[i] = std::string(option) + "=9";
+        given = true;
+      }
+    }
+    if (!given) args.insert(args.begin() + 1, {option, "9"});
+  }
+}
+
 /// `run` builds only the cheap products: report (a timing study by design), tolerance (Monte Carlo of
-/// as many devices as the design asks), sweep (a grid of any
-/// size), parts and simulate (OpenSCAD processes) and workspace (sampled fields and pictures: ~6 s per design in
+/// as many devices as the design asks), sweep (a grid of any size), parts, simulate and control (OpenSCAD processes, control through parts) and workspace (sampled fields and pictures: ~6 s per design in
 /// this build, against a 10 s timeout per input) are left to their own tests and to the
 /// hostile-input suite. Names of those four in a --products list
 /// are dropped, and a run without a list gets the cheap ones, so that the design file's own
 /// `products:` cannot ask for them either.
 void limit_run_products(std::vector<std::string>& args) {
   if (args.empty() || args[0] != "run") return;
-  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace", "simulate", "tolerance"};
+  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace", "simulate", "tolerance",
+                                                   "control"};
   const auto filtered = [&](const std::string& list) {
     std::vector<std::string> kept;
     std::size_t start = 0;
@@ -219,6 +241,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<std::string> args = arguments(line);
   limit_run_products(args);
   limit_simulate(args);
+  limit_control(args);
   std::vector<std::string> storage{"fivebar"};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;

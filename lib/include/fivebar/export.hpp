@@ -107,6 +107,7 @@ struct ExportGate {
   std::vector<std::string> stations;  ///< the stations gated (and exported)
   std::vector<GateCheck> checks;      ///< in a fixed order: names, geometry, per station, patterns
   std::vector<JointSweep> joints;     ///< ranges over the ellipses, for reports
+  Json validation = Json::object();   ///< the loop checks' figures (above); empty without `motor:`
   bool passed() const;
   /// "subject kind: detail" of every failed check.
   std::vector<std::string> reasons() const;
@@ -127,7 +128,18 @@ struct ExportGate {
 ///   hardware_limits, joint_margin  the usable range of every joint from its potentiometer's travel
 ///                and the hard stops (fivebar/joint_limits.hpp), and the target and every pattern at
 ///                least controller.joint_margin inside it, the proximal links clear of the other leg's;
-///   pattern      every pattern of `patterns:` for the station passes check_pattern().
+///   pattern      every pattern of `patterns:` for the station passes check_pattern();
+/// and, for a design with `motor:` (and `geometry:`), the loop (lib/src/export_control_gate.cpp):
+///   stability    per mechanism, the sampled PID loop is stable (spectral radius < 1) at every
+///                pose of a grid over its target (fivebar/control.hpp);
+///   tracking     per pattern, simulated under the PID (fivebar/dynamics.hpp), each tactor stays
+///                within controller.max_tracking_error_mm of its reference;
+///   saturation   per pattern, each mechanism's motors are saturated for at most
+///                controller.max_saturation_fraction of the time.
+/// The figures of those checks go into the exported files under fivebar.validation (SI units):
+/// `<station>.<mechanism>: {max_rho, kp_margin, kd_margin, worst_pose_m, oscillatory_damping,
+/// oscillatory_frequency_hz, min_bandwidth_hz, max_tracking_error_m, max_saturation_fraction}`; check_export()
+/// leaves that block out of its comparison (measured figures, not design values).
 /// Every check runs on the stations with their usable ranges as joint limits (with_usable_limits()).
 /// Throws InputError for a design without `controller:` or an unknown station in options.
 ExportGate export_gate(const Design& design, const ExportOptions& options = {});

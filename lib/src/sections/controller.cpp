@@ -154,6 +154,13 @@ void ControllerSettings::validate() const {
   if (!(joint_margin >= 0.0) || !(joint_margin < std::numbers::pi)) {
     throw ValidationError("joint_margin_deg", "= " + format_degrees(joint_margin) + " deg: must be >= 0 and < 180 deg");
   }
+  if (!(max_tracking_error_mm > 0.0) || !(max_tracking_error_mm <= 1000.0)) {
+    throw ValidationError("max_tracking_error_mm",
+                          "= " + plain_number(max_tracking_error_mm) + " mm: must be > 0 and <= 1000 mm");
+  }
+  if (!(max_saturation_fraction >= 0.0) || !(max_saturation_fraction <= 1.0)) {
+    throw ValidationError("max_saturation_fraction", "= " + plain_number(max_saturation_fraction) + ": must be in [0, 1]");
+  }
   rules::validate_nested("pid", [&] { pid.validate(); });
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
   for (const ControlOverride& o : overrides) {
@@ -212,9 +219,11 @@ void load(const Value& v, Design& design) {
   ControllerSettings& c = design.set(ControllerSettings{});
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                              "min_lci", "joint_margin_deg", "pid", "potentiometer", "mechanisms", "stations"},
+                              "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction", "pid",
+                              "potentiometer", "mechanisms", "stations"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                             "joint_margin_deg, pid, potentiometer, mechanisms, stations)");
+                             "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, pid, potentiometer, "
+                             "mechanisms, stations)");
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -230,6 +239,8 @@ void load(const Value& v, Design& design) {
   if (const Value* p = find(all, "collision_priority")) c.collision_priority = p->text("must be upper");
   c.min_lci = number_or(all, "min_lci", c.min_lci, "");
   if (const Value* m = find(all, "joint_margin_deg")) c.joint_margin = kRadPerDeg * m->number("deg");
+  c.max_tracking_error_mm = number_or(all, "max_tracking_error_mm", c.max_tracking_error_mm, "mm");
+  c.max_saturation_fraction = number_or(all, "max_saturation_fraction", c.max_saturation_fraction, "");
   ControlOverride defaults;
   control_keys(all, defaults);
   if (defaults.kp) c.pid.kp = *defaults.kp;
@@ -347,6 +358,8 @@ void write(const Design& d, Out& top) {
   out.add("collision_priority", Out::quoted(c.collision_priority));
   out.add("min_lci", Out::number(c.min_lci));
   out.add("joint_margin_deg", Out::degrees(c.joint_margin));
+  out.add("max_tracking_error_mm", Out::number(c.max_tracking_error_mm));
+  out.add("max_saturation_fraction", Out::number(c.max_saturation_fraction));
   ControlOverride defaults;
   defaults.kp = c.pid.kp, defaults.ki = c.pid.ki, defaults.kd = c.pid.kd, defaults.i_clamp = c.pid.i_clamp;
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;

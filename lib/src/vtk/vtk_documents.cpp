@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "fivebar/error.hpp"
+#include "fivebar/control.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/workspace_io.hpp"
 
@@ -182,6 +183,26 @@ std::string image_vti(const ImageField& f) {
   image->SetSpacing(f.spacing, f.spacing, f.spacing);
   for (const auto& [name, values] : f.arrays) add_point_array<vtkDoubleArray>(image, name.c_str(), values);
   if (!f.arrays.empty()) image->GetPointData()->SetActiveScalars(f.arrays.front().first.c_str());
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  return write_document(writer.Get(), ".vti");
+}
+
+// The stability field of fivebar/control.hpp (declared there; VTK stays in this file).
+std::string rho_field_vti(const RhoField& f) {
+  const Grid& g = f.grid;
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(g.nx, g.ny, 1);
+  image->SetOrigin(g.x0, g.y0, 0.0);
+  image->SetSpacing(g.spacing, g.spacing, g.spacing);
+  add_point_array<vtkDoubleArray>(image, "rho", f.rho);
+  add_point_array<vtkUnsignedCharArray>(image, "status", f.status);
+  image->GetPointData()->SetActiveScalars("rho");
+  vtkNew<vtkStringArray> status_names;  // index = status value; 255: outside the joint limits
+  status_names->SetName("status_names");
+  for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
+    status_names->InsertNextValue(std::string(to_string(s)));
+  image->GetFieldData()->AddArray(status_names);
   vtkNew<vtkXMLImageDataWriter> writer;
   writer->SetInputData(image);
   return write_document(writer.Get(), ".vti");

@@ -92,6 +92,14 @@ struct ControllerSettings {
   /// joint's usable range (fivebar/joint_limits.hpp; file: joint_margin_deg, default 5 deg, an
   /// assumption: room for the PID's overshoot before a hard stop or the end of a potentiometer).
   double joint_margin = 0.08726646259971647;
+  /// Export gate (with `motor:`): the tactor's tracking error |P - P_ref| in every simulated
+  /// pattern (fivebar/dynamics.hpp) must stay at most this, mm. 0.5 mm is an ASSUMPTION (a sixth
+  /// of the patterns' default 3 mm amplitude), to replace with the rendering task's requirement.
+  double max_tracking_error_mm = 0.5;
+  /// Export gate (with `motor:`): the share of a simulated pattern's time a mechanism may spend
+  /// saturated (a joint at full duty or at the driver's current limit), in [0, 1]. 0.05 is an
+  /// ASSUMPTION: brief saturation at a pattern's start is tolerated, sustained saturation is not.
+  double max_saturation_fraction = 0.05;
   PidGains pid;                   ///< every joint, unless overridden
   Potentiometer potentiometer;    ///< every joint, unless overridden
   std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first

@@ -22,10 +22,12 @@ constexpr const char* kPreamble =
     "when the export gate passes: every mechanism covers its target, the LCI over the target stays above the "
     "threshold, the joint limits hold over the whole target, each joint's range reads within the ADC range, "
     "the target and the patterns keep a margin inside each joint's usable range (the potentiometers' travel and "
-    "the links' hard stops: docs/urdf.md) and the declared patterns are renderable. The three files hold the same "
-    "values (SI units); `fivebar export --check FILE DESIGN` confirms a file still matches the design. Each "
-    "station also gets a URDF with a `<ros2_control>` block (masses and meshes from the parts' STL renders when "
-    "the scene built them).\n\n";
+    "the links' hard stops: docs/urdf.md), the declared patterns are renderable and, with the motors' data, the "
+    "sampled PID loop is stable at every pose of each target and every pattern, simulated, keeps its tracking "
+    "error and saturation within `controller.max_tracking_error_mm` and `controller.max_saturation_fraction`. The "
+    "three files hold the same values (SI units); `fivebar export --check FILE DESIGN` confirms a file still "
+    "matches the design. Each station also gets a URDF with a `<ros2_control>` block (masses and meshes from the "
+    "parts' STL renders when the scene built them).\n\n";
 
 }  // namespace
 

@@ -1,0 +1,196 @@
+// fivebar control: the sampled-data loop of every mechanism linearised over its target ellipse
+// (ZOH plant, PID with one period of delay; fivebar/control.hpp): spectral radius map, worst pose,
+// verdict, gain margins and the damping of the dominant pole; picture, VTK field, CSV, JSON.
+
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+
+#include "common.hpp"
+#include "fivebar/control.hpp"
+#include "fivebar/dynamics.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/parts.hpp"
+#include "tactors.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+struct ControlCliOptions {
+  std::string design;
+  std::string station;
+  bool render = false;
+  int grid = 41;
+  int field = 81;
+  std::string out;
+  bool json = false;
+  bool tune = false;
+  double tune_seconds = 30.0;
+  int tune_evaluations = 60;
+};
+
+std::string gains_text(const PidGains& g) {
+  return "kp " + fixed(g.kp, 3) + ", ki " + fixed(g.ki, 3) + ", kd " + fixed(g.kd, 4);
+}
+
+/// Before and after side by side, one block per mechanism.
+void print_tuning(const TuneResult& r) {
+  std::cout << "tuning (max rho <= " << fixed(r.rho_limit, 2) << " over the target; worst simulated tracking error over "
+            << "the patterns), " << fixed(r.wall_s, 1) << " s:\n";
+  std::cout << "  mechanism      gains before                       gains after                        "
+               "max rho before/after  error before/after (mm)  saturated before/after  evals  stop\n";
+  for (const TunedMechanism& t : r.mechanisms) {
+    std::string name = t.station + "/" + t.mechanism;
+    name.resize(std::max<std::size_t>(name.size(), 13), ' ');
+    std::string before = gains_text(t.before[0]), after = gains_text(t.after[0]);
+    before.resize(std::max<std::size_t>(before.size(), 34), ' ');
+    after.resize(std::max<std::size_t>(after.size(), 34), ' ');
+    std::cout << "  " << name << "  " << before << " " << after << " " << fixed(t.rho_before, 4) << " / "
+              << fixed(t.rho_after, 4) << "       " << fixed(t.error_before_mm, 3) << " / " << fixed(t.error_after_mm, 3)
+              << "            " << fixed(100 * t.saturation_before, 1) << " % / " << fixed(100 * t.saturation_after, 1)
+              << " %        " << t.evaluations << "     " << t.stop << (t.feasible ? "" : ", NOT FEASIBLE") << "\n";
+  }
+}
+
+int run_control(const ControlCliOptions& opt) {
+  if (opt.grid < 3 || opt.grid > 401) throw InputError("--grid must be within [3, 401]");
+  if (opt.field < 3 || opt.field > 801) throw InputError("--field must be within [3, 801]");
+  if (!(opt.tune_seconds > 0.0) || !(opt.tune_seconds <= 3600.0)) throw InputError("--tune-seconds must be > 0 and <= 3600");
+  if (opt.tune_evaluations < 1 || opt.tune_evaluations > 10000) throw InputError("--tune-evaluations must be within [1, 10000]");
+  const Design design = load(opt.design);
+  const std::vector<const Station*> stations = design.select_stations(opt.station);
+  if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
+  require_geometry(design);
+  // Missing sections are bad input before anything is written.
+  for (const Station* s : stations) {
+    std::map<std::string, MechanismInertia> none;
+    for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
+    (void)loop_models(design, *s, none);
+  }
+  const std::filesystem::path dir = output_dir(design, opt.out, "control");
+  const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
+  std::optional<Json> parts;
+  const std::filesystem::path parts_dir = dir / "parts";
+  if (opt.render) {
+    PartsOptions po;
+    po.out_dir = parts_dir;
+    if (!opt.station.empty()) po.station = opt.station;
+    po.progress = terminal_progress("control");
+    const PartsReport report = build_parts(design, po);
+    if (!report.passed()) {
+      std::cerr << "fivebar control: the parts' renders failed their checks (see " << parts_dir.generic_string()
+                << "); no mass properties\n";
+      return kCheckFailed;
+    }
+    parts = to_json(report);
+  }
+  ControlOptions co;
+  co.stability.grid = opt.grid;
+  co.field_cells = opt.field;
+  const auto progress = terminal_progress("control");
+  make_directories(dir);
+  Json doc = {{"command", "control"}, {"design", design.name}};
+  Json studies = Json::array();
+  std::vector<std::string> files;
+  bool stable = true;
+  std::map<std::string, std::map<std::string, MechanismInertia>> inertias;
+  for (const Station* s : stations) {
+    if (progress) progress("stability of station " + s->name);
+    const auto inertia = station_inertia(design, *s, parts ? &*parts : nullptr, parts_dir);
+    inertias[s->name] = inertia;
+    const StationControl study = station_control(design, *s, inertia, co);
+    stable = stable && study.stable();
+    for (const auto& [name, bytes] : control_files(study, *s, "design " + design.name)) {
+      const std::filesystem::path path = dir / name;
+      write_file_atomic(path, bytes);
+      files.push_back(path.generic_string());
+    }
+    Json j = to_json(study);
+    std::string mass;
+    for (const auto& [name, in] : inertia) mass += (mass.empty() ? "" : "; ") + name + ": " + in.note;
+    j["mass_properties"] = mass;
+    studies.push_back(j);
+    if (!opt.json) {
+      for (const std::string& line : summary_lines(study)) std::cout << line << "\n";
+    }
+  }
+  std::optional<TuneResult> tuned;
+  if (opt.tune) {
+    std::vector<const Station*> pairs;
+    for (const Station* s : stations)
+      if (s->lower && s->upper) pairs.push_back(s);
+    if (pairs.empty()) throw InputError("--tune: no station with both mechanisms (the patterns move both tactors)");
+    TuneOptions to;
+    to.max_seconds = opt.tune_seconds;
+    to.max_evaluations = opt.tune_evaluations;
+    to.progress = progress;
+    tuned = tune_controller(design, pairs, inertias, to);
+    const std::filesystem::path patch = dir / "tuned-controller.yaml";
+    write_file_atomic(patch, tuned_patch_yaml(*tuned));
+    files.push_back(patch.generic_string());
+  }
+  if (opt.json) {
+    doc["stations"] = studies;
+    if (tuned) doc["tuning"] = to_json(*tuned);
+    doc["files"] = files;
+    print_json(doc);
+  } else {
+    if (tuned) print_tuning(*tuned);
+    for (const std::string& f : files) std::cout << "  wrote " << f << "\n";
+  }
+  if (tuned) {
+    bool feasible = true;
+    for (const TunedMechanism& t : tuned->mechanisms) feasible = feasible && t.feasible;
+    if (!feasible) {
+      std::cerr << "fivebar control --tune: no gains met the constraints for every mechanism (see the table)\n";
+      return kCheckFailed;
+    }
+    return kOk;
+  }
+  if (!stable) {
+    std::cerr << "fivebar control: the loop is unstable (max rho >= 1) somewhere on a target (see above)\n";
+    return kCheckFailed;
+  }
+  return kOk;
+}
+
+}  // namespace
+
+void setup_control(CLI::App& app) {
+  auto opt = std::make_shared<ControlCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "control",
+      "Stability of each mechanism's sampled PID loop over its target ellipse: spectral radius of the ZOH plant "
+      "linearised at every pose with one period of delay, worst pose, gain margins, damping; picture, VTK, CSV");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("-s,--station", opt->station, "Only this station (default: every station with a mechanism)")
+      ->type_name("NAME");
+  sub->add_flag("--render", opt->render,
+                "Links' masses from the parts' STL renders (openscad) instead of the closed form (slab with bosses)");
+  sub->add_option("--grid", opt->grid, "Grid points per axis over the target ellipse's box (default 41)")
+      ->type_name("N");
+  sub->add_option("--field", opt->field, "Grid points per axis over each mechanism's reach (default 81)")
+      ->type_name("N");
+  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/control)")
+      ->type_name("DIR");
+  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  sub->add_flag("--tune", opt->tune,
+                "Tune kp, ki, kd per mechanism (NLopt COBYLA): least worst tracking error over the patterns with "
+                "max rho <= 0.9; writes tuned-controller.yaml (a patch of controller:) and prints before/after");
+  sub->add_option("--tune-seconds", opt->tune_seconds, "Wall-time bound of the whole tuning (s, default 30)")
+      ->type_name("S");
+  sub->add_option("--tune-evaluations", opt->tune_evaluations, "Objective evaluations per mechanism (default 60)")
+      ->type_name("N");
+  sub->footer(
+      "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
+      "Files: <station>-stability.svg|.png, <station>-<mechanism>-rho.vti, <station>-stability.csv.\n"
+      "Exit status: 0 stable everywhere on every target (with --tune: the tuned gains meet the constraints),\n"
+      "1 unstable somewhere, tuned gains infeasible or a part failed to render,\n"
+      "2 bad input, 3 internal error or output not writable.");
+  sub->callback([opt]() { finish(run_control(*opt)); });
+}
+
+}  // namespace fivebar::cli

@@ -1,0 +1,239 @@
+// Gains per mechanism by NLopt's COBYLA (fivebar/control.hpp "Tuning"); the only file that sees NLopt.
+
+#include <nlopt.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "fivebar/control.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
+
+namespace fivebar {
+
+namespace {
+
+/// Worst tracking error (mm) and saturated fraction of one mechanism over its pattern runs.
+struct Tracking {
+  double error_mm = 0.0;
+  double saturation = 0.0;
+  bool ok = true;
+};
+
+Tracking track(const std::vector<SimulationInput>& runs, const std::array<PidGains, 2>& gains, double rtol) {
+  Tracking t;
+  SimulationOptions o;
+  o.rtol = rtol;
+  o.record = false;
+  o.max_wall_s = 10.0;
+  for (SimulationInput in : runs) {
+    in.mechanisms[0].control[0].pid = gains[0];
+    in.mechanisms[0].control[1].pid = gains[1];
+    const SimulationResult r = simulate(in, o);
+    if (!r.ok() || r.summary.empty()) {
+      t.ok = false;
+      return t;
+    }
+    t.error_mm = std::max(t.error_mm, r.summary[0].max_error_mm);
+    t.saturation = std::max(t.saturation, r.t_end > 0.0 ? r.summary[0].saturation_s / r.t_end : 0.0);
+  }
+  return t;
+}
+
+std::array<PidGains, 2> with(const std::array<PidGains, 2>& base, const std::vector<double>& x) {
+  std::array<PidGains, 2> g = base;
+  for (PidGains& p : g) {
+    p.kp = std::exp(x[0]);
+    p.ki = std::exp(x[1]);
+    p.kd = std::exp(x[2]);
+  }
+  return g;
+}
+
+constexpr double kFloor = 1e-3;        // a zero gain starts here (ln 0 is not a start)
+constexpr double kSaturationPenaltyMm = 10.0;
+constexpr double kFailedRunMm = 1e3;   // a run that did not finish
+constexpr double kRange = 5.0;         // ln of the factor each gain may move by: e^5 ~ 148
+constexpr double kRhoSafety = 0.003;   // COBYLA ends within its tolerance of the constraint: aim inside
+
+struct Problem {
+  const std::vector<SimulationInput>* runs;
+  const std::vector<PoseLoop>* poses;
+  std::array<PidGains, 2> base;
+  double rho_limit, saturation_limit, rtol;
+  bool delay;
+  int evaluations = 0;
+  const TuneOptions* options;
+  std::string label;
+};
+
+double objective(unsigned n, const double* x, double*, void* data) {
+  auto& p = *static_cast<Problem*>(data);
+  const std::array<PidGains, 2> g = with(p.base, std::vector<double>(x, x + n));
+  ++p.evaluations;
+  // An unstable loop is not simulated: its error is that of a failed run.
+  const double rho = max_spectral_radius(*p.poses, g, p.delay, 1.0);
+  double value = kFailedRunMm;
+  if (rho < 1.0) {
+    const Tracking t = track(*p.runs, g, p.rtol);
+    if (t.ok) value = t.error_mm + kSaturationPenaltyMm * std::max(0.0, t.saturation - p.saturation_limit);
+  }
+  if (p.options->progress) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s: evaluation %d, kp %.4g ki %.4g kd %.4g: max rho %.4f, objective %.4f mm",
+                  p.label.c_str(), p.evaluations, g[0].kp, g[0].ki, g[0].kd, rho, value);
+    p.options->progress(buf);
+  }
+  return value;
+}
+
+double constraint(unsigned n, const double* x, double*, void* data) {
+  auto& p = *static_cast<Problem*>(data);
+  return max_spectral_radius(*p.poses, with(p.base, std::vector<double>(x, x + n)), p.delay) - (p.rho_limit - kRhoSafety);
+}
+
+std::string stop_text(nlopt::result r) {
+  switch (r) {
+    case nlopt::MAXEVAL_REACHED: return "evaluation limit";
+    case nlopt::MAXTIME_REACHED: return "time limit";
+    case nlopt::XTOL_REACHED:
+    case nlopt::FTOL_REACHED: return "converged";
+    case nlopt::SUCCESS: return "converged";
+    default: return "stopped (" + std::to_string(int(r)) + ")";
+  }
+}
+
+}  // namespace
+
+TuneResult tune_controller(const Design& d, const std::vector<const Station*>& stations,
+                           const std::map<std::string, std::map<std::string, MechanismInertia>>& inertia,
+                           const TuneOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  if (!d.get<ControllerSettings>()) throw InputError("tune: the design has no `controller:` section");
+  const double saturation_limit = d.get<ControllerSettings>()->max_saturation_fraction;
+  TuneResult result;
+  result.rho_limit = options.rho_limit;
+  // Every mechanism's pattern runs and constraint poses first (InputError before any work).
+  struct Job {
+    const Station* station;
+    LoopModel loop;
+    std::vector<SimulationInput> runs;
+    std::vector<PoseLoop> poses;
+  };
+  std::vector<Job> jobs;
+  for (const Station* s : stations) {
+    const auto it = inertia.find(s->name);
+    if (it == inertia.end()) throw InputError("tune: no mass properties for station " + s->name);
+    SimulationRequest request;
+    request.station = s->name;
+    const std::vector<SimulationInput> all = simulation_inputs(d, request, it->second);
+    std::size_t k = 0;
+    for (const LoopModel& loop : loop_models(d, *s, it->second)) {
+      Job job{s, loop, {}, {}};
+      for (const SimulationInput& in : all) {
+        if (!in.unusable.empty()) throw InputError("tune: station " + s->name + " " + in.reference_name + ": " + in.unusable);
+        SimulationInput one = in;
+        one.mechanisms = {in.mechanisms[k]};
+        job.runs.push_back(std::move(one));
+      }
+      for (const Vec2& P : ellipse_grid(s->target, options.grid)) job.poses.push_back(pose_loop(loop, P));
+      jobs.push_back(std::move(job));
+      ++k;
+    }
+  }
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    Job& job = jobs[j];
+    TunedMechanism t;
+    t.station = job.station->name;
+    t.mechanism = job.loop.model.mechanism.name;
+    t.before = job.loop.gains;
+    t.rho_before = max_spectral_radius(job.poses, t.before, job.loop.delay);
+    const Tracking tb = track(job.runs, t.before, options.rtol);
+    t.error_before_mm = tb.ok ? tb.error_mm : std::numeric_limits<double>::infinity();
+    t.saturation_before = tb.saturation;
+
+    Problem p{&job.runs, &job.poses, t.before, options.rho_limit, saturation_limit, options.rtol, job.loop.delay, 0,
+              &options, t.station + "/" + t.mechanism};
+    const PidGains& g0 = t.before[0];
+    std::vector<double> x{std::log(std::max(g0.kp, kFloor)), std::log(std::max(g0.ki, kFloor)),
+                          std::log(std::max(g0.kd, kFloor))};
+    std::vector<double> lo(3), hi(3);
+    for (int i = 0; i < 3; ++i) {
+      lo[std::size_t(i)] = x[std::size_t(i)] - kRange;
+      hi[std::size_t(i)] = x[std::size_t(i)] + kRange;
+    }
+    nlopt::opt opt(nlopt::LN_COBYLA, 3);
+    opt.set_lower_bounds(lo);
+    opt.set_upper_bounds(hi);
+    opt.set_min_objective(objective, &p);
+    opt.add_inequality_constraint(constraint, &p, 1e-4);
+    opt.set_initial_step(std::log(2.0));
+    opt.set_xtol_rel(1e-3);
+    opt.set_maxeval(options.max_evaluations);
+    const double spent = std::chrono::duration<double>(Clock::now() - start).count();
+    opt.set_maxtime(std::max(0.5, (options.max_seconds - spent) / double(jobs.size() - j)));
+    double best = 0.0;
+    nlopt::result r = nlopt::FAILURE;
+    try {
+      r = opt.optimize(x, best);
+    } catch (const nlopt::roundoff_limited&) {
+      r = nlopt::ROUNDOFF_LIMITED;
+    } catch (const nlopt::forced_stop&) {
+      r = nlopt::FORCED_STOP;
+    }
+    t.stop = stop_text(r);
+    t.evaluations = p.evaluations;
+    t.after = with(t.before, x);
+    t.rho_after = max_spectral_radius(job.poses, t.after, job.loop.delay);
+    const Tracking ta = track(job.runs, t.after, options.rtol);
+    t.error_after_mm = ta.ok ? ta.error_mm : std::numeric_limits<double>::infinity();
+    t.saturation_after = ta.saturation;
+    t.feasible = ta.ok && t.rho_after <= options.rho_limit && t.saturation_after <= saturation_limit;
+    result.mechanisms.push_back(t);
+  }
+  result.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  return result;
+}
+
+std::string tuned_patch_yaml(const TuneResult& result) {
+  std::string out =
+      "# Tuned by fivebar control --tune: per mechanism the PID minimising the worst simulated tracking error\n"
+      "# over the station's patterns with the loop's spectral radius <= " +
+      format::shortest(result.rho_limit) +
+      " over the target. Merge into the design's controller: section.\n"
+      "controller:\n  stations:\n";
+  std::string station;
+  for (const TunedMechanism& t : result.mechanisms) {
+    if (t.station != station) {
+      out += "    " + t.station + ":\n";
+      station = t.station;
+    }
+    out += "      " + t.mechanism + ": {pid: {kp: " + format::shortest(t.after[0].kp) +
+           ", ki: " + format::shortest(t.after[0].ki) + ", kd: " + format::shortest(t.after[0].kd) + "}}" +
+           (t.feasible ? "" : "  # NOT feasible: see the tuning table") + "\n";
+  }
+  return out;
+}
+
+Json to_json(const TuneResult& result) {
+  Json mechs = Json::array();
+  for (const TunedMechanism& t : result.mechanisms) {
+    const auto gains = [](const PidGains& g) { return Json{{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}, {"i_clamp", g.i_clamp}}; };
+    mechs.push_back({{"station", t.station},
+                     {"mechanism", t.mechanism},
+                     {"before", {{"gains", gains(t.before[0])}, {"max_rho", t.rho_before},
+                                 {"max_tracking_error_mm", t.error_before_mm}, {"saturation_fraction", t.saturation_before}}},
+                     {"after", {{"gains", gains(t.after[0])}, {"max_rho", t.rho_after},
+                                {"max_tracking_error_mm", t.error_after_mm}, {"saturation_fraction", t.saturation_after}}},
+                     {"evaluations", t.evaluations},
+                     {"feasible", t.feasible},
+                     {"stop", t.stop}});
+  }
+  return {{"rho_limit", result.rho_limit}, {"wall_s", result.wall_s}, {"mechanisms", mechs}};
+}
+
+}  // namespace fivebar

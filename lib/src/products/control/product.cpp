@@ -1,0 +1,93 @@
+// The `control` product: the sampled PID loop of every mechanism linearised over its target ellipse
+// (fivebar/control.hpp), with the links' masses from the `parts` product's STL renders: spectral
+// radius map, worst pose, verdict, gain margins, damping; picture, VTK field and CSV under control/.
+
+#include <string>
+
+#include "fivebar/control.hpp"
+#include "products/markdown.hpp"
+#include "products/product.hpp"
+
+namespace fivebar::products {
+
+namespace {
+
+constexpr const char* kPreamble =
+    "Each mechanism's loop as the device samples it: the dynamics (masses from the printed parts' STL renders, "
+    "the `motor:` section, the skin of `contact:` in stick) linearised at every pose of a grid over the target "
+    "ellipse, discretised exactly under zero-order hold at the loop period, closed by the exported PID with one "
+    "period of computation delay (lib/include/fivebar/control.hpp). The loop is stable where the spectral radius "
+    "ρ of the closed-loop matrix is below 1; the margins are the largest factors on kp (and on kd) that keep it "
+    "so over the whole target. Small-signal figures: the driver's limits, Coulomb friction and the ADC "
+    "quantisation are in the `simulate` product, not here.\n\n";
+
+constexpr const char* kPerformance =
+    "The worst over each target of: the −3 dB bandwidth of tactor displacement (the discrete closed loop's "
+    "frequency response in the tactor's worst direction), the tactor step of one ADC count, the largest "
+    "continuous shear force the motors hold in every direction (fingertip devices are compared at ≥ 1.5 N) and "
+    "the Z-width, the stiffest virtual wall the loop renders passively from the device's own damping "
+    "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm).\n\n";
+
+}  // namespace
+
+Product control_product() {
+  Product p;
+  p.name = "control";
+  p.title = "Loop stability over the target";
+  p.prerequisites = {"parts"};
+  p.unavailable = [](const Design& d) -> std::optional<std::string> {
+    if (!d.get<MotorSettings>()) return "the design has no `motor:` section (the motors' data)";
+    if (!d.get<ControllerSettings>()) return "the design has no `controller:` section (the PID to check)";
+    return without_pairs(d, "the links' outlines give their masses");
+  };
+  p.build = [](Context& ctx) {
+    const Design& d = ctx.design;
+    const Json* parts = ctx.result_of("parts");
+    md::Table table({"station", "mechanism", "verdict", "max ρ", "worst pose (mm)", "dominant pole ζ / Hz",
+                     "least-damped oscillation ζ / Hz", "kp margin", "kd margin"},
+                    "lllrlrrrr");
+    md::Table performance({"station", "mechanism", "bandwidth ≥ (Hz)", "resolution ≤ (µm/count)",
+                           "force in every direction ≥ (N)", "Z-width ≥ (N/mm)"},
+                          "llrrrr");
+    Json studies = Json::array();
+    bool stable = true;
+    std::size_t maps = 0;
+    std::string files;
+    for (const Station& s : d.stations) {
+      if (!has_pair(s)) continue;
+      ctx.say("stability of station " + s.name);
+      const auto inertia = station_inertia(d, s, parts, ctx.dir / "parts");
+      const StationControl study = station_control(d, s, inertia);
+      stable = stable && study.stable();
+      for (const auto& [name, bytes] : control_files(study, s, "design " + d.name)) {
+        ctx.write_file(std::filesystem::path("control") / name, bytes);
+      }
+      files += "![" + s.name + "](control/" + s.name + "-stability.svg)\n\n";
+      for (const StabilityMap& m : study.maps) {
+        ++maps;
+        const Vec2 w = m.worst_P_mm();
+        table.row({s.name, m.mechanism, m.stable ? "stable" : "**unstable**", md::fixed(m.max_rho, 4),
+                   "(" + md::fixed(w.x(), 2) + ", " + md::fixed(w.y(), 2) + ")",
+                   md::fixed(m.damping, 3) + " / " + md::fixed(m.frequency_hz, 2),
+                   md::fixed(m.oscillatory_damping, 3) + " / " + md::fixed(m.oscillatory_frequency_hz, 2),
+                   md::fixed(m.kp_margin, 2), md::fixed(m.kd_margin, 2)});
+      }
+      for (const PerformanceMap& m : study.performance) {
+        performance.row({s.name, m.mechanism, md::fixed(m.worst_bandwidth.bandwidth_hz, 2),
+                         md::fixed(m.worst_resolution.resolution_um, 3), md::fixed(m.worst_force.force_N, 2),
+                         md::fixed(m.worst_zwidth.zwidth_N_per_mm, 1)});
+      }
+      studies.push_back(to_json(study));
+    }
+    Built b;
+    b.result = {{"stations", studies}, {"stable", stable}};
+    b.markdown = std::string(kPreamble) + table.str() + "\n" + kPerformance + performance.str() + "\n" + files;
+    b.passed = stable;
+    b.check = stable ? "stable over every target (" + std::to_string(maps) + " mechanisms)"
+                     : "the loop is unstable somewhere on a target";
+    return b;
+  };
+  return p;
+}
+
+}  // namespace fivebar::products

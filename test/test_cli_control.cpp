@@ -1,0 +1,156 @@
+// End-to-end tests of `fivebar control`: real processes, stdout, stderr, exit codes and files. The
+// expected relations are independent of the library's arithmetic: the index station is mirror
+// symmetric about y = 15.5 (so both mechanisms get the same figures, the worst poses mirrored), the
+// verdict flips where the reported kp margin says it does (a design whose kp is scaled past it
+// exits 1, below it exits 0), and a design without the motors' data is bad input naming the file.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "cli_test.hpp"
+
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+namespace {
+
+class CliControl : public ft::CliTest {
+ protected:
+  CliControl() : CliTest("fivebar_test_cli_control") {}
+};
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST_F(CliControl, JsonFilesAndMirrorSymmetryOfTheIndexStation) {
+  const std::string out = (dir_ / "control").string();
+  const Outcome r = run({"control", kDesign, "-s", "index", "--grid", "21", "--field", "31", "--out", out, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  ASSERT_EQ(j["stations"].size(), 1u);
+  const json& st = j["stations"][0];
+  EXPECT_EQ(st["station"], "index");
+  EXPECT_TRUE(st["stable"].get<bool>());
+  ASSERT_EQ(st["mechanisms"].size(), 2u);
+  const json& lo = st["mechanisms"][0];
+  const json& up = st["mechanisms"][1];
+  EXPECT_EQ(lo["mechanism"], "lower");
+  EXPECT_EQ(up["mechanism"], "upper");
+  for (const char* key : {"max_rho", "kp_margin", "kd_margin", "oscillatory_damping", "oscillatory_frequency_hz"}) {
+    SCOPED_TRACE(key);
+    EXPECT_NEAR(lo[key].get<double>(), up[key].get<double>(), 1e-6 * std::abs(lo[key].get<double>()) + 1e-9);
+  }
+  EXPECT_LT(lo["max_rho"].get<double>(), 1.0);
+  EXPECT_GT(lo["kp_margin"].get<double>(), 1.0);
+  EXPECT_NEAR(lo["worst_pose_mm"][0].get<double>(), up["worst_pose_mm"][0].get<double>(), 1e-9);
+  EXPECT_NEAR(lo["worst_pose_mm"][1].get<double>() + up["worst_pose_mm"][1].get<double>(), 31.0, 1e-9);
+  for (const char* f : {"index-stability.svg", "index-stability.png", "index-lower-rho.vti", "index-upper-rho.vti",
+                        "index-stability.csv", "index-performance.csv"}) {
+    SCOPED_TRACE(f);
+    EXPECT_TRUE(std::filesystem::is_regular_file(std::filesystem::path(out) / f));
+  }
+  const std::string vti = read_text(std::filesystem::path(out) / "index-lower-rho.vti");
+  EXPECT_THAT(vti, HasSubstr("<ImageData"));
+  EXPECT_THAT(vti, HasSubstr("Name=\"rho\""));
+  const std::string csv = read_text(std::filesystem::path(out) / "index-stability.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "station,mechanism,x_mm,y_mm,status,rho,damping,frequency_hz");
+  const std::string perf = read_text(std::filesystem::path(out) / "index-performance.csv");
+  EXPECT_EQ(perf.substr(0, perf.find('\n')),
+            "station,mechanism,x_mm,y_mm,status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,"
+            "tactor_damping_N_s_per_mm,zwidth_N_per_mm");
+  const json& pl = st["performance"][0];
+  const json& pu = st["performance"][1];
+  for (const char* key : {"min_bandwidth_hz", "max_resolution_um_per_count", "min_force_every_direction_N",
+                          "min_zwidth_N_per_mm"}) {
+    SCOPED_TRACE(key);
+    EXPECT_GT(pl[key].get<double>(), 0.0);
+    EXPECT_NEAR(pl[key].get<double>(), pu[key].get<double>(), 1e-6 * pl[key].get<double>());
+  }
+}
+
+TEST_F(CliControl, TheVerdictFlipsAtTheReportedKpMargin) {
+  const Outcome base = run({"control", kDesign, "-s", "index", "--grid", "11", "--field", "5", "--out",
+                            (dir_ / "a").string(), "--json"});
+  ASSERT_EQ(base.code, 0) << base.err;
+  const double margin = parse(base)["stations"][0]["mechanisms"][0]["kp_margin"].get<double>();
+  ASSERT_GT(margin, 1.0);
+  std::string text = read_text(kDesign);
+  const std::string pid = "pid: {kp: 5,";
+  const std::size_t at = text.find(pid);
+  ASSERT_NE(at, std::string::npos);
+  for (const double factor : {0.97, 1.03}) {
+    SCOPED_TRACE(factor);
+    std::ostringstream kp;
+    kp.precision(17);
+    kp << "pid: {kp: " << 5.0 * margin * factor << ",";
+    std::string scaled = text;
+    scaled.replace(at, pid.size(), kp.str());
+    const std::filesystem::path design = dir_ / "scaled.yaml";
+    std::ofstream(design) << scaled;
+    const Outcome r = run({"control", design.string(), "-s", "index", "--grid", "11", "--field", "5", "--out",
+                           (dir_ / "b").string()});
+    if (factor < 1.0) {
+      EXPECT_EQ(r.code, 0) << r.err;
+      EXPECT_THAT(r.out, HasSubstr("index lower: stable over the target"));
+    } else {
+      EXPECT_EQ(r.code, 1) << r.err;
+      EXPECT_THAT(r.out, HasSubstr("index lower: UNSTABLE over the target"));
+      EXPECT_THAT(r.err, HasSubstr("unstable"));
+    }
+  }
+}
+
+TEST_F(CliControl, TuneWritesThePatchAndPrintsBeforeAndAfter) {
+  const std::string out = (dir_ / "tune").string();
+  const Outcome r = run({"control", kDesign, "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                         "--tune-evaluations", "3", "--out", out, "--json"});
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;  // 3 evaluations need not reach the constraint
+  const json j = parse(r);
+  ASSERT_EQ(j["tuning"]["mechanisms"].size(), 2u);
+  bool feasible = true;
+  for (const json& m : j["tuning"]["mechanisms"]) {
+    EXPECT_EQ(m["station"], "index");
+    EXPECT_EQ(m["evaluations"], 3);
+    EXPECT_EQ(m["before"]["gains"]["kp"], 5.0);  // the design's
+    feasible = feasible && m["feasible"].get<bool>();
+  }
+  EXPECT_EQ(r.code, feasible ? 0 : 1);
+  const std::string patch = read_text(std::filesystem::path(out) / "tuned-controller.yaml");
+  EXPECT_THAT(patch, HasSubstr("controller:\n  stations:\n    index:\n      lower: {pid: {kp: "));
+  const Outcome text = run({"control", kDesign, "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                            "--tune-evaluations", "3", "--out", out});
+  EXPECT_THAT(text.out, HasSubstr("gains before"));
+  EXPECT_THAT(text.out, HasSubstr("gains after"));
+  EXPECT_THAT(text.out, HasSubstr("index/lower    kp 5.000, ki 1.000, kd 0.0500"));
+}
+
+TEST_F(CliControl, ADesignWithoutMotorsIsBadInputAndWritesNothing) {
+  std::string text = read_text(kDesign);
+  const std::size_t from = text.find("\nmotor:\n");
+  ASSERT_NE(from, std::string::npos);
+  std::size_t to = text.find("\n\n", from + 1);
+  text.erase(from + 1, to - from);
+  const std::filesystem::path design = dir_ / "nomotor.yaml";
+  std::ofstream(design) << text;
+  const std::filesystem::path out = dir_ / "none";
+  const Outcome r = run({"control", design.string(), "--out", out.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("nomotor.yaml"));
+  EXPECT_THAT(r.err, HasSubstr("motor:"));
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace

@@ -1,0 +1,476 @@
+// The sampled-data loop (fivebar/control.hpp) against independent references: central finite
+// differences of the nonlinear right-hand side the simulation integrates, the closed-form ZOH of a
+// first-order plant and of a double integrator, a fine RK4 integration over one period, the loop
+// stepped by hand with the device's DiscretePid, and the nonlinear simulation (CVODE) of a small
+// step at the worst pose, decaying for the design's gains and growing beyond the kp margin.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dynamics/system.hpp"
+#include "fivebar/control.hpp"
+#include "fivebar/dynamics.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/kinematics.hpp"
+#include "fivebar/sections/contact.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/motor.hpp"
+#include "fivebar/sections/print.hpp"
+
+namespace fivebar {
+namespace {
+
+const Design& paper() {
+  static const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  return d;
+}
+
+std::map<std::string, MechanismInertia> paper_inertia(const std::string& station) {
+  const Design& d = paper();
+  std::map<std::string, MechanismInertia> out;
+  for (const Mechanism* m : d.require_station(station).mechanisms()) {
+    out[m->name] = closed_form_inertia(*m, *d.get<Geometry>(), *d.get<PrintSettings>());
+  }
+  return out;
+}
+
+LoopModel paper_loop(const std::string& station, const std::string& which) {
+  const Design& d = paper();
+  for (LoopModel& l : loop_models(d, d.require_station(station), paper_inertia(station))) {
+    if (l.model.mechanism.name == which) return l;
+  }
+  throw std::logic_error("no such mechanism");
+}
+
+/// The right-hand side of fivebar/dynamics.hpp (lib/src/dynamics/system.cpp) for one mechanism
+/// at a state (theta, w, i), the skin anchored at `anchor` (m) and sticking, a held duty.
+struct Rhs {
+  SimulationInput input;
+  SimulationOptions options;
+  Vec2 anchor{0.0, 0.0};
+  Eigen::Matrix<double, 6, 1> operator()(const Eigen::Matrix<double, 6, 1>& x, const Eigen::Vector2d& duty) const {
+    dynamics_detail::System s = dynamics_detail::make_system(input, options);
+    s.duty[0] = {duty[0], duty[1]};
+    double y[dynamics_detail::kStateSize] = {x[0], x[1], x[2], x[3], x[4], x[5], anchor.x(), anchor.y()};
+    const dynamics_detail::Evaluation ev = dynamics_detail::evaluate(s, 0, y);
+    EXPECT_TRUE(ev.ok);
+    Eigen::Matrix<double, 6, 1> dy;
+    for (int k = 0; k < 6; ++k) dy[k] = ev.dy[static_cast<std::size_t>(k)];
+    return dy;
+  }
+};
+
+TEST(Control, LinearPlantIsTheJacobianOfTheSimulatedRightHandSide) {
+  const Design& d = paper();
+  for (const std::string which : {"lower", "upper"}) {
+    SCOPED_TRACE(which);
+    LoopModel loop = paper_loop("index", which);
+    // Coulomb friction is left out of the linear model (fivebar/control.hpp): out of the reference too.
+    for (MotorParams& mp : loop.model.motors) mp.coulomb_friction_mNm = 0.0;
+    const Ellipse& e = d.require_station("index").target;
+    for (const Vec2& P : {e.center, e.boundary_point(0.7), e.boundary_point(3.9)}) {
+      const AnglesResult a = ik_angles(loop.model.mechanism, P);
+      ASSERT_EQ(a.status, Status::ok);
+      const LinearPlant plant = linear_plant(loop.model, Eigen::Vector2d(a.theta1, a.theta2), &loop.skin);
+      ASSERT_EQ(plant.status, Status::ok);
+      Rhs f;
+      SimulatedMechanism sm;
+      sm.name = which;
+      sm.model = loop.model;
+      f.input.mechanisms.push_back(sm);
+      f.input.contact = loop.skin;
+      f.anchor = 1e-3 * P;
+      Eigen::Matrix<double, 6, 1> x0;
+      x0 << a.theta1, a.theta2, 0.0, 0.0, 0.0, 0.0;
+      const Eigen::Vector2d u0 = Eigen::Vector2d::Zero();
+      EXPECT_LT(f(x0, u0).norm(), 1e-9);  // an equilibrium
+      const double h = 1e-6;
+      for (int k = 0; k < 6; ++k) {
+        Eigen::Matrix<double, 6, 1> dx = Eigen::Matrix<double, 6, 1>::Zero();
+        dx[k] = h;
+        const Eigen::Matrix<double, 6, 1> col = (f(x0 + dx, u0) - f(x0 - dx, u0)) / (2 * h);
+        EXPECT_LT((col - plant.A.col(k)).norm(), 1e-6 * std::max(1.0, col.norm())) << "column " << k << "\n"
+                                                                                 << col.transpose() << "\n"
+                                                                                 << plant.A.col(k).transpose();
+      }
+      for (int k = 0; k < 2; ++k) {
+        const Eigen::Vector2d du = h * Eigen::Vector2d::Unit(k);
+        const Eigen::Matrix<double, 6, 1> col = (f(x0, du) - f(x0, -du)) / (2 * h);
+        EXPECT_LT((col - plant.B.col(k)).norm(), 1e-6 * col.norm()) << "input " << k;
+      }
+    }
+  }
+}
+
+TEST(Control, ZeroOrderHoldMatchesTheClosedForms) {
+  const double T = 0.01;
+  // First order dx/dt = a x + b u: Ad = e^{aT}, Bd = (e^{aT} - 1) b / a.
+  for (const double a : {-3.0, 0.5, -2000.0}) {
+    Eigen::MatrixXd A(1, 1), B(1, 1);
+    A << a;
+    B << 2.0;
+    const auto [Ad, Bd] = zoh(A, B, T);
+    EXPECT_NEAR(Ad(0, 0), std::exp(a * T), 1e-14);
+    EXPECT_NEAR(Bd(0, 0), (std::exp(a * T) - 1.0) * 2.0 / a, 1e-14);
+  }
+  // Double integrator: Ad = [1 T; 0 1], Bd = [T^2 / 2; T].
+  Eigen::MatrixXd A(2, 2), B(2, 1);
+  A << 0, 1, 0, 0;
+  B << 0, 1;
+  const auto [Ad, Bd] = zoh(A, B, T);
+  EXPECT_NEAR(Ad(0, 0), 1.0, 1e-15);
+  EXPECT_NEAR(Ad(0, 1), T, 1e-15);
+  EXPECT_NEAR(Ad(1, 0), 0.0, 1e-15);
+  EXPECT_NEAR(Ad(1, 1), 1.0, 1e-15);
+  EXPECT_NEAR(Bd(0, 0), 0.5 * T * T, 1e-16);
+  EXPECT_NEAR(Bd(1, 0), T, 1e-15);
+}
+
+TEST(Control, DiscretisedPlantAgreesWithAFineIntegrationOverOnePeriod) {
+  const LoopModel loop = paper_loop("index", "lower");
+  const Vec2 P = paper().require_station("index").target.center;
+  const AnglesResult a = ik_angles(loop.model.mechanism, P);
+  const LinearPlant plant = linear_plant(loop.model, Eigen::Vector2d(a.theta1, a.theta2), &loop.skin);
+  const DiscretePlant dp = discretise(plant, loop.period_s);
+  Eigen::Matrix<double, 6, 1> x0;
+  x0 << 1e-3, -2e-3, 0.05, 0.02, 0.1, -0.05;
+  const Eigen::Vector2d u(0.3, -0.2);
+  // Classical RK4 at 1 us (the electrical time constant is 100 us).
+  const auto f = [&](const Eigen::Matrix<double, 6, 1>& x) { return (plant.A * x + plant.B * u).eval(); };
+  Eigen::Matrix<double, 6, 1> x = x0;
+  const int n = 10000;
+  const double h = loop.period_s / n;
+  for (int k = 0; k < n; ++k) {
+    const auto k1 = f(x), k2 = f(x + 0.5 * h * k1), k3 = f(x + 0.5 * h * k2), k4 = f(x + h * k3);
+    x += h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4);
+  }
+  const Eigen::Matrix<double, 6, 1> exact = dp.Ad * x0 + dp.Bd * u;
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(exact[k], x[k], 1e-9 * std::max(1.0, std::abs(x[k]))) << k;
+}
+
+TEST(Control, ClosedLoopMatrixEqualsSteppingThePlantWithTheDevicesPid) {
+  const LoopModel loop = paper_loop("index", "upper");
+  const PoseLoop pl = pose_loop(loop, paper().require_station("index").target.center);
+  ASSERT_EQ(pl.status, Status::ok);
+  std::array<PidGains, 2> gains = loop.gains;
+  gains[0] = {4.0, 3.0, 0.07, 1e9};  // joints differ; no integral clamp in the small-signal range
+  gains[1] = {6.0, 1.5, 0.03, 1e9};
+  for (const bool delay : {true, false}) {
+    SCOPED_TRACE(delay ? "delay" : "no delay");
+    const LoopMatrix phi = closed_loop(pl.plant, gains, delay);
+    Eigen::Matrix<double, 6, 1> x;
+    x << 2e-3, -1e-3, 0.0, 0.0, 0.0, 0.0;
+    // The loop state at the first sample: nothing applied yet, no integral, previous error = this
+    // error (DiscretePid's derivative is 0 at its first sample).
+    Eigen::Matrix<double, kLoopStates, 1> z = Eigen::Matrix<double, kLoopStates, 1>::Zero();
+    z.head<6>() = x;
+    z[10] = -x[0];
+    z[11] = -x[1];
+    std::array<DiscretePid, 2> pid{DiscretePid(gains[0], pl.plant.period_s), DiscretePid(gains[1], pl.plant.period_s)};
+    Eigen::Vector2d pending = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 60; ++k) {
+      Eigen::Vector2d fresh;
+      for (int j = 0; j < 2; ++j) fresh[j] = pid[static_cast<std::size_t>(j)].update(0.0 - x[j]);
+      const Eigen::Vector2d applied = delay ? pending : fresh;
+      pending = fresh;
+      x = pl.plant.Ad * x + pl.plant.Bd * applied;
+      z = phi * z;
+      ASSERT_LT(fresh.cwiseAbs().maxCoeff(), 1.0);  // the duty clamp stays inactive
+      for (int i = 0; i < 6; ++i) EXPECT_NEAR(z[i], x[i], 1e-12 + 1e-9 * x.cwiseAbs().maxCoeff()) << k << " " << i;
+      EXPECT_NEAR(z[8], pid[0].integral(), 1e-12);
+      EXPECT_NEAR(z[9], pid[1].integral(), 1e-12);
+    }
+  }
+}
+
+TEST(Control, DampingAndFrequencyOfTheDominantPoleComeFromItsLogarithm) {
+  // A loop matrix whose eigenvalues are known: a rotation-scaling block r (cos a, -sin a; sin a, cos a).
+  LoopMatrix phi = LoopMatrix::Zero();
+  const double r = 0.9, ang = 0.3, T = 0.01;
+  phi(0, 0) = phi(1, 1) = r * std::cos(ang);
+  phi(0, 1) = -r * std::sin(ang);
+  phi(1, 0) = r * std::sin(ang);
+  phi(2, 2) = 0.5;
+  const LoopPoles p = loop_poles(phi, T);
+  EXPECT_NEAR(p.rho, r, 1e-14);
+  const double sr = std::log(r) / T, si = ang / T;
+  EXPECT_NEAR(p.damping, -sr / std::hypot(sr, si), 1e-12);
+  EXPECT_NEAR(p.frequency_hz, si / (2 * std::numbers::pi), 1e-9);
+  EXPECT_NEAR(p.oscillatory_damping, p.damping, 1e-12);
+  // A slower real pole (an integrator's) dominates; the oscillation is still reported.
+  phi(3, 3) = 0.95;
+  const LoopPoles q = loop_poles(phi, T);
+  EXPECT_NEAR(q.rho, 0.95, 1e-14);
+  EXPECT_NEAR(q.damping, 1.0, 1e-12);
+  EXPECT_NEAR(q.frequency_hz, 0.0, 1e-9);
+  EXPECT_NEAR(q.oscillatory_damping, -sr / std::hypot(sr, si), 1e-12);
+  EXPECT_NEAR(q.oscillatory_frequency_hz, si / (2 * std::numbers::pi), 1e-9);
+}
+
+/// A small step of one mechanism's tactor at P (mm) simulated by CVODE with `gains`: the largest
+/// joint error over the first and the last `window` seconds, relative to the step's.
+struct StepResponse {
+  SimStatus status;
+  double initial = 0.0;  ///< joint error of the step, rad
+  double late = 0.0;     ///< largest joint error over the last window, rad
+};
+
+StepResponse simulate_step(const LoopModel& loop, const Vec2& P, const std::array<PidGains, 2>& gains) {
+  const Design& d = paper();
+  SimulationInput in;
+  in.station = loop.station;
+  in.reference_name = "step";
+  in.controller = *d.get<ControllerSettings>();
+  in.contact = loop.skin;
+  SimulatedMechanism sm;
+  sm.name = loop.model.mechanism.name;
+  sm.model = loop.model;
+  sm.control[0].pid = gains[0];
+  sm.control[1].pid = gains[1];
+  const AnglesResult a0 = ik_angles(loop.model.mechanism, P);
+  const Vec2 target = P + Vec2(0.05, 0.0);
+  const AnglesResult a1 = ik_angles(loop.model.mechanism, target);
+  EXPECT_EQ(a0.status, Status::ok);
+  EXPECT_EQ(a1.status, Status::ok);
+  const std::size_t n = 150;  // 1.5 s at 100 Hz
+  sm.reference.assign(n, {a1.theta1, a1.theta2});
+  sm.reference.front() = {a0.theta1, a0.theta2};
+  sm.reference_point_mm.assign(n, target);
+  sm.reference_point_mm.front() = P;
+  sm.theta0 = {a0.theta1, a0.theta2};
+  in.mechanisms.push_back(sm);
+  SimulationOptions o;
+  o.quantise = false;
+  o.settle_s = 0.0;
+  o.max_wall_s = 20.0;
+  const SimulationResult r = simulate(in, o);
+  StepResponse out;
+  out.status = r.status;
+  out.initial = std::max(std::abs(a1.theta1 - a0.theta1), std::abs(a1.theta2 - a0.theta2));
+  for (const TimeSample& s : r.samples) {
+    if (s.t < r.t_end - 0.3) continue;
+    const MechanismSample& m = s.mechanisms[0];
+    out.late = std::max({out.late, std::abs(m.theta[0] - m.theta_ref[0]), std::abs(m.theta[1] - m.theta_ref[1])});
+  }
+  return out;
+}
+
+TEST(Control, TheVerdictAgreesWithTheNonlinearSimulationOfAStepAtTheWorstPose) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("index", "lower");
+  const StabilityMap map = stability_map(loop, ellipse_grid(d.require_station("index").target, 15));
+  ASSERT_EQ(map.not_ok, 0u);
+  ASSERT_TRUE(map.stable) << map.max_rho;
+  ASSERT_GT(map.kp_margin, 1.0);
+  const Vec2 worst = map.worst_P_mm();
+  // The margin is where max rho crosses 1.
+  std::array<PidGains, 2> below = loop.gains, above = loop.gains;
+  for (int j = 0; j < 2; ++j) {
+    below[static_cast<std::size_t>(j)].kp *= map.kp_margin * 0.99;
+    above[static_cast<std::size_t>(j)].kp *= map.kp_margin * 1.01;
+  }
+  EXPECT_LT(max_spectral_radius(map.poses, below, true), 1.0);
+  EXPECT_GE(max_spectral_radius(map.poses, above, true), 1.0);
+
+  // The design's gains: the step settles.
+  const StepResponse ok = simulate_step(loop, worst, loop.gains);
+  ASSERT_EQ(ok.status, SimStatus::ok);
+  EXPECT_LT(ok.late, 0.05 * ok.initial);
+  // 30 % beyond the kp margin: the linear verdict says unstable; the simulation grows (or leaves
+  // the workspace trying).
+  std::array<PidGains, 2> unstable = loop.gains;
+  for (PidGains& g : unstable) g.kp *= 1.3 * map.kp_margin;
+  ASSERT_GT(max_spectral_radius(map.poses, unstable, true), 1.0);
+  const StepResponse bad = simulate_step(loop, worst, unstable);
+  if (bad.status == SimStatus::ok) EXPECT_GT(bad.late, 2.0 * bad.initial);
+}
+
+TEST(Control, TheKdMarginBoundsTheDerivativeGainBothWays) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("index", "upper");
+  const StabilityMap map = stability_map(loop, ellipse_grid(d.require_station("index").target, 11));
+  ASSERT_TRUE(map.stable);
+  ASSERT_GT(map.kd_margin, 0.0);
+  ASSERT_LT(map.kd_margin, StabilityOptions{}.margin_cap);
+  std::array<PidGains, 2> g = loop.gains;
+  for (PidGains& x : g) x.kd *= 1.2 * map.kd_margin;
+  EXPECT_GT(max_spectral_radius(map.poses, g, true), 1.0);
+  const StepResponse bad = simulate_step(loop, map.worst_P_mm(), g);
+  if (bad.status == SimStatus::ok) EXPECT_GT(bad.late, 2.0 * bad.initial);
+}
+
+TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTunedGains) {
+  const Design& d = paper();
+  const Station& index = d.require_station("index");
+  TuneOptions o;
+  o.max_evaluations = 8;
+  o.max_seconds = 120.0;  // the evaluation count stops it: deterministic
+  std::map<std::string, std::map<std::string, MechanismInertia>> inertia{{"index", paper_inertia("index")}};
+  const TuneResult a = tune_controller(d, {&index}, inertia, o);
+  const TuneResult b = tune_controller(d, {&index}, inertia, o);
+  ASSERT_EQ(a.mechanisms.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const TunedMechanism& t = a.mechanisms[k];
+    SCOPED_TRACE(t.mechanism);
+    EXPECT_EQ(t.after[0].kp, b.mechanisms[k].after[0].kp);
+    EXPECT_EQ(t.after[0].ki, b.mechanisms[k].after[0].ki);
+    EXPECT_EQ(t.after[0].kd, b.mechanisms[k].after[0].kd);
+    EXPECT_EQ(t.evaluations, 8);
+    EXPECT_EQ(t.after[0].i_clamp, t.before[0].i_clamp);
+    // The figures after are those of the gains after, recomputed independently here.
+    const LoopModel loop = paper_loop("index", t.mechanism);
+    std::vector<PoseLoop> poses;
+    for (const Vec2& P : ellipse_grid(index.target, o.grid)) poses.push_back(pose_loop(loop, P));
+    EXPECT_NEAR(max_spectral_radius(poses, t.after, true), t.rho_after, 1e-12);
+    EXPECT_NEAR(max_spectral_radius(poses, t.before, true), t.rho_before, 1e-12);
+    EXPECT_EQ(t.feasible, t.rho_after <= o.rho_limit && t.saturation_after <= d.get<ControllerSettings>()->max_saturation_fraction);
+  }
+  // The patch, merged into the design file, gives each mechanism the tuned gains on both joints.
+  const std::string patch = tuned_patch_yaml(a);
+  std::ifstream in(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string design = text.str();
+  const std::size_t stations = patch.find("  stations:\n");
+  ASSERT_NE(stations, std::string::npos);
+  const std::size_t end = design.find("\n# The motors and drivers");
+  ASSERT_NE(end, std::string::npos);
+  design.insert(end + 1, patch.substr(stations));
+  const Design merged = load_design_from_string(design, "merged.yaml");
+  for (const TunedMechanism& t : a.mechanisms) {
+    for (int j = 1; j <= 2; ++j) {
+      const PidGains g = merged.get<ControllerSettings>()->joint("index", t.mechanism, j).pid;
+      EXPECT_EQ(g.kp, t.after[0].kp);
+      EXPECT_EQ(g.ki, t.after[0].ki);
+      EXPECT_EQ(g.kd, t.after[0].kd);
+    }
+    const PidGains other = merged.get<ControllerSettings>()->joint("thumb", t.mechanism, 1).pid;
+    EXPECT_EQ(other.kp, t.before[0].kp);  // the other station keeps its gains
+  }
+}
+
+TEST(ControlPerformance, TactorGainEqualsTheSteadyStateOfTheLoopSteppedByHand) {
+  LoopModel loop = paper_loop("index", "lower");
+  for (PidGains& g : loop.gains) g = {6.5, 40.0, 0.19, 1e9};  // a faster integrator: short transients
+  const Vec2 P = paper().require_station("index").target.center + Vec2(1.0, -2.0);
+  const AnglesResult a = ik_angles(loop.model.mechanism, P);
+  const LinearPlant plant = linear_plant(loop.model, Eigen::Vector2d(a.theta1, a.theta2), &loop.skin);
+  const DiscretePlant dp = discretise(plant, loop.period_s);
+  const double T = loop.period_s, f = 5.0, w = 2 * std::numbers::pi * f;
+  // H(:, c) from a sine on joint c's reference, stepped with DiscretePid and the one-period delay.
+  Eigen::Matrix2cd H;
+  for (int c = 0; c < 2; ++c) {
+    std::array<DiscretePid, 2> pid{DiscretePid(loop.gains[0], T), DiscretePid(loop.gains[1], T)};
+    Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Vector2d pending = Eigen::Vector2d::Zero();
+    const int n = 6000, keep = 2000;  // 100 periods kept after the transient
+    Eigen::Vector2cd acc = Eigen::Vector2cd::Zero();
+    for (int k = 0; k < n; ++k) {
+      const double r = 1e-3 * std::sin(w * k * T);
+      if (k >= n - keep) acc += x.head<2>().cast<std::complex<double>>() * std::polar(1.0, -w * k * T);
+      Eigen::Vector2d fresh;
+      for (int j = 0; j < 2; ++j) fresh[j] = pid[std::size_t(j)].update((j == c ? r : 0.0) - x[j]);
+      x = dp.Ad * x + dp.Bd * pending;
+      pending = fresh;
+    }
+    // sin has the complex amplitude -j: X = H (-j) 1e-3.
+    H.col(c) = (2.0 / keep) * acc / (std::complex<double>(0.0, -1.0) * 1e-3);
+  }
+  const Eigen::Matrix2cd Ht = plant.J.cast<std::complex<double>>() * H * plant.J.inverse().cast<std::complex<double>>();
+  const Eigen::JacobiSVD<Eigen::Matrix2cd> svd(Ht);
+  const std::array<double, 2> g = tactor_gain(dp, loop.gains, true, plant.J, f);
+  EXPECT_NEAR(g[0], svd.singularValues()[1], 1e-6);
+  EXPECT_NEAR(g[1], svd.singularValues()[0], 1e-6);
+  // At zero frequency the integral makes the loop exact: unit gain in every direction.
+  const std::array<double, 2> dc = tactor_gain(dp, loop.gains, true, plant.J, 0.0);
+  EXPECT_NEAR(dc[0], 1.0, 1e-9);
+  EXPECT_NEAR(dc[1], 1.0, 1e-9);
+}
+
+TEST(ControlPerformance, ResolutionForceAndZWidthAgreeWithFiniteDifferencesOfTheKinematics) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("index", "upper");
+  const ControllerSettings& c = *d.get<ControllerSettings>();
+  const std::array<Potentiometer, 2> pots{c.joint("index", "upper", 1).potentiometer, c.joint("index", "upper", 2).potentiometer};
+  const Vec2 P = d.require_station("index").target.center + Vec2(-1.5, 1.0);
+  const PoseFigures f = pose_figures(loop, P, c.adc_bits, c.adc_range_v, pots);
+  ASSERT_EQ(f.status, Status::ok);
+  const AnglesResult a = ik_angles(loop.model.mechanism, P);
+  // J by central differences of FK (mm/rad -> m/rad).
+  Eigen::Matrix2d J;
+  const double h = 1e-6;
+  for (int j = 0; j < 2; ++j) {
+    const double d1 = j == 0 ? h : 0.0, d2 = j == 1 ? h : 0.0;
+    const Vec2 p = fk_point(loop.model.mechanism, a.theta1 + d1, a.theta2 + d2).P;
+    const Vec2 m = fk_point(loop.model.mechanism, a.theta1 - d1, a.theta2 - d2).P;
+    J.col(j) = 1e-3 * (p - m) / (2 * h);
+  }
+  // Resolution: the tactor's move for one count on the worse joint, by FK.
+  double step_um = 0.0;
+  for (int j = 0; j < 2; ++j) {
+    const double count = std::abs(pots[std::size_t(j)].rad_per_volt) * (c.adc_range_v[1] - c.adc_range_v[0]) / 65536.0;
+    const Vec2 p0 = fk_point(loop.model.mechanism, a.theta1, a.theta2).P;
+    const Vec2 p1 = fk_point(loop.model.mechanism, a.theta1 + (j == 0 ? count : 0.0), a.theta2 + (j == 1 ? count : 0.0)).P;
+    step_um = std::max(step_um, 1e3 * (p1 - p0).norm());
+  }
+  EXPECT_NEAR(f.resolution_um, step_um, 1e-3 * step_um);
+  // Force in every direction: the worst of 3600 directions of min_j tau_j / |J_j . u|.
+  double worst = 1e300;
+  for (int k = 0; k < 3600; ++k) {
+    const Vec2 u(std::cos(k * std::numbers::pi / 3600), std::sin(k * std::numbers::pi / 3600));
+    double fu = 1e300;
+    for (int j = 0; j < 2; ++j) {
+      const MotorParams& mp = loop.model.motors[std::size_t(j)];
+      const double tau = mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.current_limit_A;
+      fu = std::min(fu, tau / std::abs(J.col(j).dot(u)));
+    }
+    worst = std::min(worst, fu);
+  }
+  EXPECT_NEAR(f.force_N, worst, 1e-4 * worst);
+  // Z-width: the least tactor damping over 3600 directions, b(u) = min over F . u for unit speed along u.
+  double bmin = 1e300;
+  Eigen::Matrix2d Bj = Eigen::Matrix2d::Zero();
+  for (int j = 0; j < 2; ++j) {
+    const MotorParams& mp = loop.model.motors[std::size_t(j)];
+    Bj(j, j) = mp.viscous_friction() + mp.gearbox_efficiency * mp.gear_ratio * mp.gear_ratio * mp.torque_constant() *
+                                           mp.back_emf_constant() / mp.resistance();
+  }
+  for (int k = 0; k < 3600; ++k) {
+    const Vec2 u(std::cos(k * std::numbers::pi / 3600), std::sin(k * std::numbers::pi / 3600));
+    const Eigen::Vector2d wdot = J.inverse() * u;           // joint rates for unit tactor speed along u
+    bmin = std::min(bmin, wdot.dot(Bj * wdot));             // power dissipated = b(u)
+  }
+  EXPECT_NEAR(f.damping_N_s_per_mm, 1e-3 * bmin, 1e-4 * 1e-3 * bmin);
+  EXPECT_NEAR(f.zwidth_N_per_mm, 2.0 * f.damping_N_s_per_mm / loop.period_s, 1e-9);
+}
+
+TEST(Control, EllipseGridStaysInsideAndHoldsTheCentre) {
+  Ellipse e;
+  e.center = {3.0, -2.0};
+  e.axes = {10.0, 4.0};
+  e.angle = 0.4;
+  const std::vector<Vec2> pts = ellipse_grid(e, 21);
+  bool centre = false;
+  for (const Vec2& p : pts) {
+    const Vec2 q = p - e.center;
+    const double u = (std::cos(e.angle) * q.x() + std::sin(e.angle) * q.y()) / 5.0;
+    const double v = (-std::sin(e.angle) * q.x() + std::cos(e.angle) * q.y()) / 2.0;
+    EXPECT_LE(u * u + v * v, 1.0 + 1e-12);
+    centre = centre || q.norm() < 1e-12;
+  }
+  EXPECT_TRUE(centre);
+  // About one point per cell of the 20 x 20 cells over the box, pi/4 of them: pi 10^2.
+  EXPECT_NEAR(double(pts.size()), 100 * std::numbers::pi, 8.0);
+}
+
+}  // namespace
+}  // namespace fivebar
