@@ -48,8 +48,11 @@
 /// g = dd/dq (central differences, step 1 % of each sigma), so its standard deviation is
 /// sigma(b) = sqrt(sum_j g_j(b)^2 sigma_j^2) and the robust margin is the signed margin minus the
 /// error at each boundary point: min_b d(b) - z_p sigma(b), z_p = Phi^{-1}(p), capped by the
-/// certified margin. A device covers only if every point does, so min_b Phi(d(b) / sigma(b)) is
-/// an upper bound of the fraction of devices that cover (the points' errors are correlated, and
+/// certified margin. The signed distance moves at most 1 mm per mm of any length or base
+/// coordinate, so sigma(b) <= S = sqrt(sum sigma_j^2) and the gradients are taken only at the
+/// points (by increasing d(b)) where d(b) - z S could still set the robust margin: the same answer
+/// at a fraction of the cost. A device covers only if every point does, so min_b Phi(d(b) /
+/// sigma(b)) over those points is an upper bound of the fraction of devices that cover (the points' errors are correlated, and
 /// where two boundary points are nearly as close the true fraction is lower). The Monte Carlo
 /// reference evaluates containment() on each sampled device: the fraction that covers, and the
 /// (1 - p) quantile of their margins to set beside the robust margin. Joint angle offsets and
