@@ -243,7 +243,8 @@ TEST_F(CliWorkspace, RobustCoverageAsksThePrintedDevicesToo) {
   // The paper's own target keeps a robust margin.
   const Outcome paper = run({"coverage", kDesign, "-s", "index", "--robust", "--json"});
   EXPECT_EQ(paper.code, 0) << paper.err;
-  for (const json& mech : ft::station(parse(paper), "index")["mechanisms"]) {
+  const json paper_doc = parse(paper);
+  for (const json& mech : ft::station(paper_doc, "index")["mechanisms"]) {
     EXPECT_GT(mech["robust"]["robust_margin_mm"].get<double>(), 0.5);
     EXPECT_EQ(mech["robust"]["fraction_monte_carlo"].get<double>(), 1.0);
   }
