@@ -35,21 +35,6 @@ std::string num(double v, int digits = 2) { return format::fixed(v, digits); }
 /// Millimetres rounded to 0.1 um for the JSON (shortest text of the rounded value).
 double r4(double v) { return std::round(v * 1e4) / 1e4; }
 
-std::string xml_escape(std::string_view s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 /// JSON text that is also safe as XML character data and inside an HTML page: '<', '>' and '&'
 /// occur only in strings, where \u escapes mean the same.
 std::string safe_json(const Json& j) {
@@ -457,20 +442,20 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
   o << "<svg xmlns=\"http://www.w3.org/2000/svg\" id=\"" << id << "\" class=\"fivebar-animation\" width=\"" << num(width, 0)
     << "\" height=\"" << num(height, 0) << "\" viewBox=\"0 0 " << num(width, 0) << " " << num(height, 0)
     << "\" font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n";
-  o << "<title>" << xml_escape(pattern + " on station " + station.name) << "</title>\n";
+  o << "<title>" << format::xml_escape(pattern + " on station " + station.name) << "</title>\n";
   o << "<metadata class=\"fivebar-animation-data\">" << safe_json(data) << "</metadata>\n";
   o << "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
   // Header.
   const double duration = frames.back().time_s;
   o << "<text x=\"" << kSide << "\" y=\"24\" font-size=\"17\" font-weight=\"bold\" fill=\"" << kInk << "\">"
-    << xml_escape(pattern + " — " + station.name) << "</text>\n";
+    << format::xml_escape(pattern + " — " + station.name) << "</text>\n";
   std::string verdict = result.passed ? "renderable" : "NOT renderable";
   if (result.first_failure) {
     verdict += ": " + std::string(to_string(result.first_failure->status)) + " at t = " +
                num(result.first_failure->time_s) + " s (" + result.first_failure->mechanism + ")";
   }
   o << "<text x=\"" << kSide << "\" y=\"44\" font-size=\"12\" fill=\"" << (result.passed ? "#1a8033" : "#bf1a1a") << "\">"
-    << xml_escape(std::to_string(result.samples.size()) + " samples at " + format::shortest(result.spec.rate_hz) +
+    << format::xml_escape(std::to_string(result.samples.size()) + " samples at " + format::shortest(result.spec.rate_hz) +
                   " Hz over " + num(duration) + " s at true speed; left the station, right the tactors' region; " + verdict)
     << "</text>\n";
 
@@ -559,7 +544,7 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
     const std::string what = panel == 0   ? "the station"
                              : zoom >= 1.0 ? "the tactors' region, " + num(zoom, 1) + "× enlarged"
                                            : "the tactors' region, at " + num(zoom, 1) + "× the station's scale";
-    o << "<text x=\"10\" y=\"18\" font-size=\"11\" fill=\"" << kGrey << "\">" << xml_escape(what) << "</text>\n";
+    o << "<text x=\"10\" y=\"18\" font-size=\"11\" fill=\"" << kGrey << "\">" << format::xml_escape(what) << "</text>\n";
     o << "</svg>\n";
   }
 
@@ -591,7 +576,7 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
     o << "<line x1=\"" << num(lx) << "\" y1=\"" << num(ly - 4.0) << "\" x2=\"" << num(lx + 24.0) << "\" y2=\"" << num(ly - 4.0)
       << "\" stroke=\"" << colour << "\" stroke-width=\"3\"" << (dash[0] ? std::string(" stroke-dasharray=\"") + dash + "\"" : "")
       << "/><text x=\"" << num(lx + 30.0) << "\" y=\"" << num(ly) << "\" font-size=\"11\" fill=\"" << kInk << "\">"
-      << xml_escape(label) << "</text>\n";
+      << format::xml_escape(label) << "</text>\n";
     lx += 30.0 + 6.2 * static_cast<double>(label.size()) + 18.0;
   };
   swatch(kUpperColour, "", "upper linkage and tactor path");

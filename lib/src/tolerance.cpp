@@ -71,6 +71,11 @@ ParameterSigmas parameter_sigmas(const ToleranceSettings& t) {
   return {link, link, link, link, base, base, base, base, angle, angle};
 }
 
+double major_3sigma_mm(const Eigen::Matrix2d& C) {
+  const double mid = 0.5 * (C(0, 0) + C(1, 1));
+  return 3.0 * std::sqrt(std::max(0.0, mid + std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1))));
+}
+
 double angle_per_count(int bits) {
   return 2.0 * std::numbers::pi / std::ldexp(1.0, std::clamp(bits, 1, 32));
 }

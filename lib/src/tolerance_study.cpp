@@ -50,11 +50,6 @@ std::vector<Vec2> ellipse_grid(const Ellipse& e) {
   return out;
 }
 
-double major_3sigma(const Eigen::Matrix2d& C) {
-  const double mid = 0.5 * (C(0, 0) + C(1, 1));
-  return 3.0 * std::sqrt(std::max(0.0, mid + std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1))));
-}
-
 /// The mechanism of a printed device: lengths and base positions moved by dq.
 Mechanism perturbed(const Mechanism& m, const std::array<double, kToleranceParameters>& dq) {
   Mechanism p = m;
@@ -378,7 +373,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
 
   map.centre = tolerance_first_order(m, target.center, src.sigma, per_count);
   map.centre_monte_carlo = tolerance_monte_carlo(m, target.center, src.sigma, src.samples, src.seed);
-  map.centre_monte_carlo_3sigma_mm = major_3sigma(map.centre_monte_carlo.covariance);
+  map.centre_monte_carlo_3sigma_mm = major_3sigma_mm(map.centre_monte_carlo.covariance);
   map.centre_play = tolerance_play(m, target.center, src.leg_play_mm);
   map.target_points_mm = ellipse_grid(target);
   for (const Vec2& p : map.target_points_mm) {

@@ -27,6 +27,9 @@ std::string fixed(double value, int digits);
 /// The items separated by `separator`.
 std::string join(const std::vector<std::string>& items, std::string_view separator = ", ");
 
+/// Text for XML and HTML: & < > " ' as entities (&#39; for the quote, valid in both).
+std::string xml_escape(std::string_view text);
+
 /// FNV-1a offset basis (64 bit): the hash of no bytes.
 inline constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
 /// FNV-1a, 64 bit, of `bytes`, continuing from `hash`: a fingerprint of inputs (designs, render

@@ -139,6 +139,8 @@ struct MonteCarloTolerance {
 };
 MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
                                           std::size_t samples, std::uint64_t seed);
+/// The 3-sigma major semi-axis of a 2 x 2 covariance (mm^2 -> mm): 3 sqrt(largest eigenvalue).
+double major_3sigma_mm(const Eigen::Matrix2d& covariance);
 
 /// The Monte Carlo reference at many tactor points at once: the same `samples` printed devices
 /// (drawn in order from `seed`, as tolerance_monte_carlo() draws them) at every point, the points

@@ -2,6 +2,8 @@
 
 #include "products/html.hpp"
 
+#include "fivebar/format.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <vector>
@@ -326,21 +328,7 @@ class Renderer {
 
 }  // namespace
 
-std::string html_escape(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
+std::string html_escape(std::string_view text) { return format::xml_escape(text); }
 
 std::string to_html_page(std::string_view markdown, std::string_view title, const HtmlFiles& files) {
   const Renderer renderer(files);

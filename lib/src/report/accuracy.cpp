@@ -640,12 +640,6 @@ std::optional<double> fit_log_slope(const std::vector<double>& x, const std::vec
 
 // --- tolerance estimates -------------------------------------------------------------------------
 
-/// 3 sqrt(largest eigenvalue) of a 2 x 2 covariance.
-static double major_3sigma(const Eigen::Matrix2d& C) {
-  const double mid = 0.5 * (C(0, 0) + C(1, 1));
-  return 3.0 * std::sqrt(std::max(0.0, mid + std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1))));
-}
-
 static void tolerance_study(const Mechanism& m, const Ellipse& target, const AccuracyOptions& o, MechanismAccuracy& out) {
   const Timing tm = timing_for(o.quick);
   // Illustrative tolerances: 0.05 mm on lengths and base positions, 0.5 deg on the joint angles;
@@ -658,7 +652,7 @@ static void tolerance_study(const Mechanism& m, const Ellipse& target, const Acc
   if (ik(m, P).status != Status::ok) return;
   out.tolerance_reference_samples = o.quick ? 200000 : 1000000;
   out.tolerance_reference_3sigma_mm =
-      major_3sigma(tolerance_monte_carlo(m, std::vector<Vec2>{P}, sigma, out.tolerance_reference_samples, o.seed + 7)[0].covariance);
+      major_3sigma_mm(tolerance_monte_carlo(m, std::vector<Vec2>{P}, sigma, out.tolerance_reference_samples, o.seed + 7)[0].covariance);
   const double ref = out.tolerance_reference_3sigma_mm;
 
   WorkSeries mc{"Monte Carlo 3-sigma", "samples", "mm", {}, {}, {},
@@ -667,7 +661,7 @@ static void tolerance_study(const Mechanism& m, const Ellipse& target, const Acc
     if (o.quick && n > 10000) break;
     MonteCarloTolerance r;
     const double t = median_time(tm, [&] { r = tolerance_monte_carlo(m, P, sigma, n, o.seed); });
-    const double v = major_3sigma(r.covariance);
+    const double v = major_3sigma_mm(r.covariance);
     mc.points.push_back({double(n), t, v, std::abs(v - ref), v / std::sqrt(2.0 * double(n))});
   }
   // Order in N (about -1/2), above the reference's own standard error.

@@ -125,6 +125,29 @@ void add_point_array(vtkImageData* image, const char* name, const std::vector<T>
   image->GetPointData()->AddArray(a);
 }
 
+/// Image data of nx x ny points from (x0, y0) at `spacing` mm (z = 0).
+void shape_image(vtkImageData* image, double x0, double y0, double spacing, int nx, int ny) {
+  image->SetDimensions(nx, ny, 1);
+  image->SetOrigin(x0, y0, 0.0);
+  image->SetSpacing(spacing, spacing, spacing);
+}
+
+/// The field data array `status_names`: index = Status value.
+void add_status_names(vtkImageData* image) {
+  vtkNew<vtkStringArray> status_names;
+  status_names->SetName("status_names");
+  for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
+    status_names->InsertNextValue(std::string(to_string(s)));
+  image->GetFieldData()->AddArray(status_names);
+}
+
+/// The `.vti` document of `image`.
+std::string image_document(vtkImageData* image) {
+  vtkNew<vtkXMLImageDataWriter> writer;
+  writer->SetInputData(image);
+  return write_document(writer.Get(), ".vti");
+}
+
 }  // namespace
 
 std::string regions_vtp(const StationWorkspace& ws) {
@@ -145,9 +168,7 @@ std::string regions_vtp(const StationWorkspace& ws) {
 std::string field_vti(const WorkspaceField& f) {
   const Grid& g = f.grid;
   vtkNew<vtkImageData> image;
-  image->SetDimensions(g.nx, g.ny, 1);
-  image->SetOrigin(g.x0, g.y0, 0.0);
-  image->SetSpacing(g.spacing, g.spacing, g.spacing);
+  shape_image(image, g.x0, g.y0, g.spacing, g.nx, g.ny);
   // VTK's point order (x fastest, then y) is WorkspaceField's row-major j * nx + i.
   add_point_array<vtkUnsignedCharArray>(image, "reach", f.reach);
   add_point_array<vtkUnsignedCharArray>(image, "status", f.status);
@@ -159,14 +180,8 @@ std::string field_vti(const WorkspaceField& f) {
   add_point_array<vtkDoubleArray>(image, "transmission_deg", f.transmission_deg);
   add_point_array<vtkDoubleArray>(image, "force_capability", f.force_capability);
   image->GetPointData()->SetActiveScalars("lci");
-  vtkNew<vtkStringArray> status_names;  // index = status value
-  status_names->SetName("status_names");
-  for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
-    status_names->InsertNextValue(std::string(to_string(s)));
-  image->GetFieldData()->AddArray(status_names);
-  vtkNew<vtkXMLImageDataWriter> writer;
-  writer->SetInputData(image);
-  return write_document(writer.Get(), ".vti");
+  add_status_names(image);
+  return image_document(image);
 }
 
 std::string image_vti(const ImageField& f) {
@@ -178,34 +193,22 @@ std::string image_vti(const ImageField& f) {
     }
   }
   vtkNew<vtkImageData> image;
-  image->SetDimensions(f.nx, f.ny, 1);
-  image->SetOrigin(f.x0, f.y0, 0.0);
-  image->SetSpacing(f.spacing, f.spacing, f.spacing);
+  shape_image(image, f.x0, f.y0, f.spacing, f.nx, f.ny);
   for (const auto& [name, values] : f.arrays) add_point_array<vtkDoubleArray>(image, name.c_str(), values);
   if (!f.arrays.empty()) image->GetPointData()->SetActiveScalars(f.arrays.front().first.c_str());
-  vtkNew<vtkXMLImageDataWriter> writer;
-  writer->SetInputData(image);
-  return write_document(writer.Get(), ".vti");
+  return image_document(image);
 }
 
 // The stability field of fivebar/control.hpp (declared there; VTK stays in this file).
 std::string rho_field_vti(const RhoField& f) {
   const Grid& g = f.grid;
   vtkNew<vtkImageData> image;
-  image->SetDimensions(g.nx, g.ny, 1);
-  image->SetOrigin(g.x0, g.y0, 0.0);
-  image->SetSpacing(g.spacing, g.spacing, g.spacing);
+  shape_image(image, g.x0, g.y0, g.spacing, g.nx, g.ny);
   add_point_array<vtkDoubleArray>(image, "rho", f.rho);
-  add_point_array<vtkUnsignedCharArray>(image, "status", f.status);
+  add_point_array<vtkUnsignedCharArray>(image, "status", f.status);  // 255: outside the joint limits
   image->GetPointData()->SetActiveScalars("rho");
-  vtkNew<vtkStringArray> status_names;  // index = status value; 255: outside the joint limits
-  status_names->SetName("status_names");
-  for (Status s : {Status::ok, Status::unreachable, Status::singular_type1, Status::singular_type2})
-    status_names->InsertNextValue(std::string(to_string(s)));
-  image->GetFieldData()->AddArray(status_names);
-  vtkNew<vtkXMLImageDataWriter> writer;
-  writer->SetInputData(image);
-  return write_document(writer.Get(), ".vti");
+  add_status_names(image);
+  return image_document(image);
 }
 
 }  // namespace fivebar
