@@ -95,6 +95,7 @@ std::string limits_text(const Mechanism& m, const Pose& pose);
 void setup_fk(CLI::App& app);
 void setup_ik(CLI::App& app);
 void setup_sweep(CLI::App& app);
+void setup_optimize(CLI::App& app);
 void setup_run(CLI::App& app);
 void setup_workspace(CLI::App& app);
 void setup_coverage(CLI::App& app);

@@ -90,6 +90,7 @@ int run(int argc, char** argv) {
   setup_fk(app);
   setup_ik(app);
   setup_sweep(app);
+  setup_optimize(app);
   setup_run(app);
   setup_workspace(app);
   setup_coverage(app);

@@ -260,18 +260,34 @@ std::string fmt_margin(const std::string& which, double margin) {
 SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint64_t index, std::vector<double> values,
                          const CoverageOptions& cov) {
   SweepRow row;
-  row.index = index;
-  row.values = std::move(values);
   Station st;
   try {
-    st = apply_sweep(design, s, row.values);
+    st = apply_sweep(design, s, values);
   } catch (const ValidationError& e) {
+    row.index = index;
+    row.values = std::move(values);
     row.status = std::string("invalid: ") + e.what();
     return row;
   }
+  StationFigureRequest request;
+  request.mechanism = s.mechanism;
+  request.collision_spacing_mm = s.collision_spacing_mm;
+  request.robust = std::find(s.objectives.begin(), s.objectives.end(), "robust") != s.objectives.end();
+  request.coverage = cov;
+  row = evaluate_station_figures(design, st, request);
+  row.index = index;
+  row.values = std::move(values);
+  return row;
+}
+
+}  // namespace
+
+SweepRow evaluate_station_figures(const Design& design, const Station& st, const StationFigureRequest& request) {
+  SweepRow row;
+  const CoverageOptions& cov = request.coverage;
   std::vector<const Mechanism*> targets;
   for (const Mechanism* m : st.mechanisms()) {
-    if (s.mechanism.empty() || s.mechanism == m->name) targets.push_back(m);
+    if (request.mechanism.empty() || request.mechanism == m->name) targets.push_back(m);
   }
   // Hard constraints in order of cost; the first failure ends the evaluation.
   for (const Mechanism* m : targets) {
@@ -305,13 +321,13 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
   }
   footprint(st, targets, design, row);
   // Soft: the collision fraction (the costliest metric, so last and only for covered designs).
-  if (design.get<Geometry>() && st.lower && st.upper && s.collision_spacing_mm > 0.0) {
+  if (design.get<Geometry>() && st.lower && st.upper && request.collision_spacing_mm > 0.0) {
     row.collision_fraction =
-        collision_fraction(st, *design.get<Geometry>(), sweep_collision_spacing(s, st.target)).fraction;
+        collision_fraction(st, *design.get<Geometry>(), std::max(request.collision_spacing_mm, std::max(st.target.axes.x(), st.target.axes.y()) / kSweepCollisionStepsAcross)).fraction;
   }
   // Soft: the robust margin (72 boundary points, 17 margins each per mechanism: about 1 ms), only
   // when asked for.
-  if (std::find(s.objectives.begin(), s.objectives.end(), "robust") != s.objectives.end()) {
+  if (request.robust) {
     row.robust_margin_mm = std::numeric_limits<double>::infinity();
     for (const Mechanism* m : targets) {
       const ToleranceSources src = tolerance_sources(design, st, *m);
@@ -324,7 +340,6 @@ SweepRow evaluate_values(const Design& design, const SweepSettings& s, std::uint
   return row;
 }
 
-}  // namespace
 
 SweepRow evaluate_sweep_design(const Design& design, const SweepSettings& settings, std::uint64_t index,
                                const CoverageOptions& coverage) {

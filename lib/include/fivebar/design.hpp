@@ -191,6 +191,15 @@ const std::vector<std::string>& known_products();
 /// The design as a design file (YAML, file units, numbers in shortest round-trip form) that
 /// load_design_from_string() reads back to an equal design.
 std::string to_yaml(const Design& design);
+/// The number at `key`, a key path of the design file in file units (mm, degrees, as
+/// docs/design-file.md lists them): "stations.index.mechanisms.lower.links[2]",
+/// "stations.index.target.axes[0]", "geometry.link_width", "controller.pid.kp". The path is followed
+/// through to_yaml(design), so a key the file leaves at its default is found too. ValidationError
+/// naming the key when the path leads nowhere or to something that is not a number.
+double design_number(const Design& design, std::string_view key);
+/// The design with the numbers at the key paths replaced (file units), read back by the loader:
+/// every rule of a design file applies (InputError / ValidationError otherwise).
+Design with_design_numbers(const Design& design, const std::vector<std::pair<std::string, double>>& values);
 /// Limits on design files (README "Hardening"), checked before the YAML parser sees the text so
 /// that no file can exhaust the stack or the memory: larger files, deeper nesting, bytes that are
 /// not UTF-8 or characters YAML forbids (control characters) are refused with an InputError.

@@ -61,6 +61,18 @@ CoverageOptions sweep_coverage_options();
 SweepRow evaluate_sweep_design(const Design& design, const SweepSettings& settings, std::uint64_t index,
                                const CoverageOptions& coverage = sweep_coverage_options());
 
+/// What evaluate_station_figures() computes beyond coverage, conditioning and footprint.
+struct StationFigureRequest {
+  std::string mechanism;              ///< "lower", "upper" or empty: every mechanism and the shared region
+  double collision_spacing_mm = 0.0;  ///< > 0: the collision fraction at this spacing (coarsened as sweeps do)
+  bool robust = false;                ///< the robust margin (fivebar/tolerance.hpp robust_coverage())
+  CoverageOptions coverage = sweep_coverage_options();
+};
+/// The per-design figures of one station as the sweep computes them, with early exit on the first
+/// failed coverage rule (row.status says which; row.covered when every one holds). index and
+/// values are left empty. The station must be valid (Station::validate()).
+SweepRow evaluate_station_figures(const Design& design, const Station& station, const StationFigureRequest& request);
+
 /// Non-dominated set of covered designs over the objectives (online; deterministic for rows
 /// inserted in index order).
 class ParetoArchive {
