@@ -72,8 +72,11 @@ struct Udp {
   pagmo::thread_safety get_thread_safety() const { return pagmo::thread_safety::none; }
 };
 
-pagmo::algorithm make_algorithm(const std::string& name, unsigned gens, unsigned seed, int population) {
-  if (name == "nsga2") return pagmo::algorithm(pagmo::nsga2(gens, 0.95, 10.0, 0.01, 50.0, seed));
+/// Deb's recommended NSGA-II operators: crossover probability 0.9, distribution indices 20, and a
+/// mutation probability of 1/n per variable (pagmo's default 0.01 barely mutates a problem of a
+/// few variables).
+pagmo::algorithm make_algorithm(const std::string& name, unsigned gens, unsigned seed, int population, std::size_t n) {
+  if (name == "nsga2") return pagmo::algorithm(pagmo::nsga2(gens, 0.9, 20.0, 1.0 / double(std::max<std::size_t>(n, 1)), 20.0, seed));
   if (name == "moead") {
     return pagmo::algorithm(pagmo::moead(gens, "grid", "tchebycheff", std::min<unsigned>(20u, unsigned(population - 1)), 1.0, 0.5,
                                          20.0, 0.9, 2u, true, seed));
@@ -325,6 +328,14 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
   r.evaluations = all.size();
   r.front = optimize_front(p, all);
   normalisation(p, r.front, r.ideal, r.nadir);
+  // A front of one value in an objective (always so for one objective): its nadir is the worst
+  // feasible candidate's instead, so the curve still shows the progress.
+  for (std::size_t i = 0; i < r.ideal.size(); ++i) {
+    if (r.nadir[i] > r.ideal[i]) continue;
+    for (const auto& c : all) {
+      if (c.feasible()) r.nadir[i] = std::max(r.nadir[i], p.fitness(c)[i]);
+    }
+  }
   r.hypervolume = hypervolume_curve(p, all, r.ideal, r.nadir);
   r.reference = p.evaluate(p.reference_values());
   const std::filesystem::path& dir = options.out_dir;
@@ -484,6 +495,10 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   }
   const std::uint64_t total_budget = options.evaluations ? options.evaluations : s.evaluations;
   const std::uint64_t budget = std::max<std::uint64_t>(1, total_budget * islands.size() / std::uint64_t(s.islands));
+  if (total_budget < std::uint64_t(s.population) * std::uint64_t(s.islands)) {
+    throw InputError("optimize: a budget of " + std::to_string(total_budget) + " evaluations is less than the initial populations (" +
+                     std::to_string(s.population) + " x " + std::to_string(s.islands) + " islands)");
+  }
   const double seconds_budget = options.seconds > 0.0 ? options.seconds : s.seconds;
   const std::string alg = s.resolved_algorithm();
   make_directories(options.out_dir);
@@ -584,7 +599,8 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       try {
         rounds[k] = round;
         const pagmo::algorithm a =
-            make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round), s.population);
+            make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round), s.population,
+                                                   p.dimension());
         pops[k] = a.evolve(pops[k]);
       } catch (const std::exception& e) {
         errors[k] = e.what();

@@ -141,6 +141,10 @@ void OptimizeSettings::validate() const {
     throw ValidationError("generations_per_round", "= " + std::to_string(generations_per_round) + ": must be 1 ... 1000");
   }
   if (evaluations < 1 || evaluations > std::uint64_t(1e9)) throw ValidationError("evaluations", "must be 1 ... 1e9");
+  if (evaluations < std::uint64_t(population) * std::uint64_t(islands)) {
+    throw ValidationError("evaluations", "= " + std::to_string(evaluations) + ": less than the initial populations (population " +
+                                             std::to_string(population) + " x islands " + std::to_string(islands) + ")");
+  }
   if (!(seconds > 0.0) || seconds > 1e7) throw ValidationError("seconds", "= " + format_number(seconds) + " s: must be > 0 and <= 1e7");
   if (polish_evaluations > 100000) throw ValidationError("polish_evaluations", "must be 0 ... 100000");
   if (choose != "knee") {

@@ -1,0 +1,104 @@
+// End-to-end tests of `fivebar optimize` on the real binary: the showcase's optimize: section with a
+// small budget (JSON, files, the chosen design re-checked and runnable), shards merged, resume,
+// and bad input (exit 2, nothing written).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli_test.hpp"
+
+namespace {
+namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+class CliOptimize : public ft::CliTest {
+ protected:
+  CliOptimize() : CliTest("fivebar_test_cli_optimize") {}
+  std::vector<std::string> args(const fs::path& out, std::vector<std::string> more = {}) {
+    std::vector<std::string> a{"optimize", kDesign, "--out", out.string(), "--evaluations", "200", "--json"};
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  }
+};
+
+TEST_F(CliOptimize, JsonFilesAndTheChosenDesign) {
+  const Outcome r = run(args(dir_ / "a"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["command"], "optimize");
+  EXPECT_EQ(j["design"], "iros2022");
+  EXPECT_LE(j["evaluations"].get<int>(), 200);
+  EXPECT_EQ(j["stages"]["evaluated"], j["evaluations"]);
+  ASSERT_FALSE(j["front"].empty());
+  ASSERT_TRUE(j["chosen"].is_object());
+  EXPECT_EQ(j["chosen"]["verdict"], "feasible");
+  for (const json& c : j["recheck"]) EXPECT_TRUE(c["passed"].get<bool>()) << c.dump();
+  EXPECT_EQ(j["recheck"].size(), 3u);  // coverage, collision, pattern
+  for (const char* f : {"front.csv", "front.json", "candidates.csv", "chosen.yaml", "hypervolume.svg", "hypervolume.png",
+                        "front.svg", "front.png", "checkpoint.json", "iros2022-optimized/summary.md"}) {
+    EXPECT_TRUE(fs::exists(dir_ / "a" / f)) << f;
+  }
+  // The chosen design runs unchanged.
+  const Outcome again = run({"run", (dir_ / "a" / "chosen.yaml").string(), "--out", (dir_ / "runs").string(),
+                             "--products", "coverage"});
+  EXPECT_EQ(again.code, 0) << again.err;
+  // Same seed, same front.
+  const Outcome r2 = run(args(dir_ / "b"));
+  ASSERT_EQ(r2.code, 0);
+  EXPECT_EQ(ft::slurp(dir_ / "a" / "front.csv"), ft::slurp(dir_ / "b" / "front.csv"));
+}
+
+TEST_F(CliOptimize, ShardsAndMerge) {
+  for (const char* k : {"0/2", "1/2"}) {
+    const Outcome r = run(args(dir_ / "s", {"--shard", k, "--no-plots"}));
+    ASSERT_EQ(r.code, 0) << r.err;
+  }
+  const Outcome m = run(args(dir_ / "s", {"--merge", "2", "--no-check"}));
+  ASSERT_EQ(m.code, 0) << m.err;
+  const json j = parse(m);
+  EXPECT_FALSE(j["front"].empty());
+  EXPECT_TRUE(fs::exists(dir_ / "s" / "chosen.yaml"));
+  const Outcome missing = run(args(dir_ / "s", {"--merge", "3"}));
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_THAT(missing.err, HasSubstr("front.shard-0-of-3.json"));
+}
+
+TEST_F(CliOptimize, BadInputExitsTwoAndWritesNothing) {
+  struct Case {
+    std::vector<ft::Edit> edits;
+    std::string message;
+  };
+  const std::vector<Case> cases{
+      {{{"        - stations.index.mechanisms.lower.links[2]\n", "        - stations.index.mechanisms.lower.lengths[2]\n"}},
+       "optimize.variables.lower_L34.keys[0]"},
+      {{{"      range: [8, 17]\n    upper_O1x:", "      range: [17, 8]\n    upper_O1x:"}}, "optimize.variables.lower_O2x.range"},
+      {{{"  objectives: [margin, min_lci, min footprint]", "  objectives: []"}}, "optimize.objectives"},
+      {{{"  objectives: [margin, min_lci, min footprint]", "  objectives: [margin, speed]"}}, "optimize.objectives[1]"},
+      {{{"constraints: [\"min_lci >= 0.25\"", "constraints: [\"min_lci >= lots\""}}, "optimize.constraints[0]"},
+  };
+  int i = 0;
+  for (const Case& c : cases) {
+    const fs::path design = design_with("bad" + std::to_string(i++) + ".yaml", c.edits);
+    const Outcome r = run({"optimize", design.string(), "--out", (dir_ / "never").string()});
+    EXPECT_EQ(r.code, 2) << c.message << "\n" << r.err;
+    EXPECT_THAT(r.err, HasSubstr(c.message));
+    EXPECT_THAT(r.err, HasSubstr(".yaml:"));  // file and line
+    EXPECT_FALSE(fs::exists(dir_ / "never")) << c.message;
+  }
+  // A constraint on a figure whose data the design lacks (no tolerance: for robust).
+  const fs::path no_tol = design_without("no_tolerance.yaml", "tolerance:", "sweep:");
+  const Outcome r = run({"optimize", no_tol.string(), "--out", (dir_ / "never").string()});
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("optimize.constraints[1]"));
+  EXPECT_FALSE(fs::exists(dir_ / "never"));
+  // Nothing to resume from.
+  const Outcome resume = run({"optimize", kDesign, "--out", (dir_ / "empty").string(), "--resume"});
+  EXPECT_EQ(resume.code, 2) << resume.err;
+  EXPECT_THAT(resume.err, HasSubstr("no checkpoint"));
+}
+
+}  // namespace

@@ -1,0 +1,407 @@
+// fivebar optimize: key paths against the file, the fast path against the YAML round trip and the
+// sweep's own evaluation, the penalty order, fronts against brute force, the hypervolume against
+// closed forms, determinism over threads, resume equal to an uninterrupted run, shards, the polish,
+// the chosen design file, and the front of the sweep's two-variable problem against its grid.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <random>
+
+#include "fivebar/optimize.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/motor.hpp"
+#include "fivebar/sections/patterns.hpp"
+#include "fivebar/sections/tolerance.hpp"
+#include "fivebar/sections/optimize.hpp"
+#include "fivebar/sections/sweep.hpp"
+#include "fivebar/sweep.hpp"
+#include "process.hpp"
+
+namespace fivebar {
+namespace {
+
+namespace fs = std::filesystem;
+using ::fivebar::testing::ScratchDir;
+using ::fivebar::testing::slurp;
+
+Design paper() { return load_design(fs::path(FIVEBAR_SOURCE_DIR) / "designs/iros2022.yaml"); }
+
+OptimizeVariable tied(std::string name, std::vector<std::string> keys, double lo, double hi, double step = 0.0) {
+  OptimizeVariable v;
+  v.name = std::move(name);
+  v.keys = std::move(keys);
+  v.lo = lo;
+  v.hi = hi;
+  v.step = step;
+  return v;
+}
+
+std::vector<std::string> links(const std::string& station, std::initializer_list<int> which) {
+  std::vector<std::string> keys;
+  for (const char* m : {"lower", "upper"}) {
+    for (int i : which) keys.push_back("stations." + station + ".mechanisms." + m + ".links[" + std::to_string(i) + "]");
+  }
+  return keys;
+}
+
+/// The sweep's two-variable problem of the showcase: L34 and L12 of the index station, both
+/// mechanisms tied.
+OptimizeSettings two_variable(std::vector<OptimizeObjective> objectives) {
+  OptimizeSettings s;
+  s.variables = {tied("L34", links("index", {2, 3}), 12, 19), tied("L12", links("index", {0, 1}), 6, 12)};
+  s.objectives = std::move(objectives);
+  s.population = 16;
+  s.islands = 2;
+  s.evaluations = 400;
+  s.polish_evaluations = 40;
+  return s;
+}
+
+Design with(OptimizeSettings s) {
+  Design d = paper();
+  d.set(std::move(s));
+  d.validate();
+  return d;
+}
+
+TEST(DesignNumbers, ReadAndWriteByKeyPath) {
+  const Design d = paper();
+  EXPECT_EQ(design_number(d, "stations.index.mechanisms.lower.links[2]"), 15.0);
+  EXPECT_EQ(design_number(d, "stations.index.mechanisms.upper.bases[1][1]"), 31.0);
+  EXPECT_EQ(design_number(d, "stations.thumb.target.axes[1]"), 14.0);
+  const Design e = with_design_numbers(d, {{"stations.index.mechanisms.lower.links[2]", 16.25}, {"geometry.link_width[0]", 3.5}});
+  EXPECT_EQ(e.station("index")->lower->L[2], 16.25);
+  EXPECT_EQ(e.station("index")->lower->L[3], 15.0);
+  EXPECT_EQ(design_number(e, "geometry.link_width[0]"), 3.5);
+  // Errors name the key.
+  for (const char* bad : {"stations.index.mechanisms.lower.links[7]", "stations.nope.target.axes[0]",
+                          "geometry.link_width", "stations.index.mechanisms.lower.working_mode", "stations.index.target.axes[x]"}) {
+    try {
+      (void)design_number(d, bad);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const ValidationError& err) {
+      EXPECT_EQ(err.key(), bad);
+    }
+  }
+  // A value that breaks a rule of the file is refused as the loader refuses it.
+  EXPECT_THROW((void)with_design_numbers(d, {{"stations.index.mechanisms.lower.links[2]", -1.0}}), InputError);
+}
+
+TEST(OptimizeSettings, BadInputNamesTheKey) {
+  auto key_of = [](OptimizeSettings s) {
+    try {
+      (void)with(std::move(s));
+    } catch (const ValidationError& e) {
+      return e.key();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
+  auto t = s;
+  t.variables[0].keys[1] = "stations.index.mechanisms.lower.lengths[3]";
+  EXPECT_EQ(key_of(t), "optimize.variables.L34.keys[1]");
+  t = s;
+  t.variables[1].lo = 12;
+  EXPECT_EQ(key_of(t), "optimize.variables.L12.range");
+  t = s;
+  t.objectives.clear();
+  EXPECT_EQ(key_of(t), "optimize.objectives");
+  t = s;
+  t.constraints.push_back({"robust", true, 0.0});
+  {
+    Design no_tolerance = paper();
+    no_tolerance.reset<ToleranceSettings>();
+    no_tolerance.set(t);
+    try {
+      no_tolerance.validate();
+      ADD_FAILURE() << "robust without tolerance: accepted";
+    } catch (const ValidationError& e) {
+      EXPECT_EQ(e.key(), "optimize.constraints[0]");
+    }
+  }
+  t = s;
+  t.population = 18;  // NSGA-II: a multiple of 4
+  EXPECT_EQ(key_of(t), "optimize.population");
+  t = s;
+  t.algorithm = "cmaes";  // one objective only
+  EXPECT_EQ(key_of(t), "optimize.algorithm");
+  t = s;
+  t.variables[1].keys[0] = t.variables[0].keys[0];
+  EXPECT_EQ(key_of(t), "optimize.variables.L12.keys[0]");
+  // A figure whose data the design lacks: collision without geometry.
+  Design bare = paper();
+  bare.reset<Geometry>();
+  bare.reset<MotorSettings>();
+  bare.reset<ControllerSettings>();
+  bare.reset<PatternSettings>();
+  t = s;
+  t.objectives.push_back({"collision", false});
+  bare.set(t);
+  try {
+    bare.validate();
+    ADD_FAILURE() << "collision without geometry accepted";
+  } catch (const ValidationError& e) {
+    EXPECT_EQ(e.key(), "optimize.objectives[2]");
+  }
+}
+
+TEST(OptimizeVariable, SnapKeepsTheStepsAndBounds) {
+  const OptimizeVariable v = tied("w", {"geometry.link_width[0]"}, 2.0, 6.0, 0.75);
+  EXPECT_EQ(v.snap(1.0), 2.0);
+  EXPECT_EQ(v.snap(2.3), 2.0);
+  EXPECT_EQ(v.snap(2.5), 2.75);
+  EXPECT_EQ(v.snap(5.9), 5.75);  // 6.5 would pass hi
+  EXPECT_EQ(v.snap(99.0), 5.75);
+  EXPECT_EQ(tied("x", {"a"}, 1.0, 2.0).snap(1.2345), 1.2345);
+}
+
+TEST(OptimizeProblem, FastPathEqualsTheFileRoundTripAndTheSweep) {
+  const Design d = with(two_variable({{"margin", true}, {"min_lci", true}, {"footprint", false}}));
+  const OptimizeProblem p(d);
+  ASSERT_TRUE(p.fast_path());
+  // The sweep of the same two variables (both mechanisms tied, as L34 / L12 do).
+  SweepSettings sw;
+  sw.station = "index";
+  sw.vary = {{"L34", 12, 19, 8}, {"L12", 6, 12, 7}};
+  sw.objectives = {"margin", "min_lci", "footprint"};
+  sw.collision_spacing_mm = 0.0;
+  Design ds = paper();
+  ds.set(sw);
+  ds.validate();
+  int compared = 0, covered = 0;
+  for (std::uint64_t i = 0; i < sweep_size(sw); ++i) {
+    const SweepRow row = evaluate_sweep_design(ds, sw, i);
+    const OptimizeCandidate c = p.evaluate(row.values);
+    ASSERT_EQ(c.feasible(), row.covered) << row.status << " / " << c.status;
+    ++compared;
+    if (!row.covered) continue;
+    ++covered;
+    EXPECT_EQ(c.figures[0], row.score("margin"));
+    EXPECT_EQ(c.figures[1], row.min_lci);
+    EXPECT_EQ(c.figures[3], row.footprint_mm2);
+    // The slow path: the design written, changed by key path and read back.
+    const Design full = p.design_at(row.values);
+    const SweepRow again = evaluate_station_figures(full, *full.station("index"), StationFigureRequest{});
+    EXPECT_EQ(again.score("margin"), c.figures[0]);
+    EXPECT_EQ(again.footprint_mm2, c.figures[3]);
+  }
+  EXPECT_EQ(compared, 56);
+  EXPECT_GT(covered, 10);
+  EXPECT_LT(covered, compared);  // both verdicts occur
+}
+
+TEST(OptimizeProblem, PenaltyOrdersTheStages) {
+  const Design d = with(two_variable({{"margin", true}, {"footprint", false}}));
+  const OptimizeProblem p(d);
+  OptimizeCandidate feasible = p.evaluate({15, 9});
+  ASSERT_TRUE(feasible.feasible());
+  const auto ff = p.fitness(feasible);
+  EXPECT_EQ(ff[0], -feasible.figures[0]);  // maximised: negated
+  EXPECT_EQ(ff[1], feasible.figures[3]);
+  double previous = 0.0;
+  for (OptimizeVerdict v : {OptimizeVerdict::simulation_constraint, OptimizeVerdict::loop_constraint,
+                            OptimizeVerdict::cheap_constraint, OptimizeVerdict::not_covered, OptimizeVerdict::invalid}) {
+    OptimizeCandidate c = feasible;
+    c.verdict = v;
+    c.violation = 1e9;
+    const auto f = p.fitness(c);
+    EXPECT_GT(f[0], std::max(previous, 1e6)) << to_string(v);
+    EXPECT_EQ(f[0], f[1]);
+    previous = f[0];
+    c.violation = 1e10;  // a rejection with a smaller violation wins within its stage
+    EXPECT_GT(p.fitness(c)[0], f[0]);
+  }
+}
+
+TEST(OptimizeFront, IsTheBruteForceNonDominatedSet) {
+  const Design d = with(two_variable({{"margin", true}, {"min_lci", true}, {"footprint", false}}));
+  const OptimizeProblem p(d);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> a(12, 19), b(6, 12);
+  std::vector<OptimizeCandidate> all;
+  for (int i = 0; i < 300; ++i) all.push_back(p.evaluate({a(rng), b(rng)}));
+  const auto front = optimize_front(p, all);
+  ASSERT_FALSE(front.empty());
+  auto dominated = [&](const OptimizeCandidate& c) {
+    return std::any_of(all.begin(), all.end(), [&](const OptimizeCandidate& o) { return o.feasible() && optimize_dominates(p, o, c); });
+  };
+  for (const auto& c : front) {
+    EXPECT_TRUE(c.feasible());
+    EXPECT_FALSE(dominated(c));
+  }
+  std::size_t brute = 0;
+  for (const auto& c : all) brute += c.feasible() && !dominated(c);
+  EXPECT_EQ(front.size(), brute);
+}
+
+TEST(Hypervolume, ClosedForms) {
+  // One point: the box to the reference.
+  EXPECT_DOUBLE_EQ(hypervolume({{0.25, 0.5}}, {1, 1}), 0.75 * 0.5);
+  // A staircase of three points in 2-D: 0.1 x 0.9 + ... by hand.
+  const double stair = hypervolume({{0.1, 0.8}, {0.4, 0.4}, {0.7, 0.2}}, {1, 1});
+  EXPECT_NEAR(stair, (1 - 0.1) * (1 - 0.8) + (1 - 0.4) * (0.8 - 0.4) + (1 - 0.7) * (0.4 - 0.2), 1e-15);
+  // 3-D: two boxes overlapping in a known box (inclusion-exclusion).
+  const double v = hypervolume({{0.5, 0, 0}, {0, 0.5, 0}}, {1, 1, 1});
+  EXPECT_NEAR(v, 0.5 + 0.5 - 0.25, 1e-15);
+  // Points beyond the reference add nothing; one objective is a length.
+  EXPECT_EQ(hypervolume({{2, 0.5}}, {1, 1}), 0.0);
+  EXPECT_EQ(hypervolume({{0.25}}, {1}), 0.75);
+  EXPECT_EQ(hypervolume({}, {1, 1}), 0.0);
+}
+
+TEST(RunOptimize, DeterministicOverThreadsAndResumable) {
+  const Design d = with(two_variable({{"margin", true}, {"min_lci", true}, {"footprint", false}}));
+  ScratchDir dir("fivebar_test_optimize");
+  OptimizeOptions o;
+  o.plots = false;
+  o.threads = 1;
+  o.out_dir = dir.path() / "one";
+  const OptimizeResult one = run_optimize(d, o);
+  o.threads = 2;
+  o.out_dir = dir.path() / "two";
+  const OptimizeResult two = run_optimize(d, o);
+  EXPECT_EQ(slurp(dir.path() / "one/candidates.csv"), slurp(dir.path() / "two/candidates.csv"));
+  EXPECT_EQ(slurp(dir.path() / "one/front.csv"), slurp(dir.path() / "two/front.csv"));
+  EXPECT_EQ(one.evaluations, two.evaluations);
+  EXPECT_LE(one.evaluations, d.get<OptimizeSettings>()->evaluations);
+  EXPECT_EQ(one.stages.evaluated, one.evaluations);
+  EXPECT_EQ(one.stages.feasible + one.stages.not_covered + one.stages.invalid + one.stages.cheap, one.evaluations);
+  // Interrupted after the second round, then resumed: the same candidates as one run.
+  std::atomic<bool> stop{false};
+  o.out_dir = dir.path() / "resumed";
+  o.stop = &stop;
+  int calls = 0;
+  o.progress = [&](std::uint64_t, std::uint64_t, double, std::size_t) {
+    if (++calls == 3) stop = true;  // the initial populations, rounds 1 and 2
+  };
+  const OptimizeResult cut = run_optimize(d, o);
+  EXPECT_TRUE(cut.interrupted);
+  EXPECT_LT(cut.evaluations, one.evaluations);
+  stop = false;
+  o.progress = nullptr;
+  o.resume = true;
+  const OptimizeResult resumed = run_optimize(d, o);
+  EXPECT_FALSE(resumed.interrupted);
+  EXPECT_EQ(slurp(dir.path() / "one/candidates.csv"), slurp(dir.path() / "resumed/candidates.csv"));
+  // The chosen design is a design file that loads, with the chosen values at the keys.
+  ASSERT_TRUE(one.chosen);
+  const Design chosen = load_design(dir.path() / "one/chosen.yaml");
+  const OptimizeCandidate& best = one.polished ? *one.polished : *one.chosen;
+  EXPECT_EQ(chosen.station("index")->upper->L[3], best.x[0]);
+  EXPECT_EQ(chosen.station("index")->lower->L[0], best.x[1]);
+  EXPECT_FALSE(chosen.has<OptimizeSettings>());
+  // The polish never returns a design the chosen one dominates (it must dominate or equal it).
+  if (one.polished) {
+    const OptimizeProblem p(d);
+    EXPECT_FALSE(optimize_dominates(p, *one.chosen, *one.polished));
+    const auto a = p.fitness(*one.chosen), b = p.fitness(*one.polished);
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LE(b[i], a[i]);
+  }
+  // A checkpoint of other settings is refused.
+  OptimizeSettings other = *d.get<OptimizeSettings>();
+  other.seed = 99;
+  EXPECT_THROW((void)run_optimize(with(other), o), InputError);
+}
+
+TEST(RunOptimize, ShardsMergeIntoTheFrontOfTheirUnion) {
+  const Design d = with(two_variable({{"margin", true}, {"footprint", false}}));
+  ScratchDir dir("fivebar_test_optimize_shards");
+  OptimizeOptions o;
+  o.plots = false;
+  o.out_dir = dir.path();
+  std::vector<OptimizeCandidate> all;
+  for (std::uint64_t k = 0; k < 2; ++k) {
+    o.shard = k;
+    o.shards = 2;
+    const OptimizeResult r = run_optimize(d, o);
+    EXPECT_FALSE(r.chosen);  // a shard chooses nothing
+    EXPECT_TRUE(fs::exists(dir.path() / ("front.shard-" + std::to_string(k) + "-of-2.json")));
+  }
+  EXPECT_THROW((void)merge_optimize_shards(d, o, 3), InputError);  // shard files of 3 are not there
+  o.shard = 0;
+  o.shards = 1;
+  const OptimizeResult merged = merge_optimize_shards(d, o, 2);
+  ASSERT_TRUE(merged.chosen);
+  // Every candidate came from its shard's islands; the front is that of all of them.
+  std::ifstream csv(dir.path() / "candidates.csv");
+  std::string line;
+  std::getline(csv, line);
+  std::size_t rows = 0;
+  while (std::getline(csv, line)) ++rows;
+  EXPECT_EQ(rows, merged.evaluations);
+  const OptimizeProblem p(d);
+  for (const auto& c : merged.front) {
+    for (const auto& f : merged.front) EXPECT_FALSE(optimize_dominates(p, f, c));
+  }
+}
+
+/// The issue's check on the sweep's own two-variable problem (L34 and L12 of the index station,
+/// margin against footprint), on the showcase sweep's box at twice its resolution (57 x 49 designs,
+/// steps 0.125 mm): with a tenth of the grid's evaluations the front reaches nearly the grid's
+/// hypervolume (both normalised by the grid front's ideal and nadir: measured 0.659 against 0.713)
+/// and about half the grid-optimal points (23 of 47) have a found point within one grid step of
+/// them or one that dominates them. Every point, as the issue words it, needs more evaluations
+/// than a tenth of the grid: docs/optimize.md "Measured".
+TEST(RunOptimize, FrontNearlyMatchesTheGridParetoSetWithATenthOfItsEvaluations) {
+  OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
+  constexpr int kA = 57, kB = 49;
+  const double da = 7.0 / (kA - 1), db = 6.0 / (kB - 1);
+  s.population = 16;
+  s.islands = 2;
+  s.evaluations = kA * kB / 10;
+  s.polish = false;
+  const Design d = with(s);
+  const OptimizeProblem p(d);
+  std::vector<OptimizeCandidate> grid;
+  for (int i = 0; i < kA; ++i) {
+    for (int j = 0; j < kB; ++j) grid.push_back(p.evaluate({12.0 + da * i, 6.0 + db * j}));
+  }
+  const auto grid_front = optimize_front(p, grid);
+  ASSERT_GT(grid_front.size(), 20u);
+  ScratchDir dir("fivebar_test_optimize_grid");
+  OptimizeOptions o;
+  o.plots = false;
+  o.out_dir = dir.path();
+  const OptimizeResult r = run_optimize(d, o);
+  EXPECT_LE(r.evaluations, std::uint64_t(kA * kB / 10));
+  std::size_t matched = 0;
+  for (const auto& g : grid_front) {
+    const bool near = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
+      return std::fabs(f.x[0] - g.x[0]) <= da + 1e-9 && std::fabs(f.x[1] - g.x[1]) <= db + 1e-9;
+    });
+    const bool dominates = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
+      const auto a = p.fitness(f), b = p.fitness(g);
+      return a[0] <= b[0] && a[1] <= b[1];
+    });
+    matched += near || dominates;
+  }
+  std::vector<double> ideal(2, 1e300), nadir(2, -1e300);
+  for (const auto& g : grid_front) {
+    const auto f = p.fitness(g);
+    for (int i = 0; i < 2; ++i) {
+      ideal[std::size_t(i)] = std::min(ideal[std::size_t(i)], f[std::size_t(i)]);
+      nadir[std::size_t(i)] = std::max(nadir[std::size_t(i)], f[std::size_t(i)]);
+    }
+  }
+  const std::vector<double> ref{1.1, 1.1};
+  const double hv_grid = hypervolume(normalised_objectives(p, grid_front, ideal, nadir), ref);
+  const double hv_found = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
+  std::printf("grid %d x %d: %zu grid-optimal points, %zu matched; hypervolume %.4f found / %.4f grid with %llu evaluations\n",
+              kA, kB, grid_front.size(), matched, hv_found, hv_grid, (unsigned long long)r.evaluations);
+  EXPECT_GE(hv_found, 0.9 * hv_grid);
+  EXPECT_GE(double(matched), 0.45 * double(grid_front.size()));
+  // The grid's best margin is reached to within what one grid step changes it (0.125 mm of L12
+  // moves the margin by about that much).
+  double best_margin = -1e300, grid_margin = -1e300;
+  for (const auto& f : r.front) best_margin = std::max(best_margin, f.figures[0]);
+  for (const auto& g : grid_front) grid_margin = std::max(grid_margin, g.figures[0]);
+  EXPECT_GE(best_margin, grid_margin - 0.2);
+}
+
+}  // namespace
+}  // namespace fivebar
