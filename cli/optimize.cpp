@@ -31,6 +31,7 @@ struct OptimizeCliOptions {
   bool resume = false;
   bool no_plots = false;
   bool no_check = false;
+  bool no_polish = false;
   bool json = false;
 };
 
@@ -71,9 +72,10 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
   if (!design.get<OptimizeSettings>()) {
     throw InputError(o.design + ": the design has no optimize: section (docs/optimize.md shows one)");
   }
-  if (o.seed) {
+  if (o.seed || o.no_polish) {
     OptimizeSettings s = *design.get<OptimizeSettings>();
-    s.seed = *o.seed;
+    if (o.seed) s.seed = *o.seed;
+    if (o.no_polish) s.polish = false;
     design.set(s);
   }
   if (o.evaluations > std::uint64_t(1e9)) throw InputError("--evaluations: must be 1 ... 1e9");
@@ -208,6 +210,7 @@ void setup_optimize(CLI::App& app) {
   sub->add_option("--merge", opt->merge, "Merge the fronts of N finished shards in the output directory")->type_name("N");
   sub->add_flag("--resume", opt->resume, "Continue from the output directory's checkpoint");
   sub->add_flag("--no-plots", opt->no_plots, "Skip the SVG/PNG plots");
+  sub->add_flag("--no-polish", opt->no_polish, "Skip the NLopt polish of the chosen design (optimize.polish: false)");
   sub->add_flag("--no-check", opt->no_check, "Skip the re-check of the chosen design by the coverage, collision and pattern products");
   sub->add_flag("--json", opt->json, "One JSON document on stdout");
   sub->callback([opt] { finish(run_optimize_cmd(*opt)); });

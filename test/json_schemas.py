@@ -121,6 +121,7 @@ def main():
     run("collision pair", "collision", ["collision", DESIGN, "-s", "index", "--upper", "6,18", "--lower", "6,14"], (0, 1))
     run("pattern", "pattern", ["pattern", DESIGN, "-s", "thumb", "--pattern", "twist", "--out", out + "/pat"])
     run("sweep", "sweep", ["sweep", DESIGN, "--no-plots", "--out", out + "/sweep"])
+    run("optimize", "optimize", ["optimize", DESIGN, "--evaluations", "128", "--no-plots", "--out", out + "/optimize"])
     run("parts", "parts", ["parts", DESIGN, "--no-render", "--out", out])
     run("export", "export", ["export", DESIGN, "--out", out + "/export"])
     run("report stability", "report-stability", ["report", "stability", DESIGN, "-s", "index", "-q"])

@@ -374,6 +374,8 @@ std::vector<Case> cases() {
                {"--vary 'L1=abc'", "NAME=LO:HI:N"}});
   c.push_back({"SweepShardOutOfRange", sub({"sweep"}, {"-s", "index", "--vary", "L1=8:10:3", "--shard", "5/2"}), {both},
                {"--shard = '5/2'"}});
+  c.push_back({"OptimizeWithoutSection", sub({"optimize"}, {"--evaluations", "64"}), {both}, {"no optimize: section"}});
+  c.push_back({"OptimizeShardAndMerge", sub({"optimize"}, {"--shard", "0/2", "--merge", "2"}), {both}, {"no optimize: section"}});
   c.push_back({"SweepRandomWithoutCount", sub({"sweep"}, {"-s", "index", "--vary", "L1=8:10:3", "--sample", "random"}), {both},
                {"sweep.count", "required for random sampling"}});
   return c;

@@ -14,6 +14,9 @@
 #include "fivebar/format.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/motor.hpp"
+#include "fivebar/sections/tolerance.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/sweep.hpp"
 
@@ -522,23 +525,46 @@ Json OptimizeStageCounts::to_json() const {
               {"loop_constraint", loop}, {"simulation_constraint", simulation}, {"feasible", feasible}};
 }
 
+OptimizeSettings every_figure_settings(const Design& design, const OptimizeSettings& settings) {
+  OptimizeSettings all = settings;
+  bool pair = false;
+  for (const std::string& n : optimize_station_names(design, settings)) {
+    const Station* st = design.station(n);
+    pair = pair || (st && st->lower && st->upper);
+  }
+  const bool loop = pair && design.get<Geometry>() && design.get<MotorSettings>() && design.get<ControllerSettings>();
+  for (const OptimizeFigure& f : optimize_figures()) {
+    const std::string name(f.name);
+    if (name == "collision" && !(pair && design.get<Geometry>())) continue;
+    if (name == "robust" && !design.get<ToleranceSettings>()) continue;
+    if (f.stage != OptimizeStage::cheap && !loop) continue;
+    if (f.stage == OptimizeStage::simulation && !design.get<PatternSettings>()) continue;
+    all.constraints.push_back({name, true, -1e300});
+  }
+  return all;
+}
+
 std::vector<std::array<std::string, 3>> optimize_comparison(const OptimizeProblem& p, const OptimizeResult& r) {
   std::vector<std::array<std::string, 3>> rows;
-  const OptimizeCandidate* chosen = r.polished ? &*r.polished : r.chosen ? &*r.chosen : nullptr;
+  const OptimizeCandidate* chosen = !r.chosen_full.x.empty() ? &r.chosen_full
+                                    : r.polished             ? &*r.polished
+                                    : r.chosen               ? &*r.chosen
+                                                             : nullptr;
+  const OptimizeCandidate& given = !r.reference_full.x.empty() ? r.reference_full : r.reference;
   const auto& vars = p.settings().variables;
   for (std::size_t d = 0; d < vars.size(); ++d) {
     auto value = [](double v) { return std::isnan(v) ? std::string("-") : format::fixed(v, 4); };
-    rows.push_back({vars[d].name, value(r.reference.x.size() > d ? r.reference.x[d] : kNaN), chosen ? value(chosen->x[d]) : "-"});
+    rows.push_back({vars[d].name, value(given.x.size() > d ? given.x[d] : kNaN), chosen ? value(chosen->x[d]) : "-"});
   }
   const auto& figs = optimize_figures();
   for (std::size_t i = 0; i < figs.size(); ++i) {
-    const double a = r.reference.figures.size() > i ? r.reference.figures[i] : kNaN;
+    const double a = given.figures.size() > i ? given.figures[i] : kNaN;
     const double b = chosen ? chosen->figures[i] : kNaN;
     if (std::isnan(a) && std::isnan(b)) continue;
     auto cell = [](double v) { return std::isnan(v) ? std::string("-") : format::fixed(v, std::fabs(v) >= 100 ? 1 : 4); };
     rows.push_back({std::string(figs[i].name) + (figs[i].unit.empty() ? "" : " (" + std::string(figs[i].unit) + ")"), cell(a), cell(b)});
   }
-  rows.push_back({"verdict", r.reference.status, chosen ? chosen->status : "-"});
+  rows.push_back({"verdict", r.reference.status, r.polished ? r.polished->status : r.chosen ? r.chosen->status : "-"});
   return rows;
 }
 

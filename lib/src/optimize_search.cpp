@@ -50,14 +50,26 @@ unsigned seed32(std::uint64_t seed, std::uint64_t island, std::uint64_t round) {
 
 /// The pagmo user-defined problem: evaluates through OptimizeProblem and logs every candidate in
 /// its island's log (each island is evolved by one thread at a time).
+/// Thrown by an evaluation once the wall-time budget is spent or the stop flag is set: the round
+/// in progress is abandoned (the islands go back to their state before it).
+struct Halt {};
+
+struct Deadline {
+  std::chrono::steady_clock::time_point end;
+  const std::atomic<bool>* stop = nullptr;
+  bool passed() const { return (stop && stop->load()) || std::chrono::steady_clock::now() >= end; }
+};
+
 struct Udp {
   const OptimizeProblem* problem = nullptr;
   std::vector<OptimizeCandidate>* log = nullptr;
   int island = 0;
   std::uint32_t* round = nullptr;
   std::uint64_t* counter = nullptr;
+  const Deadline* deadline = nullptr;
 
   pagmo::vector_double fitness(const pagmo::vector_double& x) const {
+    if (deadline && deadline->passed()) throw Halt{};
     OptimizeCandidate c = problem->evaluate(x);
     c.island = island;
     c.round = *round;
@@ -194,9 +206,10 @@ std::size_t choose(const OptimizeProblem& p, const std::vector<OptimizeCandidate
 /// feasibility and to every objective no worse than the chosen point's, so that the result is
 /// feasible and dominates (or equals) the chosen design.
 std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const OptimizeCandidate& start, const std::vector<double>& ideal,
-                                        const std::vector<double>& nadir, std::uint64_t budget, std::uint64_t& used) {
+                                        const std::vector<double>& nadir, std::uint64_t budget, double seconds,
+                                        const std::atomic<bool>* stop, std::uint64_t& used) {
   const std::size_t n = p.dimension(), m = p.settings().objectives.size();
-  if (budget == 0 || n == 0) return std::nullopt;
+  if (budget == 0 || n == 0 || !(seconds > 0.0) || (stop && stop->load())) return std::nullopt;
   const auto f0 = p.fitness(start);
   std::vector<double> scale(m);
   for (std::size_t i = 0; i < m; ++i) scale[i] = nadir[i] > ideal[i] ? nadir[i] - ideal[i] : 1.0;
@@ -238,6 +251,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
   o.set_initial_step(step);
   o.set_maxeval(int(std::min<std::uint64_t>(budget, 1000000)));
   o.set_xtol_rel(1e-6);
+  o.set_maxtime(seconds);
   o.set_min_objective(
       [](const std::vector<double>& x, std::vector<double>&, void* data) {
         State& s = *static_cast<State*>(data);
@@ -321,7 +335,7 @@ void sort_candidates(std::vector<OptimizeCandidate>& all) {
 
 /// Everything after the search: front, curve, choice, polish, files.
 OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vector<OptimizeCandidate> all,
-                      const OptimizeOptions& options, OptimizeResult r, bool whole_run) {
+                      const OptimizeOptions& options, OptimizeResult r, bool whole_run, double polish_seconds) {
   sort_candidates(all);
   r.stages = {};
   for (const auto& c : all) r.stages.add(c);
@@ -354,7 +368,8 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
   if (!r.front.empty()) {
     r.chosen = r.front[choose(p, r.front, r.ideal, r.nadir)];
     if (p.settings().polish) {
-      r.polished = polish(p, *r.chosen, r.ideal, r.nadir, p.settings().polish_evaluations, r.polish_evaluations);
+      r.polished = polish(p, *r.chosen, r.ideal, r.nadir, p.settings().polish_evaluations, polish_seconds, options.stop,
+                          r.polish_evaluations);
     }
     const OptimizeCandidate& best = r.polished ? *r.polished : *r.chosen;
     Design chosen = p.design_at(best.x);
@@ -363,6 +378,10 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
     chosen.name = name;
     chosen.products.reset();
     r.chosen_design = chosen;
+    // Every figure of the design as given and of the chosen one, for the comparison table.
+    const OptimizeProblem full(design, every_figure_settings(design, p.settings()));
+    r.reference_full = full.evaluate(p.reference_values());
+    r.chosen_full = full.evaluate(best.x);
     const auto yaml = dir / "chosen.yaml";
     std::string header = "# The design chosen by `fivebar optimize` from " +
                          (design.source.empty() ? std::string("design '") + design.name + "'" : design.source.filename().string()) +
@@ -513,7 +532,13 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   std::vector<OptimizeCandidate> all;
   std::uint32_t round = 0;
   double prior_seconds = 0.0;
-  auto problem_of = [&](std::size_t k) { return pagmo::problem(Udp{&p, &logs[k], islands[k], &rounds[k], &counters[k]}); };
+  auto span = [](double seconds) {
+    return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+  };
+  Deadline deadline{t0 + span(seconds_budget), options.stop};
+  auto problem_of = [&](std::size_t k) {
+    return pagmo::problem(Udp{&p, &logs[k], islands[k], &rounds[k], &counters[k], &deadline});
+  };
 
   if (options.resume) {
     std::ifstream in(checkpoint);
@@ -531,6 +556,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     try {
       round = j.at("round").get<std::uint32_t>();
       prior_seconds = j.at("seconds").get<double>();
+      deadline.end -= span(std::min(prior_seconds, seconds_budget));
       for (const Json& c : j.at("candidates")) all.push_back(candidate_from(c));
       const Json& isl = j.at("islands");
       if (isl.size() != n) throw InputError("island count differs");
@@ -559,16 +585,33 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       try {
         pops[k] = pagmo::population(problem_of(k), pagmo::population::size_type(s.population),
                                     seed32(s.seed, std::uint64_t(islands[k]), 0));
+      } catch (const Halt&) {
+        errors[k] = "halt";
       } catch (const std::exception& e) {
         errors[k] = e.what();
       }
     }
+    bool halted = false;
     for (const auto& e : errors) {
-      if (!e.empty()) throw std::runtime_error("optimize: " + e);
+      if (e == "halt") halted = true;
+      else if (!e.empty()) throw std::runtime_error("optimize: " + e);
     }
     for (auto& l : logs) {
       all.insert(all.end(), l.begin(), l.end());
       l.clear();
+    }
+    if (halted) {
+      // Stopped before every island had its first population: the candidates so far are the
+      // result, and there is no state to resume from.
+      if (!(options.stop && options.stop->load())) {
+        throw InputError("optimize: the wall-time budget (optimize.seconds or --seconds: " + format::shortest(seconds_budget) +
+                         " s) ran out before the initial populations were evaluated");
+      }
+      OptimizeResult r;
+      r.algorithm = alg;
+      r.interrupted = true;
+      r.seconds = elapsed();
+      return finish(p, design, std::move(all), options, r, options.shards == 1, 0.0);
     }
   }
   // pagmo's populations hold their own copies of the problem: point them at this run's logs.
@@ -594,6 +637,8 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     }
     ++round;
     std::vector<std::string> errors(n);
+    const std::vector<pagmo::population> before = pops;
+    const std::vector<std::uint64_t> counted = counters;
 #pragma omp parallel for schedule(dynamic, 1) num_threads(std::min<int>(threads, int(n)))
     for (std::size_t k = 0; k < n; ++k) {
       try {
@@ -602,12 +647,26 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
             make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round), s.population,
                                                    p.dimension());
         pops[k] = a.evolve(pops[k]);
+      } catch (const Halt&) {
+        errors[k] = "halt";
       } catch (const std::exception& e) {
         errors[k] = e.what();
       }
     }
+    bool halted = false;
     for (const auto& e : errors) {
-      if (!e.empty()) throw std::runtime_error("optimize: " + e);
+      if (e == "halt") halted = true;
+      else if (!e.empty()) throw std::runtime_error("optimize: " + e);
+    }
+    if (halted) {
+      // The round is abandoned as a whole, so that the checkpoint stays that of the last round.
+      pops = before;
+      counters = counted;
+      for (auto& l : logs) l.clear();
+      --round;
+      if (options.stop && options.stop->load()) r.interrupted = true;
+      else r.budget_time = true;
+      break;
     }
     for (auto& l : logs) {
       all.insert(all.end(), l.begin(), l.end());
@@ -655,7 +714,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   }
   r.rounds = round;
   r.seconds = prior_seconds + elapsed();
-  OptimizeResult out = finish(p, design, std::move(all), options, r, options.shards == 1);
+  OptimizeResult out = finish(p, design, std::move(all), options, r, options.shards == 1, seconds_budget - r.seconds);
   out.files.push_back(checkpoint);
   return out;
 }
@@ -690,7 +749,7 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
   OptimizeOptions whole = options;
   whole.shard = 0;
   whole.shards = 1;
-  return finish(p, design, std::move(all), whole, r, true);
+  return finish(p, design, std::move(all), whole, r, true, options.seconds > 0.0 ? options.seconds : p.settings().seconds);
 }
 
 Json OptimizeResult::to_json(const OptimizeProblem& p) const {

@@ -120,6 +120,22 @@ void limit_control(std::vector<std::string>& args) {
   }
 }
 
+/// `optimize` runs at most 64 candidates and 2 s of wall time (an evaluation past it abandons its
+/// round), without the re-check (a `fivebar run` of the chosen design) and the polish: a design's
+/// own budget may ask for millions of candidates, each simulating every pattern.
+void limit_optimize(std::vector<std::string>& args) {
+  if (args.empty() || args[0] != "optimize") return;
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    if ((args[i] == "--evaluations" || args[i] == "--seconds") && i + 1 < args.size()) args[i + 1] = "";
+  }
+  args.erase(std::remove(args.begin() + 1, args.end(), std::string("")), args.end());
+  args.erase(std::remove_if(args.begin() + 1, args.end(),
+                            [](const std::string& a) { return a == "--evaluations" || a == "--seconds" ||
+                                                              a.starts_with("--evaluations=") || a.starts_with("--seconds="); }),
+             args.end());
+  args.insert(args.begin() + 1, {"--evaluations", "64", "--seconds", "2", "--no-check", "--no-polish"});
+}
+
 /// `run` builds only the cheap products: report (a timing study by design), tolerance (Monte Carlo of
 /// as many devices as the design asks), export (its gate simulates every pattern under the PID and
 /// maps the loop's stability: over a minute per design in this build), collision (the map over
@@ -131,8 +147,8 @@ void limit_control(std::vector<std::string>& args) {
 /// `products:` cannot ask for them either.
 void limit_run_products(std::vector<std::string>& args) {
   if (args.empty() || args[0] != "run") return;
-  static const std::vector<std::string> kExpensive{"report", "sweep", "parts", "workspace", "simulate", "tolerance",
-                                                   "control", "export", "collision"};
+  static const std::vector<std::string> kExpensive{"report", "sweep", "optimize", "parts", "workspace", "simulate",
+                                                   "tolerance", "control", "export", "collision"};
   const auto filtered = [&](const std::string& list) {
     std::vector<std::string> kept;
     std::size_t start = 0;
@@ -245,6 +261,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limit_run_products(args);
   limit_simulate(args);
   limit_control(args);
+  limit_optimize(args);
   std::vector<std::string> storage{"fivebar"};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;

@@ -97,6 +97,10 @@ class OptimizeProblem {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Settings of `design` asking for every figure the design has the data for (each as a constraint
+/// that always holds), for a complete report of one design.
+OptimizeSettings every_figure_settings(const Design& design, const OptimizeSettings& settings);
+
 /// Pareto dominance of two feasible candidates over the problem's objectives.
 bool optimize_dominates(const OptimizeProblem& problem, const OptimizeCandidate& a, const OptimizeCandidate& b);
 /// The non-dominated feasible candidates of `candidates` (stable: earlier first among equals,
@@ -150,6 +154,9 @@ struct OptimizeResult {
   std::optional<OptimizeCandidate> polished;  ///< the polish's result when it improved on chosen
   std::uint64_t polish_evaluations = 0;
   OptimizeCandidate reference;                ///< the design as given
+  /// The design as given and the chosen (or polished) one with every figure the design has the data
+  /// for (the loop and the simulation included), for the comparison table.
+  OptimizeCandidate reference_full, chosen_full;
   std::optional<Design> chosen_design;        ///< polished (or chosen) applied to the design
   std::vector<std::filesystem::path> files;   ///< every file written
   Json to_json(const OptimizeProblem& problem) const;
@@ -177,7 +184,7 @@ OptimizeResult run_optimize_mpi(const Design& design, const OptimizeOptions& opt
 SceneReport recheck_chosen(const Design& chosen, const std::filesystem::path& out_root);
 
 /// Summary table rows comparing the chosen design with the design as given: one row per
-/// variable and per figure, {name, given, chosen}.
+/// variable and per figure (every figure the design has the data for), {name, given, chosen}.
 std::vector<std::array<std::string, 3>> optimize_comparison(const OptimizeProblem& problem, const OptimizeResult& result);
 
 }  // namespace fivebar
