@@ -192,6 +192,10 @@ TEST_F(CliTactors, RunLeavesTheProductsOutAndSaysWhy) {
     ASSERT_NE(pos, std::string::npos) << upper;
     text.erase(pos, std::strlen(upper));
   }
+  // The optimize: section names the upper mechanisms' numbers: without them it goes too.
+  const auto opt = text.find("optimize:\n"), opt_end = text.find("# Skin-deformation patterns");
+  ASSERT_TRUE(opt != std::string::npos && opt_end != std::string::npos);
+  text.erase(opt, opt_end - opt);
   const fs::path lower_only = dir_ / "lower-only.yaml";
   std::ofstream(lower_only) << text;
   const Outcome b = run({"run", lower_only.string(), "--out", out.string(), "--json", "--quiet"});

@@ -27,6 +27,7 @@
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/print.hpp"
+#include "fivebar/sections/optimize.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export.hpp"
@@ -456,6 +457,7 @@ TEST(Gate, NamesMustBeIdentifiersInEveryFormat) {
   Design d = paper();
   d.stations[0].name = "int";
   d.reset<SweepSettings>();
+  d.reset<OptimizeSettings>();
   d.get<ControllerSettings>()->node = "linux";
   for (auto& o : d.get<ControllerSettings>()->overrides) {
     if (o.station == "index") o.station = "int";

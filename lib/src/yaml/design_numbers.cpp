@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <charconv>
+#include <optional>
 #include <cmath>
 #include <string>
 #include <string_view>
@@ -21,7 +22,7 @@ namespace {
 /// Follows `key` from `root`: map keys separated by '.', list indices as [i]. A map key may
 /// itself contain '.' (station names may): the longest key of the map that the path continues
 /// with wins. Returns the node (invalid when the path leads nowhere) and, on failure, why.
-YAML::Node follow(YAML::Node root, std::string_view key, std::string& why) {
+std::optional<YAML::Node> follow(YAML::Node root, std::string_view key, std::string& why) {
   YAML::Node node;
   node.reset(root);
   std::string_view rest = key;
@@ -33,11 +34,11 @@ YAML::Node follow(YAML::Node root, std::string_view key, std::string& why) {
       const auto r = std::from_chars(rest.data() + 1, rest.data() + (close == std::string_view::npos ? 1 : close), i);
       if (close == std::string_view::npos || r.ec != std::errc{} || r.ptr != rest.data() + close) {
         why = "malformed index after '" + walked + "'";
-        return {};
+        return std::nullopt;
       }
       if (!node.IsSequence() || i >= node.size()) {
         why = "'" + walked + "' has no element [" + std::to_string(i) + "]";
-        return {};
+        return std::nullopt;
       }
       node.reset(node[i]);  // rebind: Node::operator= would assign the child into the tree
       walked += std::string(rest.substr(0, close + 1));
@@ -47,13 +48,13 @@ YAML::Node follow(YAML::Node root, std::string_view key, std::string& why) {
     if (!walked.empty()) {
       if (rest.front() != '.') {
         why = "expected '.' or '[' after '" + walked + "'";
-        return {};
+        return std::nullopt;
       }
       rest.remove_prefix(1);
     }
     if (!node.IsMap()) {
       why = "'" + (walked.empty() ? std::string("the design") : walked) + "' is not a map";
-      return {};
+      return std::nullopt;
     }
     std::string best;
     for (const auto& entry : node) {
@@ -66,7 +67,7 @@ YAML::Node follow(YAML::Node root, std::string_view key, std::string& why) {
       const auto end = rest.find_first_of(".[");
       why = "'" + (walked.empty() ? std::string("the design") : walked) + "' has no key '" +
             std::string(rest.substr(0, end)) + "'";
-      return {};
+      return std::nullopt;
     }
     node.reset(node[best]);
     walked += (walked.empty() ? "" : ".") + best;
@@ -87,12 +88,12 @@ bool scalar_number(const YAML::Node& node, double& value) {
 double design_number(const Design& design, std::string_view key) {
   YAML::Node root = YAML::Load(to_yaml(design));
   std::string why;
-  const YAML::Node node = follow(root, key, why);
-  if (!node.IsDefined()) throw ValidationError(std::string(key), "not a key path of the design: " + why);
+  const std::optional<YAML::Node> node = follow(root, key, why);
+  if (!node) throw ValidationError(std::string(key), "not a key path of the design: " + why);
   double v = 0.0;
-  if (!scalar_number(node, v)) {
+  if (!scalar_number(*node, v)) {
     throw ValidationError(std::string(key), "is not a number of the design (the key holds " +
-                                                std::string(node.IsMap() ? "a map" : node.IsSequence() ? "a list" : "text") + ")");
+                                                std::string(node->IsMap() ? "a map" : node->IsSequence() ? "a list" : "text") + ")");
   }
   return v;
 }
@@ -101,12 +102,12 @@ Design with_design_numbers(const Design& design, const std::vector<std::pair<std
   YAML::Node root = YAML::Load(to_yaml(design));
   for (const auto& [key, value] : values) {
     std::string why;
-    YAML::Node node = follow(root, key, why);
+    std::optional<YAML::Node> node = follow(root, key, why);
     double old = 0.0;
-    if (!node.IsDefined() || !scalar_number(node, old)) {
-      throw ValidationError(key, node.IsDefined() ? "is not a number of the design" : "not a key path of the design: " + why);
+    if (!node || !scalar_number(*node, old)) {
+      throw ValidationError(key, node ? "is not a number of the design" : "not a key path of the design: " + why);
     }
-    node = sections::Out::number(value).text;
+    *node = sections::Out::number(value).text;
   }
   YAML::Emitter out;
   out << root;
