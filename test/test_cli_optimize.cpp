@@ -6,7 +6,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
+
 #include "cli_test.hpp"
+#include "fivebar/sweep.hpp"
 
 namespace {
 namespace fs = std::filesystem;
@@ -65,6 +68,24 @@ TEST_F(CliOptimize, ShardsAndMerge) {
   const Outcome missing = run(args(dir_ / "s", {"--merge", "3"}));
   EXPECT_EQ(missing.code, 2);
   EXPECT_THAT(missing.err, HasSubstr("front.shard-0-of-3.json"));
+}
+
+TEST_F(CliOptimize, MpiRunEqualsTheMergedShards) {
+  if (!fivebar::built_with_mpi()) GTEST_SKIP() << "built without MPI (FIVEBAR_WITH_MPI=OFF)";
+  if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun not installed";
+  for (const char* k : {"0/2", "1/2"}) ASSERT_EQ(run(args(dir_ / "s", {"--shard", k, "--no-plots"})).code, 0);
+  ASSERT_EQ(run(args(dir_ / "s", {"--merge", "2", "--no-check", "--no-plots"})).code, 0);
+  std::vector<std::string> a{"--allow-run-as-root", "--oversubscribe", "-n", "2", FIVEBAR_BINARY};
+  const auto mine = args(dir_ / "mpi", {"--no-check", "--no-plots"});
+  a.insert(a.end(), mine.begin(), mine.end());
+  ft::Child mpi = ft::spawn("mpirun", a, dir_, dir_);
+  ASSERT_GT(mpi.pid, 0);
+  const Outcome r = ft::wait(mpi, ft::child_timeout_s(600.0));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);  // one document: only rank 0 prints
+  EXPECT_TRUE(j["mpi"].get<bool>());
+  EXPECT_EQ(ft::slurp(dir_ / "mpi" / "front.csv"), ft::slurp(dir_ / "s" / "front.csv"));
+  EXPECT_EQ(ft::slurp(dir_ / "mpi" / "candidates.csv"), ft::slurp(dir_ / "s" / "candidates.csv"));
 }
 
 TEST_F(CliOptimize, BadInputExitsTwoAndWritesNothing) {
