@@ -229,6 +229,39 @@ TEST(Atlas, InscribedTargetIsWhatCoverageCertifies) {
   }
 }
 
+TEST(Atlas, NoCoveredEllipseOnTheAxisIsLargerThanTheInscribedTarget) {
+  // A reference by brute force with fivebar coverage alone: at a few heights, the largest covered
+  // ellipse of the shape (bisection on coverage().covered); s* is at least the best of them, and
+  // the search's own ellipse is covered. The first design has nearly coincident bases: its
+  // wrong-side region is a sliver near the bases that samples of a large ellipse miss.
+  const TargetShape shape{0.8, 0.0};
+  for (const DesignPoint& p : {DesignPoint{1.4789, 1.4789, 0.0422, 1.0}, DesignPoint{0.8264, 0.8264, 1.3472, 1.0},
+                               DesignPoint{0.9576, 0.2259, 1.8165, 1.0}}) {
+    const Mechanism m = atlas_mechanism(p, {-1, +1}, AssemblyMode::Plus);
+    const InscribedTarget t = inscribed_target(m, shape, quick());
+    ASSERT_EQ(t.status, AtlasStatus::ok);
+    EXPECT_TRUE(coverage(m, t.target).covered) << p.r1 << " " << p.r2 << " " << p.r3;
+    double best = 0.0;
+    const double top = std::sqrt(std::pow(p.r1 + p.r2, 2) - 0.25 * p.r3 * p.r3);
+    for (int k = 0; k < 6; ++k) {
+      const double y = top * (k + 0.5) / 6.0;
+      const auto at = [&](double s) {
+        Ellipse e;
+        e.center = Vec2(0.0, y);
+        e.axes = Vec2(2.0 * s, 2.0 * shape.aspect * s);
+        return e;
+      };
+      double lo = 0.0, hi = p.r1 + p.r2;
+      for (int it = 0; it < 12; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (coverage(m, at(mid)).covered ? lo : hi) = mid;
+      }
+      best = std::max(best, lo);
+    }
+    EXPECT_GE(t.scale, best * (1.0 - 1e-3)) << p.r1 << " " << p.r2 << " " << p.r3;
+  }
+}
+
 TEST(Atlas, TransmissionOnTheAxisMatchesTheKiteByHand) {
   // A tiny target centred on the axis at height y: its transmission is the tactor angle there.
   // By hand: the elbow A1 is where the circles |A - O1| = r1 and |A - P| = r2 meet, outward (the

@@ -159,33 +159,57 @@ class Search {
       const bool slow = w > 0.5 * width;
       width = w;
       s = (slow || !(mlo - mhi > 0.0)) ? lo + 0.5 * w : lo + w * mlo / (mlo - mhi);
+      // Regula falsi homes in on the root itself, where the bounds straddle zero and containment()
+      // falls back to its exact (CGAL) test: probe a quarter of the tolerance beside the estimate
+      // instead, on the side that closes the bracket.
+      s += (side == +1 ? 0.25 : -0.25) * tol * hi;
       const double guard = 1e-3 * w;
       s = std::clamp(s, lo + guard, hi - guard);
     }
     return lo;
   }
 
-  /// Largest s at height y inside the region and on the assembly side; `by` says which bound.
-  /// `certify` false: the assembly side on the samples only (the height search); true: certified.
-  double limit(double y, double tol, bool certify, std::string* by) {
-    const double sc = region_limit(y, tol);
-    if (by) *by = "region";
-    if (sc <= 0.0 || m_.assembly_mode == AssemblyMode::Any) return sc;
-    if (sampled_assembly_ok(m_, ellipse_at(axis_, shape_, y, sc), o_.coverage) &&
-        (!certify || certified_assembly_ok(m_, ellipse_at(axis_, shape_, y, sc), o_.coverage)))
-      return sc;
-    if (by) *by = "assembly";
-    // Bisection on the sampled side, then the certified check (shrinking until it holds).
-    double a = 0.0, b = sc;
+  /// The scale at which the ellipse of this shape centred at height y passes through q.
+  double scale_through(double y, const Vec2& q) const {
+    const Vec2 d = q - (axis_.M + y * axis_.n);
+    const double t = axis_.base_angle() + shape_.angle, c = std::cos(t), s = std::sin(t);
+    const double u = c * d.x() + s * d.y(), v = (-s * d.x() + c * d.y()) / shape_.aspect;
+    return std::hypot(u, v);
+  }
+
+  /// Largest s <= top at height y whose samples are all on the assembly side (bisection), 0 when
+  /// the centre is not.
+  double sampled_limit(double y, double top, double tol) {
+    if (sampled_assembly_ok(m_, ellipse_at(axis_, shape_, y, top), o_.coverage)) return top;
     if (!sampled_assembly_ok(m_, ellipse_at(axis_, shape_, y, 1e-9 * L_), o_.coverage)) return 0.0;
+    double a = 0.0, b = top;
     while (b - a > tol * b) {
       const double mid = 0.5 * (a + b);
       (sampled_assembly_ok(m_, ellipse_at(axis_, shape_, y, mid), o_.coverage) ? a : b) = mid;
     }
+    return a;
+  }
+
+  /// Largest s at height y inside the region and on the assembly side; `by` says which bound.
+  /// `certify` false: the assembly side on the samples only, an upper estimate (a sampled point on
+  /// the wrong side is a real crossing; a crossing between samples can be missed). True: the
+  /// sampled limit is checked by conditioning() (certified); each crossing it reports bounds s
+  /// from above and the sampled bisection runs again below it.
+  double limit(double y, double tol, bool certify, std::string* by) {
+    const double sc = region_limit(y, tol);
+    if (by) *by = "region";
+    if (sc <= 0.0 || m_.assembly_mode == AssemblyMode::Any) return sc;
+    double a = sampled_limit(y, sc, tol);
+    if (a < sc && by) *by = "assembly";
     if (!certify) return a;
-    for (int k = 0; k < 40 && a > 0.0; ++k) {
-      if (certified_assembly_ok(m_, ellipse_at(axis_, shape_, y, a), o_.coverage)) return a;
-      a *= 1.0 - std::ldexp(1.0, -(k + 4));
+    for (int it = 0; it < 60 && a > 0.0; ++it) {
+      CoverageResult r;
+      conditioning(m_, ellipse_at(axis_, shape_, y, a), o_.coverage, r);
+      if (r.assembly_ok && r.decided) return a;
+      if (by) *by = "assembly";
+      const double through = r.assembly_crossing ? scale_through(y, *r.assembly_crossing) : a;
+      // Below the crossing (or, undecided without one, half-way down).
+      a = through < a ? sampled_limit(y, through * (1.0 - tol), tol) : 0.5 * a;
     }
     return 0.0;
   }
@@ -214,18 +238,27 @@ class Search {
         ss.push_back(limit(y, coarse, false, nullptr));
       }
     }
-    const std::size_t best = std::size_t(std::max_element(ss.begin(), ss.end()) - ss.begin());
-    if (!(ss[best] > 0.0)) return finish(out);
-    // Golden section over the two intervals around the best sample, within the scanned range.
+    // The sampled limits bound the certified ones from above: certify the heights in decreasing
+    // order of their sampled limit until none left can beat the best certified one.
+    std::vector<std::size_t> order(ys.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t p, std::size_t q) { return ss[p] > ss[q]; });
+    double yb = 0.0, sb = 0.0;
+    for (const std::size_t k : order) {
+      if (!(ss[k] > sb * (1.0 + coarse))) break;
+      const double c = limit(ys[k], coarse, true, nullptr);
+      if (c > sb) yb = ys[k], sb = c;
+    }
+    if (!(sb > 0.0)) return finish(out);
+    // Golden section (on the sampled limits) over the two intervals around the best height,
+    // within the scanned range; the height found is certified below and kept if it beats yb.
     const double step = span / o_.heights;
-    const double yb = ys[best];
     const double sg = yb < 0.0 ? -1.0 : 1.0;
     double lo = std::max(std::abs(yb) - step, y_lo), hi = std::min(std::abs(yb) + step, y_hi);
     if (sg < 0.0) std::swap(lo, hi), lo = -lo, hi = -hi;
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
     double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
     double f1 = limit(x1, o_.rel_tol, false, nullptr), f2 = limit(x2, o_.rel_tol, false, nullptr);
-    double y_best = yb, s_best = limit(yb, o_.rel_tol, false, nullptr);
     while (hi - lo > o_.rel_tol * span) {
       if (f1 >= f2) {
         hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = limit(x1, o_.rel_tol, false, nullptr);
@@ -233,11 +266,13 @@ class Search {
         lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = limit(x2, o_.rel_tol, false, nullptr);
       }
     }
-    for (const auto& [y, s] : {std::pair{x1, f1}, std::pair{x2, f2}}) {
-      if (s > s_best) y_best = y, s_best = s;
-    }
+    double y_best = f1 >= f2 ? x1 : x2;
     std::string by;
-    s_best = limit(y_best, o_.rel_tol, true, &by);
+    double s_best = limit(y_best, o_.rel_tol, true, &by);
+    if (s_best < sb) {
+      y_best = yb;
+      s_best = limit(y_best, o_.rel_tol, true, &by);
+    }
     if (!(s_best > 0.0)) return finish(out);
     out.status = AtlasStatus::ok;
     out.scale = s_best;
