@@ -310,6 +310,21 @@ Json point_json(const DesignPoint& p) {
 
 Json nullable(bool ok, double v) { return ok ? Json(v) : Json(nullptr); }
 
+double scale_of(const InscribedTarget& f) { return f.scale; }
+double lci_of(const InscribedTarget& f) { return f.min_lci; }
+double transmission_of(const InscribedTarget& f) { return f.min_transmission_sin; }
+
+/// The cell of largest `value` among those with a workspace and s* >= min_scale (nullptr if none).
+template <class Value>
+const AtlasCell* best_cell(const Atlas& a, Value value, double min_scale) {
+  const AtlasCell* top = nullptr;
+  for (const AtlasCell& c : a.cells) {
+    if (c.figures.status != AtlasStatus::ok || c.figures.scale < min_scale) continue;
+    if (!top || value(c.figures) > value(top->figures)) top = &c;
+  }
+  return top;
+}
+
 }  // namespace
 
 // --- Design space ---------------------------------------------------------------------------------
@@ -511,22 +526,29 @@ Json to_json(const Atlas& a) {
   j["counts"] = {{"ok", a.count(AtlasStatus::ok)},
                  {"no_workspace", a.count(AtlasStatus::no_workspace)},
                  {"outside", a.count(AtlasStatus::outside)}};
-  Json best = Json::object();
-  const auto best_of = [&](const char* key, auto value) {
-    const AtlasCell* top = nullptr;
-    for (const AtlasCell& c : a.cells)
-      if (c.figures.status == AtlasStatus::ok && (!top || value(c.figures) > value(top->figures))) top = &c;
+  const auto best_of = [&](Json& into, const char* key, auto value, double min_scale) {
+    const AtlasCell* top = best_cell(a, value, min_scale);
     if (!top) {
-      best[key] = nullptr;
+      into[key] = nullptr;
       return;
     }
-    best[key] = {{"value", value(top->figures)}, {"point", point_json(top->point)},
+    into[key] = {{"value", value(top->figures)}, {"point", point_json(top->point)},
                  {"chart", {top->chart.x(), top->chart.y()}}};
   };
-  best_of("inscribed_scale_D", [](const InscribedTarget& f) { return f.scale; });
-  best_of("min_lci", [](const InscribedTarget& f) { return f.min_lci; });
-  best_of("min_transmission_sin", [](const InscribedTarget& f) { return f.min_transmission_sin; });
+  Json best = Json::object();
+  best_of(best, "inscribed_scale_D", scale_of, 0.0);
+  best_of(best, "min_lci", lci_of, 0.0);
+  best_of(best, "min_transmission_sin", transmission_of, 0.0);
   j["best"] = best;
+  if (a.station) {
+    // Among the designs whose inscribed target holds the station's own (s* >= its scale).
+    Json holding = Json::object();
+    best_of(holding, "min_lci", lci_of, a.station->target_scale);
+    best_of(holding, "min_transmission_sin", transmission_of, a.station->target_scale);
+    j["best_holding_station_target"] = holding;
+  } else {
+    j["best_holding_station_target"] = nullptr;
+  }
   if (a.station) {
     const AtlasStation& s = *a.station;
     const bool ok = s.figures.status == AtlasStatus::ok;
@@ -573,17 +595,20 @@ std::vector<std::string> summary_lines(const Atlas& a) {
                 " s; target aspect " + fixed(o.shape.aspect, 3) + " at " + fixed(angle_deg(o.shape.angle), 1) +
                 " deg, working mode " + to_string(o.working_mode) + ", assembly " + to_string(o.assembly_mode) +
                 "; LCI and transmission over " + fixed(o.fraction, 2) + " of the inscribed target");
-  const auto best_line = [&](const char* what, auto value, int digits) {
-    const AtlasCell* top = nullptr;
-    for (const AtlasCell& c : a.cells)
-      if (c.figures.status == AtlasStatus::ok && (!top || value(c.figures) > value(top->figures))) top = &c;
+  const auto best_line = [&](const std::string& what, auto value, double min_scale) {
+    const AtlasCell* top = best_cell(a, value, min_scale);
     if (!top) return;
-    out.push_back(std::string(what) + " " + fixed(value(top->figures), digits) + " at (r1, r2, r3) = (" +
-                  fixed(top->point.r1, 3) + ", " + fixed(top->point.r2, 3) + ", " + fixed(top->point.r3, 3) + ")");
+    out.push_back(what + " " + fixed(value(top->figures), 4) + " at (r1, r2, r3) = (" + fixed(top->point.r1, 3) +
+                  ", " + fixed(top->point.r2, 3) + ", " + fixed(top->point.r3, 3) + ")");
   };
-  best_line("largest inscribed target: s* (semi-major) =", [](const InscribedTarget& f) { return f.scale; }, 4);
-  best_line("best conditioning: min LCI", [](const InscribedTarget& f) { return f.min_lci; }, 4);
-  best_line("best transmission: min |sin| of the tactor angle", [](const InscribedTarget& f) { return f.min_transmission_sin; }, 4);
+  best_line("largest inscribed target: s* (semi-major) =", scale_of, 0.0);
+  best_line("best conditioning: min LCI", lci_of, 0.0);
+  best_line("best transmission: min |sin| of the tactor angle", transmission_of, 0.0);
+  if (a.station) {
+    const std::string among = " among the designs that hold the station's target (s* >= " + fixed(a.station->target_scale, 4) + "):";
+    best_line("best conditioning" + among + " min LCI", lci_of, a.station->target_scale);
+    best_line("best transmission" + among, transmission_of, a.station->target_scale);
+  }
   if (a.station) {
     const AtlasStation& s = *a.station;
     std::string line = "station " + s.station + " (" + s.mechanism + "): (r1, r2, r3) = (" + fixed(s.point.r1, 3) +

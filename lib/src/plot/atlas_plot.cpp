@@ -60,21 +60,23 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
   };
   const double n = double(figures.size());
   const double width = kLeft + n * kPanelW + (n - 1.0) * kGap + 30.0;
-  const double height = kTop + kPanelH + 150.0;
+  const double height = kTop + kPanelH + 140.0;
   Canvas canvas(width, height);
   cairo_t* cr = canvas.cr();
   const AtlasOptions& o = atlas.options;
   text(cr, kLeft, 28.0, "Performance atlas of the symmetric five-bar", 19.0, kInk, 0.0, true);
-  text(cr, kLeft, 50.0,
-       "D = (L1 + L3 + b) / 3, r1 = L1/D, r2 = L3/D, r3 = b/D (b: base spacing), r1 + r2 + r3 = 3. Target: aspect " +
-           fmt("%.3f", o.shape.aspect) + ", major axis at " + fmt("%.1f", o.shape.angle * 180.0 / std::numbers::pi) +
-           " deg to the base line, centred on the symmetry axis at its best height; working mode " +
-           to_string(o.working_mode) + ", assembly " + to_string(o.assembly_mode) + ".",
+  text(cr, kLeft, 48.0,
+       "D = (L1 + L3 + b) / 3, r1 = L1/D, r2 = L3/D, r3 = b/D (b: base spacing), r1 + r2 + r3 = 3; designs of one "
+       "shape and different sizes are one point.",
        11.5, kInk);
-  text(cr, kLeft, 68.0,
-       subtitle.empty() ? "grid of " + std::to_string(atlas.nx) + " x " + std::to_string(atlas.ny) + " designs"
-                        : subtitle,
-       11.0, kGrey);
+  text(cr, kLeft, 64.0,
+       "Target: aspect " + fmt("%.3f", o.shape.aspect) + ", major axis at " +
+           fmt("%.1f", o.shape.angle * 180.0 / std::numbers::pi) +
+           " deg to the base line, centred on the symmetry axis at its best height; working mode " +
+           to_string(o.working_mode) + ", assembly " + to_string(o.assembly_mode) + ", no joint limits.",
+       11.5, kInk);
+  const std::string grid = std::to_string(atlas.cells.size() - atlas.count(AtlasStatus::outside)) + " designs";
+  text(cr, kLeft, 80.0, subtitle.empty() ? grid : subtitle + " — " + grid, 11.0, kGrey);
 
   const std::array<double, 4> bounds{-kSqrt3 - 0.12, -0.22, kSqrt3 + 0.12, 3.12};
   for (std::size_t k = 0; k < figures.size(); ++k) {
@@ -91,6 +93,8 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       if (std::isfinite(v) && (!top || v > hi)) hi = v, top = &c;
     }
     const auto colour = [&](double v) { return ramp_colour(hi > 0.0 ? v / hi : 0.0); };
+    // Designs whose inscribed target is smaller than the station's own target are veiled.
+    const double veil = atlas.station ? atlas.station->target_scale : 0.0;
     // The cells as one raster (one pixel per cell, drawn nearest), clipped to the triangle.
     if (atlas.nx > 0 && atlas.ny > 0) {
       cairo_surface_t* img = cairo_image_surface_create(CAIRO_FORMAT_ARGB32, atlas.nx, atlas.ny);
@@ -98,16 +102,24 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       unsigned char* data = cairo_image_surface_get_data(img);
       const int stride = cairo_image_surface_get_stride(img);
       const auto byte = [](double v) { return std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+      const auto cell_colour = [&](const AtlasCell& c) {
+        Rgb rgb = c.figures.status == AtlasStatus::ok ? colour(fig.value(c.figures)) : kNoWorkspace;
+        if (veil && c.figures.status == AtlasStatus::ok && c.figures.scale < veil) {
+          rgb = {0.55 * rgb.r + 0.45, 0.55 * rgb.g + 0.45, 0.55 * rgb.b + 0.45};
+        }
+        return rgb;
+      };
       for (int j = 0; j < atlas.ny; ++j) {
         auto* row = reinterpret_cast<std::uint32_t*>(data + std::ptrdiff_t(atlas.ny - 1 - j) * stride);
         for (int i = 0; i < atlas.nx; ++i) {
-          const AtlasCell& c = atlas.at(i, j);
-          if (c.figures.status == AtlasStatus::outside) {
-            // Off the triangle: transparent.
-            row[i] = 0u;
-            continue;
+          // A cell off the triangle takes its row's nearest design (the raster is clipped to the
+          // triangle, whose edges cut through cells): no gaps along the edges.
+          int from = -1;
+          for (int d = 0; d < atlas.nx && from < 0; ++d) {
+            for (int q : {i - d, i + d})
+              if (from < 0 && q >= 0 && q < atlas.nx && atlas.at(q, j).figures.status != AtlasStatus::outside) from = q;
           }
-          const Rgb rgb = c.figures.status == AtlasStatus::ok ? colour(fig.value(c.figures)) : kNoWorkspace;
+          const Rgb rgb = from < 0 ? kNoWorkspace : cell_colour(atlas.at(from, j));
           row[i] = 0xFF000000u | (byte(rgb.r) << 16) | (byte(rgb.g) << 8) | byte(rgb.b);
         }
       }
@@ -155,6 +167,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
     // Best cell and the station.
     if (top) {
       const auto p = panel.px(top->chart);
+      cairo_new_path(cr);
       cairo_arc(cr, p[0], p[1], 5.0, 0.0, 2.0 * std::numbers::pi);
       set_colour(cr, Rgb{1.0, 1.0, 1.0});
       cairo_set_line_width(cr, 2.0);
@@ -163,6 +176,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
     if (atlas.station) {
       const AtlasStation& s = *atlas.station;
       const auto p = panel.px(s.chart);
+      cairo_new_path(cr);
       cairo_set_line_width(cr, 3.6);
       set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.9);
       cairo_move_to(cr, p[0] - 7, p[1] - 7);
@@ -208,22 +222,41 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       const AtlasStation& s = *atlas.station;
       const bool ok = s.figures.status == AtlasStatus::ok;
       text(cr, x0, by + 60.0,
-           "station " + s.station + " (cross) at (" + fmt("%.3f", s.point.r1) + ", " + fmt("%.3f", s.point.r2) + ", " +
-               fmt("%.3f", s.point.r3) + "), D = " + fmt("%.2f", s.point.D_mm) + " mm: " +
-               (ok ? fmt("%.4f", fig.value(s.figures)) : std::string("no workspace")),
+           "station " + s.station + " (cross): " + (ok ? fmt("%.4f", fig.value(s.figures)) : std::string("no workspace")),
            11.0, kInk, 0.0, true);
-      if (k == 0 && ok) {
+      if (k == 0) {
         text(cr, x0, by + 78.0,
-             "its own target: " + fmt("%.4f", s.target_scale) + " D (" + fmt("%.1f", 100.0 * s.target_scale / s.figures.scale) +
-                 " % of s*); s* = " + fmt("%.2f", s.figures.scale * s.point.D_mm) + " mm, limited by the " +
-                 s.figures.limited_by,
+             "at (r1, r2, r3) = (" + fmt("%.3f", s.point.r1) + ", " + fmt("%.3f", s.point.r2) + ", " +
+                 fmt("%.3f", s.point.r3) + "), D = " + fmt("%.2f", s.point.D_mm) + " mm",
              10.5, kInk);
-      }
-      if (k == 1) {
-        text(cr, x0, by + 78.0, "over its own target: min LCI " + fmt("%.4f", s.target_min_lci), 10.5, kInk);
-      }
-      if (k == 2) {
-        text(cr, x0, by + 78.0, "over its own target: " + fmt("%.4f", s.target_min_transmission_sin), 10.5, kInk);
+        if (ok) {
+          text(cr, x0, by + 96.0,
+               "its own target: " + fmt("%.4f", s.target_scale) + " D (" +
+                   fmt("%.1f", 100.0 * s.target_scale / s.figures.scale) + " % of s*); s* = " +
+                   fmt("%.2f", s.figures.scale * s.point.D_mm) + " mm, limited by the " + s.figures.limited_by,
+               10.5, kInk);
+        }
+        text(cr, x0, by + 114.0,
+             "veiled: designs whose s* is below the station's target (" + fmt("%.4f", s.target_scale) + " D)", 10.0,
+             kGrey);
+      } else {
+        text(cr, x0, by + 78.0,
+             std::string("over its own target: ") + (k == 1 ? "min LCI " : "") +
+                 fmt("%.4f", k == 1 ? s.target_min_lci : s.target_min_transmission_sin),
+             10.5, kInk);
+        // The best design that holds the station's target.
+        const AtlasCell* held = nullptr;
+        for (const AtlasCell& c : atlas.cells) {
+          if (c.figures.status != AtlasStatus::ok || c.figures.scale < s.target_scale) continue;
+          if (!held || fig.value(c.figures) > fig.value(held->figures)) held = &c;
+        }
+        if (held) {
+          text(cr, x0, by + 96.0,
+               "best holding its target: " + fmt("%.4f", fig.value(held->figures)) + " at (" +
+                   fmt("%.3f", held->point.r1) + ", " + fmt("%.3f", held->point.r2) + ", " +
+                   fmt("%.3f", held->point.r3) + ")",
+               10.5, kInk);
+        }
       }
     } else if (!atlas.station_note.empty() && k == 0) {
       text(cr, x0, by + 60.0, atlas.station_note, 10.0, kGrey);
