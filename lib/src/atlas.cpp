@@ -85,13 +85,6 @@ bool sampled_assembly_ok(const Mechanism& m, const Ellipse& e, const CoverageOpt
   return true;
 }
 
-/// Certified assembly side over the filled ellipse (which must be inside the region).
-bool certified_assembly_ok(const Mechanism& m, const Ellipse& e, const CoverageOptions& o) {
-  CoverageResult r;
-  conditioning(m, e, o, r);
-  return r.assembly_ok && r.decided;
-}
-
 /// Smallest |sin| of the tactor angle over the samples of the filled ellipse (0 where a sample is
 /// unreachable or singular), and where.
 std::pair<double, Vec2> min_transmission(const Mechanism& m, const Ellipse& e, const CoverageOptions& o) {

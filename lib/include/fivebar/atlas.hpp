@@ -27,22 +27,32 @@
 ///     the symmetry axis at c = M + y n (M the bases' midpoint, n the unit normal left of O1 -> O2),
 ///     that the mechanism covers: inside the reachable region (containment(), certified) and on the
 ///     design's assembly side over the whole filled ellipse (conditioning(), certified), maximised
-///     over the height y. For a circle (beta = 1) s* is Liu's maximal inscribed circle radius.
+///     over the height y. For a circle (beta = 1) s* is the radius of the largest inscribed circle
+///     centred on the axis, the counterpart of the 2006 paper's maximal inscribed circle.
 ///     - For a fixed centre the scaled ellipses are nested, so both verdicts are monotone in s.
 ///       The signed margin m(s) (containment().margin_mm) is non-increasing and 1-Lipschitz in s
-///       (a boundary point c + s u(t) has |u| <= 1), so with s0 tiny and m0 = m(s0):
-///       s0 + m0 is inside up to rounding and (s0 + m0) / beta is outside (the ellipse holds the disk
-///       of radius beta s). s_c, the root of m, is bracketed there and found by regula falsi
+///       (a boundary point c + s u(t) has |u| <= 1), so with s0 tiny and m0 = m(s0), s0 + m0 is
+///       inside up to rounding and (s0 + m0) / beta is outside (the ellipse holds the disk of
+///       radius beta s). s_c, the root of m, is bracketed there and found by regula falsi
 ///       (Illinois) with a bisection step whenever the bracket does not halve, each side of the
-///       bracket fixed by the certified verdict, to a width of rel_tol s.
-///     - The assembly side: when the filled ellipse at s_c is not certified on the design's side,
-///       a bisection on s over the sign of cross(P - A1, P - A2) at rings x angles samples of the
-///       filled ellipse (conditioning_batch()) finds the sampled limit, and the certified check
-///       then accepts it or halves the step until it holds.
-///     - The height: side = +1 (assembly "+"), -1 ("-"), both (any); y over (0, y_max],
-///       y_max = sqrt((r1 + r2)^2 - (r3/2)^2) (the outer circles meet on the axis there), scanned
-///       at `heights` points, then golden-section search on the two intervals around the best
-///       sample (s*(y) is a minimum of piecewise smooth functions: the scan finds the basin).
+///       bracket fixed by the certified verdict, to a width of rel_tol s. Each probe is a quarter
+///       of that width beside the falsi estimate, so that no probe lands within rounding of the
+///       boundary (where containment() would fall back to its exact CGAL test).
+///     - The assembly side: a bisection on s over the sign of cross(P - A1, P - A2) at rings x
+///       angles samples of the filled ellipse (conditioning_batch()) gives the sampled limit, an
+///       upper bound of the true one (a sample on the wrong side is a real crossing; a thin
+///       wrong-side sliver between samples can be missed). The certified check (conditioning())
+///       then accepts it, or reports a crossing q, which bounds s from above (the scale of the
+///       ellipse through q), and the sampled bisection runs again below it.
+///     - The height: side = +1 (assembly "+"), -1 ("-"), both (any). On the axis both bases are at
+///       d(y) = sqrt(y^2 + (b/2)^2) and the centre is in both annuli for r_in <= d <= r_out
+///       (r_in = max |L1 - L3|, |L2 - L4|; r_out = min L1 + L3, L2 + L4): an interval of |y|,
+///       scanned at `heights` points with the sampled limits. Those bound the certified limits
+///       from above, so the heights are certified in decreasing order of their sampled limit until
+///       no remaining one can beat the best certified (branch and bound). A golden-section search
+///       (sampled limits) over the two scan intervals around that height refines it, and the
+///       refined height is kept when its certified limit is at least the scan's best. s*(y) is a
+///       minimum of piecewise smooth functions: the scan finds the basin, the search its top.
 /// (b) Conditioning: min LCI over the concentric ellipse of semi-major fraction * s*. Over the
 ///     inscribed target itself it is 0 by construction: its boundary touches a leg circle (a type I
 ///     singularity) or the assembly boundary (type II). Measured by conditioning() (sampled and
@@ -177,8 +187,10 @@ Atlas performance_atlas(const AtlasOptions& options = {});
 /// mechanism is not symmetric gets the atlas of `options` and a note instead of a mark.
 Atlas performance_atlas(const Station& station, AtlasOptions options = {});
 
-/// JSON with units at the edges: options, cell counts by status, the best cell of each figure,
-/// the station (null when not on the chart, with the note).
+/// JSON: normalisation, grid, shape, modes, fraction, cell counts by status, the best cell of each
+/// figure (`best`) and, with a station, the best cells whose s* holds the station's own target
+/// (`best_holding_station_target`), the station (null when not on the chart; `station_note` says
+/// why), the wall time.
 Json to_json(const Atlas& atlas);
 /// Human-readable lines: the grid and its time, the best cells, where the station sits.
 std::vector<std::string> summary_lines(const Atlas& atlas);
