@@ -53,6 +53,25 @@ double largest_circle(double r1, double r2, double r3) {
   return std::max(0.0, std::min(d - std::abs(r2 - r1), r1 + r2 - d));
 }
 
+/// The rules of docs/conventions.md "JSON documents" (docs/schemas/common.schema.json) that a
+/// product's result must keep: "station" a name or null, "mechanism" lower, upper or null, no key
+/// "lower" or "upper", "stations" and "mechanisms" arrays.
+void expect_json_conventions(const Json& j, const std::string& at = "$") {
+  if (j.is_array()) {
+    for (std::size_t k = 0; k < j.size(); ++k) expect_json_conventions(j[k], at + "[" + std::to_string(k) + "]");
+    return;
+  }
+  if (!j.is_object()) return;
+  for (const auto& [key, value] : j.items()) {
+    EXPECT_NE(key, "lower") << at;
+    EXPECT_NE(key, "upper") << at;
+    if (key == "station") EXPECT_TRUE(value.is_string() || value.is_null()) << at;
+    if (key == "mechanism") EXPECT_TRUE(value.is_null() || value == "lower" || value == "upper") << at;
+    if (key == "stations" || key == "mechanisms") EXPECT_TRUE(value.is_array()) << at;
+    expect_json_conventions(value, at + "." + key);
+  }
+}
+
 TEST(Atlas, ChartIsTheTriangleAndRoundTrips) {
   std::mt19937_64 rng(testing::test_seed());
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -372,6 +391,7 @@ TEST(Atlas, GridStatusesThreadsAndFiles) {
   const Json j = Json::parse(testing::slurp(dir.path() / "atlas" / "family.json"));
   EXPECT_EQ(j["counts"]["ok"].get<std::size_t>(), one.count(AtlasStatus::ok));
   EXPECT_TRUE(j["station"].is_null());
+  expect_json_conventions(j);
   EXPECT_THROW(atlas_files(one, "../escape"), InputError);
 }
 
@@ -395,7 +415,10 @@ TEST(Atlas, StationIsMarkedWithItsOwnFigures) {
   EXPECT_TRUE(st.target_covered);  // the paper's target is covered (fivebar coverage)
   EXPECT_GT(st.target_min_lci, 0.0);
   const Json j = to_json(a);
-  EXPECT_EQ(j["station"]["station"], "index");
+  expect_json_conventions(j);
+  EXPECT_EQ(j["station"], "index");
+  EXPECT_EQ(j["mechanism"], "lower");
+  EXPECT_NEAR(j["station_figures"]["inscribed_semi_major_mm"].get<double>(), direct.scale, 1e-3 * direct.scale);
   const auto lines = summary_lines(a);
   ASSERT_GE(lines.size(), 3u);
   EXPECT_NE(lines.back().find("own target: covered"), std::string::npos) << lines.back();

@@ -549,9 +549,10 @@ Json to_json(const Atlas& a) {
     for (const AtlasCell& c : a.cells)
       if (c.figures.status == AtlasStatus::ok && c.figures.scale < s.figures.scale) ++below;
     const std::size_t with = a.count(AtlasStatus::ok);
-    j["station"] = {
-        {"station", s.station},
-        {"mechanism", s.mechanism},
+    // "station" and "mechanism" name them (docs/conventions.md "JSON documents"); the figures follow.
+    j["station"] = s.station;
+    j["mechanism"] = s.mechanism;
+    j["station_figures"] = {
         {"status", std::string(to_string(s.figures.status))},
         {"point", point_json(s.point)},
         {"D_mm", s.point.D_mm},
@@ -572,6 +573,8 @@ Json to_json(const Atlas& a) {
     };
   } else {
     j["station"] = nullptr;
+    j["mechanism"] = nullptr;
+    j["station_figures"] = nullptr;
   }
   j["station_note"] = a.station_note;
   j["seconds"] = a.seconds;

@@ -189,8 +189,9 @@ Atlas performance_atlas(const Station& station, AtlasOptions options = {});
 
 /// JSON: normalisation, grid, shape, modes, fraction, cell counts by status, the best cell of each
 /// figure (`best`) and, with a station, the best cells whose s* holds the station's own target
-/// (`best_holding_station_target`), the station (null when not on the chart; `station_note` says
-/// why), the wall time.
+/// (`best_holding_station_target`), `station` and `mechanism` (names, null when no station is
+/// marked; `station_note` says why) with `station_figures`, the wall time. The shapes follow
+/// docs/conventions.md "JSON documents" (schemas/common.schema.json).
 Json to_json(const Atlas& atlas);
 /// Human-readable lines: the grid and its time, the best cells, where the station sits.
 std::vector<std::string> summary_lines(const Atlas& atlas);
