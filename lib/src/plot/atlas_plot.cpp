@@ -104,7 +104,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       const auto byte = [](double v) { return std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
       const auto cell_colour = [&](const AtlasCell& c) {
         Rgb rgb = c.figures.status == AtlasStatus::ok ? colour(fig.value(c.figures)) : kNoWorkspace;
-        if (veil && c.figures.status == AtlasStatus::ok && c.figures.scale < veil) {
+        if (veil > 0.0 && c.figures.status == AtlasStatus::ok && c.figures.scale < veil) {
           rgb = {0.55 * rgb.r + 0.45, 0.55 * rgb.g + 0.45, 0.55 * rgb.b + 0.45};
         }
         return rgb;
