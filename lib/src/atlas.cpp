@@ -132,9 +132,10 @@ class Search {
       hi *= 2.0;
       if (k > 60) return lo;
     }
-    // First try the Lipschitz step s0 + m0 (exact for a circle), then Illinois regula falsi.
-    double s = std::min(s0 + m0, 0.5 * (lo + hi));
-    if (s <= lo) s = 0.5 * (lo + hi);
+    // First the Lipschitz step: m(s0 + m0 - d) >= d, so just below s0 + m0 is certainly inside (and
+    // for a circle the bracket is then closed); then Illinois regula falsi.
+    double s = (s0 + m0) * (1.0 - 0.25 * tol);
+    if (!(s > lo && s < hi)) s = 0.5 * (lo + hi);
     int side = 0;  // last side moved: +1 lo, -1 hi
     double width = hi - lo;
     for (int it = 0; it < 200 && hi - lo > tol * hi; ++it) {
