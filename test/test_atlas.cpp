@@ -424,6 +424,29 @@ TEST(Atlas, StationIsMarkedWithItsOwnFigures) {
   ASSERT_GE(lines.size(), 3u);
   EXPECT_NE(lines.back().find("own target: covered"), std::string::npos) << lines.back();
 
+  // A mark: another design on the same chart, its figures those of its point.
+  Atlas marked = a;
+  ASSERT_TRUE(add_mark(marked, "thumb", paper_mechanism("thumb", "lower")));
+  ASSERT_EQ(marked.marks.size(), 1u);
+  const auto thumb = design_point(paper_mechanism("thumb", "lower"));
+  EXPECT_NEAR(marked.marks[0].point.r2, thumb->r2, 1e-12);
+  DesignPoint unit = *thumb;
+  unit.D_mm = 1.0;
+  const InscribedTarget at_thumb =
+      inscribed_target(atlas_mechanism(unit, {-1, +1}, AssemblyMode::Plus), a.options.shape, quick(5));
+  EXPECT_EQ(marked.marks[0].figures.scale, at_thumb.scale);
+  Mechanism bent = paper_mechanism("thumb", "lower");
+  bent.L[0] = 9.5;
+  std::string why;
+  EXPECT_FALSE(add_mark(marked, "bent", bent, &why));
+  EXPECT_NE(why.find("not symmetric"), std::string::npos);
+  const Json jm = to_json(marked);
+  expect_json_conventions(jm);
+  ASSERT_EQ(jm["marks"].size(), 1u);
+  EXPECT_EQ(jm["marks"][0]["label"], "thumb");
+  EXPECT_NE(summary_lines(marked).back().find("mark thumb"), std::string::npos);
+  EXPECT_FALSE(plot_atlas(marked).png.empty());
+
   // Only the upper mechanism: mirrored, the same point and figure.
   Station up = s;
   up.lower.reset();

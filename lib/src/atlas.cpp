@@ -505,6 +505,21 @@ Atlas performance_atlas(const Station& station, AtlasOptions options) {
   return a;
 }
 
+bool add_mark(Atlas& atlas, const std::string& label, const Mechanism& m, std::string* why) {
+  const std::optional<DesignPoint> point = design_point(m, why);
+  if (!point) return false;
+  AtlasMark mark;
+  mark.label = label;
+  mark.point = *point;
+  mark.chart = chart_of(*point);
+  DesignPoint unit = *point;
+  unit.D_mm = 1.0;
+  const AtlasOptions& o = atlas.options;
+  mark.figures = inscribed_target(atlas_mechanism(unit, o.working_mode, o.assembly_mode), o.shape, o);
+  atlas.marks.push_back(std::move(mark));
+  return true;
+}
+
 // --- Outputs ----------------------------------------------------------------------------------------
 
 Json to_json(const Atlas& a) {
@@ -578,6 +593,20 @@ Json to_json(const Atlas& a) {
     j["station_figures"] = nullptr;
   }
   j["station_note"] = a.station_note;
+  Json marks = Json::array();
+  for (const AtlasMark& m : a.marks) {
+    const bool ok = m.figures.status == AtlasStatus::ok;
+    marks.push_back({{"label", m.label},
+                     {"status", std::string(to_string(m.figures.status))},
+                     {"point", point_json(m.point)},
+                     {"D_mm", m.point.D_mm},
+                     {"chart", {m.chart.x(), m.chart.y()}},
+                     {"inscribed_scale_D", nullable(ok, m.figures.scale)},
+                     {"inscribed_semi_major_mm", nullable(ok, m.figures.scale * m.point.D_mm)},
+                     {"min_lci", nullable(ok, m.figures.min_lci)},
+                     {"min_transmission_sin", nullable(ok, m.figures.min_transmission_sin)}});
+  }
+  j["marks"] = marks;
   j["seconds"] = a.seconds;
   return j;
 }
@@ -628,6 +657,17 @@ std::vector<std::string> summary_lines(const Atlas& a) {
     out.push_back("station " + s.station + " own target: " + (s.target_covered ? "covered" : "NOT covered") +
                   ", min LCI " + fixed(s.target_min_lci, 4) + ", transmission " +
                   fixed(s.target_min_transmission_sin, 4));
+  }
+  for (const AtlasMark& m : a.marks) {
+    std::string line = "mark " + m.label + ": (r1, r2, r3) = (" + fixed(m.point.r1, 3) + ", " + fixed(m.point.r2, 3) +
+                       ", " + fixed(m.point.r3, 3) + "), D = " + fixed(m.point.D_mm, 3) + " mm: ";
+    if (m.figures.status == AtlasStatus::ok) {
+      line += "s* = " + fixed(m.figures.scale, 4) + " D = " + fixed(m.figures.scale * m.point.D_mm, 3) +
+              " mm, min LCI " + fixed(m.figures.min_lci, 4) + ", transmission " + fixed(m.figures.min_transmission_sin, 4);
+    } else {
+      line += "no workspace on the design's side";
+    }
+    out.push_back(line);
   }
   if (!a.station_note.empty()) out.push_back("note: " + a.station_note);
   return out;

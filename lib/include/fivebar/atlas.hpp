@@ -168,6 +168,14 @@ struct AtlasStation {
   bool target_covered = false;   ///< coverage() of the station's own target by this mechanism
 };
 
+/// Another design shown on the chart (a candidate of a search, the chosen design, ...).
+struct AtlasMark {
+  std::string label;
+  DesignPoint point;       ///< with the mechanism's D_mm
+  Vec2 chart{0.0, 0.0};
+  InscribedTarget figures; ///< at its point with the atlas's options, in units of D
+};
+
 struct Atlas {
   AtlasOptions options;
   double x0 = 0.0, y0 = 0.0, spacing = 0.0;  ///< chart coordinates of cell (0, 0) and the grid step
@@ -175,6 +183,7 @@ struct Atlas {
   std::vector<AtlasCell> cells;  ///< row-major: j * nx + i, x fastest
   std::optional<AtlasStation> station;
   std::string station_note;      ///< why the station is not on the chart (when it is not)
+  std::vector<AtlasMark> marks;  ///< add_mark()
   double seconds = 0.0;          ///< wall time of the grid
   const AtlasCell& at(int i, int j) const { return cells[std::size_t(j) * std::size_t(nx) + std::size_t(i)]; }
   std::size_t count(AtlasStatus status) const;
@@ -187,10 +196,16 @@ Atlas performance_atlas(const AtlasOptions& options = {});
 /// mechanism is not symmetric gets the atlas of `options` and a note instead of a mark.
 Atlas performance_atlas(const Station& station, AtlasOptions options = {});
 
+/// Adds symmetric mechanism `m` as a mark labelled `label` (drawn as a diamond, listed in JSON and
+/// the summary lines), its figures computed at its point with the atlas's options (shape, modes):
+/// the family of the atlas, whatever the mechanism's own modes. False, with `why`, when `m` is not
+/// symmetric.
+bool add_mark(Atlas& atlas, const std::string& label, const Mechanism& m, std::string* why = nullptr);
+
 /// JSON: normalisation, grid, shape, modes, fraction, cell counts by status, the best cell of each
 /// figure (`best`) and, with a station, the best cells whose s* holds the station's own target
 /// (`best_holding_station_target`), `station` and `mechanism` (names, null when no station is
-/// marked; `station_note` says why) with `station_figures`, the wall time. The shapes follow
+/// marked; `station_note` says why) with `station_figures`, the `marks`, the wall time. The shapes follow
 /// docs/conventions.md "JSON documents" (schemas/common.schema.json).
 Json to_json(const Atlas& atlas);
 /// Human-readable lines: the grid and its time, the best cells, where the station sits.
