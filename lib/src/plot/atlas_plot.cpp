@@ -173,27 +173,6 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       cairo_set_line_width(cr, 2.0);
       cairo_stroke(cr);
     }
-    for (const AtlasMark& m : atlas.marks) {
-      const auto p = panel.px(m.chart);
-      cairo_new_path(cr);
-      cairo_move_to(cr, p[0], p[1] - 7.0);
-      cairo_line_to(cr, p[0] + 7.0, p[1]);
-      cairo_line_to(cr, p[0], p[1] + 7.0);
-      cairo_line_to(cr, p[0] - 7.0, p[1]);
-      cairo_close_path(cr);
-      set_colour(cr, Rgb{1.0, 1.0, 1.0});
-      cairo_fill_preserve(cr);
-      set_colour(cr, kInk);
-      cairo_set_line_width(cr, 1.6);
-      cairo_stroke(cr);
-      const bool ok = m.figures.status == AtlasStatus::ok;
-      const std::string label = m.label + (ok ? ": " + fmt("%.3f", fig.value(m.figures)) : ": none");
-      const double tw = text_width(cr, label, 10.5, false);
-      cairo_rectangle(cr, p[0] + 9.0, p[1] + 2.0, tw + 6.0, 15.0);
-      set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
-      cairo_fill(cr);
-      text(cr, p[0] + 12.0, p[1] + 13.0, label, 10.5, kInk);
-    }
     if (atlas.station) {
       const AtlasStation& s = *atlas.station;
       const auto p = panel.px(s.chart);
@@ -219,6 +198,28 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
       cairo_fill(cr);
       text(cr, p[0] + 12.0, p[1] - 8.0, label, 11.0, kInk, 0.0, true);
+    }
+    // Other designs on top (add_mark()).
+    for (const AtlasMark& m : atlas.marks) {
+      const auto p = panel.px(m.chart);
+      cairo_new_path(cr);
+      cairo_move_to(cr, p[0], p[1] - 7.0);
+      cairo_line_to(cr, p[0] + 7.0, p[1]);
+      cairo_line_to(cr, p[0], p[1] + 7.0);
+      cairo_line_to(cr, p[0] - 7.0, p[1]);
+      cairo_close_path(cr);
+      set_colour(cr, Rgb{1.0, 1.0, 1.0});
+      cairo_fill_preserve(cr);
+      set_colour(cr, kInk);
+      cairo_set_line_width(cr, 1.6);
+      cairo_stroke(cr);
+      const bool ok = m.figures.status == AtlasStatus::ok;
+      const std::string label = m.label + (ok ? ": " + fmt("%.3f", fig.value(m.figures)) : ": none");
+      const double tw = text_width(cr, label, 10.5, false);
+      cairo_rectangle(cr, p[0] + 9.0, p[1] + 2.0, tw + 6.0, 15.0);
+      set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
+      cairo_fill(cr);
+      text(cr, p[0] + 12.0, p[1] + 13.0, label, 10.5, kInk);
     }
     // Colour bar and the figures.
     const double by = kTop + kPanelH + 14.0;
