@@ -17,9 +17,11 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "fivebar/atlas.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/control.hpp"
 #include "fivebar/io.hpp"
@@ -208,6 +210,38 @@ std::string rho_field_vti(const RhoField& f) {
   add_point_array<vtkUnsignedCharArray>(image, "status", f.status);  // 255: outside the joint limits
   image->GetPointData()->SetActiveScalars("rho");
   add_status_names(image);
+  return image_document(image);
+}
+
+// The performance atlas of fivebar/atlas.hpp (declared there; VTK stays in this file): chart
+// coordinates as x, y; figures NaN where the status is not ok.
+std::string atlas_vti(const Atlas& a) {
+  const std::size_t n = a.cells.size();
+  std::vector<double> scale(n), height(n), lci(n), transmission(n);
+  std::vector<unsigned char> status(n);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t k = 0; k < n; ++k) {
+    const InscribedTarget& f = a.cells[k].figures;
+    const bool ok = f.status == AtlasStatus::ok;
+    scale[k] = ok ? f.scale : nan;
+    height[k] = ok ? f.height : nan;
+    lci[k] = ok ? f.min_lci : nan;
+    transmission[k] = ok ? f.min_transmission_sin : nan;
+    status[k] = static_cast<unsigned char>(f.status);
+  }
+  vtkNew<vtkImageData> image;
+  shape_image(image, a.x0, a.y0, a.spacing, a.nx, a.ny);
+  add_point_array<vtkDoubleArray>(image, "scale_D", scale);
+  add_point_array<vtkDoubleArray>(image, "min_lci", lci);
+  add_point_array<vtkDoubleArray>(image, "min_transmission_sin", transmission);
+  add_point_array<vtkDoubleArray>(image, "height_D", height);
+  add_point_array<vtkUnsignedCharArray>(image, "status", status);
+  image->GetPointData()->SetActiveScalars("scale_D");
+  vtkNew<vtkStringArray> status_names;
+  status_names->SetName("status_names");
+  for (AtlasStatus s : {AtlasStatus::ok, AtlasStatus::no_workspace, AtlasStatus::outside})
+    status_names->InsertNextValue(std::string(to_string(s)));
+  image->GetFieldData()->AddArray(status_names);
   return image_document(image);
 }
 
