@@ -32,6 +32,7 @@ struct OptimizeCliOptions {
   bool no_plots = false;
   bool no_check = false;
   bool no_polish = false;
+  bool no_atlas = false;
   bool json = false;
 };
 
@@ -72,10 +73,11 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
   if (!design.get<OptimizeSettings>()) {
     throw InputError(o.design + ": the design has no optimize: section (docs/optimize.md shows one)");
   }
-  if (o.seed || o.no_polish) {
+  if (o.seed || o.no_polish || o.no_atlas) {
     OptimizeSettings s = *design.get<OptimizeSettings>();
     if (o.seed) s.seed = *o.seed;
     if (o.no_polish) s.polish = false;
+    if (o.no_atlas) s.atlas = false;
     design.set(s);
   }
   if (o.evaluations > std::uint64_t(1e9)) throw InputError("--evaluations: must be 1 ... 1e9");
@@ -168,6 +170,10 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
       } else {
         std::printf("  no feasible design: every candidate was rejected (see candidates.csv)\n");
       }
+      for (const Json& a : r.atlases) {
+        std::printf("  atlas of station %s: see atlas-%s.svg\n", a["station"].get<std::string>().c_str(),
+                    a["station"].get<std::string>().c_str());
+      }
       if (check) {
         for (const auto& p : check->products) {
           if (p.state != ProductOutcome::State::built) continue;
@@ -211,6 +217,7 @@ void setup_optimize(CLI::App& app) {
   sub->add_flag("--resume", opt->resume, "Continue from the output directory's checkpoint");
   sub->add_flag("--no-plots", opt->no_plots, "Skip the SVG/PNG plots");
   sub->add_flag("--no-polish", opt->no_polish, "Skip the NLopt polish of the chosen design (optimize.polish: false)");
+  sub->add_flag("--no-atlas", opt->no_atlas, "Skip the performance atlas of each optimised station (optimize.atlas: false)");
   sub->add_flag("--no-check", opt->no_check, "Skip the re-check of the chosen design by the coverage, collision and pattern products");
   sub->add_flag("--json", opt->json, "One JSON document on stdout");
   sub->callback([opt] { finish(run_optimize_cmd(*opt)); });

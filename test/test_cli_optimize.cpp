@@ -49,18 +49,20 @@ TEST_F(CliOptimize, JsonFilesAndTheChosenDesign) {
   const Outcome again = run({"run", (dir_ / "a" / "chosen.yaml").string(), "--out", (dir_ / "runs").string(),
                              "--products", "coverage"});
   EXPECT_EQ(again.code, 0) << again.err;
+  EXPECT_EQ(j["atlases"].size(), 1u);
+  for (const char* f : {"atlas-index.svg", "atlas-index.vti", "atlas-index.csv"}) EXPECT_TRUE(fs::exists(dir_ / "a" / f)) << f;
   // Same seed, same front.
-  const Outcome r2 = run(args(dir_ / "b"));
+  const Outcome r2 = run(args(dir_ / "b", {"--no-atlas"}));
   ASSERT_EQ(r2.code, 0);
   EXPECT_EQ(ft::slurp(dir_ / "a" / "front.csv"), ft::slurp(dir_ / "b" / "front.csv"));
 }
 
 TEST_F(CliOptimize, ShardsAndMerge) {
   for (const char* k : {"0/2", "1/2"}) {
-    const Outcome r = run(args(dir_ / "s", {"--shard", k, "--no-plots"}));
+    const Outcome r = run(args(dir_ / "s", {"--shard", k, "--no-plots", "--no-atlas"}));
     ASSERT_EQ(r.code, 0) << r.err;
   }
-  const Outcome m = run(args(dir_ / "s", {"--merge", "2", "--no-check"}));
+  const Outcome m = run(args(dir_ / "s", {"--merge", "2", "--no-check", "--no-atlas"}));
   ASSERT_EQ(m.code, 0) << m.err;
   const json j = parse(m);
   EXPECT_FALSE(j["front"].empty());
@@ -73,10 +75,10 @@ TEST_F(CliOptimize, ShardsAndMerge) {
 TEST_F(CliOptimize, MpiRunEqualsTheMergedShards) {
   if (!fivebar::built_with_mpi()) GTEST_SKIP() << "built without MPI (FIVEBAR_WITH_MPI=OFF)";
   if (std::system("command -v mpirun > /dev/null 2>&1") != 0) GTEST_SKIP() << "mpirun not installed";
-  for (const char* k : {"0/2", "1/2"}) ASSERT_EQ(run(args(dir_ / "s", {"--shard", k, "--no-plots"})).code, 0);
-  ASSERT_EQ(run(args(dir_ / "s", {"--merge", "2", "--no-check", "--no-plots"})).code, 0);
+  for (const char* k : {"0/2", "1/2"}) ASSERT_EQ(run(args(dir_ / "s", {"--shard", k, "--no-plots", "--no-atlas"})).code, 0);
+  ASSERT_EQ(run(args(dir_ / "s", {"--merge", "2", "--no-check", "--no-plots", "--no-atlas"})).code, 0);
   std::vector<std::string> a{"--allow-run-as-root", "--oversubscribe", "-n", "2", FIVEBAR_BINARY};
-  const auto mine = args(dir_ / "mpi", {"--no-check", "--no-plots"});
+  const auto mine = args(dir_ / "mpi", {"--no-check", "--no-plots", "--no-atlas"});
   a.insert(a.end(), mine.begin(), mine.end());
   ft::Child mpi = ft::spawn("mpirun", a, dir_, dir_);
   ASSERT_GT(mpi.pid, 0);

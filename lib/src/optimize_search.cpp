@@ -22,6 +22,7 @@
 #include <map>
 #include <sstream>
 
+#include "fivebar/atlas.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/optimize.hpp"
@@ -389,6 +390,23 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
                          "): a complete design file;\n# its optimize: and sweep: sections are left out. Run it with `fivebar run`.\n";
     write_file_atomic(yaml, header + to_yaml(chosen));
     record(yaml);
+  }
+  if (p.settings().atlas && r.chosen_design) {
+    // The family of each optimised station, with the design as given and the chosen one marked.
+    for (const std::string& name : p.stations()) {
+      const Station& given = *design.station(name);
+      AtlasOptions ao;
+      ao.cells = p.settings().atlas_cells;
+      ao.threads = options.threads;
+      Atlas atlas = performance_atlas(given, ao);
+      const Station* chosen_station = r.chosen_design->station(name);
+      if (chosen_station) {
+        const Mechanism* m = chosen_station->lower ? &*chosen_station->lower : chosen_station->upper ? &*chosen_station->upper : nullptr;
+        if (m) (void)add_mark(atlas, "chosen", *m);
+      }
+      for (const auto& f : write_atlas_files(dir, atlas, "atlas-" + name, "station " + name + " of " + design.name)) record(f);
+      r.atlases.push_back(Json{{"station", name}, {"atlas", to_json(atlas)}});
+    }
   }
   {
     const auto path = dir / "front.csv";
@@ -795,6 +813,7 @@ Json OptimizeResult::to_json(const OptimizeProblem& p) const {
   j["chosen"] = chosen ? point(*chosen) : Json(nullptr);
   j["polished"] = polished ? point(*polished) : Json(nullptr);
   j["polish_evaluations"] = polish_evaluations;
+  j["atlases"] = atlases;
   return j;
 }
 

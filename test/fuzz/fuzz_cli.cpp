@@ -133,7 +133,7 @@ void limit_optimize(std::vector<std::string>& args) {
                             [](const std::string& a) { return a == "--evaluations" || a == "--seconds" ||
                                                               a.starts_with("--evaluations=") || a.starts_with("--seconds="); }),
              args.end());
-  args.insert(args.begin() + 1, {"--evaluations", "64", "--seconds", "2", "--no-check", "--no-polish"});
+  args.insert(args.begin() + 1, {"--evaluations", "64", "--seconds", "2", "--no-check", "--no-polish", "--no-atlas"});
 }
 
 /// `run` builds only the cheap products: report (a timing study by design), tolerance (Monte Carlo of

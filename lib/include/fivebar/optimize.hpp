@@ -158,6 +158,8 @@ struct OptimizeResult {
   /// for (the loop and the simulation included), for the comparison table.
   OptimizeCandidate reference_full, chosen_full;
   std::optional<Design> chosen_design;        ///< polished (or chosen) applied to the design
+  /// With settings.atlas: per optimised station {station, atlas} (fivebar/atlas.hpp to_json()).
+  Json atlases = Json::array();
   std::vector<std::filesystem::path> files;   ///< every file written
   Json to_json(const OptimizeProblem& problem) const;
 };

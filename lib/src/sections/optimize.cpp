@@ -154,6 +154,9 @@ void OptimizeSettings::validate() const {
       throw ValidationError("choose", "= " + detail::quoted(choose) + ": must be knee or one of the objectives' figures");
     }
   }
+  if (atlas_cells < 5 || atlas_cells > 401) {
+    throw ValidationError("atlas_cells", "= " + std::to_string(atlas_cells) + ": must be 5 ... 401");
+  }
   if (!(collision_spacing_mm >= 0.05 && collision_spacing_mm <= 1e6)) {
     throw ValidationError("collision_spacing_mm", "= " + format_number(collision_spacing_mm) + " mm: must be 0.05 ... 1e6");
   }
@@ -237,10 +240,10 @@ void load(const Value& v, Design& design) {
   OptimizeSettings o;
   const auto all = v.entries({"variables", "objectives", "constraints", "algorithm", "population", "islands",
                               "generations_per_round", "evaluations", "seconds", "seed", "polish", "polish_evaluations",
-                              "choose", "collision_spacing_mm"},
+                              "choose", "atlas", "atlas_cells", "collision_spacing_mm"},
                              "(variables, objectives, constraints, algorithm, population, islands, "
-                             "generations_per_round, evaluations, seconds, seed, polish, polish_evaluations, choose, "
-                             "collision_spacing_mm)");
+                             "generations_per_round, evaluations, seconds, seed, polish, polish_evaluations, choose, atlas, "
+                             "atlas_cells, collision_spacing_mm)");
   for (const Value& var : require(all, "variables", v).entries({}, "of variable names to {key, range, step}", true)) {
     OptimizeVariable ov;
     ov.name = var.name();
@@ -283,6 +286,12 @@ void load(const Value& v, Design& design) {
   }
   if (const Value* p = find(all, "polish_evaluations")) o.polish_evaluations = p->whole(0, 100000);
   if (const Value* p = find(all, "choose")) o.choose = p->text("must be knee or an objective's figure");
+  if (const Value* p = find(all, "atlas")) {
+    const std::string t = p->text("must be true or false");
+    if (t != "true" && t != "false") p->fail_value("must be true or false");
+    o.atlas = t == "true";
+  }
+  if (const Value* p = find(all, "atlas_cells")) o.atlas_cells = int(p->whole(5, 401));
   o.collision_spacing_mm = number_or(all, "collision_spacing_mm", o.collision_spacing_mm, "mm");
   design.set(std::move(o));
 }
@@ -375,6 +384,8 @@ void write(const Design& design, Out& top) {
   out.add("polish", Out::plain(o->polish ? "true" : "false"));
   out.add("polish_evaluations", Out::integer(static_cast<long long>(o->polish_evaluations)));
   out.add("choose", Out::plain(o->choose));
+  out.add("atlas", Out::plain(o->atlas ? "true" : "false"));
+  out.add("atlas_cells", Out::integer(o->atlas_cells));
   out.add("collision_spacing_mm", Out::number(o->collision_spacing_mm));
 }
 

@@ -72,6 +72,10 @@ struct OptimizeSettings {
   /// `knee` (the front's point nearest the ideal point, objectives normalised over the front)
   /// or the name of an objective's figure (the front's best in it).
   std::string choose = "knee";
+  /// Non-dimensional performance atlas (fivebar/atlas.hpp) of each optimised station's family,
+  /// the station and the chosen design marked; `atlas_cells` points along the chart's base.
+  bool atlas = false;
+  int atlas_cells = 41;
   /// Grid spacing of the collision fraction (as sweep.collision_spacing_mm).
   double collision_spacing_mm = 2.0;
   /// Rules that need no design (names, ranges, counts); the design checks keys and data.

@@ -98,6 +98,11 @@ Product optimize_product() {
     } else {
       md += "No candidate satisfied every constraint: nothing is chosen (see `optimize/candidates.csv`).\n\n";
     }
+    for (const Json& a : r.atlases) {
+      md += "Non-dimensional performance atlas of station `" + a["station"].get<std::string>() + "`'s family " +
+            "(docs/atlas.md), the design as given and the chosen one marked: `optimize/atlas-" +
+            a["station"].get<std::string>() + ".svg`.\n\n";
+    }
     md += "Files: `optimize/front.csv` and `front.json` (the Pareto front), `optimize/candidates.csv` (every candidate "
           "and the stage that rejected it), `optimize/chosen.yaml` (a complete design file), "
           "`optimize/hypervolume.svg` (convergence), `optimize/front.svg` (the front in parallel coordinates).\n";
