@@ -158,6 +158,8 @@ TEST(OptimizeVariable, SnapKeepsTheStepsAndBounds) {
   EXPECT_EQ(v.snap(5.9), 5.75);  // 6.5 would pass hi
   EXPECT_EQ(v.snap(99.0), 5.75);
   EXPECT_EQ(tied("x", {"a"}, 1.0, 2.0).snap(1.2345), 1.2345);
+  // hi - lo = 4 is not a multiple of 0.75: the largest value is 2 + 5 x 0.75, whatever is asked.
+  for (double x : {5.76, 5.99, 6.0}) EXPECT_EQ(v.snap(x), 5.75) << x;
 }
 
 TEST(OptimizeProblem, FastPathEqualsTheFileRoundTripAndTheSweep) {
@@ -306,6 +308,31 @@ TEST(RunOptimize, DeterministicOverThreadsAndResumable) {
   OptimizeSettings other = *d.get<OptimizeSettings>();
   other.seed = 99;
   EXPECT_THROW((void)run_optimize(with(other), o), InputError);
+}
+
+TEST(RunOptimize, EveryAlgorithmRuns) {
+  ScratchDir dir("fivebar_test_optimize_algorithms");
+  for (const char* alg : {"nsga2", "moead", "cmaes", "sade"}) {
+    const bool single = std::string(alg) == "cmaes" || std::string(alg) == "sade";
+    OptimizeSettings s = single ? two_variable({{"margin", true}})
+                                : two_variable({{"margin", true}, {"min_lci", true}, {"footprint", false}});
+    s.algorithm = alg;
+    s.population = 20;  // MOEA/D with three objectives: low-discrepancy weights (no binomial size needed)
+    s.evaluations = 200;
+    s.polish_evaluations = 20;
+    OptimizeOptions o;
+    o.plots = false;
+    o.out_dir = dir.path() / alg;
+    const OptimizeResult r = run_optimize(with(s), o);
+    EXPECT_EQ(r.algorithm, alg);
+    EXPECT_LE(r.evaluations, 200u);
+    ASSERT_TRUE(r.chosen) << alg;
+    if (single) {
+      // One objective: the front is the best feasible candidate, and the hypervolume only grows.
+      EXPECT_EQ(r.front.size(), 1u);
+      for (std::size_t i = 1; i < r.hypervolume.size(); ++i) EXPECT_GE(r.hypervolume[i].second, r.hypervolume[i - 1].second);
+    }
+  }
 }
 
 TEST(RunOptimize, ShardsMergeIntoTheFrontOfTheirUnion) {

@@ -88,10 +88,12 @@ struct Udp {
 /// Deb's recommended NSGA-II operators: crossover probability 0.9, distribution indices 20, and a
 /// mutation probability of 1/n per variable (pagmo's default 0.01 barely mutates a problem of a
 /// few variables).
-pagmo::algorithm make_algorithm(const std::string& name, unsigned gens, unsigned seed, int population, std::size_t n) {
+pagmo::algorithm make_algorithm(const std::string& name, unsigned gens, unsigned seed, int population, std::size_t n,
+                                std::size_t nobj) {
   if (name == "nsga2") return pagmo::algorithm(pagmo::nsga2(gens, 0.9, 20.0, 1.0 / double(std::max<std::size_t>(n, 1)), 20.0, seed));
   if (name == "moead") {
-    return pagmo::algorithm(pagmo::moead(gens, "grid", "tchebycheff", std::min<unsigned>(20u, unsigned(population - 1)), 1.0, 0.5,
+    // Grid weights need a population of a binomial size beyond two objectives: low-discrepancy ones there.
+    return pagmo::algorithm(pagmo::moead(gens, nobj > 2 ? "low discrepancy" : "grid", "tchebycheff", std::min<unsigned>(20u, unsigned(population - 1)), 1.0, 0.5,
                                          20.0, 0.9, 2u, true, seed));
   }
   if (name == "cmaes") return pagmo::algorithm(pagmo::cmaes(gens, -1, -1, -1, -1, 0.3, 1e-9, 1e-9, false, true, seed));
@@ -663,7 +665,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
         rounds[k] = round;
         const pagmo::algorithm a =
             make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round), s.population,
-                                                   p.dimension());
+                                                   p.dimension(), s.objectives.size());
         pops[k] = a.evolve(pops[k]);
       } catch (const Halt&) {
         errors[k] = "halt";

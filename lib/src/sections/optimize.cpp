@@ -47,9 +47,9 @@ int optimize_figure_index(std::string_view name) {
 double OptimizeVariable::snap(double x) const {
   double v = std::clamp(x, lo, hi);
   if (step > 0.0) {
-    const double k = std::round((v - lo) / step);
-    v = std::min(lo + k * step, hi);
-    if (v > hi) v -= step;
+    double k = std::round((v - lo) / step);
+    if (lo + k * step > hi) k -= 1.0;  // the last step below hi when hi - lo is not a multiple
+    v = lo + k * step;
   }
   return v;
 }
