@@ -28,8 +28,8 @@ struct ControlCliOptions {
   std::string out;
   bool json = false;
   bool tune = false;
-  double tune_seconds = 30.0;
-  int tune_evaluations = 60;
+  std::optional<double> tune_seconds;   ///< default: controller.tune.max_seconds (30)
+  std::optional<int> tune_evaluations;  ///< default: controller.tune.evaluations (60)
 };
 
 std::string gains_text(const PidGains& g) {
@@ -58,8 +58,12 @@ void print_tuning(const TuneResult& r) {
 int run_control(const ControlCliOptions& opt) {
   if (opt.grid < 3 || opt.grid > 401) throw InputError("--grid must be within [3, 401]");
   if (opt.field < 3 || opt.field > 801) throw InputError("--field must be within [3, 801]");
-  if (!(opt.tune_seconds > 0.0) || !(opt.tune_seconds <= 3600.0)) throw InputError("--tune-seconds must be > 0 and <= 3600");
-  if (opt.tune_evaluations < 1 || opt.tune_evaluations > 10000) throw InputError("--tune-evaluations must be within [1, 10000]");
+  if (opt.tune_seconds && (!(*opt.tune_seconds > 0.0) || !(*opt.tune_seconds <= 3600.0))) {
+    throw InputError("--tune-seconds must be > 0 and <= 3600");
+  }
+  if (opt.tune_evaluations && (*opt.tune_evaluations < 1 || *opt.tune_evaluations > 10000)) {
+    throw InputError("--tune-evaluations must be within [1, 10000]");
+  }
   const Design design = load(opt.design);
   const std::vector<const Station*> stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
@@ -123,14 +127,17 @@ int run_control(const ControlCliOptions& opt) {
     for (const Station* s : stations)
       if (s->lower && s->upper) pairs.push_back(s);
     if (pairs.empty()) throw InputError("--tune: no station with both mechanisms (the patterns move both tactors)");
-    TuneOptions to;
-    to.max_seconds = opt.tune_seconds;
-    to.max_evaluations = opt.tune_evaluations;
+    TuneOptions to = tune_options(*design.get<ControllerSettings>());
+    if (opt.tune_seconds) to.max_seconds = *opt.tune_seconds;
+    if (opt.tune_evaluations) to.max_evaluations = *opt.tune_evaluations;
     to.progress = progress;
     tuned = tune_controller(design, pairs, inertias, to);
     const std::filesystem::path patch = dir / "tuned-controller.yaml";
     write_file_atomic(patch, tuned_patch_yaml(*tuned));
     files.push_back(patch.generic_string());
+    const std::filesystem::path table = dir / "tuning.csv";
+    write_file_atomic(table, tuning_csv(*tuned));
+    files.push_back(table.generic_string());
   }
   if (opt.json) {
     doc["stations"] = studies;
@@ -178,11 +185,14 @@ void setup_control(CLI::App& app) {
       ->type_name("DIR");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->add_flag("--tune", opt->tune,
-                "Tune kp, ki, kd per mechanism (NLopt COBYLA): least worst tracking error over the patterns with "
-                "max rho <= 0.9; writes tuned-controller.yaml (a patch of controller:) and prints before/after");
-  sub->add_option("--tune-seconds", opt->tune_seconds, "Wall-time bound of the whole tuning (s, default 30)")
+                "Tune kp, ki, kd per mechanism from the hand-set gains (NLopt COBYLA): least worst tracking error over "
+                "the patterns with max rho <= controller.tune.rho_limit (0.9); writes tuned-controller.yaml (a "
+                "patch of controller:) and tuning.csv and prints before/after");
+  sub->add_option("--tune-seconds", opt->tune_seconds,
+                  "Wall-time bound of the whole tuning (s, default controller.tune.max_seconds or 30)")
       ->type_name("S");
-  sub->add_option("--tune-evaluations", opt->tune_evaluations, "Objective evaluations per mechanism (default 60)")
+  sub->add_option("--tune-evaluations", opt->tune_evaluations,
+                  "Objective evaluations per mechanism (default controller.tune.evaluations or 60)")
       ->type_name("N");
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"

@@ -108,13 +108,33 @@ std::string stop_text(nlopt::result r) {
 
 }  // namespace
 
+TuneOptions tune_options(const ControllerSettings& c) {
+  TuneOptions o;
+  const TuneSettings t = c.tune.value_or(TuneSettings{});
+  o.rho_limit = t.rho_limit;
+  o.max_evaluations = t.evaluations;
+  o.max_seconds = t.max_seconds;
+  return o;
+}
+
+bool TunedMechanism::applied() const {
+  const auto same = [](double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); };
+  for (std::size_t j = 0; j < 2; ++j) {
+    if (!same(design[j].kp, after[j].kp) || !same(design[j].ki, after[j].ki) || !same(design[j].kd, after[j].kd)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 TuneResult tune_controller(const Design& d, const std::vector<const Station*>& stations,
                            const std::map<std::string, std::map<std::string, MechanismInertia>>& inertia,
                            const TuneOptions& options) {
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   if (!d.get<ControllerSettings>()) throw InputError("tune: the design has no `controller:` section");
-  const double saturation_limit = d.get<ControllerSettings>()->max_saturation_fraction;
+  const ControllerSettings& ctl = *d.get<ControllerSettings>();
+  const double saturation_limit = ctl.max_saturation_fraction;
   TuneResult result;
   result.rho_limit = options.rho_limit;
   // Every mechanism's pattern runs and constraint poses first (InputError before any work).
@@ -150,7 +170,8 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     TunedMechanism t;
     t.station = job.station->name;
     t.mechanism = job.loop.model.mechanism.name;
-    t.before = job.loop.gains;
+    t.design = job.loop.gains;
+    for (int k = 0; k < 2; ++k) t.before[std::size_t(k)] = ctl.hand_set_pid(t.station, t.mechanism, k + 1);
     t.rho_before = max_spectral_radius(job.poses, t.before, job.loop.delay);
     const Tracking tb = track(job.runs, t.before, options.rtol);
     t.error_before_mm = tb.ok ? tb.error_mm : std::numeric_limits<double>::infinity();
@@ -229,11 +250,28 @@ Json to_json(const TuneResult& result) {
                                  {"max_tracking_error_mm", t.error_before_mm}, {"saturation_fraction", t.saturation_before}}},
                      {"after", {{"gains", gains(t.after[0])}, {"max_rho", t.rho_after},
                                 {"max_tracking_error_mm", t.error_after_mm}, {"saturation_fraction", t.saturation_after}}},
+                     {"design", {{"gains", gains(t.design[0])}, {"applied", t.applied()}}},
                      {"evaluations", t.evaluations},
                      {"feasible", t.feasible},
                      {"stop", t.stop}});
   }
   return {{"rho_limit", result.rho_limit}, {"wall_s", result.wall_s}, {"mechanisms", mechs}};
+}
+
+std::string tuning_csv(const TuneResult& result) {
+  const auto num = [](double v) { return std::isfinite(v) ? format::shortest(v) : std::string(); };
+  std::string csv =
+      "station,mechanism,kp_before,ki_before,kd_before,kp_after,ki_after,kd_after,max_rho_before,max_rho_after,"
+      "max_tracking_error_before_mm,max_tracking_error_after_mm,saturation_before,saturation_after,evaluations,"
+      "feasible,applied,stop\n";
+  for (const TunedMechanism& t : result.mechanisms) {
+    csv += t.station + "," + t.mechanism + "," + num(t.before[0].kp) + "," + num(t.before[0].ki) + "," +
+           num(t.before[0].kd) + "," + num(t.after[0].kp) + "," + num(t.after[0].ki) + "," + num(t.after[0].kd) + "," +
+           num(t.rho_before) + "," + num(t.rho_after) + "," + num(t.error_before_mm) + "," + num(t.error_after_mm) +
+           "," + num(t.saturation_before) + "," + num(t.saturation_after) + "," + std::to_string(t.evaluations) + "," +
+           (t.feasible ? "true" : "false") + "," + (t.applied() ? "true" : "false") + "," + t.stop + "\n";
+  }
+  return csv;
 }
 
 }  // namespace fivebar

@@ -299,7 +299,8 @@ std::vector<std::string> summary_lines(const StationControl& study);
 
 // --- Tuning ---------------------------------------------------------------------------------------
 //
-// Gains per mechanism (the same kp, ki, kd on both joints; i_clamp kept) that minimise the worst
+// Gains per mechanism (the same kp, ki, kd on both joints; i_clamp kept), starting from the
+// hand-set ones (ControllerSettings::hand_set_pid()), that minimise the worst
 // tracking error over the station's patterns, simulated with this mechanism alone under the new
 // gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject to max rho <= rho_limit over a
 // grid of the target (the constraint) and to the saturation limit (a penalty of 10 mm per unit of
@@ -313,23 +314,31 @@ std::vector<std::string> summary_lines(const StationControl& study);
 
 struct TuneOptions {
   double rho_limit = 0.9;       ///< max spectral radius allowed over the target
-  int grid = 9;                 ///< per axis over the target for the constraint
+  int grid = 21;                ///< per axis over the target for the constraint: the export gate's grid
   int max_evaluations = 60;     ///< objective evaluations per mechanism
   double max_seconds = 30.0;    ///< wall time for the whole tuning, shared among the mechanisms
   double rtol = 1e-3;           ///< CVODE tolerance of the tracking runs
   std::function<void(std::string_view)> progress;  ///< one line per evaluation; may be empty
 };
 
+/// The options of a design's `controller.tune` (its defaults when the key is absent).
+TuneOptions tune_options(const ControllerSettings& controller);
+
 /// Before and after, for one mechanism.
 struct TunedMechanism {
   std::string station, mechanism;
-  std::array<PidGains, 2> before, after;
+  /// before: the hand-set gains (ControllerSettings::hand_set_pid(): the file's PID without the
+  /// per-station-mechanism scopes a patch writes), the start; design: the gains the design runs
+  /// with (the hand-set ones, or an earlier patch's); after: the tuned ones.
+  std::array<PidGains, 2> before, design, after;
   double rho_before = 0.0, rho_after = 0.0;        ///< max over the constraint's grid
   double error_before_mm = 0.0, error_after_mm = 0.0;  ///< worst tracking error over the patterns
   double saturation_before = 0.0, saturation_after = 0.0;  ///< worst saturated-time fraction
   int evaluations = 0;
   bool feasible = false;   ///< rho_after <= rho_limit and the saturation within its limit
   std::string stop;        ///< why the optimiser stopped
+  /// The design already runs with the tuned gains (to 6 significant digits on every joint).
+  bool applied() const;
 };
 
 struct TuneResult {
@@ -348,6 +357,10 @@ TuneResult tune_controller(const Design& design, const std::vector<const Station
 /// {kp, ki, kd}}}}}` (the narrowest scope but the joints, so that it wins over the file's own).
 std::string tuned_patch_yaml(const TuneResult& result);
 Json to_json(const TuneResult& result);
+/// One row per mechanism: station,mechanism,kp_before,ki_before,kd_before,kp_after,ki_after,
+/// kd_after,max_rho_before,max_rho_after,max_tracking_error_before_mm,max_tracking_error_after_mm,
+/// saturation_before,saturation_after,evaluations,feasible,applied,stop.
+std::string tuning_csv(const TuneResult& result);
 
 /// The picture of a station's maps (one panel per mechanism, `fields[k]` for `maps[k]`): rho over
 /// the reachable region on a colour ramp (red where >= 1), the target ellipse dashed, the worst

@@ -107,6 +107,26 @@ JointControl ControllerSettings::joint(std::string_view station, std::string_vie
   return out;
 }
 
+PidGains ControllerSettings::hand_set_pid(std::string_view station, std::string_view mechanism, int j) const {
+  ControllerSettings without = *this;
+  for (ControlOverride& o : without.overrides) {
+    if (o.level() >= 3) o.kp = o.ki = o.kd = std::nullopt;
+  }
+  return without.joint(station, mechanism, j).pid;
+}
+
+void TuneSettings::validate() const {
+  if (!(rho_limit > 0.0) || !(rho_limit < 1.0)) {
+    throw ValidationError("rho_limit", "= " + plain_number(rho_limit) + ": must be in (0, 1) (a spectral radius below 1)");
+  }
+  if (evaluations < 1 || evaluations > 10000) {
+    throw ValidationError("evaluations", "= " + std::to_string(evaluations) + ": must be 1 ... 10000");
+  }
+  if (!(max_seconds > 0.0) || !(max_seconds <= 3600.0)) {
+    throw ValidationError("max_seconds", "= " + plain_number(max_seconds) + " s: must be > 0 and <= 3600 s");
+  }
+}
+
 bool is_ros_node_name(std::string_view name) {
   if (name.empty() || name.size() > 255) return false;
   const auto alpha = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
@@ -163,6 +183,7 @@ void ControllerSettings::validate() const {
   }
   rules::validate_nested("pid", [&] { pid.validate(); });
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
+  if (tune) rules::validate_nested("tune", [&] { tune->validate(); });
   for (const ControlOverride& o : overrides) {
     const std::string scope = o.key();
     if (!o.mechanism.empty() && o.mechanism != "lower" && o.mechanism != "upper") {
@@ -220,10 +241,10 @@ void load(const Value& v, Design& design) {
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
                               "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction", "pid",
-                              "potentiometer", "mechanisms", "stations"},
+                              "potentiometer", "tune", "mechanisms", "stations"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
                              "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, pid, potentiometer, "
-                             "mechanisms, stations)");
+                             "tune, mechanisms, stations)");
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -250,6 +271,15 @@ void load(const Value& v, Design& design) {
   if (defaults.volts_at_zero) c.potentiometer.volts_at_zero = *defaults.volts_at_zero;
   if (defaults.rad_per_volt) c.potentiometer.rad_per_volt = *defaults.rad_per_volt;
   if (defaults.travel) c.potentiometer.travel = *defaults.travel;
+  if (const Value* t = find(all, "tune")) {
+    TuneSettings& tune = c.tune.emplace();
+    if (!t->is_null()) {  // `tune:` alone: every default
+      const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds"}, "(rho_limit, evaluations, max_seconds)");
+      tune.rho_limit = number_or(keys, "rho_limit", tune.rho_limit, "");
+      if (const Value* n = find(keys, "evaluations")) tune.evaluations = int(n->whole(1, 10000));
+      tune.max_seconds = number_or(keys, "max_seconds", tune.max_seconds, "s");
+    }
+  }
 
   // One mechanism's scope (of a station, or of every station when `station` is empty) and its joints.
   const auto mechanism_scope = [&](const Value& m, const std::string& station) {
@@ -365,6 +395,12 @@ void write(const Design& d, Out& top) {
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;
   defaults.travel = c.potentiometer.travel;
   control_keys_out(out, defaults);
+  if (c.tune) {
+    Out& t = out.add("tune", Out::map(/*flow=*/true));
+    t.add("rho_limit", Out::number(c.tune->rho_limit));
+    t.add("evaluations", Out::integer(c.tune->evaluations));
+    t.add("max_seconds", Out::number(c.tune->max_seconds));
+  }
 
   // Overrides in canonical form: every station's mechanisms, then by station (design order), then
   // mechanism, then joint.

@@ -2,7 +2,10 @@
 // (fivebar/control.hpp), with the links' masses from the `parts` product's STL renders: spectral
 // radius map, worst pose, verdict, gain margins, damping; picture, VTK field and CSV under control/.
 
+#include <algorithm>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "fivebar/control.hpp"
 #include "products/markdown.hpp"
@@ -28,6 +31,18 @@ constexpr const char* kPerformance =
     "the Z-width, the stiffest virtual wall the loop renders passively from the device's own damping "
     "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm).\n\n";
 
+constexpr const char* kTuning =
+    "`controller.tune` asks for the gains to be tuned: per mechanism, from the hand-set PID (the file's gains "
+    "without the per-station-mechanism scopes a tuning patch writes), NLopt's COBYLA minimises the worst "
+    "simulated tracking error over the station's patterns subject to the spectral radius staying at most "
+    "the limit over the target and no sustained saturation (lib/include/fivebar/control.hpp \"Tuning\"). "
+    "Before and after side by side; `control/tuned-controller.yaml` is the patch of `controller:` that "
+    "applies them, `control/tuning.csv` the table.\n\n";
+
+std::string gains_cell(const PidGains& g) {
+  return "kp " + md::fixed(g.kp, 3) + ", ki " + md::fixed(g.ki, 3) + ", kd " + md::fixed(g.kd, 4);
+}
+
 }  // namespace
 
 Product control_product() {
@@ -50,6 +65,8 @@ Product control_product() {
                            "force in every direction ≥ (N)", "Z-width ≥ (N/mm)"},
                           "llrrrr");
     Json studies = Json::array();
+    std::map<std::string, std::map<std::string, MechanismInertia>> inertias;
+    std::vector<const Station*> pairs;
     bool stable = true;
     std::size_t maps = 0;
     std::string files;
@@ -57,6 +74,8 @@ Product control_product() {
       if (!has_pair(s)) continue;
       ctx.say("stability of station " + s.name);
       const auto inertia = station_inertia(d, s, parts, ctx.dir / "parts");
+      inertias[s.name] = inertia;
+      pairs.push_back(&s);
       const StationControl study = station_control(d, s, inertia);
       stable = stable && study.stable();
       for (const auto& [name, bytes] : control_files(study, s, "design " + d.name)) {
@@ -85,6 +104,43 @@ Product control_product() {
     b.passed = stable;
     b.check = stable ? "stable over every target (" + std::to_string(maps) + " mechanisms)"
                      : "the loop is unstable somewhere on a target";
+    const ControllerSettings& ctl = *d.get<ControllerSettings>();
+    if (ctl.tune && !pairs.empty()) {
+      TuneOptions to = tune_options(ctl);
+      to.progress = [&ctx](std::string_view line) { ctx.say(line); };
+      const TuneResult tuned = tune_controller(d, pairs, inertias, to);
+      ctx.write_file("control/tuned-controller.yaml", tuned_patch_yaml(tuned));
+      ctx.write_file("control/tuning.csv", tuning_csv(tuned));
+      md::Table t({"station", "mechanism", "gains before (hand-set)", "gains after (tuned)", "max ρ before → after",
+                   "worst tracking error before → after (mm)", "saturated before → after", "evaluations", "stop",
+                   "the design runs"},
+                  "llllrrrrll");
+      bool feasible = true, applied = true;
+      double worst_before = 0.0, worst_after = 0.0;
+      for (const TunedMechanism& m : tuned.mechanisms) {
+        feasible = feasible && m.feasible;
+        applied = applied && m.applied();
+        worst_before = std::max(worst_before, m.error_before_mm);
+        worst_after = std::max(worst_after, m.error_after_mm);
+        t.row({m.station, m.mechanism, gains_cell(m.before[0]), gains_cell(m.after[0]),
+               md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
+               md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3),
+               md::fixed(100 * m.saturation_before, 1) + " % → " + md::fixed(100 * m.saturation_after, 1) + " %",
+               std::to_string(m.evaluations), m.stop + (m.feasible ? "" : ", **not feasible**"),
+               m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design[0]) + ")"});
+      }
+      b.result["tuning"] = to_json(tuned);
+      b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nTuned in " + md::fixed(tuned.wall_s, 1) +
+                    " s, max ρ ≤ " + md::fixed(tuned.rho_limit, 2) + " over the target." +
+                    (applied ? " The design runs the tuned gains.\n"
+                             : " The design does not run the tuned gains everywhere: merge "
+                               "`control/tuned-controller.yaml` into its `controller:` section.\n");
+      b.passed = b.passed && feasible;
+      b.check += "; tuned: worst tracking error " + md::fixed(worst_before, 3) + " → " + md::fixed(worst_after, 3) +
+                 " mm with max ρ ≤ " + md::fixed(tuned.rho_limit, 2) +
+                 (feasible ? "" : " (NOT feasible for every mechanism)") +
+                 (applied ? ", the design runs them" : ", not applied (control/tuned-controller.yaml)");
+    }
     return b;
   };
   return p;
