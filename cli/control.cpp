@@ -28,6 +28,7 @@ struct ControlCliOptions {
   std::string out;
   bool json = false;
   bool tune = false;
+  bool per_joint = false;
   std::optional<double> tune_seconds;   ///< default: controller.tune.max_seconds (30)
   std::optional<int> tune_evaluations;  ///< default: controller.tune.evaluations (60)
 };
@@ -46,12 +47,15 @@ void print_tuning(const TuneResult& r) {
     std::string name = t.station + "/" + t.mechanism;
     name.resize(std::max<std::size_t>(name.size(), 13), ' ');
     std::string before = gains_text(t.before[0]), after = gains_text(t.after[0]);
+    const bool per_joint = t.after[0].kp != t.after[1].kp || t.after[0].ki != t.after[1].ki || t.after[0].kd != t.after[1].kd;
+    if (per_joint) after = "theta1 " + after;
     before.resize(std::max<std::size_t>(before.size(), 34), ' ');
     after.resize(std::max<std::size_t>(after.size(), 34), ' ');
     std::cout << "  " << name << "  " << before << " " << after << " " << fixed(t.rho_before, 4) << " / "
               << fixed(t.rho_after, 4) << "       " << fixed(t.error_before_mm, 3) << " / " << fixed(t.error_after_mm, 3)
               << "            " << fixed(100 * t.saturation_before, 1) << " % / " << fixed(100 * t.saturation_after, 1)
               << " %        " << t.evaluations << "     " << t.stop << (t.feasible ? "" : ", NOT FEASIBLE") << "\n";
+    if (per_joint) std::cout << std::string(15 + 35, ' ') << "theta2 " << gains_text(t.after[1]) << "\n";
   }
 }
 
@@ -130,6 +134,7 @@ int run_control(const ControlCliOptions& opt) {
     TuneOptions to = tune_options(*design.get<ControllerSettings>());
     if (opt.tune_seconds) to.max_seconds = *opt.tune_seconds;
     if (opt.tune_evaluations) to.max_evaluations = *opt.tune_evaluations;
+    if (opt.per_joint) to.per_joint = true;
     to.progress = progress;
     tuned = tune_controller(design, pairs, inertias, to);
     const std::filesystem::path patch = dir / "tuned-controller.yaml";
@@ -188,6 +193,8 @@ void setup_control(CLI::App& app) {
                 "Tune kp, ki, kd per mechanism from the hand-set gains (NLopt COBYLA): least worst tracking error over "
                 "the patterns with max rho <= controller.tune.rho_limit (0.9); writes tuned-controller.yaml (a "
                 "patch of controller:) and tuning.csv and prints before/after");
+  sub->add_flag("--per-joint", opt->per_joint,
+                "With --tune: kp, ki, kd per joint (six unknowns per mechanism; default controller.tune.per_joint)");
   sub->add_option("--tune-seconds", opt->tune_seconds,
                   "Wall-time bound of the whole tuning (s, default controller.tune.max_seconds or 30)")
       ->type_name("S");

@@ -87,17 +87,21 @@ TEST_F(CliControl, TheVerdictFlipsAtTheReportedKpMargin) {
   ASSERT_EQ(base.code, 0) << base.err;
   const double margin = parse(base)["stations"][0]["mechanisms"][0]["kp_margin"].get<double>();
   ASSERT_GT(margin, 1.0);
+  // The index station's lower mechanism runs the gains of its own scope (the tuned ones): scale its kp.
   std::string text = read_text(kDesign);
-  const std::string pid = "pid: {kp: 5,";
+  const std::string pid = "    index:\n      lower: {pid: {kp: ";
   const std::size_t at = text.find(pid);
   ASSERT_NE(at, std::string::npos);
+  const std::size_t from = at + pid.size();
+  const std::size_t to = text.find(',', from);
+  const double kp0 = std::stod(text.substr(from, to - from));
   for (const double factor : {0.97, 1.03}) {
     SCOPED_TRACE(factor);
     std::ostringstream kp;
     kp.precision(17);
-    kp << "pid: {kp: " << 5.0 * margin * factor << ",";
+    kp << kp0 * margin * factor;
     std::string scaled = text;
-    scaled.replace(at, pid.size(), kp.str());
+    scaled.replace(from, to - from, kp.str());
     const std::filesystem::path design = dir_ / "scaled.yaml";
     std::ofstream(design) << scaled;
     const Outcome r = run({"control", design.string(), "-s", "index", "--grid", "11", "--field", "5", "--out",

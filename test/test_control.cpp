@@ -333,6 +333,16 @@ TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTuned
     EXPECT_NEAR(max_spectral_radius(poses, t.after, true), t.rho_after, 1e-12);
     EXPECT_NEAR(max_spectral_radius(poses, t.before, true), t.rho_before, 1e-12);
     EXPECT_EQ(t.feasible, t.rho_after <= o.rho_limit && t.saturation_after <= d.get<ControllerSettings>()->max_saturation_fraction);
+    // Started from the pole placement, which already meets the constraint on the showcase: the
+    // result is the best feasible point evaluated, so it meets it too, on the export gate's grid.
+    EXPECT_EQ(o.grid, kControlGateGrid);
+    EXPECT_LT(t.rho_start, o.rho_limit);
+    EXPECT_GT(t.start_omega_rad_s, 0.0);
+    EXPECT_TRUE(t.feasible);
+    EXPECT_LE(t.error_after_mm, t.error_before_mm);
+    // "before" is the hand-set pid (the showcase's station scopes hold an earlier tuning).
+    EXPECT_EQ(t.before[0].kp, d.get<ControllerSettings>()->pid.kp);
+    EXPECT_EQ(t.design[0].kp, loop.gains[0].kp);
   }
   // The patch, merged into the design file, gives each mechanism the tuned gains on both joints.
   const std::string patch = tuned_patch_yaml(a);
@@ -342,6 +352,10 @@ TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTuned
   std::string design = text.str();
   const std::size_t stations = patch.find("  stations:\n");
   ASSERT_NE(stations, std::string::npos);
+  // The showcase's own station scopes (an earlier tuning) out first: the patch replaces them.
+  const std::size_t own = design.find("  stations:\n    index:\n      lower: {pid:");
+  ASSERT_NE(own, std::string::npos);
+  design.erase(own, design.find("\n\n", own) + 1 - own);
   const std::size_t end = design.find("\n# The motors and drivers");
   ASSERT_NE(end, std::string::npos);
   design.insert(end + 1, patch.substr(stations));
@@ -470,6 +484,158 @@ TEST(Control, EllipseGridStaysInsideAndHoldsTheCentre) {
   EXPECT_TRUE(centre);
   // About one point per cell of the 20 x 20 cells over the box, pi/4 of them: pi 10^2.
   EXPECT_NEAR(double(pts.size()), 100 * std::numbers::pi, 8.0);
+}
+
+
+// The pole placement against an independent reduced model: m, c, k, b of each joint from the
+// dynamics' mass matrix and Jacobian, the skin and the motors' data (not from the linear plant's
+// rows, which the library reads), and the closed loop (theta, w, int theta) of the continuous PID,
+// whose three eigenvalues must sit at -omega.
+TEST(ControlTune, PolePlacementPutsEachJointsThreeRootsAtMinusOmega) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("thumb", "lower");
+  const Vec2 centre = d.require_station("thumb").target.center;
+  const AnglesResult a = ik_angles(loop.model.mechanism, centre);
+  ASSERT_EQ(a.status, Status::ok);
+  const Eigen::Vector2d theta(a.theta1, a.theta2);
+  const LinearPlant plant = linear_plant(loop.model, theta, &loop.skin);
+  ASSERT_EQ(plant.status, Status::ok);
+  const DynamicsTerms t = dynamics_terms(loop.model, theta, Eigen::Vector2d::Zero());
+  const Eigen::Matrix2d JtJ = t.J.transpose() * t.J;
+  std::array<double, 2> m{}, c{}, k{}, b{};
+  for (int j = 0; j < 2; ++j) {
+    const MotorParams& mp = loop.model.motors[std::size_t(j)];
+    m[std::size_t(j)] = t.M(j, j);
+    k[std::size_t(j)] = 1e3 * loop.skin.shear_stiffness_N_per_mm * JtJ(j, j);
+    // Settled current i = (V u - k_e N w) / R: torque eta N k_t i.
+    c[std::size_t(j)] = 1e3 * loop.skin.damping_N_s_per_mm * JtJ(j, j) + mp.viscous_friction() +
+                        mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.back_emf_constant() *
+                            mp.gear_ratio / mp.resistance();
+    b[std::size_t(j)] = mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.supply_voltage_V / mp.resistance();
+  }
+  const std::array<PidGains, 2> base{PidGains{}, PidGains{}};
+  for (const double omega : {30.0, 60.0}) {
+    SCOPED_TRACE(omega);
+    const std::array<PidGains, 2> g = pole_placement_gains(plant, loop.model.motors, omega, /*per_joint=*/true, base);
+    for (std::size_t j = 0; j < 2; ++j) {
+      Eigen::Matrix3d A;
+      A << 0.0, 1.0, 0.0,  //
+          -(k[j] + b[j] * g[j].kp) / m[j], -(c[j] + b[j] * g[j].kd) / m[j], -b[j] * g[j].ki / m[j],  //
+          1.0, 0.0, 0.0;
+      const Eigen::Vector3cd ev = A.eigenvalues();
+      // A triple root moves by ~eps^(1/3) under rounding: 1e-3 of omega.
+      for (int r = 0; r < 3; ++r) EXPECT_NEAR(std::abs(ev[r] + omega), 0.0, 1e-3 * omega) << "joint " << j + 1;
+      EXPECT_EQ(g[j].i_clamp, base[j].i_clamp);
+    }
+    // One set for both joints: the joints' means.
+    const std::array<PidGains, 2> one = pole_placement_gains(plant, loop.model.motors, omega, false, base);
+    const double mm = 0.5 * (m[0] + m[1]), cm = 0.5 * (c[0] + c[1]), km = 0.5 * (k[0] + k[1]), bm = 0.5 * (b[0] + b[1]);
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_NEAR(one[j].kp, (3 * mm * omega * omega - km) / bm, 1e-9 * one[j].kp);
+      EXPECT_NEAR(one[j].ki, mm * omega * omega * omega / bm, 1e-9 * one[j].ki);
+      EXPECT_NEAR(one[j].kd, (3 * mm * omega - cm) / bm, 1e-9 * one[j].kd);
+    }
+  }
+  // The chosen omega: no omega of a fine scan gives a smaller max rho over the poses (to 1e-3).
+  std::vector<PoseLoop> poses;
+  for (const Vec2& P : ellipse_grid(d.require_station("thumb").target, 9)) poses.push_back(pose_loop(loop, P));
+  const PolePlacement pp = pole_placement(loop, centre, poses, false, base);
+  ASSERT_EQ(pp.status, Status::ok);
+  EXPECT_NEAR(max_spectral_radius(poses, pp.gains, true), pp.max_rho, 1e-12);
+  double scan = 1e300;
+  for (int i = 0; i <= 400; ++i) {
+    const double omega = 2.0 * std::numbers::pi * 0.2 * std::pow(125.0, i / 400.0);
+    scan = std::min(scan, max_spectral_radius(poses, pole_placement_gains(plant, loop.model.motors, omega, false, base), true));
+  }
+  EXPECT_LE(pp.max_rho, scan + 1e-3);
+}
+
+// A per-joint result writes theta1 / theta2 scopes, which read back as each joint's gains, and the
+// hand-set gains leave out exactly the scopes a patch writes.
+TEST(ControlTune, PerJointPatchReadsBackPerJointAndHandSetGainsLeaveThePatchOut) {
+  TuneResult r;
+  TunedMechanism t;
+  t.station = "thumb";
+  t.mechanism = "upper";
+  t.after[0] = {7.5, 150.0, 0.15, 0.2};
+  t.after[1] = {8.25, 175.0, 0.125, 0.2};
+  t.feasible = true;
+  r.mechanisms.push_back(t);
+  const std::string patch = tuned_patch_yaml(r);
+  EXPECT_NE(patch.find("upper: {theta1: {pid: {kp: 7.5, ki: 150, kd: 0.15}}, theta2: {pid: {kp: 8.25, ki: 175, kd: 0.125}}}"),
+            std::string::npos)
+      << patch;
+  std::ifstream in(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string design = text.str();
+  // After the controller's last line (its station scopes), as more of thumb's scopes.
+  const std::string thumb = "    thumb:\n";
+  const std::size_t at = design.find(thumb, design.find("\ncontroller:"));
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t line = patch.find("      upper: {theta1");
+  design.insert(design.find("\n\n", at) + 1, patch.substr(line, patch.find('\n', line) + 1 - line));
+  // The thumb already has an `upper:` key (the showcase's tuning): keep the joints' scopes only.
+  const std::size_t dup = design.find("      upper: {pid:", at);
+  ASSERT_NE(dup, std::string::npos);
+  design.erase(dup, design.find('\n', dup) + 1 - dup);
+  const Design merged = load_design_from_string(design, "merged.yaml");
+  const ControllerSettings& c = *merged.get<ControllerSettings>();
+  for (int j = 1; j <= 2; ++j) {
+    const PidGains g = c.joint("thumb", "upper", j).pid;
+    EXPECT_EQ(g.kp, t.after[std::size_t(j - 1)].kp);
+    EXPECT_EQ(g.ki, t.after[std::size_t(j - 1)].ki);
+    EXPECT_EQ(g.kd, t.after[std::size_t(j - 1)].kd);
+    const PidGains h = c.hand_set_pid("thumb", "upper", j);
+    EXPECT_EQ(h.kp, c.pid.kp);
+    EXPECT_EQ(h.ki, c.pid.ki);
+    EXPECT_EQ(h.kd, c.pid.kd);
+  }
+  // A wider scope's gains are hand-set: kept.
+  ControllerSettings wide = c;
+  ControlOverride o;
+  o.mechanism = "upper";
+  o.joint = 2;
+  o.kp = 3.0;
+  wide.overrides.push_back(o);
+  EXPECT_EQ(wide.hand_set_pid("thumb", "upper", 2).kp, 3.0);
+  EXPECT_EQ(wide.hand_set_pid("thumb", "upper", 1).kp, c.pid.kp);
+}
+
+TEST(ControlTune, TheTuneKeyReadsWritesBackAndNamesABadValue) {
+  const Design& d = paper();
+  ASSERT_TRUE(d.get<ControllerSettings>()->tune.has_value());
+  const TuneOptions from_file = tune_options(*d.get<ControllerSettings>());
+  EXPECT_EQ(from_file.start, TuneStart::pole_placement);
+  Design e = d;
+  TuneSettings& t = *e.get<ControllerSettings>()->tune;
+  t.rho_limit = 0.85;
+  t.evaluations = 7;
+  t.max_seconds = 12.5;
+  t.per_joint = true;
+  t.start = "hand_set";
+  const Design back = load_design_from_string(to_yaml(e), "back.yaml");
+  const TuneOptions o = tune_options(*back.get<ControllerSettings>());
+  EXPECT_EQ(o.rho_limit, 0.85);
+  EXPECT_EQ(o.max_evaluations, 7);
+  EXPECT_EQ(o.max_seconds, 12.5);
+  EXPECT_TRUE(o.per_joint);
+  EXPECT_EQ(o.start, TuneStart::hand_set);
+  std::ifstream in(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string bad = text.str();
+  const std::string key = "tune: {rho_limit: 0.9,";
+  const std::size_t at = bad.find(key);
+  ASSERT_NE(at, std::string::npos);
+  bad.replace(at, key.size(), "tune: {rho_limit: 1.5,");
+  try {
+    (void)load_design_from_string(bad, "bad.yaml");
+    ADD_FAILURE() << "rho_limit 1.5 accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("controller.tune.rho_limit"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find("bad.yaml"), std::string::npos) << err.what();
+  }
 }
 
 }  // namespace

@@ -182,7 +182,12 @@ TEST(Parameters, HoldThePapersDeviceInSiUnits) {
   EXPECT_NEAR(lim.at("max_position").get<double>(), deg(105), 1e-12);
   EXPECT_EQ(lim.at("has_velocity_limits"), true);
   EXPECT_DOUBLE_EQ(lim.at("max_velocity").get<double>(), 2.0 * kPi);
-  EXPECT_EQ(p.at("gains").at("index_lower_theta1"), Json({{"p", 5.0}, {"i", 1.0}, {"d", 0.05}, {"i_clamp", 0.2}}));
+  // Gains: the station-mechanism scope of the tuned gains (controller.stations.index.lower.pid) over the
+  // section's pid, whose i_clamp 0.2 it keeps.
+  EXPECT_EQ(p.at("gains").at("index_lower_theta1"),
+            Json({{"p", 6.848653377513271}, {"i", 134.1876883573707}, {"d", 0.18757016322827982}, {"i_clamp", 0.2}}));
+  EXPECT_EQ(p.at("gains").at("index_lower_theta2"), p.at("gains").at("index_lower_theta1"));
+  EXPECT_NE(p.at("gains").at("thumb_upper_theta1"), p.at("gains").at("index_lower_theta1"));
   EXPECT_DOUBLE_EQ(p.at("potentiometers").at("index_lower_theta1").at("rad_per_volt").get<double>(), deg(60));
   EXPECT_EQ(p.at("potentiometers").at("index_lower_theta1").at("volts_at_zero"), 0.25);
   EXPECT_EQ(p.at("potentiometers").at("thumb_upper_theta1").at("volts_at_zero"), 4.75);

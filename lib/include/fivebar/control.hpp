@@ -72,6 +72,10 @@
 
 namespace fivebar {
 
+/// Poses per axis of the grid over each target on which `fivebar export` checks the loop's
+/// stability, and on which the tuner constrains it (the same poses, so that a tuned loop passes).
+inline constexpr int kControlGateGrid = 21;
+
 inline constexpr int kPlantStates = 6;   ///< dtheta1, dtheta2, w1, w2, i1, i2
 inline constexpr int kLoopStates = 12;   ///< plant, held duty (2), integral (2), previous error (2)
 using PlantMatrix = Eigen::Matrix<double, kPlantStates, kPlantStates>;
@@ -299,22 +303,61 @@ std::vector<std::string> summary_lines(const StationControl& study);
 
 // --- Tuning ---------------------------------------------------------------------------------------
 //
-// Gains per mechanism (the same kp, ki, kd on both joints; i_clamp kept), starting from the
-// hand-set ones (ControllerSettings::hand_set_pid()), that minimise the worst
-// tracking error over the station's patterns, simulated with this mechanism alone under the new
-// gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject to max rho <= rho_limit over a
-// grid of the target (the constraint) and to the saturation limit (a penalty of 10 mm per unit of
-// saturated-time fraction beyond controller.max_saturation_fraction). NLopt's COBYLA (Powell's
-// derivative-free linear-approximation method with constraints; Powell, "A direct search
-// optimization method that models the objective and constraint functions by linear
-// interpolation", 1994) over (ln kp, ln ki, ln kd) within a factor e^5 (~148) of the start, started
-// from the design's gains with an initial step of a factor 2, the constraint aimed 0.003 inside its
-// limit (COBYLA ends within its tolerance of it). Deterministic: the same design and
+// Gains per mechanism (the same kp, ki, kd on both joints; or per joint with `per_joint`; i_clamp
+// kept) that minimise the worst tracking error over the station's patterns, simulated with this
+// mechanism alone under the new gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject
+// to max rho <= rho_limit over the target (the constraint, on the export gate's 21 x 21 grid) and
+// to the saturation limit (a penalty of 10 mm per unit of saturated-time fraction beyond
+// controller.max_saturation_fraction).
+//
+// Start: pole placement on the linearised model at the target's centre. Each joint j of the plant
+// above, with the current taken as settled (L/R = 0.1 ms with the motor defaults, far below
+// T = 10 ms: i_j = (V_s,j u_j - k_e,j N_j w_j) / R_j) and the cross terms of M, K_s, C_s left out,
+// is the second-order SISO model
+//   m_j theta'' + c_j theta' + k_j theta = b_j u,   m_j = M_jj, k_j = K_s,jj,
+//   c_j = C_s,jj + b_v,j + eta_j N_j^2 k_t,j k_e,j / R_j,   b_j = eta_j N_j k_t,j V_s,j / R_j,
+// and the continuous PID u = -(kp theta + ki int theta + kd theta') closes it with the
+// characteristic polynomial m s^3 + (c + b kd) s^2 + (k + b kp) s + b ki. Placing its three roots at
+// -omega, (s + omega)^3 = s^3 + 3 omega s^2 + 3 omega^2 s + omega^3, gives
+//   kp = (3 m omega^2 - k) / b,   ki = m omega^3 / b,   kd = (3 m omega - c) / b
+// (e.g. Astrom & Murray, "Feedback Systems", 2008, Sec. 10.3 on PID pole placement for a
+// second-order process); a gain that comes out below 1e-3 is raised to it. With one set of gains for
+// both joints, m, c, k and b are the two joints' means. omega is the one of a geometric scan from
+// 0.2 Hz to a quarter of the loop rate (60 values, the best refined by golden section) that
+// minimises the exact sampled-data max rho over the target (the continuous design does not see the
+// sample-and-hold and the period of delay; the exact check does). TuneOptions::start = hand_set
+// starts from the hand-set gains instead.
+//
+// Refinement: NLopt's COBYLA (Powell's derivative-free linear-approximation method with
+// constraints; Powell, "A direct search optimization method that models the objective and
+// constraint functions by linear interpolation", 1994) over (ln kp, ln ki, ln kd) (per joint: six)
+// within a factor e^5 (~148) of the start, an initial step of a factor 2, the constraint aimed 0.003
+// inside its limit. The result is the best evaluated point that meets the constraints (COBYLA's own
+// last point may lie just outside), else COBYLA's point. No random element: the same design and
 // options give the same gains, unless the wall-time bound stops a run first (the result says so).
+
+enum class TuneStart { pole_placement, hand_set };
+
+/// PID gains placing the three closed-loop roots of each joint's reduced model (above) of `plant`
+/// at -omega (rad/s); i_clamp from `base`. `per_joint` false: one set from the joints' means.
+std::array<PidGains, 2> pole_placement_gains(const LinearPlant& plant, const std::array<MotorParams, 2>& motors,
+                                             double omega_rad_s, bool per_joint, const std::array<PidGains, 2>& base);
+
+/// The start of the tuning: pole_placement_gains() at the omega minimising max rho over `poses`.
+struct PolePlacement {
+  Status status = Status::unreachable;  ///< of the centre pose; gains = base unless ok
+  double omega_rad_s = 0.0;
+  std::array<PidGains, 2> gains;
+  double max_rho = 0.0;                 ///< over the poses
+};
+PolePlacement pole_placement(const LoopModel& loop, const Vec2& centre_mm, const std::vector<PoseLoop>& poses,
+                             bool per_joint, const std::array<PidGains, 2>& base);
 
 struct TuneOptions {
   double rho_limit = 0.9;       ///< max spectral radius allowed over the target
-  int grid = 21;                ///< per axis over the target for the constraint: the export gate's grid
+  TuneStart start = TuneStart::pole_placement;
+  bool per_joint = false;       ///< kp, ki, kd per joint (six unknowns) instead of per mechanism
+  int grid = kControlGateGrid;  ///< per axis over the target for the constraint: the export gate's grid
   int max_evaluations = 60;     ///< objective evaluations per mechanism
   double max_seconds = 30.0;    ///< wall time for the whole tuning, shared among the mechanisms
   double rtol = 1e-3;           ///< CVODE tolerance of the tracking runs
@@ -331,6 +374,9 @@ struct TunedMechanism {
   /// per-station-mechanism scopes a patch writes), the start; design: the gains the design runs
   /// with (the hand-set ones, or an earlier patch's); after: the tuned ones.
   std::array<PidGains, 2> before, design, after;
+  std::array<PidGains, 2> start;   ///< where COBYLA started (the pole placement or the hand-set gains)
+  double start_omega_rad_s = 0.0;  ///< the pole placement's omega (0 when started from the hand-set gains)
+  double rho_start = 0.0;
   double rho_before = 0.0, rho_after = 0.0;        ///< max over the constraint's grid
   double error_before_mm = 0.0, error_after_mm = 0.0;  ///< worst tracking error over the patterns
   double saturation_before = 0.0, saturation_after = 0.0;  ///< worst saturated-time fraction

@@ -125,6 +125,9 @@ void TuneSettings::validate() const {
   if (!(max_seconds > 0.0) || !(max_seconds <= 3600.0)) {
     throw ValidationError("max_seconds", "= " + plain_number(max_seconds) + " s: must be > 0 and <= 3600 s");
   }
+  if (start != "pole_placement" && start != "hand_set") {
+    throw ValidationError("start", "= " + detail::quoted(start) + ": must be pole_placement or hand_set");
+  }
 }
 
 bool is_ros_node_name(std::string_view name) {
@@ -274,10 +277,17 @@ void load(const Value& v, Design& design) {
   if (const Value* t = find(all, "tune")) {
     TuneSettings& tune = c.tune.emplace();
     if (!t->is_null()) {  // `tune:` alone: every default
-      const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds"}, "(rho_limit, evaluations, max_seconds)");
+      const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds", "per_joint", "start"},
+                                   "(rho_limit, evaluations, max_seconds, per_joint, start)");
       tune.rho_limit = number_or(keys, "rho_limit", tune.rho_limit, "");
       if (const Value* n = find(keys, "evaluations")) tune.evaluations = int(n->whole(1, 10000));
       tune.max_seconds = number_or(keys, "max_seconds", tune.max_seconds, "s");
+      if (const Value* pj = find(keys, "per_joint")) {
+        const std::string word = pj->text("a boolean: true or false");
+        if (word != "true" && word != "false") pj->fail_value("must be true or false");
+        tune.per_joint = word == "true";
+      }
+      if (const Value* st = find(keys, "start")) tune.start = st->text("must be pole_placement or hand_set");
     }
   }
 
@@ -400,6 +410,8 @@ void write(const Design& d, Out& top) {
     t.add("rho_limit", Out::number(c.tune->rho_limit));
     t.add("evaluations", Out::integer(c.tune->evaluations));
     t.add("max_seconds", Out::number(c.tune->max_seconds));
+    t.add("per_joint", Out::plain(c.tune->per_joint ? "true" : "false"));
+    t.add("start", Out::plain(c.tune->start));
   }
 
   // Overrides in canonical form: every station's mechanisms, then by station (design order), then

@@ -75,6 +75,10 @@ struct TuneSettings {
   double rho_limit = 0.9;     ///< max spectral radius allowed over the target, in (0, 1)
   int evaluations = 60;       ///< objective evaluations per mechanism (each simulates every pattern)
   double max_seconds = 30.0;  ///< wall-time bound of the whole tuning, s (issue 16: < 30 s for the paper's device)
+  bool per_joint = false;     ///< kp, ki, kd per joint instead of one set per mechanism
+  /// Where the optimiser starts: "pole_placement" (on the linearised model at the target's
+  /// centre) or "hand_set" (the file's gains).
+  std::string start = "pole_placement";
   void validate() const;
 };
 

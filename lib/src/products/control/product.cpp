@@ -3,6 +3,7 @@
 // radius map, worst pose, verdict, gain margins, damping; picture, VTK field and CSV under control/.
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <string>
 #include <vector>
@@ -32,15 +33,23 @@ constexpr const char* kPerformance =
     "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm).\n\n";
 
 constexpr const char* kTuning =
-    "`controller.tune` asks for the gains to be tuned: per mechanism, from the hand-set PID (the file's gains "
-    "without the per-station-mechanism scopes a tuning patch writes), NLopt's COBYLA minimises the worst "
-    "simulated tracking error over the station's patterns subject to the spectral radius staying at most "
-    "the limit over the target and no sustained saturation (lib/include/fivebar/control.hpp \"Tuning\"). "
-    "Before and after side by side; `control/tuned-controller.yaml` is the patch of `controller:` that "
-    "applies them, `control/tuning.csv` the table.\n\n";
+    "`controller.tune` asks for the gains to be tuned, per mechanism (lib/include/fivebar/control.hpp "
+    "\"Tuning\"): a pole placement on the loop linearised at the target's centre (the three roots of each "
+    "joint's PID loop at −ω, ω chosen for the least spectral radius over the target) is refined by NLopt's "
+    "COBYLA to the least worst simulated tracking error over the station's patterns, with the spectral radius "
+    "at most the limit over the target (the export gate's grid) and no sustained saturation; masses from the "
+    "closed form, as the export gate. \"Before\" is the hand-set PID (the file's gains without the "
+    "per-station-mechanism scopes a tuning patch writes); `control/tuned-controller.yaml` is the patch of "
+    "`controller:` that applies the tuned gains, `control/tuning.csv` the table.\n\n";
 
 std::string gains_cell(const PidGains& g) {
   return "kp " + md::fixed(g.kp, 3) + ", ki " + md::fixed(g.ki, 3) + ", kd " + md::fixed(g.kd, 4);
+}
+
+/// One joint's gains, or both when they differ (a per-joint tuning).
+std::string gains_cell(const std::array<PidGains, 2>& g) {
+  if (g[0].kp == g[1].kp && g[0].ki == g[1].ki && g[0].kd == g[1].kd) return gains_cell(g[0]);
+  return "θ1 " + gains_cell(g[0]) + "; θ2 " + gains_cell(g[1]);
 }
 
 }  // namespace
@@ -74,7 +83,10 @@ Product control_product() {
       if (!has_pair(s)) continue;
       ctx.say("stability of station " + s.name);
       const auto inertia = station_inertia(d, s, parts, ctx.dir / "parts");
-      inertias[s.name] = inertia;
+      // The tuning with the closed-form masses the export gate checks with: reproducible (the STL
+      // renders' masses change in their last digits between openscad runs, and the optimiser's
+      // path with them).
+      inertias[s.name] = station_inertia(d, s, nullptr, {});
       pairs.push_back(&s);
       const StationControl study = station_control(d, s, inertia);
       stable = stable && study.stable();
@@ -122,12 +134,12 @@ Product control_product() {
         applied = applied && m.applied();
         worst_before = std::max(worst_before, m.error_before_mm);
         worst_after = std::max(worst_after, m.error_after_mm);
-        t.row({m.station, m.mechanism, gains_cell(m.before[0]), gains_cell(m.after[0]),
+        t.row({m.station, m.mechanism, gains_cell(m.before), gains_cell(m.after),
                md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
                md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3),
                md::fixed(100 * m.saturation_before, 1) + " % → " + md::fixed(100 * m.saturation_after, 1) + " %",
                std::to_string(m.evaluations), m.stop + (m.feasible ? "" : ", **not feasible**"),
-               m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design[0]) + ")"});
+               m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design) + ")"});
       }
       b.result["tuning"] = to_json(tuned);
       b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nTuned in " + md::fixed(tuned.wall_s, 1) +
