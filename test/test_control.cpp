@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 #include <map>
+#include <numbers>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -635,6 +637,75 @@ TEST(ControlTune, TheTuneKeyReadsWritesBackAndNamesABadValue) {
   } catch (const InputError& err) {
     EXPECT_NE(std::string(err.what()).find("controller.tune.rho_limit"), std::string::npos) << err.what();
     EXPECT_NE(std::string(err.what()).find("bad.yaml"), std::string::npos) << err.what();
+  }
+}
+
+
+// Abbott-Okamura against the 1-DOF closed form: with J = a I, the joints' damping b, Coulomb torque
+// tau and quantum delta alike, every direction sees at least the damping b / a^2, the friction
+// tau / a and a quantum a delta (the axes are the worst), so K <= min(2 b / (a^2 T), 2 tau / (a^2 delta)),
+// and a target K* needs the rate K* a^2 / (2 b) unless 2 tau / (a^2 delta) < K*.
+TEST(ControlPerformance, AbbottOkamuraBoundIsTheOneDofClosedFormForAnIsotropicJacobian) {
+  const double a = 0.015, T = 0.01;
+  const Eigen::Matrix2d J = a * Eigen::Matrix2d::Identity();
+  for (const auto& [b, tau, delta] : {std::tuple{0.01, 5e-4, 3e-4}, std::tuple{1e-4, 5e-2, 1e-5}}) {
+    SCOPED_TRACE(b);
+    PoseFigures f;
+    abbott_okamura(J, b * Eigen::Matrix2d::Identity(), {tau, tau}, {delta, delta}, T, 1.0, f);
+    const double kb = 2 * b / (a * a * T), kq = 2 * tau / (a * a * delta);  // N/m
+    EXPECT_NEAR(f.coulomb_N, tau / a, 1e-12 * tau / a);
+    EXPECT_NEAR(f.quantum_um, 1e6 * a * delta, 1e-9 * 1e6 * a * delta);
+    EXPECT_NEAR(f.zwidth_quantisation_N_per_mm, 1e-3 * kq, 1e-9 * 1e-3 * kq);
+    EXPECT_NEAR(f.zwidth_abbott_okamura_N_per_mm, 1e-3 * std::min(kb, kq), 1e-9 * 1e-3 * std::min(kb, kq));
+    if (kq >= 1e3) {
+      EXPECT_NEAR(f.rate_for_target_hz, 1e3 * a * a / (2 * b), 1e-9 * 1e3 * a * a / (2 * b));
+    } else {
+      EXPECT_TRUE(std::isinf(f.rate_for_target_hz));
+    }
+  }
+  // Little friction: quantisation-limited below 1 N/mm, so no rate renders 1 N/mm; a tenth of its bound is renderable.
+  PoseFigures g;
+  abbott_okamura(J, 1e-4 * Eigen::Matrix2d::Identity(), {5e-7, 5e-7}, {3e-4, 3e-4}, T, 1.0, g);
+  EXPECT_LT(g.zwidth_quantisation_N_per_mm, 1.0);
+  EXPECT_TRUE(std::isinf(g.rate_for_target_hz));
+  abbott_okamura(J, 1e-4 * Eigen::Matrix2d::Identity(), {5e-7, 5e-7}, {3e-4, 3e-4}, T, 0.1 * g.zwidth_quantisation_N_per_mm, g);
+  EXPECT_TRUE(std::isfinite(g.rate_for_target_hz));
+}
+
+// A rigid rotation of the tactor plane (J -> R J) turns every direction's figures with it: the
+// bounds over the directions do not change (R by a whole number of the 0.5 deg direction steps).
+TEST(ControlPerformance, AbbottOkamuraBoundIsInvariantUnderARotationOfTheTactorPlane) {
+  Eigen::Matrix2d J;
+  J << 0.012, -0.004, 0.007, 0.016;
+  const Eigen::Matrix2d B = Eigen::Vector2d(0.02, 0.05).asDiagonal();
+  PoseFigures f, r;
+  abbott_okamura(J, B, {4e-4, 7e-4}, {2e-4, 5e-4}, 0.01, 1.0, f);
+  const double angle = 37.5 * std::numbers::pi / 180.0;
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  abbott_okamura(R * J, B, {4e-4, 7e-4}, {2e-4, 5e-4}, 0.01, 1.0, r);
+  EXPECT_NEAR(r.zwidth_abbott_okamura_N_per_mm, f.zwidth_abbott_okamura_N_per_mm, 1e-9 * f.zwidth_abbott_okamura_N_per_mm);
+  EXPECT_NEAR(r.zwidth_quantisation_N_per_mm, f.zwidth_quantisation_N_per_mm, 1e-9 * f.zwidth_quantisation_N_per_mm);
+  EXPECT_NEAR(r.coulomb_N, f.coulomb_N, 1e-9 * f.coulomb_N);
+  EXPECT_NEAR(r.quantum_um, f.quantum_um, 1e-9 * f.quantum_um);
+}
+
+// On the showcase: the position quantum's worst direction is along the coarser joint's column (the
+// resolution figure, from FK by its own test above), and friction can only lower the Z-width.
+TEST(ControlPerformance, AbbottOkamuraOnTheShowcaseAgreesWithTheResolutionAndColgate) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("index", "lower");
+  const ControllerSettings& c = *d.get<ControllerSettings>();
+  const std::array<Potentiometer, 2> pots{c.joint("index", "lower", 1).potentiometer, c.joint("index", "lower", 2).potentiometer};
+  for (const Vec2& off : {Vec2(0, 0), Vec2(5, -4), Vec2(-6, 2)}) {
+    const PoseFigures f = pose_figures(loop, d.require_station("index").target.center + off, c.adc_bits, c.adc_range_v,
+                                       pots, c.target_stiffness_N_per_mm);
+    ASSERT_EQ(f.status, Status::ok);
+    EXPECT_NEAR(f.quantum_um, f.resolution_um, 1e-4 * f.resolution_um);  // 0.5 deg steps: cos 0.25 deg
+    EXPECT_LE(f.zwidth_abbott_okamura_N_per_mm, f.zwidth_N_per_mm * (1 + 1e-9));
+    EXPECT_LE(f.zwidth_abbott_okamura_N_per_mm, f.zwidth_quantisation_N_per_mm * (1 + 1e-9));
+    // The showcase's assumed motors: friction over a ~5 um quantum allows ~10 N/mm, above the target.
+    EXPECT_GT(f.zwidth_abbott_okamura_N_per_mm, c.target_stiffness_N_per_mm);
+    EXPECT_LT(f.rate_for_target_hz, c.loop_rate_hz);
   }
 }
 

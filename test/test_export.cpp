@@ -276,7 +276,8 @@ TEST(Formats, RosYamlReadByYamlCppEqualsTheDesign) {
   const YAML::Node p = y["fivebar_controller"]["ros__parameters"];
   EXPECT_EQ(p["stations"]["thumb"]["upper"]["o1_m"][1].as<double>(), 35.0 / 1000);
   EXPECT_EQ(p["stations"]["index"]["lower"]["link_lengths_m"][2].as<double>(), 15.0 / 1000);
-  EXPECT_EQ(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), 0.05);
+  EXPECT_EQ(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), d.get<ControllerSettings>()->joint("thumb", "upper", 2).pid.kd);
+  EXPECT_NE(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), d.get<ControllerSettings>()->pid.kd);  // the tuned scope
   EXPECT_EQ(p["pwm_hz"].Scalar(), "1000.0");
   EXPECT_EQ(p["adc"]["bits"].Scalar(), "16");
   EXPECT_EQ(p["fivebar"]["design_hash"].as<std::string>(), design_hash(d, {}));

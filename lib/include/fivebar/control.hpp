@@ -227,8 +227,24 @@ std::string rho_field_vti(const RhoField& field);
 // b > K T / 2 + |B|, b the device's own damping. Here b is the joint damping mapped to the tactor,
 // B_x = J^-T diag(b_j + eta_j N_j^2 k_t,j k_e,j / R_j) J^-1 (viscous friction plus the back-EMF damping of
 // the voltage-driven motor), in the direction where it is least (its smallest eigenvalue): K_max =
-// 2 (b_min - |B|) / T, and the loop rate a stiffness K needs is K / (2 (b_min - |B|)). Coulomb friction
-// and the ADC quantisation (Abbott & Okamura's refinement) are not in this bound.
+// 2 (b_min - |B|) / T, and the loop rate a stiffness K needs is K / (2 (b_min - |B|)).
+// With Coulomb friction and position quantisation (Abbott & Okamura, "Effects of position
+// quantization and sampling rate on virtual-wall passivity", IEEE Trans. Robotics 21(5), 2005: a
+// necessary and sufficient condition for a mass with Coulomb-plus-viscous friction and a quantised
+// position sensor), the wall is passive iff
+//   K <= min(2 b / T, 2 f_c / Delta),
+// f_c the Coulomb friction and Delta the position quantum. Per tactor direction u (unit), with the
+// joints' rates J^-1 u at unit tactor speed:
+//   b(u)     = u^T B_x u                                  (power of the viscous terms),
+//   f_c(u)   = sum_j tau_c,j |(J^-1 u)_j|                 (power of the joints' Coulomb friction,
+//                                                          motor.coulomb_friction_mNm),
+//   Delta(u) = max_j |u . J_j| dtheta_j                   (the tactor step along u of one ADC count
+//                                                          of the coarser joint, dtheta_j as above),
+// and the bound is the least over 360 directions of min(2 b(u) / T, 2 f_c(u) / Delta(u)). The loop
+// rate a target stiffness K* (controller.target_stiffness_N_per_mm) needs is max over u of
+// K* / (2 b(u)) where the quantisation allows K* (2 f_c(u) / Delta(u) >= K*); where it does not,
+// no loop rate renders K* passively (a finer sensor or more friction would): the rate is then
+// infinite and the pose "quantisation-limited".
 
 struct PoseFigures {
   Vec2 P_mm{0.0, 0.0};
@@ -237,8 +253,20 @@ struct PoseFigures {
   double resolution_um = 0.0;     ///< tactor step of one ADC count, worst joint
   double force_N = 0.0;           ///< continuous force in every direction
   double damping_N_s_per_mm = 0.0;  ///< least tactor damping b_min
-  double zwidth_N_per_mm = 0.0;   ///< 2 b_min / T (no virtual damping)
+  double zwidth_N_per_mm = 0.0;   ///< 2 b_min / T (no virtual damping): Colgate-Schenkel
+  double coulomb_N = 0.0;         ///< least f_c(u) over the directions
+  double quantum_um = 0.0;        ///< largest Delta(u) over the directions
+  double zwidth_quantisation_N_per_mm = 0.0;  ///< least 2 f_c(u) / Delta(u)
+  double zwidth_abbott_okamura_N_per_mm = 0.0;  ///< least min(2 b(u) / T, 2 f_c(u) / Delta(u))
+  /// Loop rate the target stiffness needs (Hz): infinity when the quantisation forbids it.
+  double rate_for_target_hz = 0.0;
 };
+
+/// The Abbott-Okamura figures of a pose (above) into `f` (its zwidth_N_per_mm and damping kept):
+/// Jacobian J (m/rad), joint damping diag Bj (N m s/rad), Coulomb torques (N m), joint quanta
+/// (rad per count), period T (s), target stiffness (N/mm).
+void abbott_okamura(const Eigen::Matrix2d& J, const Eigen::Matrix2d& Bj, const std::array<double, 2>& coulomb_Nm,
+                    const std::array<double, 2>& quantum_rad, double period_s, double target_N_per_mm, PoseFigures& f);
 
 /// The closed-loop gain from the tactor reference to the tactor at frequency f (Hz): the
 /// singular values of J H(e^{j 2 pi f T}) J^-1, smallest first.
@@ -248,7 +276,7 @@ std::array<double, 2> tactor_gain(const DiscretePlant& plant, const std::array<P
 /// The figures at tactor point P (mm); `adc_bits`, `adc_range_v` and the joints' potentiometers
 /// from the controller of the design.
 PoseFigures pose_figures(const LoopModel& loop, const Vec2& P_mm, int adc_bits, const std::array<double, 2>& adc_range_v,
-                         const std::array<Potentiometer, 2>& pots);
+                         const std::array<Potentiometer, 2>& pots, double target_N_per_mm = 1.0);
 
 /// Worst over a set of poses: the lowest bandwidth, the coarsest resolution, the weakest force,
 /// the lowest Z-width, each with its pose.
@@ -256,11 +284,16 @@ struct PerformanceMap {
   std::string station, mechanism;
   std::vector<PoseFigures> poses;
   PoseFigures worst_bandwidth, worst_resolution, worst_force, worst_zwidth;
+  PoseFigures worst_zwidth_abbott_okamura;  ///< lowest Abbott-Okamura bound
+  PoseFigures worst_rate;                   ///< highest loop rate for the target stiffness
+  double target_N_per_mm = 1.0;             ///< controller.target_stiffness_N_per_mm
+  double loop_rate_hz = 100.0;              ///< the design's
 };
 PerformanceMap performance_map(const Design& design, const LoopModel& loop, const std::vector<Vec2>& points);
 Json to_json(const PerformanceMap& map);
 /// "index lower: bandwidth >= 6.2 Hz (at ...), resolution <= 0.9 um/count, force >= 1.9 N in every
-/// direction, Z-width >= 120 N/mm (hard surface 0.8-1.0 N/mm)".
+/// direction, Z-width >= 120 N/mm (hard surface 0.8-1.0 N/mm)", then the Abbott-Okamura bound and
+/// the loop rate the target stiffness needs against the design's.
 std::string performance_line(const PerformanceMap& map);
 
 // --- A station's study (the `control` subcommand and product) ----------------------------------
@@ -289,7 +322,9 @@ StationControl station_control(const Design& design, const Station& station,
 /// (every target pose: station,mechanism,x_mm,y_mm,status,rho,damping,frequency_hz) and
 /// `<station>-performance.csv` (every pose of the performance grid: station,mechanism,x_mm,y_mm,
 /// status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,tactor_damping_N_s_per_mm,
-/// zwidth_N_per_mm).
+/// zwidth_N_per_mm,coulomb_friction_N,position_quantum_um,zwidth_quantisation_N_per_mm,
+/// zwidth_abbott_okamura_N_per_mm,loop_rate_for_target_hz; the last empty where the quantisation
+/// forbids the target stiffness).
 std::vector<std::pair<std::string, std::string>> control_files(const StationControl& study, const Station& station,
                                                                const std::string& subtitle);
 

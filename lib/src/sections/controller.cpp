@@ -184,6 +184,10 @@ void ControllerSettings::validate() const {
   if (!(max_saturation_fraction >= 0.0) || !(max_saturation_fraction <= 1.0)) {
     throw ValidationError("max_saturation_fraction", "= " + plain_number(max_saturation_fraction) + ": must be in [0, 1]");
   }
+  if (!(target_stiffness_N_per_mm > 0.0) || !(target_stiffness_N_per_mm <= 1e6)) {
+    throw ValidationError("target_stiffness_N_per_mm",
+                          "= " + plain_number(target_stiffness_N_per_mm) + " N/mm: must be > 0 and <= 1000000 N/mm");
+  }
   rules::validate_nested("pid", [&] { pid.validate(); });
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
   if (tune) rules::validate_nested("tune", [&] { tune->validate(); });
@@ -243,11 +247,11 @@ void load(const Value& v, Design& design) {
   ControllerSettings& c = design.set(ControllerSettings{});
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                              "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction", "pid",
-                              "potentiometer", "tune", "mechanisms", "stations"},
+                              "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction",
+                              "target_stiffness_N_per_mm", "pid", "potentiometer", "tune", "mechanisms", "stations"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                             "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, pid, potentiometer, "
-                             "tune, mechanisms, stations)");
+                             "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, "
+                             "target_stiffness_N_per_mm, pid, potentiometer, tune, mechanisms, stations)");
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -265,6 +269,7 @@ void load(const Value& v, Design& design) {
   if (const Value* m = find(all, "joint_margin_deg")) c.joint_margin = kRadPerDeg * m->number("deg");
   c.max_tracking_error_mm = number_or(all, "max_tracking_error_mm", c.max_tracking_error_mm, "mm");
   c.max_saturation_fraction = number_or(all, "max_saturation_fraction", c.max_saturation_fraction, "");
+  c.target_stiffness_N_per_mm = number_or(all, "target_stiffness_N_per_mm", c.target_stiffness_N_per_mm, "N/mm");
   ControlOverride defaults;
   control_keys(all, defaults);
   if (defaults.kp) c.pid.kp = *defaults.kp;
@@ -400,6 +405,7 @@ void write(const Design& d, Out& top) {
   out.add("joint_margin_deg", Out::degrees(c.joint_margin));
   out.add("max_tracking_error_mm", Out::number(c.max_tracking_error_mm));
   out.add("max_saturation_fraction", Out::number(c.max_saturation_fraction));
+  out.add("target_stiffness_N_per_mm", Out::number(c.target_stiffness_N_per_mm));
   ControlOverride defaults;
   defaults.kp = c.pid.kp, defaults.ki = c.pid.ki, defaults.kd = c.pid.kd, defaults.i_clamp = c.pid.i_clamp;
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;

@@ -114,6 +114,11 @@ struct ControllerSettings {
   /// saturated (a joint at full duty or at the driver's current limit), in [0, 1]. 0.05 is an
   /// ASSUMPTION: brief saturation at a pattern's start is tolerated, sustained saturation is not.
   double max_saturation_fraction = 0.05;
+  /// The stiffness of virtual wall the device should render passively (N/mm): the `control`
+  /// study reports the loop rate it needs (fivebar/control.hpp "Z-width"). 1.0 N/mm: a hard
+  /// surface needs at least 0.8-1.0 N/mm (Choi & Tan, "Effect of update rate on perceived
+  /// instability of virtual haptic texture", IROS 2004), the fingertip-device literature's figure.
+  double target_stiffness_N_per_mm = 1.0;
   PidGains pid;                   ///< every joint, unless overridden
   Potentiometer potentiometer;    ///< every joint, unless overridden
   std::optional<TuneSettings> tune;  ///< `tune:`; none: the `control` product does not tune

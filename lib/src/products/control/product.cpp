@@ -3,12 +3,14 @@
 // radius map, worst pose, verdict, gain margins, damping; picture, VTK field and CSV under control/.
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "fivebar/control.hpp"
+#include "fivebar/error.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -30,7 +32,10 @@ constexpr const char* kPerformance =
     "frequency response in the tactor's worst direction), the tactor step of one ADC count, the largest "
     "continuous shear force the motors hold in every direction (fingertip devices are compared at ≥ 1.5 N) and "
     "the Z-width, the stiffest virtual wall the loop renders passively from the device's own damping "
-    "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm).\n\n";
+    "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm) and with the motors' Coulomb friction and "
+    "the position quantum of one ADC count, both mapped to the tactor per direction (Abbott–Okamura, "
+    "K ≤ min(2 b / T, 2 f_c / Δ)), and the loop rate a wall of `controller.target_stiffness_N_per_mm` needs "
+    "(none when the quantisation forbids it at any rate).\n\n";
 
 constexpr const char* kTuning =
     "`controller.tune` asks for the gains to be tuned, per mechanism (lib/include/fivebar/control.hpp "
@@ -71,8 +76,9 @@ Product control_product() {
                      "least-damped oscillation ζ / Hz", "kp margin", "kd margin"},
                     "lllrlrrrr");
     md::Table performance({"station", "mechanism", "bandwidth ≥ (Hz)", "resolution ≤ (µm/count)",
-                           "force in every direction ≥ (N)", "Z-width ≥ (N/mm)"},
-                          "llrrrr");
+                           "force in every direction ≥ (N)", "Z-width ≥ (N/mm)", "with friction and quantisation ≥ (N/mm)",
+                           "loop rate for the target wall (Hz)"},
+                          "llrrrrrr");
     Json studies = Json::array();
     std::map<std::string, std::map<std::string, MechanismInertia>> inertias;
     std::vector<const Station*> pairs;
@@ -106,7 +112,13 @@ Product control_product() {
       for (const PerformanceMap& m : study.performance) {
         performance.row({s.name, m.mechanism, md::fixed(m.worst_bandwidth.bandwidth_hz, 2),
                          md::fixed(m.worst_resolution.resolution_um, 3), md::fixed(m.worst_force.force_N, 2),
-                         md::fixed(m.worst_zwidth.zwidth_N_per_mm, 1)});
+                         md::fixed(m.worst_zwidth.zwidth_N_per_mm, 1),
+                         md::fixed(m.worst_zwidth_abbott_okamura.zwidth_abbott_okamura_N_per_mm, 2),
+                         std::isfinite(m.worst_rate.rate_for_target_hz)
+                             ? md::fixed(m.worst_rate.rate_for_target_hz, 2) + " for " +
+                                   md::fixed(m.target_N_per_mm, 2) + " N/mm (" +
+                                   (m.worst_rate.rate_for_target_hz <= m.loop_rate_hz ? "met" : "**not met**") + ")"
+                             : "none: quantisation-limited"});
       }
       studies.push_back(to_json(study));
     }
@@ -120,7 +132,18 @@ Product control_product() {
     if (ctl.tune && !pairs.empty()) {
       TuneOptions to = tune_options(ctl);
       to.progress = [&ctx](std::string_view line) { ctx.say(line); };
-      const TuneResult tuned = tune_controller(d, pairs, inertias, to);
+      TuneResult tuned;
+      try {
+        tuned = tune_controller(d, pairs, inertias, to);
+      } catch (const InputError& e) {
+        // A pattern that cannot be followed (its reference unreachable): the `pattern` product says
+        // where; no tuning without it.
+        b.markdown += "### Tuning\n\n**Not tuned**: " + std::string(e.what()) + "\n";
+        b.result["tuning"] = {{"error", e.what()}};
+        b.passed = false;
+        b.check += "; not tuned: a pattern cannot be followed";
+        return b;
+      }
       ctx.write_file("control/tuned-controller.yaml", tuned_patch_yaml(tuned));
       ctx.write_file("control/tuning.csv", tuning_csv(tuned));
       md::Table t({"station", "mechanism", "gains before (hand-set)", "gains after (tuned)", "max ρ before → after",
