@@ -312,7 +312,9 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     opt.set_xtol_rel(1e-3);
     opt.set_maxeval(options.max_evaluations);
     const double spent = std::chrono::duration<double>(Clock::now() - start).count();
-    opt.set_maxtime(std::max(0.5, (options.max_seconds - spent) / double(jobs.size() - j)));
+    // What is left of the bound, less a second for each mechanism still to come: a loaded machine
+    // slows one mechanism without cutting the next ones' evaluations short.
+    opt.set_maxtime(std::max(0.5, options.max_seconds - spent - 1.0 * double(jobs.size() - j - 1)));
     double best = 0.0;
     nlopt::result r = nlopt::FAILURE;
     try {

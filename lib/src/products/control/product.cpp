@@ -161,7 +161,9 @@ Product control_product() {
                md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
                md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3),
                md::fixed(100 * m.saturation_before, 1) + " % → " + md::fixed(100 * m.saturation_after, 1) + " %",
-               std::to_string(m.evaluations), m.stop + (m.feasible ? "" : ", **not feasible**"),
+               std::to_string(m.evaluations),
+               m.stop + (m.stop == "time limit" ? " (controller.tune.max_seconds)" : "") +
+                   (m.feasible ? "" : ", **not feasible**"),
                m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design) + ")"});
       }
       b.result["tuning"] = to_json(tuned);
