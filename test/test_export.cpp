@@ -616,7 +616,12 @@ TEST(Check, AnIntegerWhereADoubleIsDeclaredIsADifference) {
 TEST(Check, AStaleFileIsReportedByHashAndValue) {
   const std::string yaml = render_ros2_yaml(controller_parameters(paper(), {}));
   Design changed = paper();
+  // kd of every joint: the section's and that of each scope giving one (the showcase's tuned
+  // controller.stations.<s>.<m> scopes, which every joint runs).
   changed.get<ControllerSettings>()->pid.kd = 0.06;
+  for (ControlOverride& o : changed.get<ControllerSettings>()->overrides) {
+    if (o.kd) *o.kd += 0.01;
+  }
   const ExportCheck c = check_export(yaml, ExportFormat::ros2, changed, "f.yaml");
   EXPECT_FALSE(c.hash_matches());
   EXPECT_FALSE(c.matches());
