@@ -203,7 +203,8 @@ void setup_control(CLI::App& app) {
       ->type_name("N");
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
-      "Files: <station>-stability.svg|.png, <station>-<mechanism>-rho.vti, <station>-stability.csv.\n"
+      "Files: <station>-stability.svg|.png, <station>-<mechanism>-rho.vti, <station>-stability.csv,\n"
+      "<station>-performance.csv; with --tune also tuned-controller.yaml (a patch of controller:) and tuning.csv.\n"
       "Exit status: 0 stable everywhere on every target (with --tune: the tuned gains meet the constraints),\n"
       "1 unstable somewhere, tuned gains infeasible or a part failed to render,\n"
       "2 bad input, 3 internal error or output not writable.");

@@ -146,10 +146,10 @@ Product control_product() {
       }
       ctx.write_file("control/tuned-controller.yaml", tuned_patch_yaml(tuned));
       ctx.write_file("control/tuning.csv", tuning_csv(tuned));
-      md::Table t({"station", "mechanism", "gains before (hand-set)", "gains after (tuned)", "max ρ before → after",
+      md::Table t({"station", "mechanism", "gains before (hand-set)", "start", "gains after (tuned)", "max ρ before → after",
                    "worst tracking error before → after (mm)", "saturated before → after", "evaluations", "stop",
                    "the design runs"},
-                  "llllrrrrll");
+                  "lllllrrrrll");
       bool feasible = true, applied = true;
       double worst_before = 0.0, worst_after = 0.0;
       for (const TunedMechanism& m : tuned.mechanisms) {
@@ -157,7 +157,11 @@ Product control_product() {
         applied = applied && m.applied();
         worst_before = std::max(worst_before, m.error_before_mm);
         worst_after = std::max(worst_after, m.error_after_mm);
-        t.row({m.station, m.mechanism, gains_cell(m.before), gains_cell(m.after),
+        t.row({m.station, m.mechanism, gains_cell(m.before),
+               (m.start_omega_rad_s > 0.0 ? "pole placement, ω " + md::fixed(m.start_omega_rad_s, 1) + " rad/s"
+                                          : std::string("the hand-set gains")) +
+                   ", max ρ " + md::fixed(m.rho_start, 4),
+               gains_cell(m.after),
                md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
                md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3),
                md::fixed(100 * m.saturation_before, 1) + " % → " + md::fixed(100 * m.saturation_after, 1) + " %",
