@@ -28,8 +28,9 @@ struct ControlCliOptions {
   std::string out;
   bool json = false;
   bool tune = false;
-  double tune_seconds = 30.0;
-  int tune_evaluations = 60;
+  bool per_joint = false;
+  std::optional<double> tune_seconds;   ///< default: controller.tune.max_seconds (30)
+  std::optional<int> tune_evaluations;  ///< default: controller.tune.evaluations (60)
 };
 
 std::string gains_text(const PidGains& g) {
@@ -46,20 +47,27 @@ void print_tuning(const TuneResult& r) {
     std::string name = t.station + "/" + t.mechanism;
     name.resize(std::max<std::size_t>(name.size(), 13), ' ');
     std::string before = gains_text(t.before[0]), after = gains_text(t.after[0]);
+    const bool per_joint = t.after[0].kp != t.after[1].kp || t.after[0].ki != t.after[1].ki || t.after[0].kd != t.after[1].kd;
+    if (per_joint) after = "theta1 " + after;
     before.resize(std::max<std::size_t>(before.size(), 34), ' ');
     after.resize(std::max<std::size_t>(after.size(), 34), ' ');
     std::cout << "  " << name << "  " << before << " " << after << " " << fixed(t.rho_before, 4) << " / "
               << fixed(t.rho_after, 4) << "       " << fixed(t.error_before_mm, 3) << " / " << fixed(t.error_after_mm, 3)
               << "            " << fixed(100 * t.saturation_before, 1) << " % / " << fixed(100 * t.saturation_after, 1)
               << " %        " << t.evaluations << "     " << t.stop << (t.feasible ? "" : ", NOT FEASIBLE") << "\n";
+    if (per_joint) std::cout << std::string(15 + 35, ' ') << "theta2 " << gains_text(t.after[1]) << "\n";
   }
 }
 
 int run_control(const ControlCliOptions& opt) {
   if (opt.grid < 3 || opt.grid > 401) throw InputError("--grid must be within [3, 401]");
   if (opt.field < 3 || opt.field > 801) throw InputError("--field must be within [3, 801]");
-  if (!(opt.tune_seconds > 0.0) || !(opt.tune_seconds <= 3600.0)) throw InputError("--tune-seconds must be > 0 and <= 3600");
-  if (opt.tune_evaluations < 1 || opt.tune_evaluations > 10000) throw InputError("--tune-evaluations must be within [1, 10000]");
+  if (opt.tune_seconds && (!(*opt.tune_seconds > 0.0) || !(*opt.tune_seconds <= 3600.0))) {
+    throw InputError("--tune-seconds must be > 0 and <= 3600");
+  }
+  if (opt.tune_evaluations && (*opt.tune_evaluations < 1 || *opt.tune_evaluations > 10000)) {
+    throw InputError("--tune-evaluations must be within [1, 10000]");
+  }
   const Design design = load(opt.design);
   const std::vector<const Station*> stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
@@ -123,14 +131,18 @@ int run_control(const ControlCliOptions& opt) {
     for (const Station* s : stations)
       if (s->lower && s->upper) pairs.push_back(s);
     if (pairs.empty()) throw InputError("--tune: no station with both mechanisms (the patterns move both tactors)");
-    TuneOptions to;
-    to.max_seconds = opt.tune_seconds;
-    to.max_evaluations = opt.tune_evaluations;
+    TuneOptions to = tune_options(*design.get<ControllerSettings>());
+    if (opt.tune_seconds) to.max_seconds = *opt.tune_seconds;
+    if (opt.tune_evaluations) to.max_evaluations = *opt.tune_evaluations;
+    if (opt.per_joint) to.per_joint = true;
     to.progress = progress;
     tuned = tune_controller(design, pairs, inertias, to);
     const std::filesystem::path patch = dir / "tuned-controller.yaml";
     write_file_atomic(patch, tuned_patch_yaml(*tuned));
     files.push_back(patch.generic_string());
+    const std::filesystem::path table = dir / "tuning.csv";
+    write_file_atomic(table, tuning_csv(*tuned));
+    files.push_back(table.generic_string());
   }
   if (opt.json) {
     doc["stations"] = studies;
@@ -178,15 +190,21 @@ void setup_control(CLI::App& app) {
       ->type_name("DIR");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->add_flag("--tune", opt->tune,
-                "Tune kp, ki, kd per mechanism (NLopt COBYLA): least worst tracking error over the patterns with "
-                "max rho <= 0.9; writes tuned-controller.yaml (a patch of controller:) and prints before/after");
-  sub->add_option("--tune-seconds", opt->tune_seconds, "Wall-time bound of the whole tuning (s, default 30)")
+                "Tune kp, ki, kd per mechanism from the hand-set gains (NLopt COBYLA): least worst tracking error over "
+                "the patterns with max rho <= controller.tune.rho_limit (0.9); writes tuned-controller.yaml (a "
+                "patch of controller:) and tuning.csv and prints before/after");
+  sub->add_flag("--per-joint", opt->per_joint,
+                "With --tune: kp, ki, kd per joint (six unknowns per mechanism; default controller.tune.per_joint)");
+  sub->add_option("--tune-seconds", opt->tune_seconds,
+                  "Wall-time bound of the whole tuning (s, default controller.tune.max_seconds or 30)")
       ->type_name("S");
-  sub->add_option("--tune-evaluations", opt->tune_evaluations, "Objective evaluations per mechanism (default 60)")
+  sub->add_option("--tune-evaluations", opt->tune_evaluations,
+                  "Objective evaluations per mechanism (default controller.tune.evaluations or 60)")
       ->type_name("N");
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
-      "Files: <station>-stability.svg|.png, <station>-<mechanism>-rho.vti, <station>-stability.csv.\n"
+      "Files: <station>-stability.svg|.png, <station>-<mechanism>-rho.vti, <station>-stability.csv,\n"
+      "<station>-performance.csv; with --tune also tuned-controller.yaml (a patch of controller:) and tuning.csv.\n"
       "Exit status: 0 stable everywhere on every target (with --tune: the tuned gains meet the constraints),\n"
       "1 unstable somewhere, tuned gains infeasible or a part failed to render,\n"
       "2 bad input, 3 internal error or output not writable.");

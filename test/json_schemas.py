@@ -130,6 +130,8 @@ def main():
     run("simulate --step", "simulate", ["simulate", DESIGN, "-s", "index", "--step", "--no-render", "--out", out + "/sim"])
     run("tolerance", "tolerance", ["tolerance", DESIGN, "--out", out + "/tol"])
     run("control", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--out", out + "/control"])
+    run("control --tune", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--tune",
+                                      "--tune-evaluations", "2", "--out", out + "/tune"], (0, 1))
     run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/twist.svg"])
     doc = run("run", "run", ["run", DESIGN, "-q", "--out", out + "/run", "-P",
                              "kinematics,workspace,coverage,collision,pattern,export"])

@@ -199,6 +199,10 @@ TEST_F(CliWorkspace, RunCoverageFailsForAStationThatIsNotCoveredAndOnlyScansTheS
   const auto per_station = text.find("\n  stations:\n    thumb:");
   ASSERT_NE(per_station, std::string::npos);
   text.erase(per_station, text.find("\n\n", per_station + 1) - per_station);
+  // ... and the controller's tuned gains of the thumb (controller.stations.thumb).
+  const auto tuned = text.find("    thumb:\n      lower: {pid:");
+  ASSERT_NE(tuned, std::string::npos);
+  text.erase(tuned, text.find("\n\n", tuned) + 1 - tuned);
   const std::string from = "axes: [15, 12]";
   text.replace(text.find(from), from.size(), "axes: [40, 12]");
   const fs::path design = dir_ / "wide.yaml";

@@ -81,7 +81,7 @@ TEST_F(Cli, RunWritesTheSummariesAndThePageAndNothingElse) {
 }
 TEST_F(Cli, RunJsonAndDefaultOutputRoot) {
   // Default root is outputs/ relative to the working directory.
-  const Outcome r = run({"run", kDesign, "--json", "--quiet"});
+  const Outcome r = run({"run", kDesign, "-P", "kinematics", "--json", "--quiet"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.err, IsEmpty());
   const json j = parse(r);

@@ -12,6 +12,8 @@
 #include <fstream>
 #include <sstream>
 #include <map>
+#include <numbers>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -333,6 +335,16 @@ TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTuned
     EXPECT_NEAR(max_spectral_radius(poses, t.after, true), t.rho_after, 1e-12);
     EXPECT_NEAR(max_spectral_radius(poses, t.before, true), t.rho_before, 1e-12);
     EXPECT_EQ(t.feasible, t.rho_after <= o.rho_limit && t.saturation_after <= d.get<ControllerSettings>()->max_saturation_fraction);
+    // Started from the pole placement, which already meets the constraint on the showcase: the
+    // result is the best feasible point evaluated, so it meets it too, on the export gate's grid.
+    EXPECT_EQ(o.grid, kControlGateGrid);
+    EXPECT_LT(t.rho_start, o.rho_limit);
+    EXPECT_GT(t.start_omega_rad_s, 0.0);
+    EXPECT_TRUE(t.feasible);
+    EXPECT_LE(t.error_after_mm, t.error_before_mm);
+    // "before" is the hand-set pid (the showcase's station scopes hold an earlier tuning).
+    EXPECT_EQ(t.before[0].kp, d.get<ControllerSettings>()->pid.kp);
+    EXPECT_EQ(t.design[0].kp, loop.gains[0].kp);
   }
   // The patch, merged into the design file, gives each mechanism the tuned gains on both joints.
   const std::string patch = tuned_patch_yaml(a);
@@ -342,6 +354,10 @@ TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTuned
   std::string design = text.str();
   const std::size_t stations = patch.find("  stations:\n");
   ASSERT_NE(stations, std::string::npos);
+  // The showcase's own station scopes (an earlier tuning) out first: the patch replaces them.
+  const std::size_t own = design.find("  stations:\n    index:\n      lower: {pid:");
+  ASSERT_NE(own, std::string::npos);
+  design.erase(own, design.find("\n\n", own) + 1 - own);
   const std::size_t end = design.find("\n# The motors and drivers");
   ASSERT_NE(end, std::string::npos);
   design.insert(end + 1, patch.substr(stations));
@@ -470,6 +486,227 @@ TEST(Control, EllipseGridStaysInsideAndHoldsTheCentre) {
   EXPECT_TRUE(centre);
   // About one point per cell of the 20 x 20 cells over the box, pi/4 of them: pi 10^2.
   EXPECT_NEAR(double(pts.size()), 100 * std::numbers::pi, 8.0);
+}
+
+
+// The pole placement against an independent reduced model: m, c, k, b of each joint from the
+// dynamics' mass matrix and Jacobian, the skin and the motors' data (not from the linear plant's
+// rows, which the library reads), and the closed loop (theta, w, int theta) of the continuous PID,
+// whose three eigenvalues must sit at -omega.
+TEST(ControlTune, PolePlacementPutsEachJointsThreeRootsAtMinusOmega) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("thumb", "lower");
+  const Vec2 centre = d.require_station("thumb").target.center;
+  const AnglesResult a = ik_angles(loop.model.mechanism, centre);
+  ASSERT_EQ(a.status, Status::ok);
+  const Eigen::Vector2d theta(a.theta1, a.theta2);
+  const LinearPlant plant = linear_plant(loop.model, theta, &loop.skin);
+  ASSERT_EQ(plant.status, Status::ok);
+  const DynamicsTerms t = dynamics_terms(loop.model, theta, Eigen::Vector2d::Zero());
+  const Eigen::Matrix2d JtJ = t.J.transpose() * t.J;
+  std::array<double, 2> m{}, c{}, k{}, b{};
+  for (int j = 0; j < 2; ++j) {
+    const MotorParams& mp = loop.model.motors[std::size_t(j)];
+    m[std::size_t(j)] = t.M(j, j);
+    k[std::size_t(j)] = 1e3 * loop.skin.shear_stiffness_N_per_mm * JtJ(j, j);
+    // Settled current i = (V u - k_e N w) / R: torque eta N k_t i.
+    c[std::size_t(j)] = 1e3 * loop.skin.damping_N_s_per_mm * JtJ(j, j) + mp.viscous_friction() +
+                        mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.back_emf_constant() *
+                            mp.gear_ratio / mp.resistance();
+    b[std::size_t(j)] = mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.supply_voltage_V / mp.resistance();
+  }
+  const std::array<PidGains, 2> base{PidGains{}, PidGains{}};
+  for (const double omega : {30.0, 60.0}) {
+    SCOPED_TRACE(omega);
+    const std::array<PidGains, 2> g = pole_placement_gains(plant, loop.model.motors, omega, /*per_joint=*/true, base);
+    for (std::size_t j = 0; j < 2; ++j) {
+      Eigen::Matrix3d A;
+      A << 0.0, 1.0, 0.0,  //
+          -(k[j] + b[j] * g[j].kp) / m[j], -(c[j] + b[j] * g[j].kd) / m[j], -b[j] * g[j].ki / m[j],  //
+          1.0, 0.0, 0.0;
+      const Eigen::Vector3cd ev = A.eigenvalues();
+      // A triple root moves by ~eps^(1/3) under rounding: 1e-3 of omega.
+      for (int r = 0; r < 3; ++r) EXPECT_NEAR(std::abs(ev[r] + omega), 0.0, 1e-3 * omega) << "joint " << j + 1;
+      EXPECT_EQ(g[j].i_clamp, base[j].i_clamp);
+    }
+    // One set for both joints: the joints' means.
+    const std::array<PidGains, 2> one = pole_placement_gains(plant, loop.model.motors, omega, false, base);
+    const double mm = 0.5 * (m[0] + m[1]), cm = 0.5 * (c[0] + c[1]), km = 0.5 * (k[0] + k[1]), bm = 0.5 * (b[0] + b[1]);
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_NEAR(one[j].kp, (3 * mm * omega * omega - km) / bm, 1e-9 * one[j].kp);
+      EXPECT_NEAR(one[j].ki, mm * omega * omega * omega / bm, 1e-9 * one[j].ki);
+      EXPECT_NEAR(one[j].kd, (3 * mm * omega - cm) / bm, 1e-9 * one[j].kd);
+    }
+  }
+  // The chosen omega: no omega of a fine scan gives a smaller max rho over the poses (to 1e-3).
+  std::vector<PoseLoop> poses;
+  for (const Vec2& P : ellipse_grid(d.require_station("thumb").target, 9)) poses.push_back(pose_loop(loop, P));
+  const PolePlacement pp = pole_placement(loop, centre, poses, false, base);
+  ASSERT_EQ(pp.status, Status::ok);
+  EXPECT_NEAR(max_spectral_radius(poses, pp.gains, true), pp.max_rho, 1e-12);
+  double scan = 1e300;
+  for (int i = 0; i <= 400; ++i) {
+    const double omega = 2.0 * std::numbers::pi * 0.2 * std::pow(125.0, i / 400.0);
+    scan = std::min(scan, max_spectral_radius(poses, pole_placement_gains(plant, loop.model.motors, omega, false, base), true));
+  }
+  EXPECT_LE(pp.max_rho, scan + 1e-3);
+}
+
+// A per-joint result writes theta1 / theta2 scopes, which read back as each joint's gains, and the
+// hand-set gains leave out exactly the scopes a patch writes.
+TEST(ControlTune, PerJointPatchReadsBackPerJointAndHandSetGainsLeaveThePatchOut) {
+  TuneResult r;
+  TunedMechanism t;
+  t.station = "thumb";
+  t.mechanism = "upper";
+  t.after[0] = {7.5, 150.0, 0.15, 0.2};
+  t.after[1] = {8.25, 175.0, 0.125, 0.2};
+  t.feasible = true;
+  r.mechanisms.push_back(t);
+  const std::string patch = tuned_patch_yaml(r);
+  EXPECT_NE(patch.find("upper: {theta1: {pid: {kp: 7.5, ki: 150, kd: 0.15}}, theta2: {pid: {kp: 8.25, ki: 175, kd: 0.125}}}"),
+            std::string::npos)
+      << patch;
+  std::ifstream in(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string design = text.str();
+  // After the controller's last line (its station scopes), as more of thumb's scopes.
+  const std::string thumb = "    thumb:\n";
+  const std::size_t at = design.find(thumb, design.find("\ncontroller:"));
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t line = patch.find("      upper: {theta1");
+  design.insert(design.find("\n\n", at) + 1, patch.substr(line, patch.find('\n', line) + 1 - line));
+  // The thumb already has an `upper:` key (the showcase's tuning): keep the joints' scopes only.
+  const std::size_t dup = design.find("      upper: {pid:", at);
+  ASSERT_NE(dup, std::string::npos);
+  design.erase(dup, design.find('\n', dup) + 1 - dup);
+  const Design merged = load_design_from_string(design, "merged.yaml");
+  const ControllerSettings& c = *merged.get<ControllerSettings>();
+  for (int j = 1; j <= 2; ++j) {
+    const PidGains g = c.joint("thumb", "upper", j).pid;
+    EXPECT_EQ(g.kp, t.after[std::size_t(j - 1)].kp);
+    EXPECT_EQ(g.ki, t.after[std::size_t(j - 1)].ki);
+    EXPECT_EQ(g.kd, t.after[std::size_t(j - 1)].kd);
+    const PidGains h = c.hand_set_pid("thumb", "upper", j);
+    EXPECT_EQ(h.kp, c.pid.kp);
+    EXPECT_EQ(h.ki, c.pid.ki);
+    EXPECT_EQ(h.kd, c.pid.kd);
+  }
+  // A wider scope's gains are hand-set: kept.
+  ControllerSettings wide = c;
+  ControlOverride o;
+  o.mechanism = "upper";
+  o.joint = 2;
+  o.kp = 3.0;
+  wide.overrides.push_back(o);
+  EXPECT_EQ(wide.hand_set_pid("thumb", "upper", 2).kp, 3.0);
+  EXPECT_EQ(wide.hand_set_pid("thumb", "upper", 1).kp, c.pid.kp);
+}
+
+TEST(ControlTune, TheTuneKeyReadsWritesBackAndNamesABadValue) {
+  const Design& d = paper();
+  ASSERT_TRUE(d.get<ControllerSettings>()->tune.has_value());
+  const TuneOptions from_file = tune_options(*d.get<ControllerSettings>());
+  EXPECT_EQ(from_file.start, TuneStart::pole_placement);
+  Design e = d;
+  TuneSettings& t = *e.get<ControllerSettings>()->tune;
+  t.rho_limit = 0.85;
+  t.evaluations = 7;
+  t.max_seconds = 12.5;
+  t.per_joint = true;
+  t.start = "hand_set";
+  const Design back = load_design_from_string(to_yaml(e), "back.yaml");
+  const TuneOptions o = tune_options(*back.get<ControllerSettings>());
+  EXPECT_EQ(o.rho_limit, 0.85);
+  EXPECT_EQ(o.max_evaluations, 7);
+  EXPECT_EQ(o.max_seconds, 12.5);
+  EXPECT_TRUE(o.per_joint);
+  EXPECT_EQ(o.start, TuneStart::hand_set);
+  std::ifstream in(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string bad = text.str();
+  const std::string key = "tune: {rho_limit: 0.9,";
+  const std::size_t at = bad.find(key);
+  ASSERT_NE(at, std::string::npos);
+  bad.replace(at, key.size(), "tune: {rho_limit: 1.5,");
+  try {
+    (void)load_design_from_string(bad, "bad.yaml");
+    ADD_FAILURE() << "rho_limit 1.5 accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("controller.tune.rho_limit"), std::string::npos) << err.what();
+    EXPECT_NE(std::string(err.what()).find("bad.yaml"), std::string::npos) << err.what();
+  }
+}
+
+
+// Abbott-Okamura against the 1-DOF closed form: with J = a I, the joints' damping b, Coulomb torque
+// tau and quantum delta alike, every direction sees at least the damping b / a^2, the friction
+// tau / a and a quantum a delta (the axes are the worst), so K <= min(2 b / (a^2 T), 2 tau / (a^2 delta)),
+// and a target K* needs the rate K* a^2 / (2 b) unless 2 tau / (a^2 delta) < K*.
+TEST(ControlPerformance, AbbottOkamuraBoundIsTheOneDofClosedFormForAnIsotropicJacobian) {
+  const double a = 0.015, T = 0.01;
+  const Eigen::Matrix2d J = a * Eigen::Matrix2d::Identity();
+  for (const auto& [b, tau, delta] : {std::tuple{0.01, 5e-4, 3e-4}, std::tuple{1e-4, 5e-2, 1e-5}}) {
+    SCOPED_TRACE(b);
+    PoseFigures f;
+    abbott_okamura(J, b * Eigen::Matrix2d::Identity(), {tau, tau}, {delta, delta}, T, 1.0, f);
+    const double kb = 2 * b / (a * a * T), kq = 2 * tau / (a * a * delta);  // N/m
+    EXPECT_NEAR(f.coulomb_N, tau / a, 1e-12 * tau / a);
+    EXPECT_NEAR(f.quantum_um, 1e6 * a * delta, 1e-9 * 1e6 * a * delta);
+    EXPECT_NEAR(f.zwidth_quantisation_N_per_mm, 1e-3 * kq, 1e-9 * 1e-3 * kq);
+    EXPECT_NEAR(f.zwidth_abbott_okamura_N_per_mm, 1e-3 * std::min(kb, kq), 1e-9 * 1e-3 * std::min(kb, kq));
+    if (kq >= 1e3) {
+      EXPECT_NEAR(f.rate_for_target_hz, 1e3 * a * a / (2 * b), 1e-9 * 1e3 * a * a / (2 * b));
+    } else {
+      EXPECT_TRUE(std::isinf(f.rate_for_target_hz));
+    }
+  }
+  // Little friction: quantisation-limited below 1 N/mm, so no rate renders 1 N/mm; a tenth of its bound is renderable.
+  PoseFigures g;
+  abbott_okamura(J, 1e-4 * Eigen::Matrix2d::Identity(), {5e-7, 5e-7}, {3e-4, 3e-4}, T, 1.0, g);
+  EXPECT_LT(g.zwidth_quantisation_N_per_mm, 1.0);
+  EXPECT_TRUE(std::isinf(g.rate_for_target_hz));
+  abbott_okamura(J, 1e-4 * Eigen::Matrix2d::Identity(), {5e-7, 5e-7}, {3e-4, 3e-4}, T, 0.1 * g.zwidth_quantisation_N_per_mm, g);
+  EXPECT_TRUE(std::isfinite(g.rate_for_target_hz));
+}
+
+// A rigid rotation of the tactor plane (J -> R J) turns every direction's figures with it: the
+// bounds over the directions do not change (R by a whole number of the 0.5 deg direction steps).
+TEST(ControlPerformance, AbbottOkamuraBoundIsInvariantUnderARotationOfTheTactorPlane) {
+  Eigen::Matrix2d J;
+  J << 0.012, -0.004, 0.007, 0.016;
+  const Eigen::Matrix2d B = Eigen::Vector2d(0.02, 0.05).asDiagonal();
+  PoseFigures f, r;
+  abbott_okamura(J, B, {4e-4, 7e-4}, {2e-4, 5e-4}, 0.01, 1.0, f);
+  const double angle = 37.5 * std::numbers::pi / 180.0;
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(angle).toRotationMatrix();
+  abbott_okamura(R * J, B, {4e-4, 7e-4}, {2e-4, 5e-4}, 0.01, 1.0, r);
+  EXPECT_NEAR(r.zwidth_abbott_okamura_N_per_mm, f.zwidth_abbott_okamura_N_per_mm, 1e-9 * f.zwidth_abbott_okamura_N_per_mm);
+  EXPECT_NEAR(r.zwidth_quantisation_N_per_mm, f.zwidth_quantisation_N_per_mm, 1e-9 * f.zwidth_quantisation_N_per_mm);
+  EXPECT_NEAR(r.coulomb_N, f.coulomb_N, 1e-9 * f.coulomb_N);
+  EXPECT_NEAR(r.quantum_um, f.quantum_um, 1e-9 * f.quantum_um);
+}
+
+// On the showcase: the position quantum's worst direction is along the coarser joint's column (the
+// resolution figure, from FK by its own test above), and friction can only lower the Z-width.
+TEST(ControlPerformance, AbbottOkamuraOnTheShowcaseAgreesWithTheResolutionAndColgate) {
+  const Design& d = paper();
+  const LoopModel loop = paper_loop("index", "lower");
+  const ControllerSettings& c = *d.get<ControllerSettings>();
+  const std::array<Potentiometer, 2> pots{c.joint("index", "lower", 1).potentiometer, c.joint("index", "lower", 2).potentiometer};
+  for (const Vec2& off : {Vec2(0, 0), Vec2(5, -4), Vec2(-6, 2)}) {
+    const PoseFigures f = pose_figures(loop, d.require_station("index").target.center + off, c.adc_bits, c.adc_range_v,
+                                       pots, c.target_stiffness_N_per_mm);
+    ASSERT_EQ(f.status, Status::ok);
+    EXPECT_NEAR(f.quantum_um, f.resolution_um, 1e-4 * f.resolution_um);  // 0.5 deg steps: cos 0.25 deg
+    EXPECT_LE(f.zwidth_abbott_okamura_N_per_mm, f.zwidth_N_per_mm * (1 + 1e-9));
+    EXPECT_LE(f.zwidth_abbott_okamura_N_per_mm, f.zwidth_quantisation_N_per_mm * (1 + 1e-9));
+    // The showcase's assumed motors: friction over a ~5 um quantum allows ~10 N/mm, above the target.
+    EXPECT_GT(f.zwidth_abbott_okamura_N_per_mm, c.target_stiffness_N_per_mm);
+    EXPECT_LT(f.rate_for_target_hz, c.loop_rate_hz);
+  }
 }
 
 }  // namespace

@@ -183,7 +183,12 @@ TEST(Parameters, HoldThePapersDeviceInSiUnits) {
   EXPECT_NEAR(lim.at("max_position").get<double>(), deg(105), 1e-12);
   EXPECT_EQ(lim.at("has_velocity_limits"), true);
   EXPECT_DOUBLE_EQ(lim.at("max_velocity").get<double>(), 2.0 * kPi);
-  EXPECT_EQ(p.at("gains").at("index_lower_theta1"), Json({{"p", 5.0}, {"i", 1.0}, {"d", 0.05}, {"i_clamp", 0.2}}));
+  // Gains: the station-mechanism scope of the tuned gains (controller.stations.index.lower.pid) over the
+  // section's pid, whose i_clamp 0.2 it keeps.
+  EXPECT_EQ(p.at("gains").at("index_lower_theta1"),
+            Json({{"p", 6.848653377513271}, {"i", 134.1876883573707}, {"d", 0.18757016322827982}, {"i_clamp", 0.2}}));
+  EXPECT_EQ(p.at("gains").at("index_lower_theta2"), p.at("gains").at("index_lower_theta1"));
+  EXPECT_NE(p.at("gains").at("thumb_upper_theta1"), p.at("gains").at("index_lower_theta1"));
   EXPECT_DOUBLE_EQ(p.at("potentiometers").at("index_lower_theta1").at("rad_per_volt").get<double>(), deg(60));
   EXPECT_EQ(p.at("potentiometers").at("index_lower_theta1").at("volts_at_zero"), 0.25);
   EXPECT_EQ(p.at("potentiometers").at("thumb_upper_theta1").at("volts_at_zero"), 4.75);
@@ -272,7 +277,8 @@ TEST(Formats, RosYamlReadByYamlCppEqualsTheDesign) {
   const YAML::Node p = y["fivebar_controller"]["ros__parameters"];
   EXPECT_EQ(p["stations"]["thumb"]["upper"]["o1_m"][1].as<double>(), 35.0 / 1000);
   EXPECT_EQ(p["stations"]["index"]["lower"]["link_lengths_m"][2].as<double>(), 15.0 / 1000);
-  EXPECT_EQ(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), 0.05);
+  EXPECT_EQ(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), d.get<ControllerSettings>()->joint("thumb", "upper", 2).pid.kd);
+  EXPECT_NE(p["gains"]["thumb_upper_theta2"]["d"].as<double>(), d.get<ControllerSettings>()->pid.kd);  // the tuned scope
   EXPECT_EQ(p["pwm_hz"].Scalar(), "1000.0");
   EXPECT_EQ(p["adc"]["bits"].Scalar(), "16");
   EXPECT_EQ(p["fivebar"]["design_hash"].as<std::string>(), design_hash(d, {}));
@@ -612,7 +618,12 @@ TEST(Check, AnIntegerWhereADoubleIsDeclaredIsADifference) {
 TEST(Check, AStaleFileIsReportedByHashAndValue) {
   const std::string yaml = render_ros2_yaml(controller_parameters(paper(), {}));
   Design changed = paper();
+  // kd of every joint: the section's and that of each scope giving one (the showcase's tuned
+  // controller.stations.<s>.<m> scopes, which every joint runs).
   changed.get<ControllerSettings>()->pid.kd = 0.06;
+  for (ControlOverride& o : changed.get<ControllerSettings>()->overrides) {
+    if (o.kd) *o.kd += 0.01;
+  }
   const ExportCheck c = check_export(yaml, ExportFormat::ros2, changed, "f.yaml");
   EXPECT_FALSE(c.hash_matches());
   EXPECT_FALSE(c.matches());

@@ -100,7 +100,7 @@ TEST(ExportLoopGate, GainsBeyondTheKpMarginAreRefusedNamingThePoseAndNothingIsWr
   ControlOverride o;
   o.station = "index";
   o.mechanism = "lower";
-  o.kp = c.pid.kp * before.kp_margin * 1.3;
+  o.kp = loop.gains[0].kp * before.kp_margin * 1.3;  // the margin is a factor on the loop's own kp
   c.overrides.push_back(o);
   c.max_tracking_error_mm = 1000.0;  // the stability check alone decides
   c.max_saturation_fraction = 1.0;

@@ -366,6 +366,8 @@ std::vector<Case> cases() {
   c.push_back({"ControlFieldNotANumber", sub({"control"}, {"--field", "abc"}), {both}, {"--field", "abc"}});
   c.push_back({"ControlTuneSecondsNegative", sub({"control"}, {"--tune", "--tune-seconds", "-1"}), {both},
                {"--tune-seconds must be > 0"}});
+  c.push_back({"ControlTuneEvaluationsZero", sub({"control"}, {"--tune", "--per-joint", "--tune-evaluations", "0"}), {both},
+               {"--tune-evaluations must be within [1, 10000]"}});
   c.push_back({"ControlWithoutMotorSection", sub({"control"}, {}), {both}, {"both.yaml", "no `motor:` section"}});
   c.push_back({"PartsNoJobs", sub({"parts"}, {"--jobs", "0"}), {both}, {"--jobs", "0"}});
   c.push_back({"SweepBillionSteps", sub({"sweep"}, {"-s", "index", "--vary", "L1=1:2:1000000000"}), {both},

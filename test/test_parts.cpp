@@ -33,6 +33,7 @@
 
 #include "cli_test.hpp"
 #include "process.hpp"
+#include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/print.hpp"
@@ -707,6 +708,9 @@ TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {
   d.stations.pop_back();  // the scene has the index station only
   if (d.get<PatternSettings>()) {       // and so no per-station pattern settings for the thumb
     std::erase_if(d.get<PatternSettings>()->per_station, [](const auto& entry) { return entry.first == "thumb"; });
+  }
+  if (d.get<ControllerSettings>()) {  // nor the controller's gains for it (controller.stations.thumb)
+    std::erase_if(d.get<ControllerSettings>()->overrides, [](const ControlOverride& o) { return o.station == "thumb"; });
   }
   SceneOptions so;
   so.out_root = dir_ / "scene";

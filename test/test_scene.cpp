@@ -12,6 +12,7 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/scene.hpp"
+#include "fivebar/sections/controller.hpp"
 #include "products/product.hpp"
 
 namespace fivebar {
@@ -121,7 +122,10 @@ TEST(Registry, TheSceneRunnerAndTheDesignNameNoProduct) {
 }
 
 TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
-  const Design d = load_design(kDesign);
+  Design d = load_design(kDesign);
+  // The control product tunes (controller.tune): two evaluations per mechanism keep this test fast.
+  ASSERT_TRUE(d.get<ControllerSettings>()->tune.has_value());
+  d.get<ControllerSettings>()->tune->evaluations = 2;
   std::vector<std::string> progress;
   SceneOptions o = options();
   o.progress = [&](std::string_view line) { progress.emplace_back(line); };

@@ -14,6 +14,7 @@
 #include <numbers>
 
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -414,14 +415,17 @@ std::vector<std::pair<std::string, std::string>> control_files(const StationCont
   files.emplace_back(study.station + "-stability.csv", csv);
   std::string perf =
       "station,mechanism,x_mm,y_mm,status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,"
-      "tactor_damping_N_s_per_mm,zwidth_N_per_mm\n";
+      "tactor_damping_N_s_per_mm,zwidth_N_per_mm,coulomb_friction_N,position_quantum_um,zwidth_quantisation_N_per_mm,"
+      "zwidth_abbott_okamura_N_per_mm,loop_rate_for_target_hz\n";
   for (const PerformanceMap& m : study.performance) {
     for (const PoseFigures& f : m.poses) {
       const bool ok = f.status == Status::ok;
       const auto v = [&](double x) { return ok ? num(x) : std::string(); };
       perf += study.station + "," + m.mechanism + "," + num(f.P_mm.x()) + "," + num(f.P_mm.y()) + "," +
               std::string(to_string(f.status)) + "," + v(f.bandwidth_hz) + "," + v(f.resolution_um) + "," +
-              v(f.force_N) + "," + v(f.damping_N_s_per_mm) + "," + v(f.zwidth_N_per_mm) + "\n";
+              v(f.force_N) + "," + v(f.damping_N_s_per_mm) + "," + v(f.zwidth_N_per_mm) + "," + v(f.coulomb_N) + "," +
+              v(f.quantum_um) + "," + v(f.zwidth_quantisation_N_per_mm) + "," + v(f.zwidth_abbott_okamura_N_per_mm) +
+              "," + v(f.rate_for_target_hz) + "\n";
     }
   }
   files.emplace_back(study.station + "-performance.csv", perf);
@@ -491,8 +495,37 @@ std::array<double, 2> tactor_gain(const DiscretePlant& plant, const std::array<P
   return {sv[1], sv[0]};
 }
 
+void abbott_okamura(const Eigen::Matrix2d& J, const Eigen::Matrix2d& Bj, const std::array<double, 2>& coulomb_Nm,
+                    const std::array<double, 2>& quantum_rad, double period_s, double target_N_per_mm, PoseFigures& f) {
+  const Eigen::Matrix2d Jinv = J.inverse();
+  const double target = 1e3 * target_N_per_mm;  // N/m
+  double coulomb = std::numeric_limits<double>::infinity(), quantum = 0.0;
+  double kq = std::numeric_limits<double>::infinity(), kao = std::numeric_limits<double>::infinity();
+  double rate = 0.0;
+  constexpr int kDirections = 360;  // over [0, pi): u and -u are the same direction
+  for (int k = 0; k < kDirections; ++k) {
+    const double a = std::numbers::pi * k / kDirections;
+    const Eigen::Vector2d u(std::cos(a), std::sin(a));
+    const Eigen::Vector2d w = Jinv * u;  // joint rates at unit tactor speed along u
+    const double b = w.dot(Bj * w);      // N s/m
+    const double fc = coulomb_Nm[0] * std::abs(w[0]) + coulomb_Nm[1] * std::abs(w[1]);  // N
+    const double delta = std::max(std::abs(u.dot(J.col(0))) * quantum_rad[0], std::abs(u.dot(J.col(1))) * quantum_rad[1]);
+    const double k_q = delta > 0.0 ? 2.0 * fc / delta : std::numeric_limits<double>::infinity();
+    coulomb = std::min(coulomb, fc);
+    quantum = std::max(quantum, delta);
+    kq = std::min(kq, k_q);
+    kao = std::min(kao, std::min(2.0 * b / period_s, k_q));
+    rate = std::max(rate, k_q >= target ? target / (2.0 * b) : std::numeric_limits<double>::infinity());
+  }
+  f.coulomb_N = coulomb;
+  f.quantum_um = 1e6 * quantum;
+  f.zwidth_quantisation_N_per_mm = 1e-3 * kq;
+  f.zwidth_abbott_okamura_N_per_mm = 1e-3 * kao;
+  f.rate_for_target_hz = rate;
+}
+
 PoseFigures pose_figures(const LoopModel& loop, const Vec2& P_mm, int adc_bits, const std::array<double, 2>& adc_range_v,
-                         const std::array<Potentiometer, 2>& pots) {
+                         const std::array<Potentiometer, 2>& pots, double target_N_per_mm) {
   PoseFigures f;
   f.P_mm = P_mm;
   const AnglesResult a = ik_angles(loop.model.mechanism, P_mm);
@@ -529,8 +562,11 @@ PoseFigures pose_figures(const LoopModel& loop, const Vec2& P_mm, int adc_bits, 
   const double span = adc_range_v[1] - adc_range_v[0];
   double torque_min_ratio = std::numeric_limits<double>::infinity();
   Eigen::Matrix2d Bj = Eigen::Matrix2d::Zero();
+  std::array<double, 2> coulomb{}, quantum{};
   for (int j = 0; j < 2; ++j) {
     const double dtheta = std::abs(pots[static_cast<std::size_t>(j)].rad_per_volt) * span / std::ldexp(1.0, adc_bits);
+    quantum[static_cast<std::size_t>(j)] = dtheta;
+    coulomb[static_cast<std::size_t>(j)] = loop.model.motors[static_cast<std::size_t>(j)].coulomb_friction();
     f.resolution_um = std::max(f.resolution_um, 1e6 * J.col(j).norm() * dtheta);
     const MotorParams& mp = loop.model.motors[static_cast<std::size_t>(j)];
     const double torque = mp.gearbox_efficiency * mp.gear_ratio * mp.torque_constant() * mp.current_limit_A;
@@ -545,6 +581,7 @@ PoseFigures pose_figures(const LoopModel& loop, const Vec2& P_mm, int adc_bits, 
   const double bmin = es.eigenvalues()[0];
   f.damping_N_s_per_mm = 1e-3 * bmin;
   f.zwidth_N_per_mm = 1e-3 * 2.0 * bmin / loop.period_s;
+  abbott_okamura(J, Bj, coulomb, quantum, loop.period_s, target_N_per_mm, f);
   return f;
 }
 
@@ -555,15 +592,21 @@ PerformanceMap performance_map(const Design& design, const LoopModel& loop, cons
   const ControllerSettings& c = *design.get<ControllerSettings>();
   const std::array<Potentiometer, 2> pots{c.joint(loop.station, m.mechanism, 1).potentiometer,
                                           c.joint(loop.station, m.mechanism, 2).potentiometer};
+  m.target_N_per_mm = c.target_stiffness_N_per_mm;
+  m.loop_rate_hz = c.loop_rate_hz;
   bool any = false;
   for (const Vec2& P : points) {
-    m.poses.push_back(pose_figures(loop, P, c.adc_bits, c.adc_range_v, pots));
+    m.poses.push_back(pose_figures(loop, P, c.adc_bits, c.adc_range_v, pots, c.target_stiffness_N_per_mm));
     const PoseFigures& f = m.poses.back();
     if (f.status != Status::ok) continue;
     if (!any || f.bandwidth_hz < m.worst_bandwidth.bandwidth_hz) m.worst_bandwidth = f;
     if (!any || f.resolution_um > m.worst_resolution.resolution_um) m.worst_resolution = f;
     if (!any || f.force_N < m.worst_force.force_N) m.worst_force = f;
     if (!any || f.zwidth_N_per_mm < m.worst_zwidth.zwidth_N_per_mm) m.worst_zwidth = f;
+    if (!any || f.zwidth_abbott_okamura_N_per_mm < m.worst_zwidth_abbott_okamura.zwidth_abbott_okamura_N_per_mm) {
+      m.worst_zwidth_abbott_okamura = f;
+    }
+    if (!any || f.rate_for_target_hz > m.worst_rate.rate_for_target_hz) m.worst_rate = f;
     any = true;
   }
   return m;
@@ -582,7 +625,19 @@ Json to_json(const PerformanceMap& m) {
           {"min_force_pose_mm", at(m.worst_force)},
           {"min_tactor_damping_N_s_per_mm", m.worst_zwidth.damping_N_s_per_mm},
           {"min_zwidth_N_per_mm", m.worst_zwidth.zwidth_N_per_mm},
-          {"min_zwidth_pose_mm", at(m.worst_zwidth)}};
+          {"min_zwidth_pose_mm", at(m.worst_zwidth)},
+          {"min_coulomb_friction_N", m.worst_zwidth_abbott_okamura.coulomb_N},
+          {"max_position_quantum_um", m.worst_zwidth_abbott_okamura.quantum_um},
+          {"min_zwidth_quantisation_N_per_mm", m.worst_zwidth_abbott_okamura.zwidth_quantisation_N_per_mm},
+          {"min_zwidth_abbott_okamura_N_per_mm", m.worst_zwidth_abbott_okamura.zwidth_abbott_okamura_N_per_mm},
+          {"min_zwidth_abbott_okamura_pose_mm", at(m.worst_zwidth_abbott_okamura)},
+          {"target_stiffness_N_per_mm", m.target_N_per_mm},
+          {"loop_rate_hz", m.loop_rate_hz},
+          // null when the quantisation forbids the target at some pose (no loop rate renders it)
+          {"loop_rate_for_target_hz", std::isfinite(m.worst_rate.rate_for_target_hz) ? Json(m.worst_rate.rate_for_target_hz)
+                                                                                      : Json(nullptr)},
+          {"loop_rate_for_target_pose_mm", at(m.worst_rate)},
+          {"target_renderable", m.worst_rate.rate_for_target_hz <= m.loop_rate_hz}};
 }
 
 std::string performance_line(const PerformanceMap& m) {
@@ -591,7 +646,15 @@ std::string performance_line(const PerformanceMap& m) {
          at(m.worst_bandwidth) + "; resolution <= " + fixed(m.worst_resolution.resolution_um, 3) + " um per count" +
          at(m.worst_resolution) + "; force >= " + fixed(m.worst_force.force_N, 2) + " N in every direction" +
          at(m.worst_force) + " (fingertip devices: >= 1.5 N); Z-width >= " + fixed(m.worst_zwidth.zwidth_N_per_mm, 1) +
-         " N/mm" + at(m.worst_zwidth) + " (hard surface: 0.8-1.0 N/mm)";
+         " N/mm" + at(m.worst_zwidth) + " (hard surface: 0.8-1.0 N/mm); with Coulomb friction and quantisation " +
+         "(Abbott-Okamura) >= " + fixed(m.worst_zwidth_abbott_okamura.zwidth_abbott_okamura_N_per_mm, 2) + " N/mm" +
+         at(m.worst_zwidth_abbott_okamura) + "; a " + format::shortest(m.target_N_per_mm) + " N/mm wall needs " +
+         (std::isfinite(m.worst_rate.rate_for_target_hz)
+              ? "a loop rate >= " + fixed(m.worst_rate.rate_for_target_hz, 2) + " Hz" + at(m.worst_rate) + " (here " +
+                    format::shortest(m.loop_rate_hz) + " Hz: " +
+                    (m.worst_rate.rate_for_target_hz <= m.loop_rate_hz ? "renderable" : "NOT renderable") + ")"
+              : "a finer position sensor or more friction: the quantisation forbids it at any loop rate" +
+                    at(m.worst_rate));
 }
 
 }  // namespace fivebar

@@ -26,7 +26,7 @@ std::string fixed(double v, int digits) {
 std::string point(const Vec2& p) { return "(" + fixed(p.x(), 2) + ", " + fixed(p.y(), 2) + ") mm"; }
 
 /// Grid per axis over a target for the gate's map: ~310 poses, every 0.5 mm on the paper's ellipse.
-constexpr int kGateGrid = 21;
+constexpr int kGateGrid = kControlGateGrid;  // the tuner constrains rho on the same grid
 /// Grid per axis for the bandwidth carried in the files (~70 poses).
 constexpr int kGatePerformanceGrid = 9;
 /// CVODE tolerance of the gate's simulations: measured on the paper's device, its tracking errors

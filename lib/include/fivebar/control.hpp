@@ -72,6 +72,10 @@
 
 namespace fivebar {
 
+/// Poses per axis of the grid over each target on which `fivebar export` checks the loop's
+/// stability, and on which the tuner constrains it (the same poses, so that a tuned loop passes).
+inline constexpr int kControlGateGrid = 21;
+
 inline constexpr int kPlantStates = 6;   ///< dtheta1, dtheta2, w1, w2, i1, i2
 inline constexpr int kLoopStates = 12;   ///< plant, held duty (2), integral (2), previous error (2)
 using PlantMatrix = Eigen::Matrix<double, kPlantStates, kPlantStates>;
@@ -223,8 +227,24 @@ std::string rho_field_vti(const RhoField& field);
 // b > K T / 2 + |B|, b the device's own damping. Here b is the joint damping mapped to the tactor,
 // B_x = J^-T diag(b_j + eta_j N_j^2 k_t,j k_e,j / R_j) J^-1 (viscous friction plus the back-EMF damping of
 // the voltage-driven motor), in the direction where it is least (its smallest eigenvalue): K_max =
-// 2 (b_min - |B|) / T, and the loop rate a stiffness K needs is K / (2 (b_min - |B|)). Coulomb friction
-// and the ADC quantisation (Abbott & Okamura's refinement) are not in this bound.
+// 2 (b_min - |B|) / T, and the loop rate a stiffness K needs is K / (2 (b_min - |B|)).
+// With Coulomb friction and position quantisation (Abbott & Okamura, "Effects of position
+// quantization and sampling rate on virtual-wall passivity", IEEE Trans. Robotics 21(5), 2005: a
+// necessary and sufficient condition for a mass with Coulomb-plus-viscous friction and a quantised
+// position sensor), the wall is passive iff
+//   K <= min(2 b / T, 2 f_c / Delta),
+// f_c the Coulomb friction and Delta the position quantum. Per tactor direction u (unit), with the
+// joints' rates J^-1 u at unit tactor speed:
+//   b(u)     = u^T B_x u                                  (power of the viscous terms),
+//   f_c(u)   = sum_j tau_c,j |(J^-1 u)_j|                 (power of the joints' Coulomb friction,
+//                                                          motor.coulomb_friction_mNm),
+//   Delta(u) = max_j |u . J_j| dtheta_j                   (the tactor step along u of one ADC count
+//                                                          of the coarser joint, dtheta_j as above),
+// and the bound is the least over 360 directions of min(2 b(u) / T, 2 f_c(u) / Delta(u)). The loop
+// rate a target stiffness K* (controller.target_stiffness_N_per_mm) needs is max over u of
+// K* / (2 b(u)) where the quantisation allows K* (2 f_c(u) / Delta(u) >= K*); where it does not,
+// no loop rate renders K* passively (a finer sensor or more friction would): the rate is then
+// infinite and the pose "quantisation-limited".
 
 struct PoseFigures {
   Vec2 P_mm{0.0, 0.0};
@@ -233,8 +253,20 @@ struct PoseFigures {
   double resolution_um = 0.0;     ///< tactor step of one ADC count, worst joint
   double force_N = 0.0;           ///< continuous force in every direction
   double damping_N_s_per_mm = 0.0;  ///< least tactor damping b_min
-  double zwidth_N_per_mm = 0.0;   ///< 2 b_min / T (no virtual damping)
+  double zwidth_N_per_mm = 0.0;   ///< 2 b_min / T (no virtual damping): Colgate-Schenkel
+  double coulomb_N = 0.0;         ///< least f_c(u) over the directions
+  double quantum_um = 0.0;        ///< largest Delta(u) over the directions
+  double zwidth_quantisation_N_per_mm = 0.0;  ///< least 2 f_c(u) / Delta(u)
+  double zwidth_abbott_okamura_N_per_mm = 0.0;  ///< least min(2 b(u) / T, 2 f_c(u) / Delta(u))
+  /// Loop rate the target stiffness needs (Hz): infinity when the quantisation forbids it.
+  double rate_for_target_hz = 0.0;
 };
+
+/// The Abbott-Okamura figures of a pose (above) into `f` (its zwidth_N_per_mm and damping kept):
+/// Jacobian J (m/rad), joint damping diag Bj (N m s/rad), Coulomb torques (N m), joint quanta
+/// (rad per count), period T (s), target stiffness (N/mm).
+void abbott_okamura(const Eigen::Matrix2d& J, const Eigen::Matrix2d& Bj, const std::array<double, 2>& coulomb_Nm,
+                    const std::array<double, 2>& quantum_rad, double period_s, double target_N_per_mm, PoseFigures& f);
 
 /// The closed-loop gain from the tactor reference to the tactor at frequency f (Hz): the
 /// singular values of J H(e^{j 2 pi f T}) J^-1, smallest first.
@@ -244,7 +276,7 @@ std::array<double, 2> tactor_gain(const DiscretePlant& plant, const std::array<P
 /// The figures at tactor point P (mm); `adc_bits`, `adc_range_v` and the joints' potentiometers
 /// from the controller of the design.
 PoseFigures pose_figures(const LoopModel& loop, const Vec2& P_mm, int adc_bits, const std::array<double, 2>& adc_range_v,
-                         const std::array<Potentiometer, 2>& pots);
+                         const std::array<Potentiometer, 2>& pots, double target_N_per_mm = 1.0);
 
 /// Worst over a set of poses: the lowest bandwidth, the coarsest resolution, the weakest force,
 /// the lowest Z-width, each with its pose.
@@ -252,11 +284,16 @@ struct PerformanceMap {
   std::string station, mechanism;
   std::vector<PoseFigures> poses;
   PoseFigures worst_bandwidth, worst_resolution, worst_force, worst_zwidth;
+  PoseFigures worst_zwidth_abbott_okamura;  ///< lowest Abbott-Okamura bound
+  PoseFigures worst_rate;                   ///< highest loop rate for the target stiffness
+  double target_N_per_mm = 1.0;             ///< controller.target_stiffness_N_per_mm
+  double loop_rate_hz = 100.0;              ///< the design's
 };
 PerformanceMap performance_map(const Design& design, const LoopModel& loop, const std::vector<Vec2>& points);
 Json to_json(const PerformanceMap& map);
 /// "index lower: bandwidth >= 6.2 Hz (at ...), resolution <= 0.9 um/count, force >= 1.9 N in every
-/// direction, Z-width >= 120 N/mm (hard surface 0.8-1.0 N/mm)".
+/// direction, Z-width >= 120 N/mm (hard surface 0.8-1.0 N/mm)", then the Abbott-Okamura bound and
+/// the loop rate the target stiffness needs against the design's.
 std::string performance_line(const PerformanceMap& map);
 
 // --- A station's study (the `control` subcommand and product) ----------------------------------
@@ -285,7 +322,9 @@ StationControl station_control(const Design& design, const Station& station,
 /// (every target pose: station,mechanism,x_mm,y_mm,status,rho,damping,frequency_hz) and
 /// `<station>-performance.csv` (every pose of the performance grid: station,mechanism,x_mm,y_mm,
 /// status,bandwidth_hz,resolution_um_per_count,force_every_direction_N,tactor_damping_N_s_per_mm,
-/// zwidth_N_per_mm).
+/// zwidth_N_per_mm,coulomb_friction_N,position_quantum_um,zwidth_quantisation_N_per_mm,
+/// zwidth_abbott_okamura_N_per_mm,loop_rate_for_target_hz; the last empty where the quantisation
+/// forbids the target stiffness).
 std::vector<std::pair<std::string, std::string>> control_files(const StationControl& study, const Station& station,
                                                                const std::string& subtitle);
 
@@ -299,37 +338,88 @@ std::vector<std::string> summary_lines(const StationControl& study);
 
 // --- Tuning ---------------------------------------------------------------------------------------
 //
-// Gains per mechanism (the same kp, ki, kd on both joints; i_clamp kept) that minimise the worst
-// tracking error over the station's patterns, simulated with this mechanism alone under the new
-// gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject to max rho <= rho_limit over a
-// grid of the target (the constraint) and to the saturation limit (a penalty of 10 mm per unit of
-// saturated-time fraction beyond controller.max_saturation_fraction). NLopt's COBYLA (Powell's
-// derivative-free linear-approximation method with constraints; Powell, "A direct search
-// optimization method that models the objective and constraint functions by linear
-// interpolation", 1994) over (ln kp, ln ki, ln kd) within a factor e^5 (~148) of the start, started
-// from the design's gains with an initial step of a factor 2, the constraint aimed 0.003 inside its
-// limit (COBYLA ends within its tolerance of it). Deterministic: the same design and
+// Gains per mechanism (the same kp, ki, kd on both joints; or per joint with `per_joint`; i_clamp
+// kept) that minimise the worst tracking error over the station's patterns, simulated with this
+// mechanism alone under the new gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject
+// to max rho <= rho_limit over the target (the constraint, on the export gate's 21 x 21 grid) and
+// to the saturation limit (a penalty of 10 mm per unit of saturated-time fraction beyond
+// controller.max_saturation_fraction).
+//
+// Start: pole placement on the linearised model at the target's centre. Each joint j of the plant
+// above, with the current taken as settled (L/R = 0.1 ms with the motor defaults, far below
+// T = 10 ms: i_j = (V_s,j u_j - k_e,j N_j w_j) / R_j) and the cross terms of M, K_s, C_s left out,
+// is the second-order SISO model
+//   m_j theta'' + c_j theta' + k_j theta = b_j u,   m_j = M_jj, k_j = K_s,jj,
+//   c_j = C_s,jj + b_v,j + eta_j N_j^2 k_t,j k_e,j / R_j,   b_j = eta_j N_j k_t,j V_s,j / R_j,
+// and the continuous PID u = -(kp theta + ki int theta + kd theta') closes it with the
+// characteristic polynomial m s^3 + (c + b kd) s^2 + (k + b kp) s + b ki. Placing its three roots at
+// -omega, (s + omega)^3 = s^3 + 3 omega s^2 + 3 omega^2 s + omega^3, gives
+//   kp = (3 m omega^2 - k) / b,   ki = m omega^3 / b,   kd = (3 m omega - c) / b
+// (e.g. Astrom & Murray, "Feedback Systems", 2008, Sec. 10.3 on PID pole placement for a
+// second-order process); a gain that comes out below 1e-3 is raised to it. With one set of gains for
+// both joints, m, c, k and b are the two joints' means. omega is the one of a geometric scan from
+// 0.2 Hz to a quarter of the loop rate (60 values, the best refined by golden section) that
+// minimises the exact sampled-data max rho over the target (the continuous design does not see the
+// sample-and-hold and the period of delay; the exact check does). TuneOptions::start = hand_set
+// starts from the hand-set gains instead.
+//
+// Refinement: NLopt's COBYLA (Powell's derivative-free linear-approximation method with
+// constraints; Powell, "A direct search optimization method that models the objective and
+// constraint functions by linear interpolation", 1994) over (ln kp, ln ki, ln kd) (per joint: six)
+// within a factor e^5 (~148) of the start, an initial step of a factor 2, the constraint aimed 0.003
+// inside its limit. The result is the best evaluated point that meets the constraints (COBYLA's own
+// last point may lie just outside), else COBYLA's point. No random element: the same design and
 // options give the same gains, unless the wall-time bound stops a run first (the result says so).
+
+enum class TuneStart { pole_placement, hand_set };
+
+/// PID gains placing the three closed-loop roots of each joint's reduced model (above) of `plant`
+/// at -omega (rad/s); i_clamp from `base`. `per_joint` false: one set from the joints' means.
+std::array<PidGains, 2> pole_placement_gains(const LinearPlant& plant, const std::array<MotorParams, 2>& motors,
+                                             double omega_rad_s, bool per_joint, const std::array<PidGains, 2>& base);
+
+/// The start of the tuning: pole_placement_gains() at the omega minimising max rho over `poses`.
+struct PolePlacement {
+  Status status = Status::unreachable;  ///< of the centre pose; gains = base unless ok
+  double omega_rad_s = 0.0;
+  std::array<PidGains, 2> gains;
+  double max_rho = 0.0;                 ///< over the poses
+};
+PolePlacement pole_placement(const LoopModel& loop, const Vec2& centre_mm, const std::vector<PoseLoop>& poses,
+                             bool per_joint, const std::array<PidGains, 2>& base);
 
 struct TuneOptions {
   double rho_limit = 0.9;       ///< max spectral radius allowed over the target
-  int grid = 9;                 ///< per axis over the target for the constraint
+  TuneStart start = TuneStart::pole_placement;
+  bool per_joint = false;       ///< kp, ki, kd per joint (six unknowns) instead of per mechanism
+  int grid = kControlGateGrid;  ///< per axis over the target for the constraint: the export gate's grid
   int max_evaluations = 60;     ///< objective evaluations per mechanism
   double max_seconds = 30.0;    ///< wall time for the whole tuning, shared among the mechanisms
   double rtol = 1e-3;           ///< CVODE tolerance of the tracking runs
   std::function<void(std::string_view)> progress;  ///< one line per evaluation; may be empty
 };
 
+/// The options of a design's `controller.tune` (its defaults when the key is absent).
+TuneOptions tune_options(const ControllerSettings& controller);
+
 /// Before and after, for one mechanism.
 struct TunedMechanism {
   std::string station, mechanism;
-  std::array<PidGains, 2> before, after;
+  /// before: the hand-set gains (ControllerSettings::hand_set_pid(): the file's PID without the
+  /// per-station-mechanism scopes a patch writes), the start; design: the gains the design runs
+  /// with (the hand-set ones, or an earlier patch's); after: the tuned ones.
+  std::array<PidGains, 2> before, design, after;
+  std::array<PidGains, 2> start;   ///< where COBYLA started (the pole placement or the hand-set gains)
+  double start_omega_rad_s = 0.0;  ///< the pole placement's omega (0 when started from the hand-set gains)
+  double rho_start = 0.0;
   double rho_before = 0.0, rho_after = 0.0;        ///< max over the constraint's grid
   double error_before_mm = 0.0, error_after_mm = 0.0;  ///< worst tracking error over the patterns
   double saturation_before = 0.0, saturation_after = 0.0;  ///< worst saturated-time fraction
   int evaluations = 0;
   bool feasible = false;   ///< rho_after <= rho_limit and the saturation within its limit
   std::string stop;        ///< why the optimiser stopped
+  /// The design already runs with the tuned gains (to 6 significant digits on every joint).
+  bool applied() const;
 };
 
 struct TuneResult {
@@ -348,6 +438,10 @@ TuneResult tune_controller(const Design& design, const std::vector<const Station
 /// {kp, ki, kd}}}}}` (the narrowest scope but the joints, so that it wins over the file's own).
 std::string tuned_patch_yaml(const TuneResult& result);
 Json to_json(const TuneResult& result);
+/// One row per mechanism: station,mechanism,kp_before,ki_before,kd_before,kp_after,ki_after,
+/// kd_after,max_rho_before,max_rho_after,max_tracking_error_before_mm,max_tracking_error_after_mm,
+/// saturation_before,saturation_after,evaluations,feasible,applied,stop.
+std::string tuning_csv(const TuneResult& result);
 
 /// The picture of a station's maps (one panel per mechanism, `fields[k]` for `maps[k]`): rho over
 /// the reachable region on a colour ramp (red where >= 1), the target ellipse dashed, the worst

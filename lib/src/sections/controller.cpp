@@ -107,6 +107,29 @@ JointControl ControllerSettings::joint(std::string_view station, std::string_vie
   return out;
 }
 
+PidGains ControllerSettings::hand_set_pid(std::string_view station, std::string_view mechanism, int j) const {
+  ControllerSettings without = *this;
+  for (ControlOverride& o : without.overrides) {
+    if (o.level() >= 3) o.kp = o.ki = o.kd = std::nullopt;
+  }
+  return without.joint(station, mechanism, j).pid;
+}
+
+void TuneSettings::validate() const {
+  if (!(rho_limit > 0.0) || !(rho_limit < 1.0)) {
+    throw ValidationError("rho_limit", "= " + plain_number(rho_limit) + ": must be in (0, 1) (a spectral radius below 1)");
+  }
+  if (evaluations < 1 || evaluations > 10000) {
+    throw ValidationError("evaluations", "= " + std::to_string(evaluations) + ": must be 1 ... 10000");
+  }
+  if (!(max_seconds > 0.0) || !(max_seconds <= 3600.0)) {
+    throw ValidationError("max_seconds", "= " + plain_number(max_seconds) + " s: must be > 0 and <= 3600 s");
+  }
+  if (start != "pole_placement" && start != "hand_set") {
+    throw ValidationError("start", "= " + detail::quoted(start) + ": must be pole_placement or hand_set");
+  }
+}
+
 bool is_ros_node_name(std::string_view name) {
   if (name.empty() || name.size() > 255) return false;
   const auto alpha = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || c == '_'; };
@@ -161,8 +184,13 @@ void ControllerSettings::validate() const {
   if (!(max_saturation_fraction >= 0.0) || !(max_saturation_fraction <= 1.0)) {
     throw ValidationError("max_saturation_fraction", "= " + plain_number(max_saturation_fraction) + ": must be in [0, 1]");
   }
+  if (!(target_stiffness_N_per_mm > 0.0) || !(target_stiffness_N_per_mm <= 1e6)) {
+    throw ValidationError("target_stiffness_N_per_mm",
+                          "= " + plain_number(target_stiffness_N_per_mm) + " N/mm: must be > 0 and <= 1000000 N/mm");
+  }
   rules::validate_nested("pid", [&] { pid.validate(); });
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
+  if (tune) rules::validate_nested("tune", [&] { tune->validate(); });
   for (const ControlOverride& o : overrides) {
     const std::string scope = o.key();
     if (!o.mechanism.empty() && o.mechanism != "lower" && o.mechanism != "upper") {
@@ -219,11 +247,11 @@ void load(const Value& v, Design& design) {
   ControllerSettings& c = design.set(ControllerSettings{});
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
-                              "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction", "pid",
-                              "potentiometer", "mechanisms", "stations"},
+                              "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction",
+                              "target_stiffness_N_per_mm", "pid", "potentiometer", "tune", "mechanisms", "stations"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
-                             "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, pid, potentiometer, "
-                             "mechanisms, stations)");
+                             "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, "
+                             "target_stiffness_N_per_mm, pid, potentiometer, tune, mechanisms, stations)");
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -241,6 +269,7 @@ void load(const Value& v, Design& design) {
   if (const Value* m = find(all, "joint_margin_deg")) c.joint_margin = kRadPerDeg * m->number("deg");
   c.max_tracking_error_mm = number_or(all, "max_tracking_error_mm", c.max_tracking_error_mm, "mm");
   c.max_saturation_fraction = number_or(all, "max_saturation_fraction", c.max_saturation_fraction, "");
+  c.target_stiffness_N_per_mm = number_or(all, "target_stiffness_N_per_mm", c.target_stiffness_N_per_mm, "N/mm");
   ControlOverride defaults;
   control_keys(all, defaults);
   if (defaults.kp) c.pid.kp = *defaults.kp;
@@ -250,6 +279,22 @@ void load(const Value& v, Design& design) {
   if (defaults.volts_at_zero) c.potentiometer.volts_at_zero = *defaults.volts_at_zero;
   if (defaults.rad_per_volt) c.potentiometer.rad_per_volt = *defaults.rad_per_volt;
   if (defaults.travel) c.potentiometer.travel = *defaults.travel;
+  if (const Value* t = find(all, "tune")) {
+    TuneSettings& tune = c.tune.emplace();
+    if (!t->is_null()) {  // `tune:` alone: every default
+      const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds", "per_joint", "start"},
+                                   "(rho_limit, evaluations, max_seconds, per_joint, start)");
+      tune.rho_limit = number_or(keys, "rho_limit", tune.rho_limit, "");
+      if (const Value* n = find(keys, "evaluations")) tune.evaluations = int(n->whole(1, 10000));
+      tune.max_seconds = number_or(keys, "max_seconds", tune.max_seconds, "s");
+      if (const Value* pj = find(keys, "per_joint")) {
+        const std::string word = pj->text("a boolean: true or false");
+        if (word != "true" && word != "false") pj->fail_value("must be true or false");
+        tune.per_joint = word == "true";
+      }
+      if (const Value* st = find(keys, "start")) tune.start = st->text("must be pole_placement or hand_set");
+    }
+  }
 
   // One mechanism's scope (of a station, or of every station when `station` is empty) and its joints.
   const auto mechanism_scope = [&](const Value& m, const std::string& station) {
@@ -360,11 +405,20 @@ void write(const Design& d, Out& top) {
   out.add("joint_margin_deg", Out::degrees(c.joint_margin));
   out.add("max_tracking_error_mm", Out::number(c.max_tracking_error_mm));
   out.add("max_saturation_fraction", Out::number(c.max_saturation_fraction));
+  out.add("target_stiffness_N_per_mm", Out::number(c.target_stiffness_N_per_mm));
   ControlOverride defaults;
   defaults.kp = c.pid.kp, defaults.ki = c.pid.ki, defaults.kd = c.pid.kd, defaults.i_clamp = c.pid.i_clamp;
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;
   defaults.travel = c.potentiometer.travel;
   control_keys_out(out, defaults);
+  if (c.tune) {
+    Out& t = out.add("tune", Out::map(/*flow=*/true));
+    t.add("rho_limit", Out::number(c.tune->rho_limit));
+    t.add("evaluations", Out::integer(c.tune->evaluations));
+    t.add("max_seconds", Out::number(c.tune->max_seconds));
+    t.add("per_joint", Out::plain(c.tune->per_joint ? "true" : "false"));
+    t.add("start", Out::plain(c.tune->start));
+  }
 
   // Overrides in canonical form: every station's mechanisms, then by station (design order), then
   // mechanism, then joint.

@@ -68,6 +68,20 @@ struct ControlOverride {
   int level() const;
 };
 
+/// `controller.tune`: what `fivebar run` (the `control` product) and `fivebar control --tune` tune
+/// the PID with (fivebar/control.hpp "Tuning"). Present in a design: the product tunes every
+/// station with both mechanisms and reports the hand-set gains beside the tuned ones.
+struct TuneSettings {
+  double rho_limit = 0.9;     ///< max spectral radius allowed over the target, in (0, 1)
+  int evaluations = 60;       ///< objective evaluations per mechanism (each simulates every pattern)
+  double max_seconds = 30.0;  ///< wall-time bound of the whole tuning, s (issue 16: < 30 s for the paper's device)
+  bool per_joint = false;     ///< kp, ki, kd per joint instead of one set per mechanism
+  /// Where the optimiser starts: "pole_placement" (on the linearised model at the target's
+  /// centre) or "hand_set" (the file's gains).
+  std::string start = "pole_placement";
+  void validate() const;
+};
+
 /// The ROS controller on the device (`controller:`; paper Sec. II-D): per mechanism an IK module,
 /// FK of the measured joints for collision checks with the upper mechanism's priority, and a PID
 /// per motor at loop_rate_hz driving the motor by PWM at pwm_hz; joint angles read from
@@ -100,13 +114,23 @@ struct ControllerSettings {
   /// saturated (a joint at full duty or at the driver's current limit), in [0, 1]. 0.05 is an
   /// ASSUMPTION: brief saturation at a pattern's start is tolerated, sustained saturation is not.
   double max_saturation_fraction = 0.05;
+  /// The stiffness of virtual wall the device should render passively (N/mm): the `control`
+  /// study reports the loop rate it needs (fivebar/control.hpp "Z-width"). 1.0 N/mm: a hard
+  /// surface needs at least 0.8-1.0 N/mm (Choi & Tan, "Effect of update rate on perceived
+  /// instability of virtual haptic texture", IROS 2004), the fingertip-device literature's figure.
+  double target_stiffness_N_per_mm = 1.0;
   PidGains pid;                   ///< every joint, unless overridden
   Potentiometer potentiometer;    ///< every joint, unless overridden
+  std::optional<TuneSettings> tune;  ///< `tune:`; none: the `control` product does not tune
   std::vector<ControlOverride> overrides;  ///< in file order; applied widest scope first
 
   /// Gains and calibration of joint `joint` (1 or 2) of a mechanism: the defaults, then the
   /// overrides from the widest scope to the narrowest (ControlOverride), in file order within one.
   JointControl joint(std::string_view station, std::string_view mechanism, int joint) const;
+  /// The hand-set gains of a joint: as joint(), without the PID keys of the scopes a tuning patch
+  /// writes (`stations.<s>.<m>` and `stations.<s>.<m>.theta1|theta2`, levels 3 and 4): what the
+  /// tuner starts from and reports as "before".
+  PidGains hand_set_pid(std::string_view station, std::string_view mechanism, int joint) const;
   /// Rules that need no design (ranges, names); Design::validate() checks the override scopes.
   void validate() const;
 };

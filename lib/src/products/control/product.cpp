@@ -2,9 +2,15 @@
 // (fivebar/control.hpp), with the links' masses from the `parts` product's STL renders: spectral
 // radius map, worst pose, verdict, gain margins, damping; picture, VTK field and CSV under control/.
 
+#include <algorithm>
+#include <cmath>
+#include <array>
+#include <map>
 #include <string>
+#include <vector>
 
 #include "fivebar/control.hpp"
+#include "fivebar/error.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -26,7 +32,30 @@ constexpr const char* kPerformance =
     "frequency response in the tactor's worst direction), the tactor step of one ADC count, the largest "
     "continuous shear force the motors hold in every direction (fingertip devices are compared at ≥ 1.5 N) and "
     "the Z-width, the stiffest virtual wall the loop renders passively from the device's own damping "
-    "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm).\n\n";
+    "(Colgate–Schenkel, K < 2 b / T; a hard surface is 0.8–1.0 N/mm) and with the motors' Coulomb friction and "
+    "the position quantum of one ADC count, both mapped to the tactor per direction (Abbott–Okamura, "
+    "K ≤ min(2 b / T, 2 f_c / Δ)), and the loop rate a wall of `controller.target_stiffness_N_per_mm` needs "
+    "(none when the quantisation forbids it at any rate).\n\n";
+
+constexpr const char* kTuning =
+    "`controller.tune` asks for the gains to be tuned, per mechanism (lib/include/fivebar/control.hpp "
+    "\"Tuning\"): a pole placement on the loop linearised at the target's centre (the three roots of each "
+    "joint's PID loop at −ω, ω chosen for the least spectral radius over the target) is refined by NLopt's "
+    "COBYLA to the least worst simulated tracking error over the station's patterns, with the spectral radius "
+    "at most the limit over the target (the export gate's grid) and no sustained saturation; masses from the "
+    "closed form, as the export gate. \"Before\" is the hand-set PID (the file's gains without the "
+    "per-station-mechanism scopes a tuning patch writes); `control/tuned-controller.yaml` is the patch of "
+    "`controller:` that applies the tuned gains, `control/tuning.csv` the table.\n\n";
+
+std::string gains_cell(const PidGains& g) {
+  return "kp " + md::fixed(g.kp, 3) + ", ki " + md::fixed(g.ki, 3) + ", kd " + md::fixed(g.kd, 4);
+}
+
+/// One joint's gains, or both when they differ (a per-joint tuning).
+std::string gains_cell(const std::array<PidGains, 2>& g) {
+  if (g[0].kp == g[1].kp && g[0].ki == g[1].ki && g[0].kd == g[1].kd) return gains_cell(g[0]);
+  return "θ1 " + gains_cell(g[0]) + "; θ2 " + gains_cell(g[1]);
+}
 
 }  // namespace
 
@@ -47,9 +76,12 @@ Product control_product() {
                      "least-damped oscillation ζ / Hz", "kp margin", "kd margin"},
                     "lllrlrrrr");
     md::Table performance({"station", "mechanism", "bandwidth ≥ (Hz)", "resolution ≤ (µm/count)",
-                           "force in every direction ≥ (N)", "Z-width ≥ (N/mm)"},
-                          "llrrrr");
+                           "force in every direction ≥ (N)", "Z-width ≥ (N/mm)", "with friction and quantisation ≥ (N/mm)",
+                           "loop rate for the target wall (Hz)"},
+                          "llrrrrrr");
     Json studies = Json::array();
+    std::map<std::string, std::map<std::string, MechanismInertia>> inertias;
+    std::vector<const Station*> pairs;
     bool stable = true;
     std::size_t maps = 0;
     std::string files;
@@ -57,6 +89,11 @@ Product control_product() {
       if (!has_pair(s)) continue;
       ctx.say("stability of station " + s.name);
       const auto inertia = station_inertia(d, s, parts, ctx.dir / "parts");
+      // The tuning with the closed-form masses the export gate checks with: reproducible (the STL
+      // renders' masses change in their last digits between openscad runs, and the optimiser's
+      // path with them).
+      inertias[s.name] = station_inertia(d, s, nullptr, {});
+      pairs.push_back(&s);
       const StationControl study = station_control(d, s, inertia);
       stable = stable && study.stable();
       for (const auto& [name, bytes] : control_files(study, s, "design " + d.name)) {
@@ -75,7 +112,13 @@ Product control_product() {
       for (const PerformanceMap& m : study.performance) {
         performance.row({s.name, m.mechanism, md::fixed(m.worst_bandwidth.bandwidth_hz, 2),
                          md::fixed(m.worst_resolution.resolution_um, 3), md::fixed(m.worst_force.force_N, 2),
-                         md::fixed(m.worst_zwidth.zwidth_N_per_mm, 1)});
+                         md::fixed(m.worst_zwidth.zwidth_N_per_mm, 1),
+                         md::fixed(m.worst_zwidth_abbott_okamura.zwidth_abbott_okamura_N_per_mm, 2),
+                         std::isfinite(m.worst_rate.rate_for_target_hz)
+                             ? md::fixed(m.worst_rate.rate_for_target_hz, 2) + " for " +
+                                   md::fixed(m.target_N_per_mm, 2) + " N/mm (" +
+                                   (m.worst_rate.rate_for_target_hz <= m.loop_rate_hz ? "met" : "**not met**") + ")"
+                             : "none: quantisation-limited"});
       }
       studies.push_back(to_json(study));
     }
@@ -85,6 +128,60 @@ Product control_product() {
     b.passed = stable;
     b.check = stable ? "stable over every target (" + std::to_string(maps) + " mechanisms)"
                      : "the loop is unstable somewhere on a target";
+    const ControllerSettings& ctl = *d.get<ControllerSettings>();
+    if (ctl.tune && !pairs.empty()) {
+      TuneOptions to = tune_options(ctl);
+      to.progress = [&ctx](std::string_view line) { ctx.say(line); };
+      TuneResult tuned;
+      try {
+        tuned = tune_controller(d, pairs, inertias, to);
+      } catch (const InputError& e) {
+        // A pattern that cannot be followed (its reference unreachable): the `pattern` product says
+        // where; no tuning without it.
+        b.markdown += "### Tuning\n\n**Not tuned**: " + std::string(e.what()) + "\n";
+        b.result["tuning"] = {{"error", e.what()}};
+        b.passed = false;
+        b.check += "; not tuned: a pattern cannot be followed";
+        return b;
+      }
+      ctx.write_file("control/tuned-controller.yaml", tuned_patch_yaml(tuned));
+      ctx.write_file("control/tuning.csv", tuning_csv(tuned));
+      md::Table t({"station", "mechanism", "gains before (hand-set)", "start", "gains after (tuned)", "max ρ before → after",
+                   "worst tracking error before → after (mm)", "saturated before → after", "evaluations", "stop",
+                   "the design runs"},
+                  "lllllrrrrll");
+      bool feasible = true, applied = true;
+      double worst_before = 0.0, worst_after = 0.0;
+      for (const TunedMechanism& m : tuned.mechanisms) {
+        feasible = feasible && m.feasible;
+        applied = applied && m.applied();
+        worst_before = std::max(worst_before, m.error_before_mm);
+        worst_after = std::max(worst_after, m.error_after_mm);
+        t.row({m.station, m.mechanism, gains_cell(m.before),
+               (m.start_omega_rad_s > 0.0 ? "pole placement, ω " + md::fixed(m.start_omega_rad_s, 1) + " rad/s"
+                                          : std::string("the hand-set gains")) +
+                   ", max ρ " + md::fixed(m.rho_start, 4),
+               gains_cell(m.after),
+               md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
+               md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3),
+               md::fixed(100 * m.saturation_before, 1) + " % → " + md::fixed(100 * m.saturation_after, 1) + " %",
+               std::to_string(m.evaluations),
+               m.stop + (m.stop == "time limit" ? " (controller.tune.max_seconds)" : "") +
+                   (m.feasible ? "" : ", **not feasible**"),
+               m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design) + ")"});
+      }
+      b.result["tuning"] = to_json(tuned);
+      b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nTuned in " + md::fixed(tuned.wall_s, 1) +
+                    " s, max ρ ≤ " + md::fixed(tuned.rho_limit, 2) + " over the target." +
+                    (applied ? " The design runs the tuned gains.\n"
+                             : " The design does not run the tuned gains everywhere: merge "
+                               "`control/tuned-controller.yaml` into its `controller:` section.\n");
+      b.passed = b.passed && feasible;
+      b.check += "; tuned: worst tracking error " + md::fixed(worst_before, 3) + " → " + md::fixed(worst_after, 3) +
+                 " mm with max ρ ≤ " + md::fixed(tuned.rho_limit, 2) +
+                 (feasible ? "" : " (NOT feasible for every mechanism)") +
+                 (applied ? ", the design runs them" : ", not applied (control/tuned-controller.yaml)");
+    }
     return b;
   };
   return p;
