@@ -12,6 +12,8 @@
 
 #include "fivebar/optimize.hpp"
 #include "fivebar/sections/optimize.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/sweep.hpp"
@@ -29,6 +31,7 @@ Design showcase() { return load_design(fs::path(FIVEBAR_SOURCE_DIR) / "designs/i
 Design problem(int which) {
   Design d = showcase();
   OptimizeSettings s = *d.get<OptimizeSettings>();
+  s.atlas = false;  // the search alone (the atlas is its own benchmark, bench_atlas.cpp)
   if (which == 0) {
     OptimizeVariable l3{"L3", {"stations.index.mechanisms.lower.links[2]"}, 10, 20, 0};
     OptimizeVariable l4{"L4", {"stations.index.mechanisms.lower.links[3]"}, 10, 20, 0};
@@ -38,6 +41,8 @@ Design problem(int which) {
     // Only the lower mechanism: a station of one mechanism, as the sweep's lower-only problem.
     d.stations[0].upper.reset();
     d.reset<PatternSettings>();
+    d.reset<ControllerSettings>();  // its tuned scopes name the upper mechanism
+    d.reset<MotorSettings>();
   } else if (which == 1) {
     OptimizeVariable l34{"L34", {}, 12, 19, 0}, l12{"L12", {}, 6, 12, 0};
     for (const char* m : {"lower", "upper"}) {
