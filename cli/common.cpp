@@ -3,6 +3,7 @@
 
 #include "fivebar/ranges.hpp"
 
+#include <csignal>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
@@ -256,5 +257,32 @@ void print_pose(std::ostream& out, const Mechanism& m, const Pose& pose) {
   row("closure error (mm)", closure);
   row("joint limits", limits_text(m, pose));
 }
+
+// --- Interrupts ---------------------------------------------------------------------------------
+
+namespace {
+std::atomic<bool> g_interrupted{false};
+extern "C" void on_stop_signal(int) { g_interrupted.store(true); }
+}  // namespace
+
+struct StopOnInterrupt::Saved {
+  struct sigaction int_action {}, term_action {};
+};
+
+StopOnInterrupt::StopOnInterrupt() : saved_(std::make_unique<Saved>()) {
+  g_interrupted.store(false);
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &saved_->int_action);
+  sigaction(SIGTERM, &sa, &saved_->term_action);
+}
+
+StopOnInterrupt::~StopOnInterrupt() {
+  sigaction(SIGINT, &saved_->int_action, nullptr);
+  sigaction(SIGTERM, &saved_->term_action, nullptr);
+}
+
+const std::atomic<bool>* StopOnInterrupt::stop() const { return &g_interrupted; }
 
 }  // namespace fivebar::cli

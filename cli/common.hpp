@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <atomic>
 #include <functional>
 #include <istream>
 #include <memory>
@@ -57,6 +58,22 @@ struct Selection {
 /// Resolves --station / --mechanism: an empty choice means "the only one present"; otherwise, or
 /// for a name that is not there, InputError listing the choices.
 Selection select(const Design& design, const Target& target);
+
+/// While alive, SIGINT and SIGTERM set stop() instead of ending the process, so that a long
+/// command (sweep, optimize) stops at its next checkpoint and says how to resume; the previous
+/// handlers come back when it is destroyed. One at a time.
+class StopOnInterrupt {
+ public:
+  StopOnInterrupt();
+  ~StopOnInterrupt();
+  StopOnInterrupt(const StopOnInterrupt&) = delete;
+  StopOnInterrupt& operator=(const StopOnInterrupt&) = delete;
+  const std::atomic<bool>* stop() const;
+
+ private:
+  struct Saved;
+  std::unique_ptr<Saved> saved_;
+};
 
 /// Progress lines on stderr, only when it is a terminal (docs/conventions.md "Progress").
 std::function<void(std::string_view)> terminal_progress(std::string_view command);

@@ -36,8 +36,6 @@ struct OptimizeCliOptions {
   bool json = false;
 };
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_optimize_interrupt(int) { g_stop.store(true); }
 
 void progress_line(std::uint64_t done, std::uint64_t budget, double seconds, std::size_t front) {
   std::fprintf(stderr, "\r  %llu / %llu candidates  %.1f s  front %zu   ", (unsigned long long)done,
@@ -46,29 +44,8 @@ void progress_line(std::uint64_t done, std::uint64_t budget, double seconds, std
   std::fflush(stderr);
 }
 
-Json point_json(const OptimizeProblem& p, const OptimizeCandidate& c) {
-  Json values = Json::object(), figures = Json::object();
-  for (std::size_t d = 0; d < p.settings().variables.size(); ++d) values[p.settings().variables[d].name] = c.x[d];
-  for (std::size_t i = 0; i < optimize_figures().size(); ++i) {
-    if (std::isfinite(c.figures[i])) figures[std::string(optimize_figures()[i].name)] = c.figures[i];
-  }
-  return Json{{"values", values}, {"figures", figures}, {"verdict", to_string(c.verdict)}, {"status", c.status}};
-}
-
 int run_optimize_cmd(const OptimizeCliOptions& o) {
-  struct sigaction sa {};
-  sa.sa_handler = on_optimize_interrupt;
-  sigemptyset(&sa.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
-  struct Restore {
-    const struct sigaction *i, *t;
-    ~Restore() {
-      sigaction(SIGINT, i, nullptr);
-      sigaction(SIGTERM, t, nullptr);
-    }
-  } restore{&old_int, &old_term};
+  const StopOnInterrupt interrupt;  // SIGINT / SIGTERM: stop at the next checkpoint
   Design design = load(o.design);
   if (!design.get<OptimizeSettings>()) {
     throw InputError(o.design + ": the design has no optimize: section (docs/optimize.md shows one)");
@@ -98,7 +75,7 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
   }
   (void)sweep_threads(o.threads);
   options.threads = o.threads;
-  options.stop = &g_stop;
+  options.stop = interrupt.stop();
   const bool mpi = launched_by_mpi();
   if (mpi && (!o.shard.empty() || o.merge)) throw InputError("--shard / --merge and an MPI launch both split the islands: use one");
   if (mpi && o.resume) throw InputError("--resume is not supported in an MPI launch: rerun with the same ranks");

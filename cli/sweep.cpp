@@ -37,8 +37,6 @@ struct SweepCliOptions {
   bool json = false;
 };
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_interrupt(int) { g_stop.store(true); }
 
 /// NAME=LO:HI:N -> SweepVariable (N optional for random/Sobol sampling: 1).
 SweepVariable parse_vary(const std::string& text) {
@@ -130,19 +128,7 @@ Json row_json(const SweepSettings& s, const SweepRow& r) {
 int run_sweep_cmd(const SweepCliOptions& o) {
   // An interrupt from here on stops the sweep cleanly (after its current chunk, CSV resumable);
   // one that comes before the sweep starts stops it before its first chunk.
-  struct sigaction sa {};
-  sa.sa_handler = on_interrupt;
-  sigemptyset(&sa.sa_mask);
-  struct sigaction old_int {}, old_term {};
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
-  struct Restore {
-    const struct sigaction *i, *t;
-    ~Restore() {
-      sigaction(SIGINT, i, nullptr);
-      sigaction(SIGTERM, t, nullptr);
-    }
-  } restore{&old_int, &old_term};
+  const StopOnInterrupt interrupt;  // SIGINT / SIGTERM: stop at the next checkpoint
   Design design = load(o.design);
   SweepSettings settings = settings_of(design, o);
   try {
@@ -166,7 +152,7 @@ int run_sweep_cmd(const SweepCliOptions& o) {
   }
   (void)sweep_threads(o.threads);  // OMP_NUM_THREADS too, before any file is written
   options.threads = o.threads;
-  options.stop = &g_stop;
+  options.stop = interrupt.stop();
   const bool mpi = launched_by_mpi();
   if (mpi && !o.shard.empty()) throw InputError("--shard and an MPI launch both split the sweep: use one");
   if (mpi && o.resume) throw InputError("--resume is not supported in an MPI launch: rerun with the same ranks");

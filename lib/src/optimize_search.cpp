@@ -28,6 +28,7 @@
 #include "fivebar/optimize.hpp"
 #include "fivebar/sections/optimize.hpp"
 #include "fivebar/sweep.hpp"
+#include "csv.hpp"
 #include "plot/optimize_plot.hpp"
 
 namespace fivebar {
@@ -301,20 +302,12 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
   return st.best;
 }
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += c == '\n' ? ' ' : c;
-  }
-  return out + "\"";
-}
-std::string cell(double v) { return std::isnan(v) ? std::string() : format::shortest(v); }
+using csv::field;
+std::string cell(double v) { return csv::number(v); }
 
 std::string csv_header(const OptimizeProblem& p, bool with_status) {
   std::string h = "island,round,evaluation";
-  for (const auto& v : p.settings().variables) h += "," + csv_field(v.name);
+  for (const auto& v : p.settings().variables) h += "," + field(v.name);
   for (const auto& f : optimize_figures()) h += "," + std::string(f.name);
   if (with_status) h += ",verdict,status";
   return h + "\n";
@@ -323,8 +316,18 @@ std::string csv_row(const OptimizeCandidate& c, bool with_status) {
   std::string r = std::to_string(c.island) + "," + std::to_string(c.round) + "," + std::to_string(c.evaluation);
   for (double x : c.x) r += "," + cell(x);
   for (double f : c.figures) r += "," + cell(f);
-  if (with_status) r += std::string(",") + to_string(c.verdict) + "," + csv_field(c.status);
+  if (with_status) r += std::string(",") + to_string(c.verdict) + "," + field(c.status);
   return r + "\n";
+}
+
+/// A population's individuals, best first: pagmo's non-dominated sorting (crowding distance within a
+/// front) for several objectives, the fitness for one.
+std::vector<pagmo::pop_size_t> best_first(const std::vector<pagmo::vector_double>& f) {
+  if (!f.empty() && f.front().size() > 1) return pagmo::sort_population_mo(f);
+  std::vector<pagmo::pop_size_t> order(f.size());
+  for (std::size_t i = 0; i < f.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return f[a][0] < f[b][0]; });
+  return order;
 }
 
 /// Order of candidates in files: by round, island, evaluation (the same for any thread count).
@@ -698,29 +701,14 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       std::vector<std::vector<std::pair<pagmo::vector_double, pagmo::vector_double>>> emigrants(n);
       for (std::size_t k = 0; k < n; ++k) {
         const auto& f = pops[k].get_f();
-        std::vector<pagmo::pop_size_t> order;
-        if (s.objectives.size() > 1) {
-          order = pagmo::sort_population_mo(f);
-        } else {
-          order.resize(f.size());
-          for (std::size_t i = 0; i < f.size(); ++i) order[i] = i;
-          std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return f[a][0] < f[b][0]; });
-        }
+        const std::vector<pagmo::pop_size_t> order = best_first(f);
         for (std::size_t i = 0; i < q && i < order.size(); ++i) {
           emigrants[k].emplace_back(pops[k].get_x()[order[i]], f[order[i]]);
         }
       }
       for (std::size_t k = 0; k < n; ++k) {
         auto& dst = pops[(k + 1) % n];
-        const auto& f = dst.get_f();
-        std::vector<pagmo::pop_size_t> order;
-        if (s.objectives.size() > 1) {
-          order = pagmo::sort_population_mo(f);
-        } else {
-          order.resize(f.size());
-          for (std::size_t i = 0; i < f.size(); ++i) order[i] = i;
-          std::stable_sort(order.begin(), order.end(), [&](auto a, auto b) { return f[a][0] < f[b][0]; });
-        }
+        const std::vector<pagmo::pop_size_t> order = best_first(dst.get_f());
         for (std::size_t i = 0; i < emigrants[k].size() && i < order.size(); ++i) {
           dst.set_xf(order[order.size() - 1 - i], emigrants[k][i].first, emigrants[k][i].second);
         }

@@ -3,6 +3,7 @@
 // output does not depend on the number of threads.
 #include "fivebar/format.hpp"
 #include "fivebar/sweep.hpp"
+#include "csv.hpp"
 
 #include <boost/random/sobol.hpp>
 #include <omp.h>
@@ -40,18 +41,9 @@ std::uint64_t splitmix64(std::uint64_t x) {
 /// Uniform [0, 1) from 53 random bits.
 double unit(std::uint64_t bits) { return double(bits >> 11) * 0x1.0p-53; }
 
+using csv::field;
 /// CSV cell of a number: shortest round-trip form, empty for "no value" (NaN).
-std::string num(double v) { return std::isnan(v) ? std::string() : format::shortest(v); }
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"') out += '"';
-    out += c == '\n' ? ' ' : c;
-  }
-  return out + "\"";
-}
+std::string num(double v) { return csv::number(v); }
 
 const Vec2 kX(1.0, 0.0);
 
@@ -381,7 +373,7 @@ std::string sweep_csv_header(const SweepSettings& s) {
 std::string sweep_csv_row(const SweepRow& r) {
   std::string line = std::to_string(r.index);
   for (double v : r.values) line += "," + num(v);
-  line += "," + csv_field(r.status) + "," + (r.covered ? "1" : "0");
+  line += "," + field(r.status) + "," + (r.covered ? "1" : "0");
   for (double v : {r.margin_lower_mm, r.margin_upper_mm, r.margin_shared_mm, r.min_lci, r.min_force_capability,
                    r.footprint_w_mm, r.footprint_h_mm, r.footprint_mm2, r.collision_fraction, r.robust_margin_mm}) {
     line += "," + num(v);

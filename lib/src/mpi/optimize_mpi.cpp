@@ -6,44 +6,28 @@
 #include <stdexcept>
 
 #include "fivebar/optimize.hpp"
+#include "mpi/mpi_session.hpp"
 
 namespace fivebar {
 
 OptimizeResult run_optimize_mpi(const Design& design, const OptimizeOptions& options) {
-  int initialized = 0;
-  MPI_Initialized(&initialized);
-  if (!initialized) MPI_Init(nullptr, nullptr);
-  struct Finalize {
-    bool owned;
-    ~Finalize() {
-      int finalized = 0;
-      MPI_Finalized(&finalized);
-      if (owned && !finalized) MPI_Finalize();
-    }
-  } finalize{initialized == 0};
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const detail::MpiSession mpi;
+  const int rank = mpi.rank(), size = mpi.size();
   OptimizeOptions mine = options;
   mine.shard = std::uint64_t(rank);
   mine.shards = std::uint64_t(size);
   mine.resume = false;
   if (rank != 0) mine.progress = nullptr;
   OptimizeResult local;
-  int failed = 0;
+  bool failed = false;
   std::string error;
   try {
     local = run_optimize(design, mine);
   } catch (const std::exception& e) {
-    failed = 1;
+    failed = true;
     error = e.what();
   }
-  int any_failed = 0;
-  MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  if (any_failed) {
-    if (failed) throw std::runtime_error("rank " + std::to_string(rank) + ": " + error);
-    throw std::runtime_error("another rank failed");
-  }
+  mpi.all_succeeded(failed, error);
   MPI_Barrier(MPI_COMM_WORLD);  // every shard file is complete
   if (rank != 0) return local;
   OptimizeOptions whole = options;

@@ -9,27 +9,15 @@
 
 #include "fivebar/io.hpp"
 #include "fivebar/sweep.hpp"
+#include "mpi/mpi_session.hpp"
 
 namespace fivebar {
 
 bool built_with_mpi() { return true; }
 
 SweepResult run_sweep_mpi(const Design& design, const SweepOptions& options) {
-  int initialized = 0;
-  MPI_Initialized(&initialized);
-  if (!initialized) MPI_Init(nullptr, nullptr);
-  // Every rank finalizes on every path (mpirun reports a rank that exits without it as a failure).
-  struct Finalize {
-    bool owned;
-    ~Finalize() {
-      int finalized = 0;
-      MPI_Finalized(&finalized);
-      if (owned && !finalized) MPI_Finalize();
-    }
-  } finalize{initialized == 0};
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const detail::MpiSession mpi;
+  const int rank = mpi.rank(), size = mpi.size();
 
   SweepOptions mine = options;
   mine.shard = std::uint64_t(rank);
@@ -38,20 +26,15 @@ SweepResult run_sweep_mpi(const Design& design, const SweepOptions& options) {
   mine.resume = false;
   if (rank != 0) mine.progress = nullptr;
   SweepResult local;
-  int failed = 0;
+  bool failed = false;
   std::string error;
   try {
     local = run_sweep(design, mine);
   } catch (const std::exception& e) {
-    failed = 1;
+    failed = true;
     error = e.what();
   }
-  int any_failed = 0;
-  MPI_Allreduce(&failed, &any_failed, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-  if (any_failed) {
-    if (failed) throw std::runtime_error("rank " + std::to_string(rank) + ": " + error);
-    throw std::runtime_error("another rank failed");
-  }
+  mpi.all_succeeded(failed, error);
   unsigned long long counts[4] = {local.evaluated, local.covered, local.invalid, local.interrupted ? 1ull : 0ull};
   unsigned long long sums[4] = {0, 0, 0, 0};
   MPI_Reduce(counts, sums, 4, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);

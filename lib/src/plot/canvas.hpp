@@ -6,6 +6,8 @@
 #include <cairo-svg.h>
 #include <cairo.h>
 
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -74,6 +76,33 @@ std::string draw_png(const Surface& s, Draw&& draw) {
 template <class Draw>
 RenderedPlot draw_both(const Surface& s, Draw&& draw) {
   return {draw_svg(s, draw), draw_png(s, draw)};
+}
+
+/// Text at (x, y) in the sans-serif face; `align` 0 left, 0.5 centred, 1 right of x.
+inline void text(cairo_t* cr, double x, double y, const std::string& s, double size, double align = 0.0, bool bold = false) {
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
+  cairo_set_font_size(cr, size);
+  cairo_text_extents_t e;
+  cairo_text_extents(cr, s.c_str(), &e);
+  cairo_move_to(cr, x - align * e.width, y);
+  cairo_show_text(cr, s.c_str());
+}
+
+/// A "nice" tick step for a range (1, 2 or 5 times a power of ten), about 6 ticks.
+inline double tick_step(double span) {
+  const double raw = span / 6.0;
+  const double p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (raw <= m * p) return m * p;
+  }
+  return 10 * p;
+}
+
+/// A tick label: four significant digits, no "-0".
+inline std::string tick_label(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", std::fabs(v) < 1e-12 ? 0.0 : v);
+  return buf;
 }
 
 }  // namespace fivebar::plot_detail

@@ -15,29 +15,9 @@ namespace {
 
 constexpr double kWidth = 900, kHeight = 600;
 
-void text(cairo_t* cr, double x, double y, const std::string& s, double size, double align = 0.0, bool bold = false) {
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t e;
-  cairo_text_extents(cr, s.c_str(), &e);
-  cairo_move_to(cr, x - align * e.width, y);
-  cairo_show_text(cr, s.c_str());
-}
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", std::fabs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
-
-double tick_step(double span) {
-  const double raw = span / 6.0;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (raw <= m * p) return m * p;
-  }
-  return 10 * p;
-}
+using plot_detail::text;
+using plot_detail::tick_step;
+std::string fmt(double v) { return plot_detail::tick_label(v); }
 
 }  // namespace
 

@@ -43,21 +43,9 @@ struct Axis {
   }
 };
 
-/// "Nice" tick step for a range (1, 2, 5 times a power of ten), about 6 ticks.
-double tick_step(double span) {
-  const double raw = span / 6.0;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (raw <= m * p) return m * p;
-  }
-  return 10 * p;
-}
-
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", std::fabs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
+using plot_detail::text;
+using plot_detail::tick_step;
+std::string fmt(double v) { return plot_detail::tick_label(v); }
 
 struct Frame {
   double x0 = 90, y0 = 60, x1 = kWidth - 40, y1 = kHeight - 80;  // plot box in pixels
@@ -65,15 +53,6 @@ struct Frame {
   double px(double x) const { return x0 + (x - ax.lo) / (ax.hi - ax.lo) * (x1 - x0); }
   double py(double y) const { return y1 - (y - ay.lo) / (ay.hi - ay.lo) * (y1 - y0); }
 };
-
-void text(cairo_t* cr, double x, double y, const std::string& s, double size, double align = 0.0, bool bold = false) {
-  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t e;
-  cairo_text_extents(cr, s.c_str(), &e);
-  cairo_move_to(cr, x - align * e.width, y);
-  cairo_show_text(cr, s.c_str());
-}
 
 void axes(cairo_t* cr, const Frame& f, const std::string& title) {
   cairo_set_source_rgb(cr, 1, 1, 1);
