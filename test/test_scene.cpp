@@ -12,6 +12,7 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/scene.hpp"
+#include "fivebar/sections/optimize.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "products/product.hpp"
 
@@ -126,6 +127,12 @@ TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
   // The control product tunes (controller.tune): two evaluations per mechanism keep this test fast.
   ASSERT_TRUE(d.get<ControllerSettings>()->tune.has_value());
   d.get<ControllerSettings>()->tune->evaluations = 2;
+  // The optimize product: the smallest budget it accepts (the initial populations and a round), a
+  // short polish and a coarse atlas (the showcase's full search is 3,000 candidates and 729 cells).
+  ASSERT_TRUE(d.get<OptimizeSettings>() != nullptr);
+  d.get<OptimizeSettings>()->evaluations = 128;
+  d.get<OptimizeSettings>()->polish_evaluations = 10;
+  d.get<OptimizeSettings>()->atlas_cells = 9;
   std::vector<std::string> progress;
   SceneOptions o = options();
   o.progress = [&](std::string_view line) { progress.emplace_back(line); };
