@@ -67,6 +67,7 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
   if (o.merge && o.resume) throw InputError("--merge and --resume: merge after every shard has finished");
   options.resume = o.resume;
   options.plots = !o.no_plots;
+  options.full_figures = !o.no_check;
   options.evaluations = o.evaluations;
   options.seconds = o.seconds;
   if (o.threads < 0 || o.threads > kMaxSweepThreads) {
@@ -195,7 +196,7 @@ void setup_optimize(CLI::App& app) {
   sub->add_flag("--no-plots", opt->no_plots, "Skip the SVG/PNG plots");
   sub->add_flag("--no-polish", opt->no_polish, "Skip the NLopt polish of the chosen design (optimize.polish: false)");
   sub->add_flag("--no-atlas", opt->no_atlas, "Skip the performance atlas of each optimised station (optimize.atlas: false)");
-  sub->add_flag("--no-check", opt->no_check, "Skip the re-check of the chosen design by the coverage, collision and pattern products");
+  sub->add_flag("--no-check", opt->no_check, "Skip the re-check of the chosen design (the coverage, collision and pattern products, and its loop and simulated figures beside the given design's)");
   sub->add_flag("--json", opt->json, "One JSON document on stdout");
   sub->callback([opt] { finish(run_optimize_cmd(*opt)); });
 }

@@ -342,6 +342,7 @@ void sort_candidates(std::vector<OptimizeCandidate>& all) {
 /// Everything after the search: front, curve, choice, polish, files.
 OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vector<OptimizeCandidate> all,
                       const OptimizeOptions& options, OptimizeResult r, bool whole_run, double polish_seconds) {
+  // polish_seconds: what is left of the wall-time budget, for the polish and the full figures.
   sort_candidates(all);
   r.stages = {};
   for (const auto& c : all) r.stages.add(c);
@@ -384,10 +385,13 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
     chosen.name = name;
     chosen.products.reset();
     r.chosen_design = chosen;
-    // Every figure of the design as given and of the chosen one, for the comparison table.
-    const OptimizeProblem full(design, every_figure_settings(design, p.settings()));
-    r.reference_full = full.evaluate(p.reference_values());
-    r.chosen_full = full.evaluate(best.x);
+    // Every figure of the design as given and of the chosen one, for the comparison table (the
+    // loop and the simulations included: seconds), when the wall-time budget has some left.
+    if (options.full_figures && polish_seconds > 0.0 && !(options.stop && options.stop->load())) {
+      const OptimizeProblem full(design, every_figure_settings(design, p.settings()));
+      r.reference_full = full.evaluate(p.reference_values());
+      r.chosen_full = full.evaluate(best.x);
+    }
     const auto yaml = dir / "chosen.yaml";
     std::string header = "# The design chosen by `fivebar optimize` from " +
                          (design.source.empty() ? std::string("design '") + design.name + "'" : design.source.filename().string()) +

@@ -124,6 +124,9 @@ struct OptimizeOptions {
   std::uint64_t shards = 1;
   bool resume = false;            ///< continue from out_dir's checkpoint
   bool plots = true;
+  /// Every figure the design has the data for (the loop and the simulations: seconds) of the
+  /// design as given and of the chosen one, for the comparison (OptimizeResult::reference_full).
+  bool full_figures = true;
   /// Overrides of the section's budget (0: the section's).
   std::uint64_t evaluations = 0;
   double seconds = 0.0;
