@@ -154,6 +154,7 @@ struct OptimizeProblem::Impl {
   bool all_fast = true;
   std::array<bool, 4> stage{};     ///< by OptimizeStage value
   std::vector<bool> figure;        ///< asked for by an objective or a constraint
+  std::vector<std::size_t> objective_figure;  ///< optimize_figures() index of each objective
 };
 
 OptimizeProblem::OptimizeProblem(const Design& design)
@@ -199,7 +200,10 @@ OptimizeProblem::OptimizeProblem(const Design& design, const OptimizeSettings& s
     m.figure[std::size_t(i)] = true;
     m.stage[std::size_t(optimize_figures()[std::size_t(i)].stage)] = true;
   };
-  for (const auto& o : m.s.objectives) ask(o.figure);
+  for (const auto& o : m.s.objectives) {
+    ask(o.figure);
+    m.objective_figure.push_back(std::size_t(optimize_figure_index(o.figure)));
+  }
   for (const auto& c : m.s.constraints) ask(c.figure);
   m.stage[std::size_t(OptimizeStage::cheap)] = true;
 }
@@ -444,7 +448,7 @@ std::vector<double> OptimizeProblem::fitness(const OptimizeCandidate& c) const {
     return f;
   }
   for (std::size_t i = 0; i < obj.size(); ++i) {
-    const double v = c.figures[std::size_t(optimize_figure_index(obj[i].figure))];
+    const double v = c.figures[impl_->objective_figure[i]];
     f[i] = obj[i].maximise ? -v : v;
   }
   return f;

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -85,6 +86,27 @@ struct Udp {
   std::string get_name() const { return "fivebar optimize"; }
   pagmo::thread_safety get_thread_safety() const { return pagmo::thread_safety::none; }
 };
+
+/// Runs work(k) for every island k on up to `threads` threads. An evaluation past the deadline
+/// (Halt) makes it return true once every island has stopped; any other error is rethrown.
+bool on_every_island(std::size_t n, int threads, const std::function<void(std::size_t)>& work) {
+  std::vector<std::string> errors(n);
+  std::vector<char> halted(n, 0);
+#pragma omp parallel for schedule(dynamic, 1) num_threads(std::min<int>(threads, int(n)))
+  for (std::size_t k = 0; k < n; ++k) {
+    try {
+      work(k);
+    } catch (const Halt&) {
+      halted[k] = 1;
+    } catch (const std::exception& e) {
+      errors[k] = e.what();
+    }
+  }
+  for (const auto& e : errors) {
+    if (!e.empty()) throw std::runtime_error("optimize: " + e);
+  }
+  return std::find(halted.begin(), halted.end(), 1) != halted.end();
+}
 
 /// Deb's recommended NSGA-II operators: crossover probability 0.9, distribution indices 20, and a
 /// mutation probability of 1/n per variable (pagmo's default 0.01 barely mutates a problem of a
@@ -606,23 +628,10 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     }
   } else {
     pops.resize(n);
-    std::vector<std::string> errors(n);
-#pragma omp parallel for schedule(dynamic, 1) num_threads(std::min<int>(threads, int(n)))
-    for (std::size_t k = 0; k < n; ++k) {
-      try {
-        pops[k] = pagmo::population(problem_of(k), pagmo::population::size_type(s.population),
-                                    seed32(s.seed, std::uint64_t(islands[k]), 0));
-      } catch (const Halt&) {
-        errors[k] = "halt";
-      } catch (const std::exception& e) {
-        errors[k] = e.what();
-      }
-    }
-    bool halted = false;
-    for (const auto& e : errors) {
-      if (e == "halt") halted = true;
-      else if (!e.empty()) throw std::runtime_error("optimize: " + e);
-    }
+    const bool halted = on_every_island(n, threads, [&](std::size_t k) {
+      pops[k] = pagmo::population(problem_of(k), pagmo::population::size_type(s.population),
+                                  seed32(s.seed, std::uint64_t(islands[k]), 0));
+    });
     for (auto& l : logs) {
       all.insert(all.end(), l.begin(), l.end());
       l.clear();
@@ -663,28 +672,14 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       break;
     }
     ++round;
-    std::vector<std::string> errors(n);
     const std::vector<pagmo::population> before = pops;
     const std::vector<std::uint64_t> counted = counters;
-#pragma omp parallel for schedule(dynamic, 1) num_threads(std::min<int>(threads, int(n)))
-    for (std::size_t k = 0; k < n; ++k) {
-      try {
-        rounds[k] = round;
-        const pagmo::algorithm a =
-            make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round), s.population,
-                                                   p.dimension(), s.objectives.size());
-        pops[k] = a.evolve(pops[k]);
-      } catch (const Halt&) {
-        errors[k] = "halt";
-      } catch (const std::exception& e) {
-        errors[k] = e.what();
-      }
-    }
-    bool halted = false;
-    for (const auto& e : errors) {
-      if (e == "halt") halted = true;
-      else if (!e.empty()) throw std::runtime_error("optimize: " + e);
-    }
+    const bool halted = on_every_island(n, threads, [&](std::size_t k) {
+      rounds[k] = round;
+      const pagmo::algorithm a = make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round),
+                                                s.population, p.dimension(), s.objectives.size());
+      pops[k] = a.evolve(pops[k]);
+    });
     if (halted) {
       // The round is abandoned as a whole, so that the checkpoint stays that of the last round.
       pops = before;
