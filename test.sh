@@ -4,28 +4,31 @@
 #   ./test.sh              the test suite through ctest (build/, Release)
 #   ./test.sh --sanitize   the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer
 #                          (build-sanitize/, Debug at -O1, gcc)
+#   ./test.sh --core       fivebar::core alone, configured with only its dependencies (Eigen, yaml-cpp,
+#                          CGAL, GoogleTest), and its suites and layering test (build-core/)
 #   ./test.sh --fuzz       each libFuzzer target for FIVEBAR_FUZZ_SECONDS seconds (default 60)
 #                          (build-fuzz/, clang; test/fuzz/run_fuzzers.sh)
-#   ./test.sh --all        the three in that order; what `./test.sh` does when CI=true (.ci/run)
+#   ./test.sh --all        the four in that order; what `./test.sh` does when CI=true (.ci/run)
 #
 # Other arguments go to ctest (e.g. ./test.sh -R hostile).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 source .ci/setup.sh
 
-normal=0 sanitize=0 fuzz=0
+normal=0 core=0 sanitize=0 fuzz=0
 ctest_args=()
 for arg in "$@"; do
   case "$arg" in
     --sanitize) sanitize=1 ;;
+    --core) core=1 ;;
     --fuzz) fuzz=1 ;;
-    --all) normal=1 sanitize=1 fuzz=1 ;;
+    --all) normal=1 core=1 sanitize=1 fuzz=1 ;;
     *) ctest_args+=("$arg") ;;
   esac
 done
-if ((normal + sanitize + fuzz == 0)); then
+if ((normal + core + sanitize + fuzz == 0)); then
   normal=1
-  if [[ "${CI:-}" == "true" ]]; then sanitize=1 fuzz=1; fi
+  if [[ "${CI:-}" == "true" ]]; then core=1 sanitize=1 fuzz=1; fi
 fi
 
 fivebar_install_packages
@@ -34,6 +37,14 @@ if ((normal)); then
   fivebar_build_in build "Release" --
   fivebar_log "test suite (build/)"
   ctest --test-dir build --output-on-failure -j2 "${ctest_args[@]}"
+fi
+
+if ((core)); then
+  # The layers hold (docs/architecture.md "Layers"): the core configures with its own dependencies
+  # only, builds and passes its suites and the layering test without anything above it.
+  fivebar_build_in build-core "fivebar::core alone" -DFIVEBAR_CORE_ONLY=ON --
+  fivebar_log "core suites (build-core/)"
+  ctest --test-dir build-core --output-on-failure -j2 "${ctest_args[@]}"
 fi
 
 if ((sanitize)); then

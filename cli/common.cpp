@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "fivebar/error.hpp"
+#include "fivebar/scene.hpp"
 #include "fivebar/json.hpp"
 
 namespace fivebar::cli {
@@ -67,7 +68,7 @@ void add_target_options(CLI::App& sub, Target& target) {
       ->type_name("NAME");
 }
 
-Design load(const std::string& path) { return load_design(path); }
+Design load(const std::string& path) { return load_scene(path); }
 
 std::string Selection::label() const { return station->name + "/" + mechanism->name; }
 

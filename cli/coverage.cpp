@@ -7,8 +7,8 @@
 
 #include "common.hpp"
 #include "fivebar/tolerance.hpp"
-#include "fivebar/coverage.hpp"
-#include "fivebar/coverage_report.hpp"
+#include "fivebar/coverage/coverage.hpp"
+#include "fivebar/coverage/report.hpp"
 #include "fivebar/error.hpp"
 
 namespace fivebar::cli {

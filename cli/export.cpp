@@ -7,7 +7,7 @@
 
 #include "common.hpp"
 #include "fivebar/error.hpp"
-#include "fivebar/export.hpp"
+#include "fivebar/export/export.hpp"
 #include "fivebar/io.hpp"
 
 namespace fivebar::cli {
@@ -98,7 +98,7 @@ int run_export(const ExportCliOptions& opt) {
   const std::vector<ExportFormat> formats = formats_of(opt.format);
   const Design design = load(opt.design);
   ExportOptions options;
-  options.urdf = opt.format == "all" || opt.format == "urdf";  // fivebar/urdf.hpp: closed-form masses here
+  options.urdf = opt.format == "all" || opt.format == "urdf";  // fivebar/export/urdf.hpp: closed-form masses here
   if (!opt.station.empty()) options.stations = {opt.station};
   options.progress = terminal_progress("export");
   // The directory is created only once the gate has passed.

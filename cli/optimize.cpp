@@ -94,7 +94,7 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
   const bool whole = options.shards == 1;
   std::optional<SceneReport> check;
   if (whole && r.chosen_design && !o.no_check) {
-    check = recheck_chosen(*r.chosen_design, options.out_dir);
+    check = check_design(*r.chosen_design, options.out_dir);
     for (const auto& p : check->products) {
       for (const auto& f : p.files) r.files.push_back(check->out_dir / f);
     }

@@ -8,10 +8,10 @@
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
-#include "fivebar/station_workspace.hpp"
-#include "fivebar/workspace_files.hpp"
-#include "fivebar/workspace_io.hpp"
-#include "fivebar/workspace_plot.hpp"
+#include "fivebar/workspace/station.hpp"
+#include "fivebar/workspace/files.hpp"
+#include "fivebar/workspace/io.hpp"
+#include "fivebar/workspace/plot.hpp"
 
 namespace fivebar::cli {
 

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "fivebar/atlas.hpp"
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/error.hpp"
 #include "paper.hpp"
 #include "process.hpp"

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "dynamics/system.hpp"
+#include "simulate/system.hpp"
 #include "fivebar/control.hpp"
 #include "fivebar/dynamics.hpp"
 #include "fivebar/error.hpp"
@@ -53,7 +53,7 @@ LoopModel paper_loop(const std::string& station, const std::string& which) {
   throw std::logic_error("no such mechanism");
 }
 
-/// The right-hand side of fivebar/dynamics.hpp (lib/src/dynamics/system.cpp) for one mechanism
+/// The right-hand side of fivebar/dynamics.hpp (lib/src/simulate/system.cpp) for one mechanism
 /// at a state (theta, w, i), the skin anchored at `anchor` (m) and sticking, a held duty.
 struct Rhs {
   SimulationInput input;
@@ -269,7 +269,7 @@ StepResponse simulate_step(const LoopModel& loop, const Vec2& P, const std::arra
 TEST(Control, TheVerdictAgreesWithTheNonlinearSimulationOfAStepAtTheWorstPose) {
   const Design& d = paper();
   const LoopModel loop = paper_loop("index", "lower");
-  const StabilityMap map = stability_map(loop, ellipse_grid(d.require_station("index").target, 15));
+  const StabilityMap map = stability_map(loop, ellipse_lattice(d.require_station("index").target, 15));
   ASSERT_EQ(map.not_ok, 0u);
   ASSERT_TRUE(map.stable) << map.max_rho;
   ASSERT_GT(map.kp_margin, 1.0);
@@ -299,7 +299,7 @@ TEST(Control, TheVerdictAgreesWithTheNonlinearSimulationOfAStepAtTheWorstPose) {
 TEST(Control, TheKdMarginBoundsTheDerivativeGainBothWays) {
   const Design& d = paper();
   const LoopModel loop = paper_loop("index", "upper");
-  const StabilityMap map = stability_map(loop, ellipse_grid(d.require_station("index").target, 11));
+  const StabilityMap map = stability_map(loop, ellipse_lattice(d.require_station("index").target, 11));
   ASSERT_TRUE(map.stable);
   ASSERT_GT(map.kd_margin, 0.0);
   ASSERT_LT(map.kd_margin, StabilityOptions{}.margin_cap);
@@ -331,7 +331,7 @@ TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTuned
     // The figures after are those of the gains after, recomputed independently here.
     const LoopModel loop = paper_loop("index", t.mechanism);
     std::vector<PoseLoop> poses;
-    for (const Vec2& P : ellipse_grid(index.target, o.grid)) poses.push_back(pose_loop(loop, P));
+    for (const Vec2& P : ellipse_lattice(index.target, o.grid)) poses.push_back(pose_loop(loop, P));
     EXPECT_NEAR(max_spectral_radius(poses, t.after, true), t.rho_after, 1e-12);
     EXPECT_NEAR(max_spectral_radius(poses, t.before, true), t.rho_before, 1e-12);
     EXPECT_EQ(t.feasible, t.rho_after <= o.rho_limit && t.saturation_after <= d.get<ControllerSettings>()->max_saturation_fraction);
@@ -474,7 +474,7 @@ TEST(Control, EllipseGridStaysInsideAndHoldsTheCentre) {
   e.center = {3.0, -2.0};
   e.axes = {10.0, 4.0};
   e.angle = 0.4;
-  const std::vector<Vec2> pts = ellipse_grid(e, 21);
+  const std::vector<Vec2> pts = ellipse_lattice(e, 21);
   bool centre = false;
   for (const Vec2& p : pts) {
     const Vec2 q = p - e.center;
@@ -540,7 +540,7 @@ TEST(ControlTune, PolePlacementPutsEachJointsThreeRootsAtMinusOmega) {
   }
   // The chosen omega: no omega of a fine scan gives a smaller max rho over the poses (to 1e-3).
   std::vector<PoseLoop> poses;
-  for (const Vec2& P : ellipse_grid(d.require_station("thumb").target, 9)) poses.push_back(pose_loop(loop, P));
+  for (const Vec2& P : ellipse_lattice(d.require_station("thumb").target, 9)) poses.push_back(pose_loop(loop, P));
   const PolePlacement pp = pole_placement(loop, centre, poses, false, base);
   ASSERT_EQ(pp.status, Status::ok);
   EXPECT_NEAR(max_spectral_radius(poses, pp.gains, true), pp.max_rho, 1e-12);

@@ -9,7 +9,7 @@
 #include <numbers>
 #include <random>
 
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "paper.hpp"
 
 namespace fivebar {

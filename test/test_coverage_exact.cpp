@@ -14,8 +14,8 @@
 #include <optional>
 #include <random>
 
-#include "fivebar/coverage.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/coverage/coverage.hpp"
+#include "fivebar/workspace/region.hpp"
 #include "paper.hpp"
 
 namespace fivebar {

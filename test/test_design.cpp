@@ -1,4 +1,4 @@
-// Tests of the design model (lib/src/design.cpp) and the YAML loader (lib/src/yaml/design_loader.cpp):
+// Tests of the design model (lib/src/design/design.cpp) and the YAML loader (lib/src/yaml/design_loader.cpp):
 // the shipped designs against the paper's Table 1, every validate() rule, the malformed-file corpus
 // in test/data/malformed/, mode strings and joint ranges.
 
@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/scene.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
@@ -144,7 +145,7 @@ TEST_P(Malformed, IsRejectedWithFileLineAndKey) {
   const MalformedCase c = read_case(GetParam());
   ASSERT_FALSE(c.expects.empty()) << c.path << " lacks a first line '# expect: ...'";
   try {
-    load_design(c.path);
+    load_scene(c.path);  // with the scene's rule: a `products:` name is checked too
     FAIL() << c.path << " was accepted";
   } catch (const InputError& e) {
     const std::string message = e.what();
@@ -456,8 +457,14 @@ TEST(Design, SelectsStationsByNameOrEveryOneWithAMechanism) {
 
 TEST(DesignValidate, Products) {
   const Design d = valid_design();
-  expect_invalid(d, [](Design& x) { x.products = std::vector<std::string>{"kinematics", "nope"}; },
-                 "products[1] = 'nope': unknown product");
+  // The design checks the list's form; the names are the scene's (validate_products), above core.
+  Design unknown = d;
+  unknown.products = std::vector<std::string>{"kinematics", "nope"};
+  EXPECT_NO_THROW(unknown.validate());
+  EXPECT_THAT([&] { validate_products(unknown); },
+              ThrowsMessage<ValidationError>(HasSubstr("products[1] = 'nope': unknown product")));
+  EXPECT_THAT([&] { load_scene_from_string("products: [kinematics, nope]\n" + kMinimal, "s.yaml"); },
+              ThrowsMessage<InputError>(HasSubstr("s.yaml:1: products[1] = 'nope': unknown product")));
   expect_invalid(d, [](Design& x) { x.products = std::vector<std::string>{"kinematics", "kinematics"}; },
                  "products[1] = 'kinematics': listed twice");
   Design ok = d;

@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "design_keys.hpp"
+#include "design/design_keys.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/contact.hpp"

@@ -1,4 +1,4 @@
-// Tests of the controller export (fivebar/export.hpp): number formatting, the hash, the parameter
+// Tests of the controller export (fivebar/export/export.hpp): number formatting, the hash, the parameter
 // tree against the design (values typed here from the paper's Table 1 and the showcase's
 // controller section), every format read back with an independent reader (yaml-cpp, nlohmann) and
 // with parse_export(), the gate's checks and reasons, atomic writing, and --check's comparison.
@@ -30,7 +30,7 @@
 #include "fivebar/sections/optimize.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/error.hpp"
-#include "fivebar/export.hpp"
+#include "fivebar/export/export.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/kinematics.hpp"

@@ -1,4 +1,4 @@
-// The loop checks of the export gate (fivebar/export.hpp "stability", "tracking", "saturation"):
+// The loop checks of the export gate (fivebar/export/export.hpp "stability", "tracking", "saturation"):
 // a controller beyond its kp margin is refused naming the station, mechanism, pose and spectral
 // radius; the tracking and saturation limits refuse with the mechanism, pattern and figure, the
 // figures being those of an independent simulate() run of the same pattern; a passed export
@@ -15,7 +15,7 @@
 
 #include "fivebar/control.hpp"
 #include "fivebar/dynamics.hpp"
-#include "fivebar/export.hpp"
+#include "fivebar/export/export.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -96,7 +96,7 @@ TEST(ExportLoopGate, GainsBeyondTheKpMarginAreRefusedNamingThePoseAndNothingIsWr
   ASSERT_EQ(loop.model.mechanism.name, "lower");
   StabilityOptions so;
   so.grid = 21;
-  const StabilityMap before = stability_map(loop, ellipse_grid(d.require_station("index").target, 21), so);
+  const StabilityMap before = stability_map(loop, ellipse_lattice(d.require_station("index").target, 21), so);
   ControlOverride o;
   o.station = "index";
   o.mechanism = "lower";

@@ -15,7 +15,7 @@
 
 #include "fivebar/detail/fastmath.hpp"
 #include "fivebar/kinematics.hpp"
-#include "fivebar/tolerances.hpp"
+#include "fivebar/numerics.hpp"
 #include "paper.hpp"
 
 namespace fivebar {

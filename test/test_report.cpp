@@ -19,10 +19,10 @@
 #include <sstream>
 
 #include "cli_test.hpp"
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/report.hpp"
 #include "fivebar/scene.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/workspace/region.hpp"
 #include "report/precision.hpp"
 #include "report/quad.hpp"
 

@@ -82,15 +82,13 @@ std::vector<std::string> registered_in_def() {
 }
 
 TEST(Registry, EveryProductFolderIsRegisteredAndEveryRegistrationHasItsFolder) {
-  // docs/architecture.md "Adding a product": a folder lib/src/products/<name>/ with product.cpp,
-  // and one line in products.def; nothing else in the library names the product.
-  const fs::path root = fs::path(FIVEBAR_SOURCE_DIR) / "lib/src/products";
+  // docs/architecture.md "Adding a product": the product glue lib/src/<name>/product.cpp sits in
+  // its study's folder, and one line in products.def registers it; nothing else in the library
+  // names the product.
+  const fs::path src = fs::path(FIVEBAR_SOURCE_DIR) / "lib/src";
   std::set<std::string> folders;
-  for (const auto& e : fs::directory_iterator(root)) {
-    if (e.is_directory()) {
-      folders.insert(e.path().filename().string());
-      EXPECT_TRUE(fs::exists(e.path() / "product.cpp")) << e.path();
-    }
+  for (const auto& e : fs::directory_iterator(src)) {
+    if (e.is_directory() && fs::exists(e.path() / "product.cpp")) folders.insert(e.path().filename().string());
   }
   const std::vector<std::string> def = registered_in_def();
   EXPECT_EQ(std::set<std::string>(def.begin(), def.end()), folders);
@@ -105,7 +103,7 @@ TEST(Registry, EveryProductFolderIsRegisteredAndEveryRegistrationHasItsFolder) {
         if (!e.is_regular_file()) continue;
         const std::string text = slurp(e.path());
         if (text.find(entry) == std::string::npos) continue;
-        EXPECT_EQ(e.path(), root / name / "product.cpp") << entry << " named outside its folder";
+        EXPECT_EQ(e.path(), src / name / "product.cpp") << entry << " named outside its folder";
       }
     }
   }
@@ -113,7 +111,7 @@ TEST(Registry, EveryProductFolderIsRegisteredAndEveryRegistrationHasItsFolder) {
 
 TEST(Registry, TheSceneRunnerAndTheDesignNameNoProduct) {
   // The scene, the design model and the loader learn product names from products.def only.
-  for (const char* file : {"lib/src/scene.cpp", "lib/src/design.cpp", "lib/src/yaml/design_loader.cpp",
+  for (const char* file : {"lib/src/scene.cpp", "lib/src/design/design.cpp", "lib/src/yaml/design_loader.cpp",
                            "lib/src/products/registry.cpp", "lib/include/fivebar/design.hpp"}) {
     const std::string text = slurp(fs::path(FIVEBAR_SOURCE_DIR) / file);
     for (const std::string& name : known_products()) {

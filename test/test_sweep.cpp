@@ -18,7 +18,7 @@
 #include "fivebar/sections/print.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/collision.hpp"
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/sweep.hpp"
 #include "paper.hpp"

@@ -1,4 +1,4 @@
-// Tests of the URDF (fivebar/urdf.hpp): urdfdom's check_urdf accepts the showcase's files; the
+// Tests of the URDF (fivebar/export/urdf.hpp): urdfdom's check_urdf accepts the showcase's files; the
 // document read back by a small XML reader written here has the tree, joint limits, masses and
 // ros2_control block the design gives, compared with hand values (the hard stop's angle, the
 // potentiometer's end, the stall torque) and with an independent closed-form mass of a slab; with
@@ -25,10 +25,10 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/error.hpp"
-#include "fivebar/export.hpp"
-#include "fivebar/joint_limits.hpp"
+#include "fivebar/export/export.hpp"
+#include "fivebar/export/joint_limits.hpp"
 #include "fivebar/sections/geometry.hpp"
-#include "fivebar/urdf.hpp"
+#include "fivebar/export/urdf.hpp"
 
 namespace fivebar {
 namespace {

@@ -8,7 +8,7 @@
 #include <numbers>
 #include <random>
 
-#include "fivebar/workspace.hpp"
+#include "fivebar/workspace/region.hpp"
 #include "paper.hpp"
 
 namespace fivebar {

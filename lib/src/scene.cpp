@@ -7,7 +7,7 @@
 #include <map>
 #include <set>
 
-#include "design_keys.hpp"
+#include "design/design_keys.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/json.hpp"
@@ -119,6 +119,22 @@ SceneReport run_scene(const Design& design, const SceneOptions& options) {
   return products::run_scene_with(design, options, products::registry());
 }
 
+SceneReport check_design(const Design& design, const std::filesystem::path& out_root) {
+  return products::check_design_with(design, out_root, products::registry());
+}
+
+SceneReport products::check_design_with(const Design& design, const std::filesystem::path& out_root,
+                                        const std::vector<Product>& registry) {
+  std::vector<std::string> checks;
+  for (const Product& p : registry) {
+    if (p.checks_designs && !(p.unavailable && p.unavailable(design))) checks.push_back(p.name);
+  }
+  SceneOptions o;
+  o.out_root = out_root;
+  o.products = checks;
+  return run_scene_with(design, o, registry);
+}
+
 SceneReport products::run_scene_with(const Design& design, const SceneOptions& options,
                                      const std::vector<Product>& registry) {
   const auto find = [&registry](std::string_view name) -> const Product* {
@@ -188,7 +204,10 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
         outcome.reason = "needs " + join(missing_pre, ", ") + ", which could not be built";
       } else {
         if (options.progress) options.progress("building " + name);
-        Context ctx{design, report.out_dir, results, options.progress, {}};
+        Context ctx{design, report.out_dir, results, options.progress, {}, {}};
+        ctx.check_design = [&registry](const Design& d, const std::filesystem::path& root) {
+          return check_design_with(d, root, registry);
+        };
         Built result = product->build(ctx);
         outcome.state = ProductOutcome::State::built;
         outcome.passed = result.passed;

@@ -25,7 +25,7 @@ const Design& design() {
 }
 
 /// About 1,000 points of the index target (a 37 x 37 grid over its box).
-std::vector<Vec2> points() { return ellipse_grid(design().require_station("index").target, 37); }
+std::vector<Vec2> points() { return ellipse_lattice(design().require_station("index").target, 37); }
 
 void BM_control_stability_map_1000(benchmark::State& state) {
   const Design& d = design();

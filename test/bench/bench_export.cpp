@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "fivebar/export.hpp"
+#include "fivebar/export/export.hpp"
 
 namespace {
 

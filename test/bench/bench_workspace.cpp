@@ -5,8 +5,8 @@
 
 #include <numbers>
 
-#include "fivebar/coverage.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/coverage/coverage.hpp"
+#include "fivebar/workspace/region.hpp"
 #include "paper.hpp"
 
 namespace {

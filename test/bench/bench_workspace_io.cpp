@@ -7,10 +7,10 @@
 #include <filesystem>
 
 #include "fivebar/design.hpp"
-#include "fivebar/station_workspace.hpp"
-#include "fivebar/workspace_files.hpp"
-#include "fivebar/workspace_io.hpp"
-#include "fivebar/workspace_plot.hpp"
+#include "fivebar/workspace/station.hpp"
+#include "fivebar/workspace/files.hpp"
+#include "fivebar/workspace/io.hpp"
+#include "fivebar/workspace/plot.hpp"
 
 namespace {
 

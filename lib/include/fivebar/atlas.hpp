@@ -74,7 +74,7 @@
 #include <utility>
 #include <vector>
 
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/rendered_plot.hpp"

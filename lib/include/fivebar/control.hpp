@@ -1,5 +1,5 @@
 #pragma once
-/// Controller validation (issue 16): the sampled-data loop of one mechanism linearised at a pose,
+/// Controller validation: the sampled-data loop of one mechanism linearised at a pose,
 /// discretised exactly, closed by the exported PID with one period of delay, and its spectral
 /// radius over the target ellipse (the stability map), with margins on the gains.
 ///
@@ -68,7 +68,7 @@
 #include "fivebar/rendered_plot.hpp"
 #include "fivebar/sections/contact.hpp"
 #include "fivebar/sections/controller.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/workspace/region.hpp"
 
 namespace fivebar {
 
@@ -154,9 +154,9 @@ struct PoseLoop {
 /// The discretised plant and poles at tactor point P (mm) in the working mode.
 PoseLoop pose_loop(const LoopModel& loop, const Vec2& P_mm);
 
-/// Points of an n x n grid over the filled ellipse's bounding box (its own frame) that lie inside
-/// it; n odd includes the centre.
-std::vector<Vec2> ellipse_grid(const Ellipse& e, int n);
+/// Points of an n x n lattice over the filled ellipse's bounding box (its own frame) that lie inside
+/// it; n odd includes the centre. (ellipse_grid(), fivebar/collision.hpp, takes a spacing in mm.)
+std::vector<Vec2> ellipse_lattice(const Ellipse& e, int n);
 
 struct StabilityOptions {
   int grid = 41;            ///< per axis over the target ellipse's box (~1,300 points inside)

@@ -185,9 +185,6 @@ struct Design {
 /// outputs/: 1 to 64 characters from [A-Za-z0-9_.-], the first not '.' or '-'.
 bool is_safe_name(std::string_view name);
 
-/// Product names a scene may list, in build order (lib/src/products/products.def).
-const std::vector<std::string>& known_products();
-
 /// The design as a design file (YAML, file units, numbers in shortest round-trip form) that
 /// load_design_from_string() reads back to an equal design.
 std::string to_yaml(const Design& design);
@@ -207,11 +204,18 @@ inline constexpr std::size_t kMaxDesignFileBytes = std::size_t{1} << 20;  ///< 1
 /// Levels of block indentation, "- " / "? " items and [ { brackets, counted together.
 inline constexpr int kMaxDesignNesting = 64;
 
+/// A rule of a layer above the design, checked by the loader after Design::validate(): it throws
+/// ValidationError naming the key, which the loader reports with the file and line like its own
+/// rules. The scene's product names are one (fivebar/scene.hpp load_scene()): the design itself
+/// knows no product.
+using DesignRule = std::function<void(const Design&)>;
+
 /// Loads and validates a design file. Throws InputError whose message names the file, line, full
 /// key path, value and the rule broken ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2]
 /// = -3 mm: must be > 0"); problems of the whole file omit the line ("x.yaml: no such design file").
-Design load_design(const std::filesystem::path& path);
+/// `rule`, when given, is checked too (DesignRule).
+Design load_design(const std::filesystem::path& path, const DesignRule& rule = {});
 /// Same, from text (for tests and stdin); `origin` names the source in messages.
-Design load_design_from_string(const std::string& text, const std::string& origin);
+Design load_design_from_string(const std::string& text, const std::string& origin, const DesignRule& rule = {});
 
 }  // namespace fivebar

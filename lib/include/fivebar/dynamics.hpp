@@ -1,8 +1,8 @@
 #pragma once
-/// Dynamics of the device (issue 15): each five-bar as a 2-DOF closed chain driven by two DC
+/// Dynamics of the device: each five-bar as a 2-DOF closed chain driven by two DC
 /// gearmotors under the exported PID, the tactor on a skin spring with Coulomb stick/slip, both
 /// mechanisms of a station together, integrated by SUNDIALS CVODE (BDF, Newton, dense direct
-/// solver) or, for comparison, ARKODE's explicit Runge-Kutta (lib/src/dynamics/cvode.cpp and
+/// solver) or, for comparison, ARKODE's explicit Runge-Kutta (lib/src/simulate/cvode.cpp and
 /// arkode.cpp are the only files that see SUNDIALS).
 ///
 /// Units inside: SI (m, kg, s, rad, N, V, A); the results carry mm, deg, N, A at the edges.
@@ -278,7 +278,7 @@ struct SimulationOptions {
   double rtol = 1e-6;
   Integrator integrator = Integrator::bdf;
   PwmModel pwm = PwmModel::averaged;
-  double pwm_frequency_hz = 1000.0;  ///< the switched model's PWM frequency (the issue's 1 kHz, an assumption)
+  double pwm_frequency_hz = 1000.0;  ///< the switched model's PWM frequency (the paper's 1 kHz PWM)
   /// > 0: also record the integrator's dense output (its interpolant within each step) at the
   /// multiples of this spacing, in SimulationResult::dense; 0: not.
   double dense_dt_s = 0.0;
@@ -419,7 +419,7 @@ void write_bode_csv(std::ostream& out, const BodeResult& bode);
 std::string bode_svg(const BodeResult& bode, const std::string& title);
 std::string bode_png(const BodeResult& bode, const std::string& title);
 
-/// The picture of one run (lib/src/plot/simulation_plot.cpp): the commanded and the simulated
+/// The picture of one run (lib/src/simulate/simulation_plot.cpp): the commanded and the simulated
 /// tactor paths on the station's fingertip target with the reachable regions, and the motor
 /// currents and skin shear forces over time.
 RenderedPlot plot_simulation(const Station& station, const SimulationInput& input, const SimulationResult& result);

@@ -30,7 +30,6 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/json.hpp"
-#include "fivebar/scene.hpp"
 #include "fivebar/sections/optimize.hpp"
 
 namespace fivebar {
@@ -183,10 +182,6 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
 /// Every rank of an MPI job runs shard rank/size; rank 0 merges (merge_optimize_shards).
 /// Throws std::runtime_error when fivebar was built without MPI.
 OptimizeResult run_optimize_mpi(const Design& design, const OptimizeOptions& options);
-
-/// Re-checks a chosen design with the exact products (run_scene(): coverage at its full sampling,
-/// and collision and pattern when the design has their data) into `out_root / chosen.name`.
-SceneReport recheck_chosen(const Design& chosen, const std::filesystem::path& out_root);
 
 /// Summary table rows comparing the chosen design with the design as given: one row per
 /// variable and per figure (every figure the design has the data for), {name, given, chosen}.

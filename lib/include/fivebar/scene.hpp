@@ -69,6 +69,21 @@ struct SceneReport {
   std::string to_markdown() const;
 };
 
+/// Product names a scene may list, in build order (lib/src/products/products.def).
+const std::vector<std::string>& known_products();
+/// Checks a design's `products:` list against known_products() (a DesignRule): ValidationError
+/// naming the entry ("products[1] = 'nope': unknown product (known: ...)").
+void validate_products(const Design& design);
+/// load_design() with validate_products(): what the command line loads, a scene being any design.
+Design load_scene(const std::filesystem::path& path);
+/// Same, from text; `origin` names the source in messages.
+Design load_scene_from_string(const std::string& text, const std::string& origin);
+
+/// Re-checks a design a study proposes (the optimiser's chosen design) with the exact checking
+/// products it has the data for (coverage at its full sampling; collision and patterns when it has
+/// their sections and a station with both mechanisms), as a scene into `out_root / design.name`.
+SceneReport check_design(const Design& design, const std::filesystem::path& out_root);
+
 /// Runs a scene. Throws InputError for an unknown product name in `options.products` or an output
 /// directory escaping the root; IoError when the output cannot be written. A product that
 /// cannot be built (missing data or tool) is not an exception: it is reported as left out.

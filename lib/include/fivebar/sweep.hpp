@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/sections/sweep.hpp"
 

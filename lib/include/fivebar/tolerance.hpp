@@ -1,5 +1,5 @@
 #pragma once
-/// Manufacturing tolerance and sensing error of a five-bar (issue 17, first slice): how far the
+/// Manufacturing tolerance and sensing error of a five-bar: how far the
 /// printed device's tactor can be from where the controller believes it is.
 ///
 /// The controller computes the joint angles by the nominal IK and drives the motors there; the
@@ -43,7 +43,7 @@
 ///
 /// Robust coverage (robust_coverage()). A printed device's own reachable region is the design's
 /// with its perturbed lengths and base positions; it covers the target when its certified margin
-/// (fivebar/coverage.hpp containment()) is >= 0. At each of 72 points b of the ellipse's boundary
+/// (fivebar/coverage/coverage.hpp containment()) is >= 0. At each of 72 points b of the ellipse's boundary
 /// the signed distance to the region's boundary is, to first order, d(b) + g(b) . dq with
 /// g = dd/dq (central differences, step 1 % of each sigma), so its standard deviation is
 /// sigma(b) = sqrt(sum_j g_j(b)^2 sigma_j^2) and the robust margin is the signed margin minus the

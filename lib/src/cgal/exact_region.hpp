@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/workspace/region.hpp"
 
 namespace fivebar::detail {
 

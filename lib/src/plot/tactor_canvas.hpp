@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "fivebar/collision.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/workspace/region.hpp"
 
 namespace fivebar::tactor_plot {
 

@@ -1,6 +1,6 @@
 #pragma once
 /// The product plug-in behind run_scene() (fivebar/scene.hpp; docs/architecture.md "Products").
-/// A product is one folder lib/src/products/<name>/ whose product.cpp defines
+/// A product is the glue file lib/src/<name>/product.cpp of its study's folder, which defines
 /// `Product <name>_product()`: its name, what it needs first, whether a design has the data for it,
 /// and how to build it (results, summary section, files). It is registered by one line in
 /// products.def, which also gives known_products() its names and the build order.
@@ -29,6 +29,9 @@ struct Context {
   const std::map<std::string, Json>& results;  ///< results of products built so far
   std::function<void(std::string_view)> progress;  ///< may be empty
   std::vector<std::filesystem::path> files;        ///< files written so far, relative to dir
+  /// Runs the checking products on another design (a study's proposal): check_design() over the
+  /// scene's own product list. Set by the scene runner.
+  std::function<SceneReport(const Design&, const std::filesystem::path&)> check_design;
 
   /// The result of an earlier product (a prerequisite), or nullptr.
   const Json* result_of(std::string_view name) const;
@@ -56,6 +59,9 @@ struct Product {
   /// installed), or std::nullopt when it can.
   std::function<std::optional<std::string>(const Design&)> unavailable;
   std::function<Built(Context&)> build;
+  /// One of the exact checks a study's proposed design is re-run through (check_design(): a
+  /// design's coverage, collision, patterns), whenever the design has the data for it.
+  bool checks_designs = false;
 };
 
 /// Product::unavailable for the products that need at least one station with a mechanism.
@@ -83,6 +89,9 @@ const std::vector<Product>& registry();
 /// through this list (names, order, prerequisites), which tests extend with throwaway products.
 /// Prerequisites must come earlier in the list.
 SceneReport run_scene_with(const Design& design, const SceneOptions& options, const std::vector<Product>& registry);
+/// check_design() over a given list of products (Product::checks_designs).
+SceneReport check_design_with(const Design& design, const std::filesystem::path& out_root,
+                              const std::vector<Product>& registry);
 /// The entry named `name`, or nullptr when this build does not implement it.
 const Product* find_product(std::string_view name);
 

@@ -9,13 +9,13 @@
 #include <numbers>
 #include <random>
 
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/report.hpp"
 #include "fivebar/tolerance.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/workspace/region.hpp"
 #include "report/precision.hpp"
 #include "report/quad.hpp"
 

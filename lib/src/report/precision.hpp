@@ -1,7 +1,7 @@
 #pragma once
 // FK and IK in a chosen floating-point type (float, double, long double) for the work-precision
 // study of `fivebar report accuracy` (private). The formulas are the library's stable ones
-// (lib/src/kinematics_common.hpp, detail::chord): the intersection as ratios to the centre
+// (lib/src/kinematics/kinematics_common.hpp, detail::chord): the intersection as ratios to the centre
 // distance d, computed from d^2 alone, t = a/d = 1/2 + (r1 - r2)(r1 + r2)/(2 d^2) and
 // h/d = sqrt((d^2 - (r1 - r2)^2)((r1 + r2)^2 - d^2)/(r1 + r2)^2) (r1 + r2) / (2 d^2), each factor clamped at
 // rounding-level tangency; angles from atan2. Only the arithmetic type changes, so the series

@@ -50,12 +50,12 @@
 #include <numbers>
 #include <sstream>
 
-#include "fivebar/coverage.hpp"
+#include "fivebar/coverage/coverage.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/report.hpp"
-#include "fivebar/tolerances.hpp"
-#include "fivebar/workspace.hpp"
+#include "fivebar/numerics.hpp"
+#include "fivebar/workspace/region.hpp"
 #include "report/format.hpp"
 #include "report/quad.hpp"
 

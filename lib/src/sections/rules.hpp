@@ -1,12 +1,12 @@
 #pragma once
-/// Validation rules shared by the design model (lib/src/design.cpp) and the section modules
+/// Validation rules shared by the design model (lib/src/design/design.cpp) and the section modules
 /// (lib/src/sections/*.cpp): one wording for every "must be" message, values in file units.
 /// Private to the library.
 
 #include <string>
 #include <string_view>
 
-#include "design_keys.hpp"
+#include "design/design_keys.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/ranges.hpp"
 

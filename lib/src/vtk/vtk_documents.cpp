@@ -1,4 +1,4 @@
-// VTK XML documents of a station's workspace (fivebar/workspace_io.hpp): the only translation
+// VTK XML documents of a station's workspace (fivebar/workspace/io.hpp): the only translation
 // unit that speaks VTK. Documents are produced in memory (vtkXMLWriter's output string) so that
 // the caller writes them atomically like every other file.
 #include <vtkCellArray.h>
@@ -25,7 +25,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/control.hpp"
 #include "fivebar/io.hpp"
-#include "fivebar/workspace_io.hpp"
+#include "fivebar/workspace/io.hpp"
 
 namespace fivebar {
 

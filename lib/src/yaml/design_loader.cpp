@@ -28,7 +28,7 @@
 #include <vector>
 
 #include "fivebar/format.hpp"
-#include "design_keys.hpp"
+#include "design/design_keys.hpp"
 #include "fivebar/design.hpp"
 #include "sections/section.hpp"
 
@@ -467,6 +467,8 @@ class Loader {
  public:
   /// When set, every key a visited map allows is added here, as its shape ("stations.<name>.target").
   std::set<std::string>* catalogue = nullptr;
+  /// The caller's rule from a layer above the design (DesignRule), or none.
+  const DesignRule* rule = nullptr;
 };
 
 Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, int line,
@@ -811,6 +813,7 @@ Design Loader::load(const std::string& raw) {
 
   try {
     design.validate();
+    if (rule != nullptr && *rule) (*rule)(design);
   } catch (const ValidationError& e) {
     fail(line_for(e.key()), e.key(), e.rule());
   }
@@ -913,8 +916,10 @@ sections::Value Loader::value(const Entry& entry) {
 
 }  // namespace
 
-Design load_design_from_string(const std::string& text, const std::string& origin) {
-  return Loader(origin).load(text);
+Design load_design_from_string(const std::string& text, const std::string& origin, const DesignRule& rule) {
+  Loader loader(origin);
+  loader.rule = &rule;
+  return loader.load(text);
 }
 
 std::set<std::string> detail::design_file_keys(const std::string& text) {
@@ -925,7 +930,7 @@ std::set<std::string> detail::design_file_keys(const std::string& text) {
   return keys;
 }
 
-Design load_design(const std::filesystem::path& path) {
+Design load_design(const std::filesystem::path& path, const DesignRule& rule) {
   const std::string origin = path.string();
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
@@ -954,7 +959,7 @@ Design load_design(const std::filesystem::path& path) {
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxDesignFileBytes) throw too_large(kMaxDesignFileBytes, "more than ");
 
-  Design design = load_design_from_string(text, origin);
+  Design design = load_design_from_string(text, origin, rule);
   design.source = path;
   return design;
 }

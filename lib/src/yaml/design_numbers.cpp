@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "design_keys.hpp"
+#include "design/design_keys.hpp"
 #include "fivebar/design.hpp"
 #include "sections/section.hpp"
 

@@ -1,4 +1,4 @@
-// Reads an exported ROS 2 parameters file back (fivebar/export.hpp, export --check) with yaml-cpp,
+// Reads an exported ROS 2 parameters file back (fivebar/export/export.hpp, export --check) with yaml-cpp,
 // keeping each scalar's ROS type: `5` is an integer, `5.0` a double, `"5"` a string.
 
 #include <yaml-cpp/yaml.h>
@@ -8,7 +8,7 @@
 #include <limits>
 #include <string>
 
-#include "export_detail.hpp"
+#include "export/export_detail.hpp"
 #include "fivebar/error.hpp"
 
 namespace fivebar::detail {

@@ -7,7 +7,7 @@
 
 #include <map>
 
-#include "design_keys.hpp"
+#include "design/design_keys.hpp"
 
 namespace fivebar::detail {
 

@@ -35,7 +35,7 @@ struct PidGains {
 /// 0 V at one end of its travel and travel / |rad_per_volt| volts at the other, so the joint reads
 /// only on the arc theta in [rad_per_volt (0 - volts_at_zero), rad_per_volt (travel/|rad_per_volt|
 /// - volts_at_zero)] (ends swapped when wired reversed); potentiometer_window() in
-/// fivebar/joint_limits.hpp. Without it the potentiometer is taken to read on every angle.
+/// fivebar/export/joint_limits.hpp. Without it the potentiometer is taken to read on every angle.
 struct Potentiometer {
   double volts_at_zero = 2.5;                   ///< reading at theta = 0, V
   double rad_per_volt = 1.0471975511965976;     ///< 5 V over 300 deg: 60 deg/V; negative when wired reversed
@@ -74,7 +74,7 @@ struct ControlOverride {
 struct TuneSettings {
   double rho_limit = 0.9;     ///< max spectral radius allowed over the target, in (0, 1)
   int evaluations = 60;       ///< objective evaluations per mechanism (each simulates every pattern)
-  double max_seconds = 30.0;  ///< wall-time bound of the whole tuning, s (issue 16: < 30 s for the paper's device)
+  double max_seconds = 30.0;  ///< wall-time bound of the whole tuning, s
   bool per_joint = false;     ///< kp, ki, kd per joint instead of one set per mechanism
   /// Where the optimiser starts: "pole_placement" (on the linearised model at the target's
   /// centre) or "hand_set" (the file's gains).
@@ -85,7 +85,7 @@ struct TuneSettings {
 /// The ROS controller on the device (`controller:`; paper Sec. II-D): per mechanism an IK module,
 /// FK of the measured joints for collision checks with the upper mechanism's priority, and a PID
 /// per motor at loop_rate_hz driving the motor by PWM at pwm_hz; joint angles read from
-/// potentiometers through an ADC (the paper's 16-bit DAQ, USB-1608G). Read by fivebar/export.hpp.
+/// potentiometers through an ADC (the paper's 16-bit DAQ, USB-1608G). Read by fivebar/export/export.hpp.
 ///
 /// Joint speed limit: max_velocity is the one source of truth when a design has this section;
 /// `patterns:` then takes it from here (the loader refuses patterns.max_joint_speed_deg_s next to
@@ -103,7 +103,7 @@ struct ControllerSettings {
   /// min_lci): the ellipse keeps this far from singularities.
   double min_lci = 0.05;
   /// Export gate: the target ellipse and every pattern keep at least this far (rad) inside each
-  /// joint's usable range (fivebar/joint_limits.hpp; file: joint_margin_deg, default 5 deg, an
+  /// joint's usable range (fivebar/export/joint_limits.hpp; file: joint_margin_deg, default 5 deg, an
   /// assumption: room for the PID's overshoot before a hard stop or the end of a potentiometer).
   double joint_margin = 0.08726646259971647;
   /// Export gate (with `motor:`): the tactor's tracking error |P - P_ref| in every simulated

@@ -1,6 +1,6 @@
 #pragma once
 /// The `tolerance:` section of a design file: manufacturing and sensing errors of the printed
-/// device (issue 17). One module of the design (see docs/architecture.md "Design sections"): the
+/// device. One module of the design (see docs/architecture.md "Design sections"): the
 /// struct and its validate() here, its loader and writer hooks in lib/src/sections/tolerance.cpp.
 /// A Design holds it as `design.get<ToleranceSettings>()`; fivebar/tolerance.hpp turns it into
 /// per-parameter standard deviations.

@@ -1,0 +1,70 @@
+#pragma once
+/// URDF of a station with a ros2_control block (`fivebar export` writes one per exported station,
+/// `<design>_<station>.urdf`, beside the controller files; docs/urdf.md). SI units (REP 103).
+///
+/// Tree (URDF holds a tree; the five-bar is a closed loop, cut at the tactor joint P):
+///
+///   <station>_base                        station frame; z = 0 the base plate's top face
+///    ├─ <station>_<mech>_theta1 (revolute, motor)  at O1 ─ <..>_L1
+///    │     └─ <..>_elbow1 (continuous, passive) at A1 ─ <..>_L3
+///    │            └─ (fixed) <..>_tip_mount at P ─ <..>_tip     when L3 carries the tactor post
+///    └─ <station>_<mech>_theta2 (revolute, motor)  at O2 ─ <..>_L2
+///          └─ <..>_elbow2 (continuous, passive) at A2 ─ <..>_L4
+///                 └─ <..>_tactor (continuous, passive) at P ─ <..>_P   the loop's cut
+///
+/// (the roles of L3 and L4 swap when L4 carries the post: geometry.layers[3] > layers[2], as in
+/// fivebar/dynamics.hpp). Each link's frame is its part's frame (fivebar/parts.hpp): z along its
+/// first joint's axis, x towards its second joint; a joint angle of theta turns the link's x axis
+/// to theta in the parent's frame. So the motor joints' positions are the station-frame angles
+/// theta1, theta2 of docs/conventions.md, and a controller fills the passive joints from FK of the
+/// measured theta (fivebar/kinematics.hpp fk(), the design's assembly mode):
+///   elbow1 = phi3 - theta1,  elbow2 = phi4 - theta2,  tactor = phi_carrier - phi_other,
+/// phi3, phi4 the directions of A1->P and A2->P; then the frame <..>_P coincides with the tip's
+/// mount on the other chain, which is the loop closure URDF cannot state.
+///
+/// Heights: the proximal links' hubs (PartsHardware::hub_height) stand on the base plate; link
+/// plane k's plate starts at hub_height + k (link_thickness + layer_gap); the tip sits on the post,
+/// tactor_height above the carrier's plate top minus the tip.
+///
+/// Mass properties (fivebar/dynamics.hpp station_inertia()): from the parts' STL renders when a
+/// parts report is given (then every component of the inertia tensor, and the centre of mass
+/// height, from mass_properties() of the same files), else closed_form_inertia(): mass, centre of
+/// mass in the plane and z inertia from it, the other components those of a plate of the link's
+/// width and thickness (ixx = m (w^2 + t^2) / 12, iyy = izz - m w^2 / 12 + m t^2 / 12, centre at
+/// mid-plate). The URDF says which in a comment. The base is the root and carries no inertia.
+///
+/// Limits: motor joints carry the usable range of fivebar/export/joint_limits.hpp (continuous when the
+/// joint has none), velocity controller.max_velocity, effort the stall torque at the output of the
+/// motor section, eta N k_t min(supply / R, current limit) (0 without `motor:`: unknown).
+///
+/// ros2_control: one `<ros2_control type="system">` naming the four motor joints, each with a
+/// position command interface (min/max = the usable range) and position and velocity state
+/// interfaces (position's initial_value the joint's angle at the target centre); its hardware is
+/// ros2_control's mock_components/GenericSystem, to replace with the device's interface.
+
+#include <filesystem>
+#include <string>
+
+#include "fivebar/design.hpp"
+#include "fivebar/json.hpp"
+
+namespace fivebar {
+
+struct UrdfOptions {
+  /// A parts report (to_json(PartsReport), fivebar/parts.hpp) with STL renders: masses from them and
+  /// the meshes as visuals. nullptr: closed-form masses, no meshes.
+  const Json* parts = nullptr;
+  /// Where the report's "stl" paths are relative to (to read them).
+  std::filesystem::path parts_dir;
+  /// The same folder as the URDF should name it (relative to the URDF file, e.g. "../parts").
+  std::string mesh_prefix = "../parts";
+};
+
+/// `<design>_<station>.urdf`.
+std::string urdf_file_name(const Design& design, const Station& station);
+
+/// The URDF document of `station` (layout above). InputError without `geometry:` (the links'
+/// outlines) or when a mechanism's joints have no usable range.
+std::string render_urdf(const Design& design, const Station& station, const UrdfOptions& options = {});
+
+}  // namespace fivebar

@@ -1,0 +1,738 @@
+// Validated controller export (fivebar/export/export.hpp): the gate, the parameter tree, the design hash,
+// writing the files and checking an exported file against a design. The three formats' text is
+// in export_formats.cpp (and yaml/export_yaml_reader.cpp for reading ROS YAML back).
+
+#include "fivebar/format.hpp"
+#include "fivebar/export/export.hpp"
+#include "fivebar/sections/tolerance.hpp"
+#include "fivebar/tolerance.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include "fivebar/coverage/coverage.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/kinematics.hpp"
+#include "fivebar/pattern.hpp"
+#include "fivebar/version.hpp"
+#include "export/export_control_gate.hpp"
+
+namespace fivebar {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using format::kDegPerRad;
+/// Lengths leave in metres (REP 103). Divided, not multiplied by 1e-3: the quotient is the double
+/// nearest the true value, so 9 mm is written 0.009 rather than 0.009000000000000001.
+constexpr double kMmPerMetre = 1000.0;
+/// Version of the exported layout; a controller may refuse a layout it does not know.
+constexpr int kFormatVersion = 1;
+
+using format::fixed;
+
+std::string point_text(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ") mm"; }
+
+/// Angle in (-pi, pi].
+double normalized(double a) {
+  double r = std::remainder(a, kTwoPi);
+  if (r <= -kPi) r += kTwoPi;
+  return r;
+}
+
+double wrap_two_pi(double a) {
+  double r = std::fmod(a, kTwoPi);
+  if (r < 0.0) r += kTwoPi;
+  if (r >= kTwoPi) r = 0.0;
+  return r;
+}
+
+/// Words a name cannot take in the header: C++ keywords and alternative tokens, and the macros GNU
+/// mode predefines (`linux`, `unix`).
+const std::set<std::string_view>& reserved_words() {
+  static const std::set<std::string_view> words{
+      "alignas", "alignof", "and", "and_eq", "asm", "auto", "bitand", "bitor", "bool", "break", "case", "catch",
+      "char", "char8_t", "char16_t", "char32_t", "class", "compl", "concept", "const", "consteval", "constexpr",
+      "constinit", "const_cast", "continue", "co_await", "co_return", "co_yield", "decltype", "default", "delete",
+      "do", "double", "dynamic_cast", "else", "enum", "explicit", "export", "extern", "false", "float", "for",
+      "friend", "goto", "if", "inline", "int", "long", "mutable", "namespace", "new", "noexcept", "not", "not_eq",
+      "nullptr", "operator", "or", "or_eq", "private", "protected", "public", "register", "reinterpret_cast",
+      "requires", "return", "short", "signed", "sizeof", "static", "static_assert", "static_cast", "struct",
+      "switch", "template", "this", "thread_local", "throw", "true", "try", "typedef", "typeid", "typename",
+      "union", "unsigned", "using", "virtual", "void", "volatile", "wchar_t", "while", "xor", "xor_eq", "linux",
+      "unix"};
+  return words;
+}
+
+/// Why `name` cannot serve as a ROS parameter name component and a C++ identifier, if it cannot.
+std::optional<std::string> identifier_problem(std::string_view name) {
+  const auto letter = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z'); };
+  const auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  if (name.empty() || !letter(name.front())) return "must start with a letter";
+  if (!std::all_of(name.begin(), name.end(), [&](char c) { return letter(c) || digit(c) || c == '_'; })) {
+    return "may hold only letters, digits and _ (it names ROS parameters and C++ namespaces)";
+  }
+  if (name.find("__") != std::string_view::npos) return "must not contain \"__\" (reserved in C++)";
+  if (reserved_words().count(name) > 0) return "is a C++ keyword or predefined macro";
+  return std::nullopt;
+}
+
+std::vector<std::string> chosen_stations(const Design& d, const std::vector<std::string>& wanted) {
+  std::vector<std::string> out;
+  for (const std::string& w : wanted) d.require_station(w);  // throws for an unknown name
+  for (const Station& s : d.stations) {
+    if (wanted.empty() || std::find(wanted.begin(), wanted.end(), s.name) != wanted.end()) out.push_back(s.name);
+  }
+  return out;
+}
+
+const ControllerSettings& require_controller(const Design& d) {
+  if (!d.get<ControllerSettings>()) {
+    throw InputError("design '" + d.name +
+                     "' has no controller: section (loop rate, PWM, PID gains, potentiometer calibration): "
+                     "nothing to export; see designs/iros2022.yaml");
+  }
+  return *d.get<ControllerSettings>();
+}
+
+/// The branch a joint's angles are written on, one for the gate, the limits and the potentiometer
+/// map: the one holding the joint's angle at the target centre normalised to (-pi, pi]
+/// (`reference`). Without limits an angle is represented within pi of the reference; with limits
+/// the arc starts at the representative of lo at most one turn below the reference (so the arc
+/// holds the reference when the centre is within the limits), and an angle outside the arc is put
+/// next to its nearer end.
+struct Branch {
+  std::optional<JointRange> limits;
+  double reference = 0.0;
+  double lo() const { return reference - wrap_two_pi(reference - limits->lo); }
+  double hi() const { return lo() + limits->span(); }
+  double represent(double theta) const {
+    if (!limits) return reference + std::remainder(theta - reference, kTwoPi);
+    const double offset = wrap_two_pi(theta - lo());
+    const double span = limits->span();
+    if (offset <= span) return lo() + offset;
+    return (offset - span) < (kTwoPi - offset) ? lo() + offset : lo() + offset - kTwoPi;
+  }
+};
+
+/// The branches of both joints of `m` for the target `e`.
+std::array<Branch, 2> branches(const Mechanism& m, const Ellipse& e) {
+  std::array<Branch, 2> b;
+  const Pose centre = ik(m, e.center);
+  for (int j = 0; j < 2; ++j) {
+    if (m.joint_limits) b[j].limits = (*m.joint_limits)[j];
+    // An unreachable centre fails the gate anyway; the limits then start at lo in (-pi, pi].
+    b[j].reference = centre.status == Status::unreachable ? (m.joint_limits ? normalized((*m.joint_limits)[j].lo) : 0.0)
+                                                          : normalized(j == 0 ? centre.theta1 : centre.theta2);
+  }
+  return b;
+}
+
+/// Joint angles over the filled ellipse: boundary samples for the ranges, and rings for the limits.
+struct JointSamples {
+  std::array<double, 2> lo{0.0, 0.0}, hi{0.0, 0.0};
+  bool any = false;
+  std::size_t samples = 0, unreachable = 0, outside = 0;
+  double worst_excess = 0.0;  ///< rad beyond the limits
+  int worst_joint = 0;
+  double worst_theta = 0.0;   ///< on the branch
+  Vec2 worst_point{0.0, 0.0};
+  std::array<Branch, 2> branch;
+};
+
+JointSamples sample_joints(const Mechanism& m, const Ellipse& e, const ExportOptions& options) {
+  JointSamples out;
+  std::array<Branch, 2> branch = branches(m, e);
+  bool reference_set = ik(m, e.center).status != Status::unreachable;
+  const auto visit = [&](const Vec2& p) {
+    ++out.samples;
+    const Pose pose = ik(m, p);
+    if (pose.status == Status::unreachable) {
+      ++out.unreachable;
+      return;
+    }
+    if (!reference_set) {
+      branch[0].reference = normalized(pose.theta1), branch[1].reference = normalized(pose.theta2);
+      reference_set = true;
+    }
+    const std::array<double, 2> theta{branch[0].represent(pose.theta1), branch[1].represent(pose.theta2)};
+    for (int j = 0; j < 2; ++j) {
+      out.lo[j] = out.any ? std::min(out.lo[j], theta[j]) : theta[j];
+      out.hi[j] = out.any ? std::max(out.hi[j], theta[j]) : theta[j];
+      if (branch[j].limits) {
+        const double excess = std::max(branch[j].lo() - theta[j], theta[j] - branch[j].hi());
+        if (excess > out.worst_excess) {
+          out.worst_excess = excess, out.worst_joint = j, out.worst_theta = theta[j], out.worst_point = p;
+        }
+      }
+    }
+    out.any = true;
+    if (!pose.within_joint_limits) ++out.outside;
+  };
+  out.branch = branch;
+  visit(e.center);
+  const int n = std::max(8, options.boundary_samples);
+  for (int k = 0; k < n; ++k) visit(e.boundary_point(kTwoPi * k / n));
+  const int rings = std::max(1, options.coverage.rings);
+  const int angles = std::max(8, options.coverage.angles);
+  for (int i = 1; i < rings; ++i) {
+    const double s = double(i) / rings;
+    for (int k = 0; k < angles; ++k) visit(e.center + s * (e.boundary_point(kTwoPi * k / angles) - e.center));
+  }
+  return out;
+}
+
+std::string deg_range(double lo, double hi) { return "[" + fixed(lo * kDegPerRad, 2) + ", " + fixed(hi * kDegPerRad, 2) + "] deg"; }
+
+void say(const ExportOptions& o, const std::string& line) {
+  if (o.progress) o.progress(line);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Formats and names
+
+std::string_view to_string(ExportFormat format) {
+  switch (format) {
+    case ExportFormat::ros2: return "ros2";
+    case ExportFormat::json: return "json";
+    case ExportFormat::header: return "header";
+  }
+  return "ros2";
+}
+
+std::optional<ExportFormat> parse_export_format(std::string_view text) {
+  for (ExportFormat f : all_export_formats()) {
+    if (text == to_string(f)) return f;
+  }
+  return std::nullopt;
+}
+
+std::string_view file_extension(ExportFormat format) {
+  switch (format) {
+    case ExportFormat::ros2: return ".yaml";
+    case ExportFormat::json: return ".json";
+    case ExportFormat::header: return ".hpp";
+  }
+  return ".yaml";
+}
+
+std::vector<ExportFormat> all_export_formats() { return {ExportFormat::ros2, ExportFormat::json, ExportFormat::header}; }
+
+std::string joint_name(std::string_view station, std::string_view mechanism, int joint) {
+  return std::string(station) + "_" + std::string(mechanism) + "_theta" + std::to_string(joint);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Gate
+
+bool ExportGate::passed() const {
+  return std::all_of(checks.begin(), checks.end(), [](const GateCheck& c) { return c.passed; });
+}
+
+std::vector<std::string> ExportGate::reasons() const {
+  std::vector<std::string> out;
+  for (const GateCheck& c : checks) {
+    if (!c.passed) out.push_back(c.subject + " " + c.kind + ": " + c.detail);
+  }
+  return out;
+}
+
+ExportGate export_gate(const Design& d, const ExportOptions& options) {
+  const ControllerSettings& c = require_controller(d);
+  ExportGate gate;
+  gate.stations = chosen_stations(d, options.stations);
+  auto add = [&gate](std::string kind, std::string subject, bool passed, std::string detail) {
+    gate.checks.push_back(GateCheck{std::move(kind), std::move(subject), passed, std::move(detail)});
+  };
+
+  // Names: ROS parameter components and C++ namespaces in all three formats.
+  {
+    std::vector<std::string> problems;
+    if (auto p = identifier_problem(c.node)) problems.push_back("controller.node '" + c.node + "' " + *p);
+    for (const std::string& s : gate.stations) {
+      if (auto p = identifier_problem(s)) problems.push_back("station '" + s + "' " + *p);
+    }
+    std::string detail;
+    for (const auto& p : problems) detail += (detail.empty() ? "" : "; ") + p;
+    add("names", "design", problems.empty(), problems.empty() ? "node and station names are identifiers" : detail);
+  }
+
+  // Collision geometry for every station whose two tactors share the workspace.
+  bool pairs = false;
+  for (const std::string& name : gate.stations) {
+    const Station& s = *d.station(name);
+    pairs = pairs || (s.lower && s.upper);
+  }
+  if (pairs) {
+    add("geometry", "design", d.has<Geometry>(),
+        d.get<Geometry>() ? "link outlines for the controller's collision check: geometry: section"
+                   : "no geometry: section: the controller's collision check (FK of the measured joints, "
+                     "upper priority) needs the link widths, pins and planes");
+  }
+
+  for (const std::string& name : gate.stations) {
+    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/export/joint_limits.hpp)
+    say(options, "export gate: coverage of station " + name);
+    const StationCoverage sc = station_coverage(s, std::nullopt, options.coverage);
+    for (const Mechanism* m : s.mechanisms()) {
+      const std::string subject = name + "/" + m->name;
+      const CoverageResult& r = m->name == "lower" ? *sc.lower : *sc.upper;
+      add("coverage", subject, r.covered,
+          r.covered ? "covers the target, margin " + fixed(r.margin_mm, 3) + " mm (" + r.method + ")"
+                    : "does not cover the target: " + r.reason + " (margin " + fixed(r.margin_mm, 3) + " mm)");
+
+      const double threshold = std::max(c.min_lci, m->min_lci);
+      const bool lci_ok = r.min_lci >= threshold && r.min_lci > 0.0;
+      add("singularity", subject, lci_ok,
+          "min LCI over the ellipse " + fixed(r.min_lci, 4) + " at " + point_text(r.min_lci_point) +
+              (lci_ok ? " >= " : " below ") + fixed(threshold, 4) +
+              " (the larger of controller.min_lci and the mechanism's min_lci" +
+              (threshold > 0.0 ? ")" : "; a singular point has LCI 0)"));
+
+      const JointSamples js = sample_joints(*m, s.target, options);
+      for (int j = 0; j < 2; ++j) {
+        if (js.any) gate.joints.push_back(JointSweep{joint_name(name, m->name, j + 1), js.lo[j], js.hi[j]});
+      }
+      if (!m->joint_limits) {
+        add("joint_limits", subject, true, "no joint limits in the design (has_position_limits: false)");
+      } else {
+        std::string detail;
+        if (js.outside == 0) {
+          for (int j = 0; j < 2; ++j) {
+            detail += std::string(j ? "; " : "") + "theta" + std::to_string(j + 1) + " " +
+                      (js.any ? deg_range(js.lo[j], js.hi[j]) : std::string("-")) + " within " +
+                      deg_range(js.branch[j].lo(), js.branch[j].hi());
+          }
+          detail += " (" + std::to_string(js.samples - js.unreachable) + " samples)";
+        } else {
+          const int j = js.worst_joint;
+          detail = std::to_string(js.outside) + " of " + std::to_string(js.samples) +
+                   " samples outside the limits; worst: theta" + std::to_string(j + 1) + " = " +
+                   fixed(js.worst_theta * kDegPerRad, 2) + " deg at " + point_text(js.worst_point) + ", outside " +
+                   deg_range(js.branch[j].lo(), js.branch[j].hi());
+        }
+        add("joint_limits", subject, js.outside == 0, detail);
+      }
+
+      // Calibration: the joint's whole range reads within the ADC's input range.
+      {
+        bool ok = js.any || m->joint_limits.has_value();
+        std::string detail;
+        for (int j = 0; j < 2; ++j) {
+          const JointControl jc = c.joint(name, m->name, j + 1);
+          double lo = 0.0, hi = 0.0;
+          if (m->joint_limits) {
+            lo = js.branch[j].lo(), hi = js.branch[j].hi();
+          } else if (js.any) {
+            lo = js.lo[j], hi = js.hi[j];
+          } else {
+            continue;
+          }
+          const double v1 = jc.potentiometer.volts_at_zero + lo / jc.potentiometer.rad_per_volt;
+          const double v2 = jc.potentiometer.volts_at_zero + hi / jc.potentiometer.rad_per_volt;
+          const double vlo = std::min(v1, v2), vhi = std::max(v1, v2);
+          const bool in = vlo >= c.adc_range_v[0] && vhi <= c.adc_range_v[1];
+          ok = ok && in;
+          const double deg_per_count =
+              std::abs(jc.potentiometer.rad_per_volt) * (c.adc_range_v[1] - c.adc_range_v[0]) /
+              std::ldexp(1.0, c.adc_bits) * kDegPerRad;
+          detail += std::string(j ? "; " : "") + "theta" + std::to_string(j + 1) + " " + deg_range(lo, hi) +
+                    (m->joint_limits ? " (limits)" : " (over the ellipse)") + " reads [" + fixed(vlo, 3) + ", " +
+                    fixed(vhi, 3) + "] V" + (in ? "" : " OUTSIDE") + ", " + fixed(deg_per_count, 4) + " deg/count";
+        }
+        if (detail.empty()) detail = "no reachable point to calibrate for";
+        add("calibration", subject, ok,
+            detail + "; ADC range [" + fixed(c.adc_range_v[0], 3) + ", " + fixed(c.adc_range_v[1], 3) + "] V");
+      }
+    }
+    if (sc.shared) {
+      const CoverageResult& r = *sc.shared;
+      add("coverage", name + "/shared", r.covered,
+          r.covered ? "both tactors reach the whole target, margin " + fixed(r.margin_mm, 3) + " mm"
+                    : "the shared region does not cover the target: " + r.reason);
+    }
+    for (GateCheck& check : hardware_limit_checks(d, *d.station(name), options)) gate.checks.push_back(std::move(check));
+    // Robust coverage (fivebar/tolerance.hpp) when tolerance.export_gate asks for it: the target
+    // covered by tolerance.robust_fraction of printed devices (first order, at every boundary point).
+    if (const ToleranceSettings* t = d.get<ToleranceSettings>(); t != nullptr && t->export_gate) {
+      for (const Mechanism* m : s.mechanisms()) {
+        say(options, "export gate: robust coverage of " + name + "/" + m->name);
+        const ToleranceSources src = tolerance_sources(d, s, *m);
+        const RobustCoverage r = robust_coverage(*m, s.target, src.sigma, src.robust_fraction, 0, src.seed);
+        add("robust_coverage", name + "/" + m->name, r.covered,
+            fixed(100.0 * r.fraction, 1) + " % of printed devices keep a margin of " + fixed(r.robust_margin_mm, 3) +
+                " mm (design " + fixed(r.margin_mm, 3) + " mm, sigma " + fixed(r.sigma_mm, 3) + " mm at " +
+                point_text(r.robust_point) + ")" + (r.covered ? "" : ": printed devices lose the target"));
+      }
+    }
+  }
+
+  // Patterns declared for the exported stations.
+  if (!d.get<PatternSettings>()) {
+    add("pattern", "design", true, "no patterns: section: nothing to check");
+  } else {
+    for (const std::string& name : gate.stations) {
+      const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/export/joint_limits.hpp)
+      const std::vector<PatternSpec> specs = d.get<PatternSettings>()->for_station(name);
+      if (specs.empty() || !(s.lower && s.upper)) continue;  // patterns move both tactors
+      for (const PatternSpec& spec : specs) {
+        const std::string subject = name + " " + std::string(to_string(spec.kind));
+        if (!d.get<Geometry>()) {
+          add("pattern", subject, false, "not checked: the collision checks need a geometry: section");
+          continue;
+        }
+        say(options, "export gate: pattern " + subject);
+        const PatternResult r = check_pattern(s, *d.get<Geometry>(), spec, d.get<PatternSettings>()->max_joint_speed);
+        if (r.passed) {
+          add("pattern", subject, true,
+              "renderable: " + std::to_string(r.samples.size()) + " samples, peak motor speed " +
+                  fixed(r.peak_joint_speed * kDegPerRad, 1) + " deg/s (limit " +
+                  fixed(r.max_joint_speed * kDegPerRad, 1) + "), min clearance " +
+                  (std::isfinite(r.min_clearance_mm) ? fixed(r.min_clearance_mm, 3) + " mm" : std::string("-")));
+        } else {
+          add("pattern", subject, false,
+              "not renderable: at t = " + fixed(r.first_failure->time_s, 3) + " s, " + r.first_failure->reason);
+        }
+      }
+    }
+  }
+
+  // The loop: stability over the targets, tracking and saturation in the simulated patterns.
+  detail::ControlGate loop = detail::control_gate(d, gate.stations, options.progress);
+  for (GateCheck& check : loop.checks) gate.checks.push_back(std::move(check));
+  gate.validation = std::move(loop.figures);
+  return gate;
+}
+
+Json to_json(const ExportGate& gate) {
+  Json checks = Json::array();
+  for (const GateCheck& c : gate.checks) {
+    checks.push_back({{"kind", c.kind}, {"subject", c.subject}, {"passed", c.passed}, {"detail", c.detail}});
+  }
+  Json joints = Json::array();
+  for (const JointSweep& j : gate.joints) {
+    joints.push_back({{"name", j.name}, {"range_over_ellipse_deg", {j.lo * kDegPerRad, j.hi * kDegPerRad}}});
+  }
+  return {{"passed", gate.passed()},
+          {"stations", gate.stations},
+          {"reasons", gate.reasons()},
+          {"checks", checks},
+          {"joints", joints}};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hash and view
+
+Design export_view(const Design& d, const std::vector<std::string>& wanted) {
+  const std::vector<std::string> stations = chosen_stations(d, wanted);
+  const auto kept = [&](const std::string& s) { return std::find(stations.begin(), stations.end(), s) != stations.end(); };
+  Design v;
+  v.name = d.name;
+  for (const Station& s : d.stations) {
+    if (kept(s.name)) v.stations.push_back(s);
+  }
+  if (const Geometry* g = d.get<Geometry>()) v.set(*g);
+  if (const PatternSettings* p = d.get<PatternSettings>()) {
+    std::erase_if(v.set(*p).per_station, [&](const auto& e) { return !kept(e.first); });
+  }
+  if (const ControllerSettings* c = d.get<ControllerSettings>()) {
+    std::erase_if(v.set(*c).overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
+  }
+  return v;
+}
+
+std::string design_hash(const Design& d, const std::vector<std::string>& stations) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "fnv1a64:%016llx",
+                static_cast<unsigned long long>(format::fnv1a64(to_yaml(export_view(d, stations)))));
+  return buffer;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parameter tree
+
+Json controller_parameters(const Design& d, const std::vector<std::string>& wanted) {
+  const ControllerSettings& c = require_controller(d);
+  const std::vector<std::string> stations = chosen_stations(d, wanted);
+  const auto metres = [](double mm) { return mm / kMmPerMetre; };
+  const auto pair_m = [&](const Vec2& p) { return Json::array({metres(p.x()), metres(p.y())}); };
+
+  Json p = Json::object();
+  p["fivebar"] = {{"design", d.name},
+                  {"design_hash", design_hash(d, stations)},
+                  {"hash_algorithm", "fnv1a64 of the canonical design text (fivebar/export/export.hpp)"},
+                  {"tool_version", std::string(version())},
+                  {"format_version", kFormatVersion},
+                  {"units", "SI (REP 103): m, rad, s, V, Hz"}};
+  p["loop_rate_hz"] = c.loop_rate_hz;
+  p["pwm_hz"] = c.pwm_hz;
+  p["adc"] = {{"bits", c.adc_bits},
+              {"range_v", Json::array({c.adc_range_v[0], c.adc_range_v[1]})},
+              {"volts_per_count", (c.adc_range_v[1] - c.adc_range_v[0]) / std::ldexp(1.0, c.adc_bits)}};
+  p["station_names"] = stations;
+  Json joint_names = Json::array();
+  Json station_tree = Json::object();
+  Json limits = Json::object(), gains = Json::object(), pots = Json::object();
+  for (const std::string& name : stations) {
+    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/export/joint_limits.hpp)
+    Json st = Json::object();
+    st["target"] = {{"center_m", pair_m(s.target.center)},
+                    {"axes_m", pair_m(s.target.axes)},
+                    {"angle_rad", s.target.angle}};
+    Json mechanisms = Json::array();
+    for (const Mechanism* m : s.mechanisms()) mechanisms.push_back(m->name);
+    st["mechanisms"] = mechanisms;
+    for (const Mechanism* m : s.mechanisms()) {
+      const std::array<Branch, 2> branch = branches(*m, s.target);
+      Json names = Json::array();
+      for (int j = 1; j <= 2; ++j) names.push_back(joint_name(name, m->name, j));
+      Json links = Json::array();
+      for (double l : m->L) links.push_back(metres(l));
+      st[m->name] = {{"joint_names", names},
+                     {"o1_m", pair_m(m->O1)},
+                     {"o2_m", pair_m(m->O2)},
+                     {"link_lengths_m", links},
+                     {"working_mode", to_string(m->working_mode)},
+                     {"assembly_mode", to_string(m->assembly_mode)},
+                     {"min_lci", m->min_lci}};
+      for (int j = 1; j <= 2; ++j) {
+        const std::string joint = joint_name(name, m->name, j);
+        joint_names.push_back(joint);
+        Json lim = Json::object();
+        lim["has_position_limits"] = m->joint_limits.has_value();
+        if (m->joint_limits) {
+          lim["min_position"] = branch[j - 1].lo();
+          lim["max_position"] = branch[j - 1].hi();
+        }
+        lim["has_velocity_limits"] = true;
+        lim["max_velocity"] = c.max_velocity;
+        lim["has_acceleration_limits"] = false;
+        lim["has_jerk_limits"] = false;
+        lim["has_effort_limits"] = false;
+        limits[joint] = lim;
+        const JointControl jc = c.joint(name, m->name, j);
+        gains[joint] = {{"p", jc.pid.kp}, {"i", jc.pid.ki}, {"d", jc.pid.kd}, {"i_clamp", jc.pid.i_clamp}};
+        pots[joint] = {{"volts_at_zero", jc.potentiometer.volts_at_zero},
+                       {"rad_per_volt", jc.potentiometer.rad_per_volt}};
+      }
+    }
+    station_tree[name] = st;
+  }
+  p["joint_names"] = joint_names;
+  p["stations"] = station_tree;
+  Json collision = {{"priority", c.collision_priority}, {"checked", d.has<Geometry>()}};
+  if (d.get<Geometry>()) {
+    const Geometry& g = *d.get<Geometry>();
+    Json widths = Json::array(), layers = Json::array();
+    for (double w : g.link_width) widths.push_back(metres(w));
+    for (int l : g.layers) layers.push_back(l);
+    collision["min_clearance_m"] = metres(g.min_clearance);
+    collision["link_widths_m"] = widths;
+    collision["link_thickness_m"] = metres(g.link_thickness);
+    collision["layers"] = layers;
+    collision["layer_gap_m"] = metres(g.layer_gap);
+    collision["pin_diameter_m"] = metres(g.pin_diameter);
+    collision["boss_diameter_m"] = metres(g.boss_diameter);
+    collision["tactor_diameter_m"] = metres(g.tactor_diameter);
+    collision["tactor_height_m"] = metres(g.tactor_height);
+    collision["motor_shaft_diameter_m"] = metres(g.motor_shaft_diameter);
+  }
+  p["collision"] = collision;
+  p["joint_limits"] = limits;
+  p["gains"] = gains;
+  p["potentiometers"] = pots;
+
+  Json root = Json::object();
+  root[c.node] = {{"ros__parameters", p}};
+  return root;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+std::string export_stem(const Design& d, const std::vector<std::string>& stations) {
+  std::string stem = d.name + "_controller";
+  if (stations.size() == 1 && d.stations.size() > 1) stem += "_" + stations.front();
+  return stem;
+}
+
+ExportResult export_controller(const Design& d, const std::vector<ExportFormat>& formats,
+                               const std::filesystem::path& dir, const ExportOptions& options) {
+  ExportResult result;
+  result.gate = export_gate(d, options);
+  result.hash = design_hash(d, result.gate.stations);
+  if (!result.gate.passed()) return result;  // nothing created, nothing written
+
+  result.parameters = controller_parameters(d, result.gate.stations);
+  if (!result.gate.validation.empty()) {
+    result.parameters.begin().value()["ros__parameters"]["fivebar"]["validation"] = result.gate.validation;
+  }
+  // Every document in memory first: a rendering failure writes nothing.
+  std::vector<std::pair<std::filesystem::path, std::string>> documents;
+  const std::string stem = export_stem(d, result.gate.stations);
+  for (ExportFormat f : formats) {
+    documents.emplace_back(dir / (stem + std::string(file_extension(f))), render(f, result.parameters));
+  }
+  if (options.urdf && d.has<Geometry>()) {  // the links' outlines and masses (fivebar/export/urdf.hpp)
+    for (const std::string& name : result.gate.stations) {
+      const Station& s = *d.station(name);
+      documents.emplace_back(dir / urdf_file_name(d, s), render_urdf(d, s, options.urdf_options));
+    }
+  }
+  // A target that cannot be replaced (a directory of that name) fails before anything is written.
+  for (const auto& [path, text] : documents) {
+    std::error_code ec;
+    const auto status = std::filesystem::symlink_status(path, ec);
+    if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+      throw IoError(path.string() + ": exists and is not a regular file; nothing written");
+    }
+  }
+  make_directories(dir);
+  std::vector<AtomicFile> files;
+  for (const auto& [path, text] : documents) {
+    files.emplace_back(path);
+    files.back().stream() << text;
+  }
+  for (AtomicFile& f : files) {
+    f.commit();
+    result.files.push_back(f.path());
+  }
+  return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checking an exported file
+
+namespace {
+
+std::string kind_of(const Json& v) {
+  if (v.is_number_float()) return "double";
+  if (v.is_number_integer()) return "integer";
+  if (v.is_string()) return "string";
+  if (v.is_boolean()) return "bool";
+  if (v.is_array()) return "list";
+  if (v.is_object()) return "map";
+  return "null";
+}
+
+std::string shown(const Json& v) {
+  std::string s;
+  if (v.is_number_float()) {
+    s = format_double(v.get<double>());
+  } else if (v.is_array()) {
+    s = "[";
+    for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + shown(v[i]);
+    s += "]";
+  } else if (v.is_object()) {
+    s = "{...}";
+  } else {
+    s = v.dump();
+  }
+  if (s.size() > 120) s = s.substr(0, 117) + "...";
+  return s;
+}
+
+bool same(const Json& a, const Json& b) {
+  if (kind_of(a) != kind_of(b)) return false;
+  if (a.is_number_float()) {
+    const double x = a.get<double>(), y = b.get<double>();
+    return (x == y && std::signbit(x) == std::signbit(y)) || (std::isnan(x) && std::isnan(y));
+  }
+  if (a.is_number_integer()) return a.get<std::int64_t>() == b.get<std::int64_t>();
+  return a == b;
+}
+
+void diff(const Json& expected, const Json& found, const std::string& path, std::vector<ExportDifference>& out) {
+  const auto child = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
+  if (expected.is_object() && found.is_object()) {
+    for (const auto& [key, value] : expected.items()) {
+      if (!found.contains(key)) {
+        out.push_back({child(key), shown(value), "(absent)"});
+      } else {
+        diff(value, found.at(key), child(key), out);
+      }
+    }
+    for (const auto& [key, value] : found.items()) {
+      if (!expected.contains(key)) out.push_back({child(key), "(absent)", shown(value)});
+    }
+    return;
+  }
+  if (expected.is_array() && found.is_array() && expected.size() == found.size()) {
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      diff(expected[i], found[i], path + "[" + std::to_string(i) + "]", out);
+    }
+    return;
+  }
+  if (!same(expected, found)) {
+    std::string e = shown(expected), f = shown(found);
+    if (kind_of(expected) != kind_of(found)) e += " (" + kind_of(expected) + ")", f += " (" + kind_of(found) + ")";
+    out.push_back({path, e, f});
+  }
+}
+
+[[noreturn]] void not_export(const std::string& origin, const std::string& why) {
+  throw InputError(origin + ": not a fivebar controller export: " + why);
+}
+
+}  // namespace
+
+ExportCheck check_export(const std::string& text, ExportFormat format, const Design& d, const std::string& origin) {
+  const Json tree = parse_export(format, text, origin);
+  if (!tree.is_object() || tree.size() != 1) not_export(origin, "expected one top-level key, the node name");
+  const Json& node = tree.begin().value();
+  if (!node.is_object() || !node.contains("ros__parameters") || !node.at("ros__parameters").is_object()) {
+    not_export(origin, "no ros__parameters under the node '" + tree.begin().key() + "'");
+  }
+  const Json& params = node.at("ros__parameters");
+  const auto info_string = [&](const char* key) -> std::string {
+    if (!params.contains("fivebar") || !params.at("fivebar").is_object()) not_export(origin, "no fivebar: block");
+    const Json& info = params.at("fivebar");
+    if (!info.contains(key) || !info.at(key).is_string()) not_export(origin, std::string("no fivebar.") + key);
+    return info.at(key).get<std::string>();
+  };
+
+  ExportCheck check;
+  check.format = format;
+  check.file_design = info_string("design");
+  check.file_hash = info_string("design_hash");
+  check.file_tool_version = info_string("tool_version");
+  if (!params.contains("station_names") || !params.at("station_names").is_array()) not_export(origin, "no station_names");
+  std::vector<std::string> known;
+  for (const Json& s : params.at("station_names")) {
+    if (!s.is_string()) not_export(origin, "station_names must be strings");
+    check.stations.push_back(s.get<std::string>());
+    if (d.station(check.stations.back()) != nullptr) known.push_back(check.stations.back());
+  }
+  // None of the file's stations in the design: compare with every station (the differences say so).
+  const Json expected = controller_parameters(d, known);
+  check.design_hash = expected.begin().value().at("ros__parameters").at("fivebar").at("design_hash").get<std::string>();
+  // fivebar.validation holds what the gate measured, not values of the design: not compared.
+  Json found = tree;
+  found.begin().value()["ros__parameters"]["fivebar"].erase("validation");
+  diff(expected, found, "", check.differences);
+  return check;
+}
+
+ExportCheck check_export_file(const std::filesystem::path& file, const Design& d) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file.string() + ": no such exported file");
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in && !in.eof()) throw InputError(file.string() + ": cannot read the file");
+  const std::string content = text.str();
+  return check_export(content, detect_export_format(file, content), d, file.string());
+}
+
+}  // namespace fivebar

@@ -1,0 +1,97 @@
+// The `export` product: the design's `controller:` section, validated by the export gate and, when
+// it passes, written as ROS 2 parameters, JSON and a C++17 header under export/ (fivebar/export/export.hpp).
+// A refused export writes nothing and fails the product's check with every reason.
+
+#include <numbers>
+#include <string>
+
+#include "fivebar/format.hpp"
+#include "fivebar/export/export.hpp"
+#include "products/markdown.hpp"
+#include "products/product.hpp"
+
+namespace fivebar::products {
+
+namespace {
+
+using format::kDegPerRad;
+
+constexpr const char* kPreamble =
+    "The configuration of the device's ROS controller (paper Sec. II-D: an IK module per mechanism, FK of the "
+    "measured joints for collision checks with the upper mechanism's priority, a PID per motor), written only "
+    "when the export gate passes: every mechanism covers its target, the LCI over the target stays above the "
+    "threshold, the joint limits hold over the whole target, each joint's range reads within the ADC range, "
+    "the target and the patterns keep a margin inside each joint's usable range (the potentiometers' travel and "
+    "the links' hard stops: docs/urdf.md), the declared patterns are renderable and, with the motors' data, the "
+    "sampled PID loop is stable at every pose of each target and every pattern, simulated, keeps its tracking "
+    "error and saturation within `controller.max_tracking_error_mm` and `controller.max_saturation_fraction`. The "
+    "three files hold the same values (SI units); `fivebar export --check FILE DESIGN` confirms a file still "
+    "matches the design. Each station also gets a URDF with a `<ros2_control>` block (masses and meshes from the "
+    "parts' STL renders when the scene built them).\n\n";
+
+}  // namespace
+
+Product export_product() {
+  Product p;
+  p.name = "export";
+  p.title = "Controller export";
+  p.unavailable = [](const Design& d) -> std::optional<std::string> {
+    if (!d.get<ControllerSettings>()) return "the design has no `controller:` section";
+    return std::nullopt;
+  };
+  p.build = [](Context& ctx) {
+    const Design& d = ctx.design;
+    ExportOptions options;
+    options.progress = ctx.progress;
+    options.urdf = true;
+    // The URDF's masses and meshes from the parts' STL renders when the scene built them (the
+    // parts product comes first in products.def); the closed form otherwise (fivebar/export/urdf.hpp).
+    if (const Json* parts = ctx.result_of("parts")) {
+      options.urdf_options.parts = parts;
+      options.urdf_options.parts_dir = ctx.dir / "parts";
+      options.urdf_options.mesh_prefix = "../parts";
+    }
+    const ExportResult r = export_controller(d, all_export_formats(), ctx.dir / "export", options);
+    for (const auto& f : r.files) ctx.record(std::filesystem::path("export") / f.filename());
+
+    Built b;
+    std::string markdown = kPreamble;
+    markdown += "Node " + md::code(d.get<ControllerSettings>()->node) + ", design hash " + md::code(r.hash) + ".\n\n";
+    md::Table checks({"check", "subject", "verdict", "detail"}, "llcl");
+    for (const GateCheck& c : r.gate.checks) {
+      checks.row({c.kind, md::code(c.subject), c.passed ? "✓" : "✗ **failed**", c.detail});
+    }
+    markdown += checks.str() + "\n";
+    if (!r.gate.joints.empty()) {
+      md::Table joints({"joint", "angles over the target (deg)"}, "lr");
+      for (const JointSweep& j : r.gate.joints) {
+        joints.row({md::code(j.name), md::fixed(j.lo * kDegPerRad, 2) + " … " + md::fixed(j.hi * kDegPerRad, 2)});
+      }
+      markdown += joints.str() + "\n";
+    }
+    Json files = Json::array();
+    if (r.gate.passed()) {
+      markdown += "Files:";
+      for (const auto& f : r.files) {
+        const std::string rel = "export/" + f.filename().string();
+        markdown += " [" + md::code(rel) + "](" + rel + ")";
+        files.push_back(rel);
+      }
+      markdown += ".\n";
+    } else {
+      markdown += "**Export refused**: no file written.\n";
+    }
+    b.result = {{"node", d.get<ControllerSettings>()->node}, {"design_hash", r.hash}, {"exported", r.gate.passed()},
+                {"files", files}, {"gate", to_json(r.gate)}};
+    b.markdown = markdown;
+    b.passed = r.gate.passed();
+    const auto reasons = r.gate.reasons();
+    b.check = b.passed ? "gate passed (" + std::to_string(r.gate.checks.size()) + " checks); " +
+                             std::to_string(r.files.size()) + " files, hash " + r.hash
+                       : "export refused: " + std::to_string(reasons.size()) + " check(s) failed (" + reasons.front() + ")";
+    return b;
+  };
+  return p;
+}
+
+}  // namespace fivebar::products
