@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """The layering rules of docs/architecture.md ("Layers"), held against every #include of lib/ and
-cli/. Usage: check_layers.py SOURCE_DIR CORE_LAYER_TXT. Exit 0 when every rule holds, 1 with one
+cli/. Usage: check_layers.py SOURCE_DIR CORE_LAYER_TXT (or --self-test: each rule against a tree that
+breaks it). Exit 0 when every rule holds, 1 with one
 line per violation otherwise.
 
 Rules:
@@ -149,5 +150,53 @@ def main():
     return 1 if errors else 0
 
 
+def self_test():
+    """Each rule fails on a small tree that breaks it, and passes on one that does not."""
+    import subprocess
+    import tempfile
+    def tree(files, core):
+        d = tempfile.mkdtemp(prefix="check_layers.")
+        for path, text in files.items():
+            os.makedirs(os.path.join(d, os.path.dirname(path)), exist_ok=True)
+            with open(os.path.join(d, path), "w") as f:
+                f.write(text)
+        with open(os.path.join(d, "core_layer.txt"), "w") as f:
+            f.write("".join(os.path.join(d, c) + "\n" for c in core))
+        r = subprocess.run([sys.executable, __file__, d, os.path.join(d, "core_layer.txt")],
+                           capture_output=True, text=True)
+        return r.returncode, r.stdout
+    good = {
+        "lib/src/design/design.cpp": '#include "fivebar/design.hpp"\n',
+        "lib/include/fivebar/design.hpp": "#pragma once\n",
+        "lib/src/tolerance/tolerance.cpp": '#include "fivebar/design.hpp"\n',
+        "lib/src/tolerance/product.cpp": '#include "products/product.hpp"\n',
+        "lib/src/products/product.hpp": '#include "fivebar/scene.hpp"\n',
+        "lib/include/fivebar/scene.hpp": "#pragma once\n",
+        "cli/main.cpp": '#include "fivebar/scene.hpp"\n#include <CLI/CLI.hpp>\n',
+    }
+    core = ["lib/src/design/design.cpp"]
+    cases = [
+        ("clean", {}, 0, ""),
+        ("core", {"lib/src/design/design.cpp": '#include "fivebar/tolerance.hpp"\n',
+                  "lib/include/fivebar/tolerance.hpp": "#pragma once\n"}, 1, "core: "),
+        ("cli", {"lib/src/tolerance/tolerance.cpp": '#include "../../../cli/main.cpp"\n'}, 1, "cli: "),
+        ("scene", {"lib/src/tolerance/tolerance.cpp": '#include "fivebar/scene.hpp"\n'}, 1, "scene: "),
+        ("walls", {"lib/src/tolerance/tolerance.cpp": "#include <pagmo/pagmo.hpp>\n"}, 1, "walls: "),
+        ("cycles", {"lib/src/tolerance/a.hpp": '#include "tolerance/b.hpp"\n',
+                    "lib/src/tolerance/b.hpp": '#include "tolerance/a.hpp"\n'}, 1, "cycles: "),
+    ]
+    failed = 0
+    for name, change, code, prefix in cases:
+        files = dict(good)
+        files.update(change)
+        rc, out = tree(files, core)
+        ok = rc == code and (prefix == "" or any(line.startswith(prefix) for line in out.splitlines()))
+        print(("ok   " if ok else "FAIL ") + name + ": exit " + str(rc) + (" " + out.strip() if out.strip() else ""))
+        failed += 0 if ok else 1
+    return 1 if failed else 0
+
+
 if __name__ == "__main__":
+    if sys.argv[1:] == ["--self-test"]:
+        sys.exit(self_test())
     sys.exit(main())

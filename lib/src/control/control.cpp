@@ -384,11 +384,8 @@ std::string num(double v) {
   return buf;
 }
 
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+// Fixed point without a sign on zero ("-0.00" never appears in a message): fivebar/format.hpp.
+using format::fixed;
 
 std::string margin_text(double f, double cap) { return f >= cap ? ">" + fixed(cap, 0) : fixed(f, 2); }
 

@@ -3,6 +3,7 @@
 // (fivebar/dynamics.hpp).
 
 #include "export/export_control_gate.hpp"
+#include "fivebar/format.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -17,11 +18,8 @@ namespace fivebar::detail {
 
 namespace {
 
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+// Fixed point without a sign on zero ("-0.00" never appears in a message): fivebar/format.hpp.
+using format::fixed;
 
 std::string point(const Vec2& p) { return "(" + fixed(p.x(), 2) + ", " + fixed(p.y(), 2) + ") mm"; }
 
