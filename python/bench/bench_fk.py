@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Benchmarks of the Python module (docs/python.md "Speed"), figures quoted in the docs:
+
+  fk      FK of 10^6 random angle pairs on NumPy arrays (into preallocated out= arrays and into
+          new ones), to compare with the C++ batch benchmark BM_fk_batch_million
+          (build/fivebar_bench --benchmark_filter=BM_fk_batch_million);
+  sweep   a grid sweep of 201 x 201 = 40,401 designs of the showcase's sweep: section, in process,
+          against `fivebar sweep --no-plots` on the same file;
+  loop    an external optimiser's loop (random search, one design at a time, as scipy / pymoo drive
+          it) on Problem.evaluate in process, against one `fivebar optimize`-free CLI call per design
+          (`fivebar coverage DESIGN --json` on the edited design, the cheapest CLI evaluation).
+
+    PYTHONPATH=build/python /usr/bin/python3 python/bench/bench_fk.py [fk|sweep|loop ...]
+"""
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+import fivebar
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SHOWCASE = ROOT / "designs" / "iros2022.yaml"
+CLI = os.environ.get("FIVEBAR_CLI", str(ROOT / "build" / "fivebar"))
+
+
+def best_of(fn, repeat):
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return min(times)
+
+
+def bench_fk():
+    n = 1_000_000
+    rng = np.random.default_rng(1)
+    t1, t2 = rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n)
+    m = fivebar.load(SHOWCASE).station("index").lower
+    x, y, st = np.empty(n), np.empty(n), np.empty(n, np.uint8)
+    fivebar.fk(m, t1, t2, out=(x, y, st))  # warm up (pages of the outputs touched)
+    t_out = best_of(lambda: m.fk_batch(t1, t2, out=(x, y, st)), 20)
+    t_new = best_of(lambda: m.fk_batch(t1, t2), 20)
+    print(f"fk: 1e6 pairs into out= arrays {t_out * 1e3:.2f} ms ({n / t_out / 1e6:.1f} M/s); "
+          f"new arrays {t_new * 1e3:.2f} ms ({n / t_new / 1e6:.1f} M/s); ok {np.mean(st == 0):.3f}")
+
+
+def sweep_design(tmp):
+    text = SHOWCASE.read_text()
+    for old, new in (("L34: [12, 19, 29]", "L34: [12, 19, 201]"), ("L12: [6, 12, 25]", "L12: [6, 12, 201]")):
+        assert old in text, old
+        text = text.replace(old, new, 1)
+    path = pathlib.Path(tmp) / "sweep-40401.yaml"
+    path.write_text(text)
+    return path
+
+
+def bench_sweep():
+    with tempfile.TemporaryDirectory() as tmp:
+        path = sweep_design(tmp)
+        design = fivebar.load(path)
+        t0 = time.perf_counter()
+        cols = fivebar.sweep(design)
+        t_py = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        subprocess.run([CLI, "sweep", str(path), "--out", str(pathlib.Path(tmp) / "out"), "--no-plots", "--yes"],
+                       check=True, capture_output=True)
+        t_cli = time.perf_counter() - t0
+    n = len(cols["index"])
+    print(f"sweep: {n} designs from Python {t_py:.2f} s ({n / t_py:.0f}/s), CLI {t_cli:.2f} s ({n / t_cli:.0f}/s); "
+          f"covered {int(cols['covered'].sum())}")
+
+
+def bench_loop():
+    design = fivebar.load(SHOWCASE)
+    problem = fivebar.Problem(design)
+    rng = np.random.default_rng(5)
+    lo, hi = np.array(problem.lower), np.array(problem.upper)
+    n_py = 200
+    t0 = time.perf_counter()
+    best = None
+    for _ in range(n_py):  # one design at a time, as an external optimiser asks
+        x = rng.uniform(lo, hi)
+        f = problem.fitness(x)
+        best = f if best is None or f < best else best
+    t_py = (time.perf_counter() - t0) / n_py
+    n_cli = 10
+    keys = [v for v in problem.variables]
+    with tempfile.TemporaryDirectory() as tmp:
+        t0 = time.perf_counter()
+        for k in range(n_cli):
+            x = rng.uniform(lo, hi)
+            # The CLI way: write the edited design, run a command, parse its JSON.
+            try:
+                edited = problem.design_at(x)
+            except fivebar.InputError:
+                edited = design
+            path = pathlib.Path(tmp) / f"d{k}.yaml"
+            path.write_text(edited.to_yaml())
+            subprocess.run([CLI, "coverage", str(path), "--station", "index", "--json"], capture_output=True)
+        t_cli = (time.perf_counter() - t0) / n_cli
+    print(f"loop: in process {t_py * 1e3:.2f} ms per design ({len(keys)} variables, staged evaluation); "
+          f"CLI per design {t_cli * 1e3:.1f} ms; ratio {t_cli / t_py:.0f}x")
+
+
+if __name__ == "__main__":
+    which = sys.argv[1:] or ["fk", "sweep", "loop"]
+    for name in which:
+        {"fk": bench_fk, "sweep": bench_sweep, "loop": bench_loop}[name]()
