@@ -94,7 +94,7 @@ ProgressLine = Optional[Callable[[str], Any]]
 
 class Record:
     """A result of a study: its fields as attributes (NumPy arrays for fields and polylines),
-    ``fields()`` their names, ``to_dict()`` the document the CLI prints with --json."""
+    ``field_names()`` their names, ``to_dict()`` the document the CLI prints with --json."""
 
     __slots__ = ("_fields",)
 
@@ -106,15 +106,15 @@ class Record:
             return self._fields[name]
         except KeyError:
             raise AttributeError(
-                f"{type(self).__name__} has no field {name!r} (fields: {', '.join(self.fields())})") from None
+                f"{type(self).__name__} has no field {name!r} (fields: {', '.join(self.field_names())})") from None
 
     def __setattr__(self, name: str, value: Any) -> None:
         raise AttributeError(f"{type(self).__name__} is read-only")
 
     def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self.fields()))
+        return sorted(set(super().__dir__()) | set(self.field_names()))
 
-    def fields(self) -> List[str]:
+    def field_names(self) -> List[str]:
         return [k for k in self._fields if k != "summary"]
 
     def to_dict(self) -> Any:
