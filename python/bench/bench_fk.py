@@ -6,9 +6,10 @@
           (build/fivebar_bench --benchmark_filter=BM_fk_batch_million);
   sweep   a grid sweep of 201 x 201 = 40,401 designs of the showcase's sweep: section, in process,
           against `fivebar sweep --no-plots` on the same file;
-  loop    an external optimiser's loop (random search, one design at a time, as scipy / pymoo drive
-          it) on Problem.evaluate in process, against one `fivebar optimize`-free CLI call per design
-          (`fivebar coverage DESIGN --json` on the edited design, the cheapest CLI evaluation).
+  loop    an external optimiser's loop (one design at a time, as scipy / pymoo drive it) on
+          Problem.fitness in process, against one CLI call per design on the same designs (the
+          edited design written out, `fivebar coverage DESIGN --station index --json`, its JSON
+          read), and against the CLI's start-up alone (`fivebar --version`).
 
     PYTHONPATH=build/python /usr/bin/python3 python/bench/bench_fk.py [fk|sweep|loop ...]
 """
@@ -81,21 +82,18 @@ def bench_loop():
     problem = fivebar.Problem(design)
     rng = np.random.default_rng(5)
     lo, hi = np.array(problem.lower), np.array(problem.upper)
-    n_py = 200
+    n_py, n_cli = 400, 10
+    X = rng.uniform(lo, hi, size=(n_py, len(lo)))
     t0 = time.perf_counter()
     best = None
-    for _ in range(n_py):  # one design at a time, as an external optimiser asks
-        x = rng.uniform(lo, hi)
+    for x in X:  # one design at a time, as an external optimiser (scipy, pymoo) asks
         f = problem.fitness(x)
         best = f if best is None or f < best else best
     t_py = (time.perf_counter() - t0) / n_py
-    n_cli = 10
-    keys = [v for v in problem.variables]
+    verdicts = [problem.evaluate(x)["verdict"] for x in X[:n_cli]]
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        for k in range(n_cli):
-            x = rng.uniform(lo, hi)
-            # The CLI way: write the edited design, run a command, parse its JSON.
+        for k, x in enumerate(X[:n_cli]):  # the same designs, the CLI way: a file, a process, its JSON
             try:
                 edited = problem.design_at(x)
             except fivebar.InputError:
@@ -104,8 +102,14 @@ def bench_loop():
             path.write_text(edited.to_yaml())
             subprocess.run([CLI, "coverage", str(path), "--station", "index", "--json"], capture_output=True)
         t_cli = (time.perf_counter() - t0) / n_cli
-    print(f"loop: in process {t_py * 1e3:.2f} ms per design ({len(keys)} variables, staged evaluation); "
-          f"CLI per design {t_cli * 1e3:.1f} ms; ratio {t_cli / t_py:.0f}x")
+        t0 = time.perf_counter()
+        for _ in range(n_cli):  # the floor: the process doing nothing but start and print its version
+            subprocess.run([CLI, "--version"], capture_output=True)
+        t_floor = (time.perf_counter() - t0) / n_cli
+    print(f"loop: in process {t_py * 1e3:.2f} ms per design ({len(lo)} variables, staged evaluation, "
+          f"{n_py} random designs); CLI `coverage --json` per design {t_cli * 1e3:.1f} ms "
+          f"(verdicts of its first {n_cli}: {', '.join(sorted(set(verdicts)))}); ratio {t_cli / t_py:.0f}x; "
+          f"CLI start-up alone {t_floor * 1e3:.1f} ms, ratio {t_floor / t_py:.0f}x")
 
 
 if __name__ == "__main__":
