@@ -186,3 +186,9 @@ def test_tolerance_and_export_gate_equal_cli_json(showcase, tmp_path):
     assert [(c.kind, c.subject, c.passed, c.detail) for c in gate.checks] == [
         (c["kind"], c["subject"], c["passed"], c["detail"]) for c in cli["checks"]]
     assert all(c.passed for c in gate.checks) == gate.passed
+
+
+def test_io_errors_are_oserrors(showcase):
+    with pytest.raises(fivebar.IoError, match="/proc/fivebar-test") as err:
+        fivebar.optimize(showcase, evaluations=64, out_dir="/proc/fivebar-test")
+    assert isinstance(err.value, OSError)
