@@ -89,6 +89,9 @@ def test_sweep_columns_equal_the_cli_csv(tmp_path):
     calls = []
     columns = fivebar.sweep(fivebar.load(path), chunk=7, progress=lambda done, total, s: calls.append((done, total)))
     assert len(rows) == 20 and len(columns["index"]) == 20
+    # Ready for pandas.DataFrame(columns): one-dimensional arrays of one length, named as the CSV.
+    assert all(isinstance(c, np.ndarray) and c.shape == (20,) for c in columns.values())
+    assert list(columns)[: len(rows[0])] == list(rows[0].keys())
     assert calls[-1] == (20, 20) and len(calls) == 3
     names = [n for n in rows[0].keys()]
     for name in names:
@@ -121,18 +124,31 @@ def test_a_progress_callback_that_raises_stops_the_sweep(tmp_path):
     assert threading.active_count() == threads
 
 
-def test_ctrl_c_interrupts_a_long_call(showcase):
-    """SIGINT during a sweep (simulated with _thread.interrupt_main from a timer) raises
-    KeyboardInterrupt in the caller and leaves no thread running."""
-    design = showcase.with_numbers({})  # the showcase's 725-design sweep: seconds
+def test_ctrl_c_interrupts_a_long_call(tmp_path):
+    """SIGINT during a sweep (simulated with _thread.interrupt_main once the sweep has reported its
+    first chunk) raises KeyboardInterrupt in the caller and leaves no thread running."""
+    text = SHOWCASE.read_text()
+    for old, new in (("L34: [12, 19, 29]", "L34: [12, 19, 201]"), ("L12: [6, 12, 25]", "L12: [6, 12, 201]")):
+        text = text.replace(old, new, 1)
+    design = fivebar.Design.from_yaml(text)  # 40,401 designs: many seconds, stopped within one chunk
     threads = threading.active_count()
     seen = []
-    timer = threading.Timer(0.2, _thread.interrupt_main)
-    timer.start()
+    started = threading.Event()
+
+    def progress(done, total, seconds):
+        seen.append(done)
+        started.set()
+
+    def interrupt():
+        if started.wait(60):
+            _thread.interrupt_main()
+
+    interrupter = threading.Thread(target=interrupt)
+    interrupter.start()
     with pytest.raises(KeyboardInterrupt):
-        fivebar.sweep(design, chunk=16, progress=lambda done, total, s: seen.append(done))
-    timer.join()
-    assert seen and seen[-1] < 725
+        fivebar.sweep(design, chunk=64, progress=progress)
+    interrupter.join()
+    assert seen and seen[-1] < 40401
     assert threading.active_count() == threads
 
 
