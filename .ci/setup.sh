@@ -20,6 +20,9 @@ FIVEBAR_PACKAGES=(
   # validates every command's --json against docs/schemas/, headless Chromium loads the HTML report.
   liburdfdom-tools python3-jsonschema chromium
   openscad
+  # The Python module fivebar (python/): pybind11 bindings for the system python3 with NumPy, and
+  # its tests (pytest, run by ctest).
+  pybind11-dev python3-dev python3-numpy python3-pytest
   # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
   prusa-slicer unzip
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.

@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <random>
 #include <vector>
 
@@ -221,6 +222,29 @@ void BM_fk_batch(benchmark::State& state) {
   state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(kN));
 }
 BENCHMARK(BM_fk_batch);
+
+// The Python module's FK benchmark in C++ (python/bench/bench_fk.py "fk", docs/python.md "Speed"):
+// 10^6 motor-angle pairs uniform in [-pi, pi) (about half unreachable), out of cache as NumPy
+// arrays of that size are, so that the two figures compare the same work.
+void BM_fk_batch_million(benchmark::State& state) {
+  constexpr std::size_t n = 1'000'000;
+  const Mechanism m = paper_mechanism("index", "lower");
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(-std::numbers::pi, std::numbers::pi);
+  std::vector<double> t1(n), t2(n), ox(n), oy(n);
+  std::vector<Status> st(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    t1[k] = u(rng);
+    t2[k] = u(rng);
+  }
+  for (auto _ : state) {
+    fivebar::fk_batch(m, t1, t2, ox, oy, st);
+    benchmark::DoNotOptimize(ox.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(n));
+}
+BENCHMARK(BM_fk_batch_million)->Unit(benchmark::kMillisecond);
 
 // --- IK --------------------------------------------------------------------------------------------
 

@@ -1,0 +1,379 @@
+"""fivebar from Python: NumPy-native bindings of the fivebar library (docs/python.md).
+
+Units follow the library: lengths in mm, angles in radians (``numpy.deg2rad`` converts); every
+result's ``to_dict()`` gives the document the CLI prints with ``--json`` (mm and degrees).
+
+    import fivebar, numpy as np
+    design = fivebar.load("designs/iros2022.yaml")
+    lower = design.station("index").lower
+    pose = fivebar.fk(lower, np.deg2rad(100), np.deg2rad(80))          # one Pose
+    x, y, status = fivebar.fk(lower, theta1_array, theta2_array)       # arrays, GIL released
+
+Batch kernels read C-contiguous float64 arrays in place and write into ``out=`` arrays when given;
+every element has a status (``fivebar.Status`` values, uint8), never NaN. Bad input raises
+``fivebar.InputError`` (a ``ValueError``) naming the file, line and key, or ``TypeError`` /
+``ValueError`` naming the argument. Long calls take ``progress=`` callbacks and stop on Ctrl-C
+(``KeyboardInterrupt``).
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Union
+
+import numpy as np
+
+
+class InputError(ValueError):
+    """Bad input (design file, key path, argument): the library's message, which names the file,
+    line and key path ("designs/x.yaml:12: stations.index.mechanisms.lower.links[2] = -3 mm: must
+    be > 0"). ``file``, ``line`` and ``key`` are parsed from it (None when the message has none)."""
+
+    _located = re.compile(r"^(?P<file>[^\n]+?):(?P<line>\d+): (?P<rest>.*)$", re.S)
+    _keyed = re.compile(r"^(?P<key>[A-Za-z_][\w.\[\]-]*)(?: = |: )")
+    _whole_file = re.compile(r"^(?P<file>[^\s:]+\.(?:yaml|yml)|<[^>\n]+>): ")
+
+    def __init__(self, message: str = "") -> None:
+        super().__init__(message)
+        self.file: Optional[str] = None
+        self.line: Optional[int] = None
+        self.key: Optional[str] = None
+        m = self._located.match(message)
+        if m:
+            self.file, self.line = m.group("file"), int(m.group("line"))
+            k = self._keyed.match(m.group("rest"))
+            if k:
+                self.key = k.group("key")
+        else:
+            # Problems of a whole file: "x.yaml: no such design file".
+            f = self._whole_file.match(message)
+            if f:
+                self.file = f.group("file")
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        # The library's ValidationError sets rule_key (the key relative to what it validated):
+        # the key of the message, when it has one, is the fuller path.
+        if name == "rule_key" and getattr(self, "key", None) is None:
+            object.__setattr__(self, "key", value)
+        object.__setattr__(self, name, value)
+
+
+class IoError(OSError):
+    """A file could not be read or written (the library's IoError)."""
+
+
+from ._fivebar import (  # noqa: E402  (the exception types above are handed to the module)
+    CoverageResult,
+    Design,
+    Ellipse,
+    Mechanism,
+    Pose,
+    Problem,
+    Station,
+    Status,
+    _set_exception_types,
+    load,
+    version,
+)
+from . import _fivebar as _native  # noqa: E402
+
+_set_exception_types(InputError, IoError)
+
+__all__ = [
+    "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
+    "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
+    "simulate", "tolerance", "control", "export_gate", "Record",
+]
+
+ProgressLine = Optional[Callable[[str], Any]]
+
+
+# --- Results -------------------------------------------------------------------------------------
+
+
+class Record:
+    """A result of a study: its fields as attributes (NumPy arrays for fields and polylines),
+    ``field_names()`` their names, ``to_dict()`` the document the CLI prints with --json."""
+
+    __slots__ = ("_fields",)
+
+    def __init__(self, fields: Dict[str, Any]) -> None:
+        object.__setattr__(self, "_fields", dict(fields))
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return self._fields[name]
+        except KeyError:
+            raise AttributeError(
+                f"{type(self).__name__} has no field {name!r} (fields: {', '.join(self.field_names())})") from None
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError(f"{type(self).__name__} is read-only")
+
+    def __dir__(self) -> List[str]:
+        return sorted(set(super().__dir__()) | set(self.field_names()))
+
+    def field_names(self) -> List[str]:
+        return [k for k in self._fields if k != "summary"]
+
+    def to_dict(self) -> Any:
+        """The document the CLI prints for this result (mm, deg), as dicts and lists."""
+        return self._fields.get("summary")
+
+    def __repr__(self) -> str:
+        shown = []
+        for k, v in self._fields.items():
+            if k == "summary":
+                continue
+            if isinstance(v, (bool, int, float, str)) or v is None:
+                shown.append(f"{k}={v!r}")
+            elif isinstance(v, np.ndarray):
+                shown.append(f"{k}=<{v.dtype} array {v.shape}>")
+        return f"{type(self).__name__}({', '.join(shown[:8])}{', ...' if len(shown) > 8 else ''})"
+
+
+class Region(Record):
+    """An exact region: area_mm2, perimeter_mm, components, holes, bounds (xmin, ymin, xmax, ymax),
+    boundary (closed polylines, n x 2 mm arrays) and boundary_is_hole."""
+
+    __slots__ = ()
+
+
+class MechanismWorkspace(Region):
+    """One mechanism's workspace: its Region fields, mechanism, fields (2-D arrays over the
+    station's grid, row j = y: reach, status, assembly_ok, lci, type1_distance_mm, type1_sin,
+    type2_sin, transmission_deg, force_capability; read-only views, no copy), assembly_area_mm2 /
+    lci_area_mm2 with their error estimates and contours, centre (Pose at the target centre)."""
+
+    __slots__ = ()
+
+
+class Workspace(Record):
+    """A station's workspace (fivebar workspace): station, target, grid (x0, y0, spacing_mm, nx, ny
+    and the x, y coordinate arrays), mechanisms {name: MechanismWorkspace}, shared (Region or None)."""
+
+    __slots__ = ()
+
+
+class StationCoverage(Record):
+    """Coverage of a station's target: covered, lower / upper / shared (CoverageResult or None)."""
+
+    __slots__ = ()
+
+
+class Candidate(Record):
+    """One evaluated design of an optimisation: x {variable: value}, figures {figure: value},
+    verdict, status, violation, feasible."""
+
+    __slots__ = ()
+
+
+class OptimizeResult(Record):
+    """An optimisation run: front (columns: variables, figures, verdict, ...; pandas.DataFrame(front)),
+    chosen / polished / reference (Candidate), chosen_design (Design), hypervolume [(evaluations,
+    value)], files, algorithm, evaluations, rounds, seconds."""
+
+    __slots__ = ()
+
+
+class MechanismSeries(Record):
+    """One mechanism's time series (n samples at the loop rate): theta_ref, theta (rad), w (rad/s),
+    current_A, duty, voltage_V (n x 2, joints 1 and 2), P_ref_mm, P_mm, force_N (n x 2, x and y),
+    slipping, energy_J (n)."""
+
+    __slots__ = ()
+
+
+class Simulation(Record):
+    """One simulated reference (fivebar simulate): station, reference, status, reason, t (s),
+    mechanisms {name: MechanismSeries}."""
+
+    __slots__ = ()
+
+
+class ToleranceMap(Record):
+    """One mechanism's tolerance study (fivebar tolerance): grid, fields (status, three_sigma_mm,
+    worst_case_mm, resolution_um, play_mm: 2-D views), robust_covered, robust_margin_mm,
+    worst_3sigma_mm, worst_case_mm."""
+
+    __slots__ = ()
+
+
+class ControlStudy(Record):
+    """A station's loop study (fivebar control): station, stable, mechanisms {name: {grid, rho,
+    status, max_rho, stable, kp_margin, kd_margin}} (rho NaN outside the reachable region, status
+    says why)."""
+
+    __slots__ = ()
+
+
+class GateCheck(Record):
+    """One check of the export gate: kind, subject, passed, detail."""
+
+    __slots__ = ()
+
+
+class ExportGate(Record):
+    """The export gate's verdict (fivebar export): passed, stations, checks [GateCheck], reasons,
+    joints [(name, lo, hi) rad], validation (the loop checks' figures)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["passed"])
+
+
+# --- Kinematics ------------------------------------------------------------------------------------
+
+
+def _scalar(*values: Any) -> bool:
+    return all(not isinstance(v, np.ndarray) and np.ndim(v) == 0 for v in values)
+
+
+def fk(mechanism: Mechanism, theta1: Any, theta2: Any, *, branch: Optional[str] = None, out: Any = None) -> Any:
+    """Forward kinematics at motor angles (rad). Scalars -> Pose; arrays (float64, same shape) ->
+    (x, y, status) arrays (mm, mm, uint8) from the batch kernel, written into out=(x, y, status)
+    when given. branch ("+", "-", "any") for scalars only (arrays use the design's assembly mode)."""
+    if _scalar(theta1, theta2) and out is None:
+        return mechanism.fk(float(theta1), float(theta2), branch)
+    if branch is not None:
+        raise ValueError("branch: only for scalar angles (the batch kernel uses the design's assembly mode)")
+    return mechanism.fk_batch(theta1, theta2, out=out)
+
+
+def ik(mechanism: Mechanism, x: Any, y: Any, *, mode: Optional[str] = None, out: Any = None) -> Any:
+    """Inverse kinematics at tactor points (mm). Scalars -> Pose; arrays -> (theta1, theta2, status)
+    (rad, rad, uint8). mode (e.g. "+-") for scalars only."""
+    if _scalar(x, y) and out is None:
+        return mechanism.ik(float(x), float(y), mode)
+    if mode is not None:
+        raise ValueError("mode: only for scalar points (the batch kernel uses the design's working mode)")
+    return mechanism.ik_batch(x, y, out=out)
+
+
+def jacobian(mechanism: Mechanism, theta1: Any, theta2: Any) -> Any:
+    """Jacobian dP/dtheta (mm/rad) at motor angles (rad) -> (J, status): a 2x2 array and a Status
+    for scalars, J[..., 2, 2] and a uint8 array for arrays; J is zero where it does not exist."""
+    if _scalar(theta1, theta2):
+        J, status = mechanism.jacobian_batch(np.array([float(theta1)]), np.array([float(theta2)]))
+        return J[0], Status(int(status[0]))
+    return mechanism.jacobian_batch(theta1, theta2)
+
+
+def lci(mechanism: Mechanism, x: Any, y: Any, *, out: Any = None) -> Any:
+    """Local conditioning index 1/cond(J) at tactor points (mm) in the working mode -> (lci, status);
+    lci is 0 where the point is unreachable or singular."""
+    if _scalar(x, y) and out is None:
+        value, status = mechanism.lci_batch(np.array([float(x)]), np.array([float(y)]))
+        return float(value[0]), Status(int(status[0]))
+    return mechanism.lci_batch(x, y, out=out)
+
+
+# --- Studies ---------------------------------------------------------------------------------------
+
+
+def _station(subject: Union[Design, Station], station: Optional[str]) -> Station:
+    if isinstance(subject, Station):
+        if station is not None and station != subject.name:
+            raise ValueError(f"station={station!r} given with the station {subject.name!r}")
+        return subject
+    if isinstance(subject, Design):
+        if station is None:
+            with_mechanisms = [s for s in subject.stations if s.mechanisms]
+            if len(with_mechanisms) != 1:
+                raise ValueError("station: name one of " + ", ".join(s.name for s in with_mechanisms))
+            return with_mechanisms[0]
+        return subject.station(station)
+    raise TypeError(f"expected a fivebar.Design or fivebar.Station, got {type(subject).__name__}")
+
+
+def workspace(subject: Union[Design, Station], station: Optional[str] = None, *, spacing_mm: float = 0.2,
+              mechanism: str = "", progress: ProgressLine = None) -> Workspace:
+    """The workspace of a station (fivebar workspace): exact regions, fields on a grid of
+    spacing_mm, restricted areas, the shared region. progress(line) receives each stage."""
+    d = _native._workspace(_station(subject, station), spacing_mm, mechanism, progress)
+    d["mechanisms"] = {k: MechanismWorkspace(v) for k, v in d["mechanisms"].items()}
+    if d["shared"] is not None:
+        d["shared"] = Region(d["shared"])
+    return Workspace(d)
+
+
+def coverage(subject: Union[Design, Station, Mechanism], station: Optional[str] = None, *,
+             target: Optional[Ellipse] = None) -> Union[StationCoverage, CoverageResult]:
+    """Coverage of the target ellipse (fivebar coverage): for a station (or a design and a station
+    name) a StationCoverage with lower, upper and shared; for a Mechanism and a target a
+    CoverageResult. target overrides the station's ellipse."""
+    if isinstance(subject, Mechanism):
+        if target is None:
+            raise ValueError("target: a mechanism's coverage needs the target Ellipse")
+        return _native._coverage_mechanism(subject, target)
+    return StationCoverage(_native._coverage_station(_station(subject, station), target))
+
+
+def sweep(design: Design, *, threads: int = 0, chunk: int = 4096,
+          progress: Optional[Callable[[int, int, float], Any]] = None) -> Dict[str, np.ndarray]:
+    """Runs the design's sweep: section in memory (the CLI's `fivebar sweep` without files) and
+    returns its columns: index, the swept values (<name>_mm), status, covered, margins, min_lci,
+    min_force_capability, footprints, collision_fraction, robust_margin_mm (NaN where not
+    evaluated: status says why) and pareto (on the non-dominated set). pandas.DataFrame(result)
+    makes the table. threads 0: every core. progress(done, total, seconds) after each chunk."""
+    return _native._sweep(design, threads, chunk, progress)
+
+
+def optimize(design: Design, *, out_dir: Optional[str] = None, evaluations: int = 0, seconds: float = 0.0,
+             threads: int = 0, plots: bool = False, full_figures: bool = False, resume: bool = False,
+             progress: Optional[Callable[[int, int, float, int], Any]] = None) -> OptimizeResult:
+    """Runs the design's optimize: section (fivebar optimize) and returns the front as columns with
+    the chosen design. Files (front.csv, chosen.yaml, checkpoint.json, ...) go to out_dir (a
+    temporary directory, removed after, when None). evaluations / seconds override the budget.
+    progress(evaluations, budget, seconds, front_size) after each round; Ctrl-C stops after the
+    round (the checkpoint in out_dir resumes it with resume=True) and raises KeyboardInterrupt."""
+    def run(directory: str) -> OptimizeResult:
+        d = _native._optimize(design, directory, evaluations, seconds, threads, plots, full_figures, resume, progress)
+        for k in ("chosen", "polished", "reference"):
+            if d[k] is not None:
+                d[k] = Candidate(d[k])
+        return OptimizeResult(d)
+
+    if out_dir is not None:
+        return run(str(out_dir))
+    with tempfile.TemporaryDirectory(prefix="fivebar-optimize-") as directory:
+        result = run(directory)
+        return OptimizeResult({**result._fields, "files": []})
+
+
+def simulate(design: Design, *, station: str = "", pattern: Optional[str] = None, step: bool = False,
+             rtol: float = 1e-6, max_wall_s: float = 120.0, progress: ProgressLine = None) -> List[Simulation]:
+    """Simulates the station's patterns (or one pattern, or a 1 mm step) under the PID loop
+    (fivebar simulate --no-render: the links' masses from the closed form) and returns one
+    Simulation per reference with its time series as arrays."""
+    runs = _native._simulate(design, station, pattern, step, rtol, max_wall_s, progress)
+    out = []
+    for d in runs:
+        d["mechanisms"] = {k: MechanismSeries(v) for k, v in d["mechanisms"].items()}
+        out.append(Simulation(d))
+    return out
+
+
+def tolerance(design: Design, *, station: str = "", spacing_mm: float = 0.25,
+              progress: ProgressLine = None) -> List[ToleranceMap]:
+    """The tolerance study of every mechanism (fivebar tolerance --no-files): error maps over the
+    reachable region, figures at the centre and over the target, robust coverage."""
+    return [ToleranceMap(d) for d in _native._tolerance(design, station, spacing_mm, progress)]
+
+
+def control(design: Design, *, station: str = "", progress: ProgressLine = None) -> List[ControlStudy]:
+    """The loop study of every station (fivebar control --no-render): stability over the target,
+    spectral-radius fields, margins and performance."""
+    studies = []
+    for d in _native._control(design, station, progress):
+        studies.append(ControlStudy(d))
+    return studies
+
+
+def export_gate(design: Design, *, stations: Sequence[str] = (), progress: ProgressLine = None) -> ExportGate:
+    """The export gate (fivebar export's checks, nothing written): passed, every check, reasons."""
+    d = _native._export_gate(design, list(stations), progress)
+    d["checks"] = [GateCheck(c) for c in d["checks"]]
+    return ExportGate(d)
