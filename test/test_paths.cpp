@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string>
 
-namespace fivebar::testing {
+namespace fivebar_test_paths {
 namespace {
 
 namespace fs = std::filesystem;
@@ -50,4 +50,4 @@ const Paths& paths() {
 const char* source_dir() { return paths().source.c_str(); }
 const char* fivebar_binary() { return paths().binary.c_str(); }
 
-}  // namespace fivebar::testing
+}  // namespace fivebar_test_paths

@@ -4,11 +4,11 @@
 // compiler command names no checkout path and a second checkout reuses the compiler cache.
 // FIVEBAR_SOURCE_DIR and FIVEBAR_BINARY (test/CMakeLists.txt) expand to these calls.
 
-namespace fivebar::testing {
+namespace fivebar_test_paths {
 
 /// The source tree (CMAKE_HOME_DIRECTORY of the build), e.g. "/work/fivebar".
 const char* source_dir();
 /// The built command-line program, `<build>/fivebar`.
 const char* fivebar_binary();
 
-}  // namespace fivebar::testing
+}  // namespace fivebar_test_paths
