@@ -1,5 +1,5 @@
 #pragma once
-/// One way to edit a design: a number set by its key path (docs/design-file.md "Key paths"),
+/// One way to edit a design: a number set by its key path (docs/reliability.md "Key paths"),
 /// shared by the sweep, the optimiser and the tests, with the minimum-length rules in one place.
 ///
 /// A key path has one canonical spelling, the one messages print: map keys joined by '.', a name

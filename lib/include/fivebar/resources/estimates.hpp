@@ -13,7 +13,7 @@ namespace fivebar {
 
 /// Per Monte Carlo device and mechanism: the draws (kToleranceParameters doubles) and the margin
 /// held at once (88 bytes, rounded up), and the time measured for 1e8 devices of one two-mechanism
-/// station on the reference 2-core machine (8 min: issue 31), 2.4 us per device and mechanism.
+/// station on the reference 2-core machine: 8 min), 2.4 us per device and mechanism.
 inline constexpr double kToleranceBytesPerSample = 96.0;
 inline constexpr double kToleranceSecondsPerSample = 2.4e-6;
 /// The tolerance study of `stations` (every station with a mechanism when empty) with the design's
