@@ -78,6 +78,11 @@ int run_control(const ControlCliOptions& opt) {
     for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
     (void)loop_models(design, *s, none);
   }
+  // --tune needs a station with both mechanisms: refused before anything is written (issue 31).
+  std::vector<const Station*> pairs;
+  for (const Station* s : stations)
+    if (s->lower && s->upper) pairs.push_back(s);
+  if (opt.tune && pairs.empty()) throw InputError("--tune: no station with both mechanisms (the patterns move both tactors)");
   const std::filesystem::path dir = output_dir(design, opt.out, "control");
   const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   std::optional<Json> parts;
@@ -127,10 +132,6 @@ int run_control(const ControlCliOptions& opt) {
   }
   std::optional<TuneResult> tuned;
   if (opt.tune) {
-    std::vector<const Station*> pairs;
-    for (const Station* s : stations)
-      if (s->lower && s->upper) pairs.push_back(s);
-    if (pairs.empty()) throw InputError("--tune: no station with both mechanisms (the patterns move both tactors)");
     TuneOptions to = tune_options(*design.get<ControllerSettings>());
     if (opt.tune_seconds) to.max_seconds = *opt.tune_seconds;
     if (opt.tune_evaluations) to.max_evaluations = *opt.tune_evaluations;
@@ -163,7 +164,12 @@ int run_control(const ControlCliOptions& opt) {
     return kOk;
   }
   if (!stable) {
-    std::cerr << "fivebar control: the loop is unstable (max rho >= 1) somewhere on a target (see above)\n";
+    bool verdict = true;  // a map without one reachable pose has no verdict: not "unstable"
+    for (const Json& st : studies) {
+      for (const Json& m : st.value("mechanisms", Json::array())) verdict = verdict && !m.value("max_rho", Json()).is_null();
+    }
+    std::cerr << (verdict ? "fivebar control: the loop is unstable (max rho >= 1) somewhere on a target (see above)\n"
+                          : "fivebar control: no stability verdict: no pose of a target is reachable and regular (see above)\n");
     return kCheckFailed;
   }
   return kOk;

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -44,6 +46,51 @@ std::vector<std::string> join_dash_values(int argc, char** argv) {
     out.push_back(a);
   }
   return out;
+}
+
+/// Issue 31 family 3: every numeric flag of every command refuses, as bad input (exit 2), what
+/// is not a finite number of its type: `nan`, `inf`, an overflow (`1e999`), a negative or
+/// fractional value for a count or a seed (CLI11 would wrap `--seed -1` to 2^64 - 1). Numeric
+/// options are known by their value name: CLI11's FLOAT, INT and UINT, and the unit names the
+/// commands give theirs (S, N, PX, DEG, HZ, R).
+std::string numeric_flag_error(const std::string& type, const std::string& text) {
+  const bool whole = type == "UINT" || type == "INT" || type == "N";
+  const bool unsigned_only = type == "UINT" || type == "N";
+  std::string t = text;
+  while (!t.empty() && (t.front() == ' ' || t.front() == '\t')) t.erase(t.begin());
+  while (!t.empty() && (t.back() == ' ' || t.back() == '\t')) t.pop_back();
+  if (t.empty()) return "'" + text + "': not a number";
+  if (whole) {
+    const bool negative = t.front() == '-';
+    if (negative && unsigned_only) return "'" + t + "': must be a whole number >= 0";
+    const std::size_t digits = t.find_first_not_of("0123456789", (negative || t.front() == '+') ? 1 : 0);
+    if (digits != std::string::npos || t.size() == ((negative || t.front() == '+') ? 1u : 0u)) {
+      return "'" + t + "': must be a whole number";
+    }
+    errno = 0;
+    char* end = nullptr;
+    if (negative) (void)std::strtoll(t.c_str(), &end, 10);
+    else (void)std::strtoull(t.c_str(), &end, 10);
+    if (errno == ERANGE) return "'" + t + "': too large";
+    return "";
+  }
+  errno = 0;
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  if (end == t.c_str() || *end != '\0') return "'" + t + "': not a number";
+  if (!std::isfinite(v) || (errno == ERANGE && std::fabs(v) > 1.0)) return "'" + t + "': must be a finite number";
+  return "";
+}
+
+void guard_numeric_flags(CLI::App& app) {
+  static const std::set<std::string> numeric{"FLOAT", "INT", "UINT", "S", "N", "PX", "DEG", "HZ", "R"};
+  for (CLI::Option* option : app.get_options()) {
+    std::string type = option->get_type_name();  // "INT" or "INT:<a validator's description>"
+    type = type.substr(0, type.find(':'));
+    if (numeric.count(type) == 0 || option->get_type_size() != 1) continue;
+    option->check(CLI::Validator([type](std::string& value) { return numeric_flag_error(type, value); }, "", "finite"));
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) guard_numeric_flags(*sub);
 }
 
 }  // namespace
@@ -103,6 +150,7 @@ int run(int argc, char** argv) {
   setup_tolerance(app);
   setup_animate(app);
   setup_control(app);
+  guard_numeric_flags(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -58,7 +58,7 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
     design.set(s);
   }
   if (o.evaluations > std::uint64_t(1e9)) throw InputError("--evaluations: must be 1 ... 1e9");
-  if (o.seconds < 0.0 || o.seconds > 1e7) throw InputError("--seconds: must be > 0 and <= 1e7");
+  if (!(o.seconds >= 0.0 && o.seconds <= 1e7)) throw InputError("--seconds: must be > 0 and <= 1e7");
   OptimizeOptions options;
   options.out_dir = o.out.empty() ? std::filesystem::path("outputs") / design.name / "optimize" : std::filesystem::path(o.out);
   const WriteFence fence(options.out_dir);

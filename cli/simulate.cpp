@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "common.hpp"
+#include "fivebar/resources/estimates.hpp"
 #include "fivebar/dynamics.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
@@ -31,6 +32,7 @@ struct SimulateOptions {
   std::string integrator = "bdf";
   std::string pwm = "averaged";
   std::optional<double> dense_dt_s;
+  bool yes = false;  ///< run beyond the resource bounds (docs/reliability.md)
   double max_wall_s = 120.0;
   std::string out;
   bool json = false;
@@ -80,6 +82,7 @@ int run_simulate(const SimulateOptions& opt) {
   }
   require_geometry(design);
   // Missing sections are bad input before anything is written.
+  std::vector<SimulationInput> planned;
   for (const Station* s : stations) {
     SimulationRequest probe;
     probe.station = s->name;
@@ -88,7 +91,12 @@ int run_simulate(const SimulateOptions& opt) {
     probe.chirp = opt.chirp;
     std::map<std::string, MechanismInertia> none;
     for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
-    (void)simulation_inputs(design, probe, none);
+    for (SimulationInput& in : simulation_inputs(design, probe, none)) planned.push_back(std::move(in));
+  }
+  // The dense output's size, estimated from the request before anything is written (the one
+  // resource rule, fivebar/resources/budget.hpp).
+  if (opt.dense_dt_s) {
+    check_budget(dense_output_estimate(planned, *opt.dense_dt_s), opt.yes, "confirm with --yes, or give a coarser --dense");
   }
 
   const std::filesystem::path dir = output_dir(design, opt.out, "simulate");
@@ -137,8 +145,11 @@ int run_simulate(const SimulateOptions& opt) {
     for (const SimulationInput& in : simulation_inputs(design, request, inertia)) {
       if (!in.unusable.empty()) {
         all_ok = false;
+        // Every field a run record has (docs/schemas/simulate.schema.json), null for what does not exist.
         runs.push_back({{"station", s->name}, {"reference", in.reference_name}, {"status", "not_simulated"},
-                        {"reason", in.unusable}});
+                        {"reason", in.unusable}, {"t_end_s", nullptr}, {"steps", 0}, {"rhs_evaluations", 0},
+                        {"restarts", 0}, {"wall_s", 0.0}, {"samples", 0}, {"mechanisms", Json::array()},
+                        {"csv", nullptr}});
         if (!opt.json) std::cout << s->name << "  " << in.reference_name << ": not simulated, " << in.unusable << "\n";
         continue;
       }
@@ -180,9 +191,10 @@ int run_simulate(const SimulateOptions& opt) {
         const std::string title = "Frequency response at the target centre, station " + s->name;
         write_file_atomic(dir / (stem + ".svg"), bode_svg(bode, title));
         write_file_atomic(dir / (stem + ".png"), bode_png(bode, title));
-        Json bw = Json::object();
+        Json bw = Json::array();  // records, not an object keyed by the mechanisms' names
         for (std::size_t m = 0; m < bode.mechanisms.size(); ++m) {
-          bw[bode.mechanisms[m]] = bode.bandwidth_hz[m] ? Json(*bode.bandwidth_hz[m]) : Json(nullptr);
+          bw.push_back({{"mechanism", bode.mechanisms[m]},
+                        {"bandwidth_hz", bode.bandwidth_hz[m] ? Json(*bode.bandwidth_hz[m]) : Json(nullptr)}});
           if (!opt.json) {
             std::cout << "  " << bode.mechanisms[m] << ": -3 dB bandwidth "
                       << (bode.bandwidth_hz[m] ? fixed(*bode.bandwidth_hz[m], 2) + " Hz"
@@ -193,7 +205,7 @@ int run_simulate(const SimulateOptions& opt) {
           }
         }
         for (const char* ext : {".csv", ".svg", ".png"}) files.push_back((dir / (stem + ext)).generic_string());
-        runs.back()["bandwidth_hz"] = bw;
+        runs.back()["bandwidth"] = bw;
         runs.back()["bode_csv"] = (dir / (stem + ".csv")).generic_string();
         if (!opt.json) std::cout << "  Bode magnitude: " << (dir / (stem + ".csv")).generic_string() << ", .svg, .png\n";
       }
@@ -254,6 +266,7 @@ void setup_simulate(CLI::App& app) {
                   "averaged (V = duty x supply; the default) or switched (the 1 kHz sign-magnitude waveform, every "
                   "edge a stop time)")
       ->type_name("MODEL");
+  sub->add_flag("--yes", opt->yes, "Write a dense output estimated at over a gigabyte or an hour (refused otherwise)");
   sub->add_option("--dense", opt->dense_dt_s,
                   "Also write <station>-<reference>-dense.csv: the integrator's dense output every S seconds")
       ->type_name("S");

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "fivebar/resources/estimates.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/sections/tolerance.hpp"
@@ -29,6 +30,7 @@ struct ToleranceCliOptions {
   bool no_files = false;
   bool devices = false;
   bool json = false;
+  bool yes = false;  ///< run beyond the resource bounds (docs/reliability.md)
 };
 
 std::string point(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ")"; }
@@ -43,11 +45,15 @@ void print_mechanism(const ToleranceMap& r) {
               << " mm, resolution " << fixed(r.centre.resolution_um, 3) << " um per count, play "
               << fixed(r.centre_play.extent_mm, 4) << " mm\n";
   }
+  if (r.target_not_ok >= r.target_points) {  // nothing to report: no 0 mm at (0, 0) (issue 31)
+    std::cout << "    over the target (" << r.target_points << " points): no point is reachable and regular (no estimate)";
+  } else {
   std::cout << "    over the target (" << r.target_points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)
             << " mm at " << point(r.worst_3sigma_at) << ", worst case up to " << fixed(r.worst_case_mm, 4) << " mm at "
             << point(r.worst_case_at) << ", resolution up to " << fixed(r.worst_resolution_um, 3)
             << " um per count, play up to " << fixed(r.worst_play_mm, 4) << " mm at " << point(r.worst_play_at);
   if (r.target_not_ok > 0) std::cout << "; " << r.target_not_ok << " points unreachable or singular (no estimate)";
+  }
   std::cout << "\n";
   const RobustCoverage& c = r.robust;
   std::cout << "    robust coverage: margin " << fixed(c.margin_mm, 4) << " mm, sigma " << fixed(c.sigma_mm, 4)
@@ -65,6 +71,9 @@ int run_tolerance(const ToleranceCliOptions& opt) {
   if (!(opt.spacing_mm > 0.0) || !std::isfinite(opt.spacing_mm)) throw InputError("--spacing must be > 0 mm");
   const ToleranceSettings* given = design.get<ToleranceSettings>();
   const ToleranceSettings t = given ? *given : ToleranceSettings{};
+  // The Monte Carlo's cost, estimated from tolerance.samples before anything runs (the one
+  // resource rule, fivebar/resources/budget.hpp).
+  check_budget(tolerance_estimate(design, stations), opt.yes, "confirm with --yes, or lower tolerance.samples");
   const auto progress = terminal_progress("tolerance");
 
   // Analyse everything before writing anything.
@@ -166,6 +175,7 @@ void setup_tolerance(CLI::App& app) {
                 "parameter errors, tactor error at the target centre, the device's own coverage margin)")
       ->excludes("--no-files");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
+  sub->add_flag("--yes", opt->yes, "Run a Monte Carlo estimated at over an hour or two gigabytes of memory (refused otherwise)");
   sub->footer(
       "Tolerances come from the design's tolerance: section (docs/design-file.md), else from its defaults, which are "
       "assumptions.\nFiles: <station>-<mechanism>-tolerance.vti (ParaView: three_sigma_mm, worst_case_mm, resolution_um, "

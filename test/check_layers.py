@@ -27,6 +27,7 @@ CORE_HEADERS = [
     "lib/include/fivebar/kinematics.hpp", "lib/include/fivebar/detail/*.hpp",
     "lib/include/fivebar/workspace/region.hpp", "lib/include/fivebar/workspace/polyline.hpp",
     "lib/include/fivebar/coverage/coverage.hpp", "lib/include/fivebar/sections/*.hpp",
+    "lib/include/fivebar/design/*.hpp", "lib/include/fivebar/resources/budget.hpp",
     "lib/src/design/*.hpp", "lib/src/kinematics/*.hpp", "lib/src/sections/*.hpp", "lib/src/sections/*.def",
     "lib/src/cgal/exact_region.hpp",
 ]

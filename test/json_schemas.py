@@ -58,12 +58,32 @@ def keyed_by_station(node, path="$"):
     return found
 
 
+MECHANISMS = {"lower", "upper"}  # mechanism names: never the keys of an object either
+
+
+def keyed_by_name(node, path="$"):
+    """Paths of objects whose keys are all station or mechanism names (a map keyed by name, e.g.
+    {"lower": 10.5, "upper": 11.2}): the conventions want a list of records instead."""
+    found = []
+    if isinstance(node, dict):
+        if node and set(node) <= (STATIONS | MECHANISMS):
+            found.append(path)
+        for k, v in node.items():
+            found += keyed_by_name(v, f"{path}.{k}")
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            found += keyed_by_name(v, f"{path}[{i}]")
+    return found
+
+
 def check(label, schema, doc):
     errors = sorted(validator(schema).iter_errors(doc), key=lambda e: list(e.absolute_path))
     for e in errors[:10]:
         failures.append(f"{label}: {'/'.join(map(str, e.absolute_path)) or '(root)'}: {e.message[:300]}")
     for p in keyed_by_station(doc):
         failures.append(f"{label}: {p}: an object keyed by a station name (list station records instead)")
+    for p in keyed_by_name(doc):
+        failures.append(f"{label}: {p}: an object keyed by station or mechanism names (list records instead)")
     if not errors:
         print(f"ok    {label}  ({schema}.schema.json)")
 
@@ -133,6 +153,52 @@ def main():
     run("control --tune", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--tune",
                                       "--tune-evaluations", "2", "--out", out + "/tune"], (0, 1))
     run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/twist.svg"])
+    # Issue 31 family 5: the hostile and partial shapes validate too, and keep the conventions.
+    if keyed_by_name({"a": {"lower": 1.0, "upper": None}}) != ["$.a"] or keyed_by_name({"lower": 1, "x": 2}):
+        failures.append("self-test: the name-key walk is wrong")
+    showcase = pathlib.Path(DESIGN).read_text()
+
+    def variant(name, old, new):
+        assert old in showcase, old
+        path = WORK / name
+        path.write_text(showcase.replace(old, new, 1))
+        return str(path)
+
+    chirp = run("simulate --chirp", "simulate", ["simulate", DESIGN, "-s", "index", "--chirp", "--no-render", "--out", out + "/chirp"],
+                (0, 1))
+    if chirp is not None and not any("bandwidth" in r for r in chirp["runs"]):
+        failures.append("simulate --chirp: no run carries its bandwidth records")
+    far = variant("far.yaml", "amplitude_mm: 3             # each tactor", "amplitude_mm: 40            # each tactor")
+    sim = run("simulate, not simulated", "simulate", ["simulate", far, "-s", "index", "--pattern", "stretch", "--no-render",
+                                                      "--out", out + "/far"], (0, 1, 2))
+    if sim is not None and not any(r["status"] == "not_simulated" for r in sim["runs"]):
+        print("note  simulate, not simulated: the pattern ran (no not_simulated record to check)")
+    unreachable = variant("unreachable.yaml", "target: {center: [6.25, 15.5], axes: [15, 12], angle: 0}",
+                          "target: {center: [6.25, 95.5], axes: [15, 12], angle: 0}")
+    ctl = run("control, unreachable target", "control", ["control", unreachable, "-s", "index", "--grid", "5", "--field", "5",
+                                                         "--out", out + "/ctl-far"], (1,))
+    if ctl is not None:
+        for st in ctl["stations"]:
+            for m in st["mechanisms"]:
+                if m["max_rho"] is not None:
+                    failures.append(f"control, unreachable target: {m['mechanism']}: max_rho {m['max_rho']} where none exists (null)")
+            for m in st["performance"]:
+                if m["target_renderable"]:
+                    failures.append(f"control, unreachable target: {m['mechanism']}: renderable without a reachable pose")
+    tol = run("tolerance, unreachable target", "tolerance", ["tolerance", unreachable, "-s", "index", "--no-files"], (0, 1))
+    if tol is not None:
+        for st in tol["stations"]:
+            for m in st["mechanisms"]:
+                if m["target_points_not_ok"] >= m["target_points"] and m["target_worst_3sigma_at_mm"] is not None:
+                    failures.append(f"tolerance, unreachable target: {m['mechanism']}: a worst point where none exists (null)")
+    exported = run("export for --check", "export", ["export", DESIGN, "--out", out + "/export-check"])
+    if exported is not None:
+        yaml = [f for f in exported["files"] if f.endswith(".yaml")]
+        if yaml:
+            run("export --check", "export", ["export", "--check", yaml[0], DESIGN])
+        else:
+            failures.append("export: no parameters file to --check")
+
     doc = run("run", "run", ["run", DESIGN, "-q", "--out", out + "/run", "-P",
                              "kinematics,workspace,coverage,collision,pattern,export"])
     if doc is not None:

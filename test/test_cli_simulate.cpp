@@ -146,9 +146,18 @@ TEST_F(CliSimulate, ChirpGivesTheBodeMagnitudeAndBandwidth) {
   const json& run0 = doc["runs"][0];
   EXPECT_EQ(run0["reference"], "chirp");
   ASSERT_EQ(run0["status"], "ok");
+  // One record per mechanism (issue 31 family 5: never an object keyed by the mechanisms' names).
+  ASSERT_TRUE(run0["bandwidth"].is_array());
+  ASSERT_EQ(run0["bandwidth"].size(), 2u);
+  EXPECT_FALSE(run0.contains("bandwidth_hz"));
   for (const char* m : {"lower", "upper"}) {
-    ASSERT_TRUE(run0["bandwidth_hz"][m].is_number()) << m;
-    const double bw = run0["bandwidth_hz"][m].get<double>();
+    const json* rec = nullptr;
+    for (const json& b : run0["bandwidth"]) {
+      if (b["mechanism"] == m) rec = &b;
+    }
+    ASSERT_NE(rec, nullptr) << m;
+    ASSERT_TRUE((*rec)["bandwidth_hz"].is_number()) << m;
+    const double bw = (*rec)["bandwidth_hz"].get<double>();
     EXPECT_GT(bw, 0.62);  // within the estimated band
     EXPECT_LT(bw, 20.0);
   }

@@ -310,6 +310,27 @@ TEST(Control, TheKdMarginBoundsTheDerivativeGainBothWays) {
   if (bad.status == SimStatus::ok) EXPECT_GT(bad.late, 2.0 * bad.initial);
 }
 
+TEST(ControlTune, TheTimeBoundIsCheckedInsideTheEvaluations) {
+  // Issue 31 family 2: --tune-seconds 0.5 took 3.8-8 s: each mechanism got at least 0.5 s of
+  // COBYLA, and the tracking before and after ran outside the bound. Now the bound is checked
+  // before every evaluation and between the pattern runs of one: a bound already spent allows no
+  // evaluation, whatever the evaluation count allows, and the result says the time limit stopped it.
+  const Design& d = paper();
+  const Station& index = d.require_station("index");
+  TuneOptions o;
+  o.max_evaluations = 1000;
+  o.max_seconds = 1e-9;
+  std::map<std::string, std::map<std::string, MechanismInertia>> inertia{{"index", paper_inertia("index")}};
+  const TuneResult r = tune_controller(d, {&index}, inertia, o);
+  ASSERT_EQ(r.mechanisms.size(), 2u);
+  for (const TunedMechanism& t : r.mechanisms) {
+    SCOPED_TRACE(t.mechanism);
+    EXPECT_EQ(t.evaluations, 0);
+    EXPECT_EQ(t.stop, "time limit");
+    EXPECT_FALSE(t.feasible);  // nothing measured: no claim
+  }
+}
+
 TEST(ControlTune, DeterministicWithinTheConstraintAndItsPatchReadsBackAsTheTunedGains) {
   const Design& d = paper();
   const Station& index = d.require_station("index");

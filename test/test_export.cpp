@@ -18,6 +18,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -285,6 +286,37 @@ TEST(Formats, RosYamlReadByYamlCppEqualsTheDesign) {
   // Our own reader gives the same tree, kinds included.
   const Json back = parse_export(ExportFormat::ros2, text, "<yaml>");
   EXPECT_EQ(back, tree);
+}
+
+TEST(Formats, RosYamlKeysAreStringsInYaml11) {
+  // Issue 31 family 6: a station named `on`, `yes` or `off` became a YAML 1.1 boolean key of the
+  // ROS 2 parameters file (ROS 2's parser is YAML 1.1). Reference: the YAML 1.1 type regexps
+  // (yaml.org/type/bool.html, null.html, int.html, float.html): no unquoted key may match them.
+  Design d = paper();
+  d.stations[0].name = "on";
+  d.stations[1].name = "Yes";
+  const std::string text = render_ros2_yaml(controller_parameters(d, {}));
+  static const std::regex yaml11(
+      "y|Y|yes|Yes|YES|n|N|no|No|NO|true|True|TRUE|false|False|FALSE|on|On|ON|off|Off|OFF|~|null|Null|NULL|"
+      "[-+]?[0-9][0-9_.eE+-]*|[-+]?\\.(inf|Inf|INF|nan|NaN|NAN)");
+  std::istringstream lines(text);
+  std::string line;
+  int quoted = 0;
+  while (std::getline(lines, line)) {
+    if (line.starts_with("#")) continue;
+    const auto first = line.find_first_not_of(' ');
+    const auto colon = line.find(':', first);
+    if (first == std::string::npos || colon == std::string::npos) continue;
+    const std::string key = line.substr(first, colon - first);
+    EXPECT_FALSE(std::regex_match(key, yaml11)) << "unquoted YAML 1.1 non-string key: " << line;
+    if (key == "\"on\"" || key == "\"Yes\"") ++quoted;
+  }
+  EXPECT_GE(quoted, 2);
+  // Read back, the keys are the station names.
+  const Json back = parse_export(ExportFormat::ros2, text, "<yaml>");
+  const Json& stations = back["fivebar_controller"]["ros__parameters"]["stations"];
+  EXPECT_TRUE(stations.contains("on"));
+  EXPECT_TRUE(stations.contains("Yes"));
 }
 
 TEST(Formats, EveryDoubleLineOfTheYamlHasAPointOrExponent) {

@@ -380,6 +380,70 @@ std::vector<Case> cases() {
   c.push_back({"OptimizeShardAndMerge", sub({"optimize"}, {"--shard", "0/2", "--merge", "2"}), {both}, {"no optimize: section"}});
   c.push_back({"SweepRandomWithoutCount", sub({"sweep"}, {"-s", "index", "--vary", "L1=8:10:3", "--sample", "random"}), {both},
                {"sweep.count", "required for random sampling"}});
+  // --- Issue 31: budgets, key paths, validation before writing, identity, schemas --------------
+  // The showcase design (every section), changed by one edit.
+  const std::string show = ft::slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/iros2022.yaml");
+  const auto show_with = [&](const std::string& from, const std::string& to) {
+    std::string t = show;
+    const auto at = t.find(from);
+    if (at == std::string::npos) throw std::logic_error("the showcase has no '" + from + "'");
+    t.replace(at, from.size(), to);
+    return t;
+  };
+  const Input showcase = text("show.yaml", show);
+  // Family 1: two spellings of one number are one key; 1,200 spellings are refused at once.
+  {
+    const std::string opt = "optimize:\n  variables:\n    a: {key: \"" + L + "links[2]\", range: [12, 18]}\n";
+    c.push_back(design_case("OptimizeOneNumberSpelledTwice",
+                            kGood + opt + "    b: {key: \"stations['index'].mechanisms.lower.links[02]\", range: [12, 18]}\n"
+                                          "  objectives: [margin]\n",
+                            {"bad.yaml:", "optimize.variables.b.key", "already set by optimize.variables.a.key"}));
+    std::string keys;
+    for (int k = 0; k < 1200; ++k) keys += std::string(k ? ", " : "") + "\"" + L + "links[" + std::string(std::size_t(k), '0') + "2]\"";
+    c.push_back(design_case("OptimizeTwelveHundredSpellingsOfOneKey",
+                            kGood + "optimize:\n  variables:\n    a: {keys: [" + keys + "], range: [12, 18]}\n  objectives: [margin]\n",
+                            {"bad.yaml:", "optimize.variables.a.keys[1]", "already set by optimize.variables.a.keys[0]"}));
+  }
+  // Family 2: budgets estimated before anything starts, refused beyond the bounds without --yes.
+  c.push_back({"ToleranceSamplesHundredMillion", {"tolerance", "t.yaml", "--out", "out"},
+               {text("t.yaml", kGood + kUpper + "tolerance: {samples: 100000000}\n")},
+               {"tolerance.samples = 100000000", "is large", "GB of memory", "--yes"}});
+  c.push_back({"SimulateDenseOverATenMinutePattern",
+               {"simulate", "show.yaml", "-s", "index", "--pattern", "stretch", "--dense", "1e-5", "--no-render", "--out", "out"},
+               {text("show.yaml", show_with("    duration_s: 1\n    separation_mm: 8            # vertical",
+                                            "    duration_s: 600\n    separation_mm: 8            # vertical"))},
+               {"dense output", "is large", "GB of files", "--yes"}});
+  c.push_back({"AnimateSimulatedDevZero",
+               {"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg", "--simulated", "/dev/zero"},
+               {showcase}, {"/dev/zero:1:", "line longer than 4096 bytes"}});
+  // Family 3: bad input refused before the first byte is written; numeric flags are numbers.
+  c.push_back({"AnimateSimulatedCoordinateOf1e300",
+               {"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg", "--simulated", "sim.csv"},
+               {showcase, text("sim.csv", "t_s,mechanism,x_mm,y_mm\n0,lower,6.25,15.5\n0.01,lower,1e300,15.5\n")},
+               {"sim.csv:3:", "x_mm = 1e+300 mm", "within [-1e12, 1e12]"}});
+  c.push_back({"ControlTuneWithoutATwoMechanismStation", {"control", "solo.yaml", "-s", "solo", "--tune", "--out", "out"},
+               {text("solo.yaml", show_with("stations:\n", "stations:\n  solo:\n"
+                                                            "    target: {center: [6.25, 15.5], axes: [15, 12], angle: 0}\n"
+                                                            "    mechanisms:\n      lower: {bases: [[0, 0], [12.5, 0]], "
+                                                            "links: [9, 9, 15, 15], working_mode: \"-+\", assembly_mode: \"+\"}\n"))},
+               {"--tune: no station with both mechanisms"}});
+  c.push_back({"OptimizeSecondsNaN", {"optimize", "show.yaml", "--seconds", "nan", "--out", "out"}, {showcase},
+               {"--seconds: 'nan'", "finite"}});
+  c.push_back({"OptimizeSecondsInfinite", {"optimize", "show.yaml", "--seconds", "inf", "--out", "out"}, {showcase},
+               {"--seconds: 'inf'", "finite"}});
+  c.push_back({"OptimizeSeedNegative", {"optimize", "show.yaml", "--seed=-1", "--out", "out"}, {showcase},
+               {"--seed: '-1'", "whole number >= 0"}});
+  c.push_back({"OptimizeEvaluationsOverflow", {"optimize", "show.yaml", "--evaluations", "99999999999999999999999", "--out", "out"},
+               {showcase}, {"--evaluations: '99999999999999999999999'", "too large"}});
+  c.push_back({"OptimizeSeedFraction", {"optimize", "show.yaml", "--seed", "1.5", "--out", "out"}, {showcase},
+               {"--seed: '1.5'", "whole number"}});
+  c.push_back({"WorkspaceSpacingOverflow", sub({"workspace"}, {"--spacing", "1e999"}), {both},
+               {"--spacing = inf", "finite"}});
+  c.push_back({"OptimizeResumeWithoutCheckpoint", {"optimize", "show.yaml", "--resume", "--out", "out"}, {showcase},
+               {"checkpoint.json: no checkpoint to resume from"}});
+  c.push_back({"ExportCheckNumberBeyondADouble", {"export", "--check", "f.json", "show.yaml"},
+               {showcase, text("f.json", "{\"fivebar_controller\": {\"ros__parameters\": {\"x\": 1e999}}}\n")},
+               {"f.json", "not a file fivebar exports"}});
   return c;
 }
 

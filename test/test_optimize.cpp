@@ -2,11 +2,15 @@
 // sweep's own evaluation, the penalty order, fronts against brute force, the hypervolume against
 // closed forms, determinism over threads, resume equal to an uninterrupted run, shards, the polish,
 // the chosen design file, and the front of the sweep's two-variable problem against its grid.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
+
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "fivebar/optimize.hpp"
@@ -469,6 +473,94 @@ TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   std::printf("eight variables, %llu candidates: hypervolume %.4f (search) against %.4f (Sobol)\n",
               (unsigned long long)r.evaluations, hv_opt, hv_sobol);
   EXPECT_GT(hv_opt, hv_sobol);
+}
+
+/// Issue 31 family 4: shard, checkpoint and merge files state what they are and every reader
+/// checks it before use (InputError naming the file and the mismatch; the CLI's exit 2).
+std::string what_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+TEST(OptimizeIdentity, MergeRefusesAShardFileThatIsNotTheShardItIsNamedFor) {
+  const Design d = with(two_variable({{"margin", true}, {"footprint", false}}));
+  ScratchDir dir("fivebar_test_optimize_identity_merge");
+  OptimizeOptions o;
+  o.plots = false;
+  o.out_dir = dir.path();
+  o.shard = 0;
+  o.shards = 2;
+  (void)run_optimize(d, o);
+  const fs::path zero = dir.path() / "front.shard-0-of-2.json", one = dir.path() / "front.shard-1-of-2.json";
+  // A copy of shard 0 saved as shard 1: it counted shard 0 twice (exit 0) before.
+  fs::copy_file(zero, one);
+  o.shards = 1;
+  EXPECT_THAT(what_of([&] { (void)merge_optimize_shards(d, o, 2); }),
+              ::testing::AllOf(::testing::HasSubstr(one.string()), ::testing::HasSubstr("holds shard 0 of 2, not shard 1 of 2")));
+  // An interrupted shard: one consistent message (finish it with --resume, then merge).
+  nlohmann::json j = nlohmann::json::parse(slurp(zero));
+  j["shard"] = 1;
+  j["interrupted"] = true;
+  std::ofstream(one, std::ios::trunc) << j.dump();
+  EXPECT_THAT(what_of([&] { (void)merge_optimize_shards(d, o, 2); }),
+              ::testing::AllOf(::testing::HasSubstr("was interrupted"), ::testing::HasSubstr("--resume), then merge")));
+  // A shard whose candidate count disagrees with what it holds.
+  j["interrupted"] = false;
+  j["candidate_count"] = j["candidates"].size() + 1;
+  std::ofstream(one, std::ios::trunc) << j.dump();
+  EXPECT_THAT(what_of([&] { (void)merge_optimize_shards(d, o, 2); }), ::testing::HasSubstr("candidates but holds"));
+}
+
+TEST(OptimizeIdentity, ResumeChecksTheCheckpointsShapesBeforeUse) {
+  const Design d = with(two_variable({{"margin", true}, {"footprint", false}}));
+  ScratchDir dir("fivebar_test_optimize_identity_resume");
+  OptimizeOptions o;
+  o.plots = false;
+  o.out_dir = dir.path() / "run";
+  (void)run_optimize(d, o);
+  const fs::path cp = o.out_dir / "checkpoint.json";
+  ASSERT_TRUE(fs::exists(cp));
+  const nlohmann::json good = nlohmann::json::parse(slurp(cp));
+  o.resume = true;
+  auto resumed_with = [&](const std::function<void(nlohmann::json&)>& edit) {
+    nlohmann::json j = good;
+    edit(j);
+    std::ofstream(cp, std::ios::trunc) << j.dump();
+    return what_of([&] { (void)run_optimize(d, o); });
+  };
+  // A short fitness list was read past its end (undefined behaviour, a garbage dimension).
+  EXPECT_THAT(resumed_with([](nlohmann::json& j) { j["islands"][0]["f"].erase(j["islands"][0]["f"].size() - 1); }),
+              ::testing::AllOf(::testing::HasSubstr(cp.string()), ::testing::HasSubstr("fitness vectors")));
+  EXPECT_THAT(resumed_with([](nlohmann::json& j) { j["islands"][0]["f"][0].erase(1); }),
+              ::testing::HasSubstr("1 fitness values (the design has 2 variables and 2 objectives)"));
+  // An empty island was exit 3 (pagmo refused to evolve it).
+  EXPECT_THAT(resumed_with([](nlohmann::json& j) {
+                j["islands"][1]["x"] = nlohmann::json::array();
+                j["islands"][1]["f"] = nlohmann::json::array();
+              }),
+              ::testing::HasSubstr("island 1 holds 0 individuals"));
+  // Another shard's checkpoint, an island in the wrong place.
+  EXPECT_THAT(resumed_with([](nlohmann::json& j) { j["shard"] = 1, j["shards"] = 2; }),
+              ::testing::HasSubstr("holds shard 1 of 2, not shard 0 of 1"));
+  EXPECT_THAT(resumed_with([](nlohmann::json& j) { std::swap(j["islands"][0], j["islands"][1]); }),
+              ::testing::HasSubstr("island 1 where island 0 belongs"));
+  // The good checkpoint resumes.
+  EXPECT_EQ(resumed_with([](nlohmann::json&) {}), "(accepted)");
+}
+
+TEST(OptimizeIdentity, ResumeWithoutACheckpointCreatesNothing) {
+  const Design d = with(two_variable({{"margin", true}, {"footprint", false}}));
+  ScratchDir dir("fivebar_test_optimize_identity_nothing");
+  OptimizeOptions o;
+  o.plots = false;
+  o.out_dir = dir.path() / "never" / "here";
+  o.resume = true;
+  EXPECT_THAT(what_of([&] { (void)run_optimize(d, o); }), ::testing::HasSubstr("no checkpoint to resume from"));
+  EXPECT_FALSE(fs::exists(dir.path() / "never"));
 }
 
 }  // namespace

@@ -147,4 +147,29 @@ BENCHMARK(BM_optimize_eight_variables_vs_sobol)
     ->UseRealTime()
     ->Iterations(1);
 
+/// Issue 31 family 1: loading a design whose optimize: section ties 13 numbers of each of
+/// Arg stations in one variable (1,300 keys for 100). Every key is resolved in one reading of
+/// the design (fivebar/design/edit.hpp), so the time grows linearly with the keys (it was
+/// quadratic: 29 s for 1,200 keys). Goal: well under a second for 1,300 keys.
+void BM_LoadDesignWithManyOptimizeKeys(benchmark::State& state) {
+  const int stations = int(state.range(0));
+  std::string text = "name: many\nstations:\n", keys;
+  for (int s = 0; s < stations; ++s) {
+    const std::string n = "s" + std::to_string(s), p = "stations." + n + ".";
+    text += "  " + n + ":\n    target: {center: [6.25, 15.5], axes: [15, 12], angle: 0}\n    mechanisms:\n"
+            "      lower: {bases: [[0, 0], [12.5, 0]], links: [15, 15, 15, 15], working_mode: \"-+\", assembly_mode: \"+\"}\n";
+    const auto q = [](const std::string& k) { return "\"" + k + "\", "; };  // quoted: [ ] are flow indicators
+    for (int i = 0; i < 4; ++i) keys += q(p + "mechanisms.lower.links[" + std::to_string(i) + "]");
+    for (int i = 0; i < 4; ++i) keys += q(p + "mechanisms.lower.bases[" + std::to_string(i / 2) + "][" + std::to_string(i % 2) + "]");
+    for (int i = 0; i < 2; ++i) keys += q(p + "target.center[" + std::to_string(i) + "]") + q(p + "target.axes[" + std::to_string(i) + "]");
+    keys += q(p + "target.angle");
+  }
+  keys.resize(keys.size() - 2);
+  text += "optimize:\n  variables:\n    all: {keys: [" + keys + "], range: [12, 18]}\n  objectives: [margin]\n";
+  for (auto _ : state) benchmark::DoNotOptimize(load_design_from_string(text, "many.yaml"));
+  state.counters["keys"] = 13.0 * stations;
+  state.SetComplexityN(stations);
+}
+BENCHMARK(BM_LoadDesignWithManyOptimizeKeys)->Arg(25)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Complexity();
+
 }  // namespace

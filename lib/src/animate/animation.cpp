@@ -2,6 +2,7 @@
 // surface cannot carry a script), with the frames as JSON and a small player script.
 
 #include "fivebar/animation.hpp"
+#include "fivebar/ranges.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -223,8 +224,35 @@ std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_
     if (!line.empty() && line.back() == ',') out.emplace_back();
     return out;
   };
+  // A reader of a user-named file is bounded (issue 31 family 2): lines of at most
+  // kMaxSimulatedLineBytes (a `fivebar simulate` row is about 250) and at most
+  // kMaxSimulatedBytes in all, so /dev/zero or a wrong file is refused after one bounded read.
+  constexpr std::size_t kMaxSimulatedLineBytes = 4096;
+  constexpr std::size_t kMaxSimulatedBytes = std::size_t{1} << 30;
+  std::size_t total = 0;
+  const auto getline_bounded = [&](std::string& out, std::size_t line_no) {
+    out.clear();
+    std::streambuf* buf = in.rdbuf();
+    if (buf == nullptr || !in.good()) return false;
+    bool any = false;
+    while (true) {
+      const auto c = buf->sbumpc();
+      if (std::char_traits<char>::eq_int_type(c, std::char_traits<char>::eof())) {
+        in.setstate(std::ios::eofbit);
+        return any;
+      }
+      any = true;
+      if (++total > kMaxSimulatedBytes) fail(line_no, "more than " + std::to_string(kMaxSimulatedBytes) + " bytes: not a time series of fivebar simulate");
+      const char ch = std::char_traits<char>::to_char_type(c);
+      if (ch == '\n') return true;
+      if (out.size() >= kMaxSimulatedLineBytes) {
+        fail(line_no, "line longer than " + std::to_string(kMaxSimulatedLineBytes) + " bytes: not a time series of fivebar simulate");
+      }
+      out.push_back(ch);
+    }
+  };
   std::string line;
-  if (!std::getline(in, line)) fail(1, "empty file: expected the time series header");
+  if (!getline_bounded(line, 1)) fail(1, "empty file: expected the time series header");
   if (!line.empty() && line.back() == '\r') line.pop_back();
   const std::vector<std::string> header = split(line);
   const auto column = [&](const char* key) {
@@ -245,7 +273,7 @@ std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_
     }
     return v;
   };
-  while (std::getline(in, line)) {
+  while (getline_bounded(line, line_no + 1)) {
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
@@ -253,6 +281,10 @@ std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_
     if (cells.size() < need) fail(line_no, "expected " + std::to_string(header.size()) + " fields");
     const double t = number(cells[ct], "t_s");
     const Vec2 p(number(cells[cx], "x_mm"), number(cells[cy], "y_mm"));
+    // A tactor point is a coordinate (docs/reliability.md "Numeric ranges"): |x| <= 1e12 mm.
+    for (const auto& [v, key] : {std::pair{p.x(), "x_mm"}, std::pair{p.y(), "y_mm"}}) {
+      if (const auto why = ranges::coordinate_rule(v)) fail(line_no, std::string(key) + " = " + format::shortest(v) + " mm: " + *why);
+    }
     auto [it, added] = index.emplace(cells[cm], tracks.size());
     if (added) tracks.push_back(SimulatedTrack{cells[cm], {}, {}});
     SimulatedTrack& track = tracks[it->second];

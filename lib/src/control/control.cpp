@@ -355,6 +355,14 @@ Json to_json(const StabilityMap& map) {
   j["oscillatory_pose_mm"] = Json::array({map.oscillatory_P_mm.x(), map.oscillatory_P_mm.y()});
   j["kp_margin"] = map.kp_margin;
   j["kd_margin"] = map.kd_margin;
+  if (map.not_ok >= map.poses.size()) {
+    // No pose of the target is reachable and regular: no verdict, and null for every figure
+    // that does not exist (docs/conventions.md; issue 31 family 5), never a 0 that reads as a value.
+    for (const char* key : {"max_rho", "worst_pose_mm", "dominant_damping", "dominant_frequency_hz", "oscillatory_damping",
+                            "oscillatory_frequency_hz", "oscillatory_pose_mm", "kp_margin", "kd_margin"}) {
+      j[key] = nullptr;
+    }
+  }
   return j;
 }
 
@@ -611,6 +619,21 @@ PerformanceMap performance_map(const Design& design, const LoopModel& loop, cons
 
 Json to_json(const PerformanceMap& m) {
   const auto at = [](const PoseFigures& f) { return Json::array({f.P_mm.x(), f.P_mm.y()}); };
+  const bool any = std::any_of(m.poses.begin(), m.poses.end(), [](const PoseFigures& f) { return f.status == Status::ok; });
+  if (!any) {
+    // No pose reachable and regular: the worst figures do not exist (null), and no wall is renderable.
+    Json j = {{"station", m.station}, {"mechanism", m.mechanism}, {"poses", m.poses.size()},
+              {"target_stiffness_N_per_mm", m.target_N_per_mm}, {"loop_rate_hz", m.loop_rate_hz},
+              {"target_renderable", false}};
+    for (const char* key : {"min_bandwidth_hz", "min_bandwidth_pose_mm", "max_resolution_um_per_count", "max_resolution_pose_mm",
+                            "min_force_every_direction_N", "min_force_pose_mm", "min_tactor_damping_N_s_per_mm",
+                            "min_zwidth_N_per_mm", "min_zwidth_pose_mm", "min_coulomb_friction_N", "max_position_quantum_um",
+                            "min_zwidth_quantisation_N_per_mm", "min_zwidth_abbott_okamura_N_per_mm",
+                            "min_zwidth_abbott_okamura_pose_mm", "loop_rate_for_target_hz", "loop_rate_for_target_pose_mm"}) {
+      j[key] = nullptr;
+    }
+    return j;
+  }
   return {{"station", m.station},
           {"mechanism", m.mechanism},
           {"poses", m.poses.size()},
@@ -639,6 +662,9 @@ Json to_json(const PerformanceMap& m) {
 
 std::string performance_line(const PerformanceMap& m) {
   const auto at = [](const PoseFigures& f) { return " at (" + fixed(f.P_mm.x(), 2) + ", " + fixed(f.P_mm.y(), 2) + ")"; };
+  if (std::none_of(m.poses.begin(), m.poses.end(), [](const PoseFigures& f) { return f.status == Status::ok; })) {
+    return m.station + " " + m.mechanism + ": no pose of the target is reachable and regular: no performance figures";
+  }
   return m.station + " " + m.mechanism + ": bandwidth >= " + fixed(m.worst_bandwidth.bandwidth_hz, 2) + " Hz" +
          at(m.worst_bandwidth) + "; resolution <= " + fixed(m.worst_resolution.resolution_um, 3) + " um per count" +
          at(m.worst_resolution) + "; force >= " + fixed(m.worst_force.force_N, 2) + " N in every direction" +

@@ -24,18 +24,36 @@ struct Tracking {
   double error_mm = 0.0;
   double saturation = 0.0;
   bool ok = true;
+  bool out_of_time = false;  ///< the tuning's wall-time bound passed: not measured
 };
 
-Tracking track(const std::vector<SimulationInput>& runs, const std::array<PidGains, 2>& gains, double rtol) {
+using Clock = std::chrono::steady_clock;
+
+/// The tuning's time bound (TuneOptions::max_seconds) is checked inside the loops (issue 31
+/// family 2): before every evaluation and between the pattern runs of one, and each run is itself
+/// cut at the bound, so the tuning ends at most one simulation step past it.
+Tracking track(const std::vector<SimulationInput>& runs, const std::array<PidGains, 2>& gains, double rtol,
+               Clock::time_point deadline) {
   Tracking t;
   SimulationOptions o;
   o.rtol = rtol;
   o.record = false;
-  o.max_wall_s = 10.0;
   for (SimulationInput in : runs) {
+    const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+    if (left <= 0.0) {
+      t.ok = false;
+      t.out_of_time = true;
+      return t;
+    }
+    o.max_wall_s = std::min(10.0, left);
     in.mechanisms[0].control[0].pid = gains[0];
     in.mechanisms[0].control[1].pid = gains[1];
     const SimulationResult r = simulate(in, o);
+    if (Clock::now() >= deadline) {
+      t.ok = false;
+      t.out_of_time = true;
+      return t;
+    }
     if (!r.ok() || r.summary.empty()) {
       t.ok = false;
       return t;
@@ -73,24 +91,29 @@ struct Problem {
   int evaluations = 0;
   const TuneOptions* options;
   std::string label;
-  // The best evaluated point that meets the constraints.
+  // The best evaluated point that meets the constraints, and its tracking.
   std::vector<double> best_x;
   double best_value = std::numeric_limits<double>::infinity();
+  Tracking best_tracking;
+  Clock::time_point deadline;
 };
 
 double objective(unsigned n, const double* x, double*, void* data) {
   auto& p = *static_cast<Problem*>(data);
+  if (Clock::now() >= p.deadline) throw nlopt::forced_stop();
   const std::array<PidGains, 2> g = with(p.base, std::vector<double>(x, x + n));
   ++p.evaluations;
   // An unstable loop is not simulated: its error is that of a failed run.
   const double rho = max_spectral_radius(*p.poses, g, p.delay, 1.0);
   double value = kFailedRunMm;
   if (rho < 1.0) {
-    const Tracking t = track(*p.runs, g, p.rtol);
+    const Tracking t = track(*p.runs, g, p.rtol, p.deadline);
+    if (t.out_of_time) throw nlopt::forced_stop();  // abandoned: not a measurement
     if (t.ok) value = t.error_mm + kSaturationPenaltyMm * std::max(0.0, t.saturation - p.saturation_limit);
     if (t.ok && rho <= p.rho_limit && t.saturation <= p.saturation_limit && value < p.best_value) {
       p.best_value = value;
       p.best_x.assign(x, x + n);
+      p.best_tracking = t;
     }
   }
   if (p.options->progress) {
@@ -230,8 +253,9 @@ bool TunedMechanism::applied() const {
 TuneResult tune_controller(const Design& d, const std::vector<const Station*>& stations,
                            const std::map<std::string, std::map<std::string, MechanismInertia>>& inertia,
                            const TuneOptions& options) {
-  using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
+  const Clock::time_point deadline =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(std::min(options.max_seconds, 1e7)));
   if (!d.get<ControllerSettings>()) throw InputError("tune: the design has no `controller:` section");
   const ControllerSettings& ctl = *d.get<ControllerSettings>();
   const double saturation_limit = ctl.max_saturation_fraction;
@@ -273,12 +297,12 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     t.design = job.loop.gains;
     for (int k = 0; k < 2; ++k) t.before[std::size_t(k)] = ctl.hand_set_pid(t.station, t.mechanism, k + 1);
     t.rho_before = max_spectral_radius(job.poses, t.before, job.loop.delay);
-    const Tracking tb = track(job.runs, t.before, options.rtol);
+    const Tracking tb = track(job.runs, t.before, options.rtol, deadline);
     t.error_before_mm = tb.ok ? tb.error_mm : std::numeric_limits<double>::infinity();
     t.saturation_before = tb.saturation;
 
     Problem p{&job.runs, &job.poses, t.before, options.rho_limit, saturation_limit, options.rtol, job.loop.delay, 0,
-              &options, t.station + "/" + t.mechanism, {}, std::numeric_limits<double>::infinity()};
+              &options, t.station + "/" + t.mechanism, {}, std::numeric_limits<double>::infinity(), {}, deadline};
     t.start = t.before;
     if (options.start == TuneStart::pole_placement) {
       const PolePlacement pp = pole_placement(job.loop, job.station->target.center, job.poses, options.per_joint, t.before);
@@ -311,25 +335,31 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     opt.set_initial_step(std::log(2.0));
     opt.set_xtol_rel(1e-3);
     opt.set_maxeval(options.max_evaluations);
-    const double spent = std::chrono::duration<double>(Clock::now() - start).count();
+    const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
     // What is left of the bound, less a second for each mechanism still to come: a loaded machine
-    // slows one mechanism without cutting the next ones' evaluations short.
-    opt.set_maxtime(std::max(0.5, options.max_seconds - spent - 1.0 * double(jobs.size() - j - 1)));
+    // slows one mechanism without cutting the next ones' evaluations short. The bound itself is
+    // checked inside the evaluations (Problem::deadline): no floor here.
+    const double share = left - 1.0 * double(jobs.size() - j - 1);
+    opt.set_maxtime(std::max(std::min(left, 0.5), share));
     double best = 0.0;
-    nlopt::result r = nlopt::FAILURE;
-    try {
-      r = opt.optimize(x, best);
-    } catch (const nlopt::roundoff_limited&) {
-      r = nlopt::ROUNDOFF_LIMITED;
-    } catch (const nlopt::forced_stop&) {
-      r = nlopt::FORCED_STOP;
+    nlopt::result r = nlopt::MAXTIME_REACHED;
+    if (left > 0.0 && !tb.out_of_time) {
+      try {
+        r = opt.optimize(x, best);
+      } catch (const nlopt::roundoff_limited&) {
+        r = nlopt::ROUNDOFF_LIMITED;
+      } catch (const nlopt::forced_stop&) {
+        r = Clock::now() >= deadline ? nlopt::MAXTIME_REACHED : nlopt::FORCED_STOP;
+      }
     }
     t.stop = stop_text(r);
     t.evaluations = p.evaluations;
-    if (!p.best_x.empty()) x = p.best_x;  // the best feasible point COBYLA evaluated
+    const bool found = !p.best_x.empty();
+    if (found) x = p.best_x;  // the best feasible point COBYLA evaluated
     t.after = with(t.before, x);
     t.rho_after = max_spectral_radius(job.poses, t.after, job.loop.delay);
-    const Tracking ta = track(job.runs, t.after, options.rtol);
+    // The best point was simulated with these very inputs: its tracking is reused, not re-run.
+    const Tracking ta = found ? p.best_tracking : track(job.runs, t.after, options.rtol, deadline);
     t.error_after_mm = ta.ok ? ta.error_mm : std::numeric_limits<double>::infinity();
     t.saturation_after = ta.saturation;
     t.feasible = ta.ok && t.rho_after <= options.rho_limit && t.saturation_after <= saturation_limit;

@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -76,11 +77,24 @@ void require_ros_list(const Json& list, const std::string& path) {
   }
 }
 
+/// A map key as YAML 1.1 reads it back as the same string (issue 31 family 6): a station named
+/// `on`, `yes` or `off` must not become a boolean key, nor `null`/`~` a null or `1e3` a number.
+/// Names are is_safe_name() ([A-Za-z0-9_.-]); those YAML would read as anything but a string are
+/// written as quoted strings.
+std::string yaml_key(const std::string& key) {
+  std::string lower;
+  for (unsigned char c : key) lower += char(std::tolower(c));
+  static const char* const special[] = {"y", "n", "yes", "no", "on", "off", "true", "false", "null", "~", ""};
+  bool quote = std::find(std::begin(special), std::end(special), lower) != std::end(special);
+  quote = quote || (!key.empty() && (std::isdigit(static_cast<unsigned char>(key[0])) || key[0] == '-' || key[0] == '+' || key[0] == '.'));
+  return quote ? yaml_scalar(Json(key), key) : key;
+}
+
 void yaml_map(std::string& out, const Json& map, int indent, const std::string& path) {
   for (const auto& [key, value] : map.items()) {
     const std::string at = path.empty() ? key : path + "." + key;
     out.append(std::size_t(indent), ' ');
-    out += key + ":";
+    out += yaml_key(key) + ":";
     if (value.is_object()) {
       out += "\n";
       yaml_map(out, value, indent + 2, at);
@@ -411,6 +425,8 @@ Json parse_export(ExportFormat format, const std::string& text, const std::strin
     const std::size_t upto = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
     const auto line = 1 + std::count(text.begin(), text.begin() + std::ptrdiff_t(upto), '\n');
     throw InputError(origin + ":" + std::to_string(line) + ": not valid JSON: " + e.what());
+  } catch (const Json::exception& e) {  // e.g. a number beyond a double (1e999): bad input, not internal
+    throw InputError(origin + ": not a file fivebar exports: " + e.what());
   }
 }
 

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "fivebar/control.hpp"
+#include "fivebar/design/edit.hpp"
 #include "fivebar/dynamics.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/sections/geometry.hpp"
@@ -19,105 +20,19 @@
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/sweep.hpp"
+#include "design/design_keys.hpp"
 
 namespace fivebar {
 
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr double kDeg = std::numbers::pi / 180.0;
 /// Grid per axis of the loop stage's stability map over a target (the export gate's).
 constexpr int kLoopGrid = 21;
 /// CVODE tolerance of the simulation stage (the export gate's).
 constexpr double kSimulationRtol = 1e-4;
 
 enum Figure : int { margin, min_lci, force, footprint, collision, robust, max_rho, kp_margin, tracking_error, saturation };
-
-/// A station number the fast path sets without the YAML round trip.
-struct FastKey {
-  enum class Field : std::uint8_t { link, base, center, axes, angle } field = Field::link;
-  std::size_t station = 0;  ///< index into Impl::stations
-  bool upper = false;
-  int i = 0, j = 0;
-};
-
-bool parse_index(std::string_view& rest, int& out) {
-  if (rest.empty() || rest.front() != '[') return false;
-  const auto close = rest.find(']');
-  if (close == std::string_view::npos) return false;
-  const auto r = std::from_chars(rest.data() + 1, rest.data() + close, out);
-  if (r.ec != std::errc{} || r.ptr != rest.data() + close) return false;
-  rest.remove_prefix(close + 1);
-  return true;
-}
-
-/// The fast form of `key` when it is one (station names are matched longest first).
-std::optional<FastKey> fast_key(std::string_view key, const std::vector<std::string>& stations) {
-  if (!key.starts_with("stations.")) return std::nullopt;
-  std::string_view rest = key.substr(9);
-  std::size_t best = stations.size();
-  for (std::size_t s = 0; s < stations.size(); ++s) {
-    const std::string& n = stations[s];
-    if (rest.starts_with(n) && rest.size() > n.size() && rest[n.size()] == '.' &&
-        (best == stations.size() || n.size() > stations[best].size())) {
-      best = s;
-    }
-  }
-  if (best == stations.size()) return std::nullopt;
-  rest.remove_prefix(stations[best].size() + 1);
-  FastKey k;
-  k.station = best;
-  auto done = [&](bool ok) { return ok && rest.empty() ? std::optional<FastKey>(k) : std::nullopt; };
-  if (rest == "target.angle") {
-    k.field = FastKey::Field::angle;
-    return k;
-  }
-  if (rest.starts_with("target.center")) {
-    k.field = FastKey::Field::center;
-    rest.remove_prefix(13);
-    return done(parse_index(rest, k.i) && k.i >= 0 && k.i < 2);
-  }
-  if (rest.starts_with("target.axes")) {
-    k.field = FastKey::Field::axes;
-    rest.remove_prefix(11);
-    return done(parse_index(rest, k.i) && k.i >= 0 && k.i < 2);
-  }
-  for (const char* which : {"lower", "upper"}) {
-    const std::string prefix = std::string("mechanisms.") + which + ".";
-    if (!rest.starts_with(prefix)) continue;
-    k.upper = which[0] == 'u';
-    rest.remove_prefix(prefix.size());
-    if (rest.starts_with("links")) {
-      k.field = FastKey::Field::link;
-      rest.remove_prefix(5);
-      return done(parse_index(rest, k.i) && k.i >= 0 && k.i < 4);
-    }
-    if (rest.starts_with("bases")) {
-      k.field = FastKey::Field::base;
-      rest.remove_prefix(5);
-      return done(parse_index(rest, k.i) && parse_index(rest, k.j) && k.i >= 0 && k.i < 2 && k.j >= 0 && k.j < 2);
-    }
-  }
-  return std::nullopt;
-}
-
-void apply_fast(const FastKey& k, double v, std::vector<Station>& stations) {
-  Station& st = stations[k.station];
-  switch (k.field) {
-    case FastKey::Field::angle: st.target.angle = v * kDeg; return;
-    case FastKey::Field::center: st.target.center[k.i] = v; return;
-    case FastKey::Field::axes: st.target.axes[k.i] = v; return;
-    case FastKey::Field::link:
-    case FastKey::Field::base: {
-      std::optional<Mechanism>& m = k.upper ? st.upper : st.lower;
-      if (!m) return;  // checked when the problem is built
-      if (k.field == FastKey::Field::link) m->L[std::size_t(k.i)] = v;
-      else (k.i == 0 ? m->O1 : m->O2)[k.j] = v;
-      return;
-    }
-  }
-}
-
 
 }  // namespace
 
@@ -150,7 +65,8 @@ struct OptimizeProblem::Impl {
   OptimizeSettings s;
   std::vector<std::string> stations;  ///< optimised, file order
   std::vector<std::size_t> station_index;  ///< into base.stations
-  std::vector<std::vector<FastKey>> fast;  ///< per variable, when every key is fast
+  std::vector<std::vector<DesignKey>> fast;  ///< per variable, when every key is a station's number
+  std::vector<std::vector<std::size_t>> fast_station;  ///< per variable and key: index into the evaluated stations
   bool all_fast = true;
   std::array<bool, 4> stage{};     ///< by OptimizeStage value
   std::vector<bool> figure;        ///< asked for by an objective or a constraint
@@ -177,22 +93,29 @@ OptimizeProblem::OptimizeProblem(const Design& design, const OptimizeSettings& s
       if (m.base.stations[i].name == n) m.station_index.push_back(i);
     }
   }
-  for (const OptimizeVariable& v : m.s.variables) {
-    std::vector<FastKey> keys;
-    for (const std::string& k : v.keys) {
-      (void)design_number(m.base, k);  // ValidationError naming the key when it leads nowhere
-      const auto f = fast_key(k, m.stations);
-      if (!f) {
+  // Every key resolved once, in one reading of the design (fivebar/design/edit.hpp): the canonical
+  // spelling, and where a station's number lives (the fast path sets it without the YAML round trip).
+  for (OptimizeVariable& v : m.s.variables) {
+    const std::vector<DesignKey> resolved = design_keys(m.base, v.keys);  // ValidationError naming a key that leads nowhere
+    std::vector<DesignKey> keys;
+    std::vector<std::size_t> where;
+    for (std::size_t i = 0; i < resolved.size(); ++i) {
+      v.keys[i] = resolved[i].path;
+      const DesignKey& k = resolved[i];
+      const auto at = std::find(m.stations.begin(), m.stations.end(), k.station);
+      if (k.field == DesignKey::Field::other || at == m.stations.end()) {
         m.all_fast = false;
         continue;
       }
-      const Station& st = m.base.stations[m.station_index[f->station]];
-      if ((f->field == FastKey::Field::link || f->field == FastKey::Field::base) && !(f->upper ? st.upper : st.lower)) {
+      const Station& st = m.base.stations[m.station_index[std::size_t(at - m.stations.begin())]];
+      if ((k.field == DesignKey::Field::link || k.field == DesignKey::Field::base) && !(k.upper ? st.upper : st.lower)) {
         m.all_fast = false;  // the slow path reports it
       }
-      keys.push_back(*f);
+      keys.push_back(k);
+      where.push_back(std::size_t(at - m.stations.begin()));
     }
     m.fast.push_back(std::move(keys));
+    m.fast_station.push_back(std::move(where));
   }
   m.figure.assign(optimize_figures().size(), false);
   auto ask = [&](const std::string& name) {
@@ -260,23 +183,14 @@ OptimizeCandidate OptimizeProblem::evaluate(const std::vector<double>& x_in) con
     if (m.all_fast) {
       for (std::size_t i : m.station_index) stations.push_back(m.base.stations[i]);
       for (std::size_t d = 0; d < c.x.size(); ++d) {
-        for (const FastKey& k : m.fast[d]) apply_fast(k, c.x[d], stations);
+        for (std::size_t i = 0; i < m.fast[d].size(); ++i) set_station_number(stations[m.fast_station[d][i]], m.fast[d][i], c.x[d]);
       }
       const Geometry* g = m.base.get<Geometry>();
       for (const Station& st : stations) {
         try {
-          st.validate();
+          check_station_edit(st, g);  // the rules of an edited station, stated once
         } catch (const ValidationError& e) {
-          throw ValidationError("stations." + st.name + "." + e.key(), e.rule());
-        }
-        if (!g) continue;
-        for (const Mechanism* mech : st.mechanisms()) {
-          for (std::size_t i = 0; i < 4; ++i) {
-            if (mech->L[i] < g->boss_diameter) {
-              throw ValidationError("stations." + st.name + ".mechanisms." + mech->name + ".links[" + std::to_string(i) + "]",
-                                    "= " + format::shortest(mech->L[i]) + " mm: shorter than geometry.boss_diameter");
-            }
-          }
+          throw ValidationError(detail::key_join(detail::key_child("stations", st.name), e.key()), e.rule());
         }
       }
     } else {

@@ -39,6 +39,8 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kCheckpointFormat = "fivebar-optimize-checkpoint";
 constexpr const char* kShardFormat = "fivebar-optimize-shard";
+/// Least time between two checkpoints of a run (docs/reliability.md "Resource bounds").
+constexpr double kCheckpointSeconds = 1.0;
 
 /// SplitMix64 of a combination: the seeds of island i's population and of its round r algorithm.
 std::uint64_t mix(std::uint64_t x) {
@@ -387,7 +389,7 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
   if (!whole_run) {
     Json shard{{"format", kShardFormat}, {"design_hash", design_hash(p)}, {"shard", options.shard},
                {"shards", options.shards}, {"seconds", r.seconds}, {"rounds", r.rounds},
-               {"interrupted", r.interrupted}, {"candidates", Json::array()}};
+               {"interrupted", r.interrupted}, {"candidate_count", all.size()}, {"candidates", Json::array()}};
     for (const auto& c : all) shard["candidates"].push_back(candidate_json(c));
     const auto path = dir / ("front" + shard_suffix(options.shard, options.shards) + ".json");
     write_file_atomic(path, shard.dump() + "\n");
@@ -569,7 +571,6 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   }
   const double seconds_budget = options.seconds > 0.0 ? options.seconds : s.seconds;
   const std::string alg = s.resolved_algorithm();
-  make_directories(options.out_dir);
   const auto checkpoint = options.out_dir / ("checkpoint" + shard_suffix(options.shard, options.shards) + ".json");
 
   // Per island: its log, counters and population.
@@ -602,18 +603,53 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     if (j.value("design_hash", "") != design_hash(p)) {
       throw InputError(checkpoint.string() + ": the checkpoint is of another design or other optimize: settings");
     }
+    // Identity and sizes before use (issue 31 family 4): the shard, every island's number and
+    // population size, and every individual's dimension and fitness length.
+    auto damaged = [&](const std::string& what) { return InputError(checkpoint.string() + ": " + what); };
     try {
+      if (j.at("shard").get<std::uint64_t>() != options.shard || j.at("shards").get<std::uint64_t>() != options.shards) {
+        throw damaged("holds shard " + std::to_string(j.at("shard").get<std::uint64_t>()) + " of " +
+                      std::to_string(j.at("shards").get<std::uint64_t>()) + ", not shard " + std::to_string(options.shard) +
+                      " of " + std::to_string(options.shards));
+      }
       round = j.at("round").get<std::uint32_t>();
       prior_seconds = j.at("seconds").get<double>();
+      if (!std::isfinite(prior_seconds) || prior_seconds < 0.0) throw damaged("seconds must be a finite number >= 0");
       deadline.end -= span(std::min(prior_seconds, seconds_budget));
-      for (const Json& c : j.at("candidates")) all.push_back(candidate_from(c));
+      for (const Json& c : j.at("candidates")) {
+        OptimizeCandidate cand = candidate_from(c);
+        if (cand.x.size() != p.dimension() || cand.figures.size() != optimize_figures().size()) {
+          throw damaged("a candidate with " + std::to_string(cand.x.size()) + " values and " + std::to_string(cand.figures.size()) +
+                        " figures (the design has " + std::to_string(p.dimension()) + " variables)");
+        }
+        all.push_back(std::move(cand));
+      }
       const Json& isl = j.at("islands");
-      if (isl.size() != n) throw InputError("island count differs");
+      if (isl.size() != n) {
+        throw damaged(std::to_string(isl.size()) + " islands, this shard runs " + std::to_string(n));
+      }
+      const std::size_t objectives = s.objectives.size();
       for (std::size_t k = 0; k < n; ++k) {
+        if (isl[k].at("island").get<int>() != islands[k]) {
+          throw damaged("island " + std::to_string(isl[k].at("island").get<int>()) + " where island " + std::to_string(islands[k]) +
+                        " belongs");
+        }
         pagmo::population pop(problem_of(k), 0u, seed32(s.seed, std::uint64_t(islands[k]), 0));
         const auto xs = isl[k].at("x").get<std::vector<std::vector<double>>>();
         const auto fs = isl[k].at("f").get<std::vector<std::vector<double>>>();
-        for (std::size_t i = 0; i < xs.size(); ++i) pop.push_back(xs[i], fs[i]);
+        if (xs.size() != std::size_t(s.population) || fs.size() != xs.size()) {
+          throw damaged("island " + std::to_string(islands[k]) + " holds " + std::to_string(xs.size()) + " individuals and " +
+                        std::to_string(fs.size()) + " fitness vectors, the population is " + std::to_string(s.population));
+        }
+        for (std::size_t i = 0; i < xs.size(); ++i) {
+          if (xs[i].size() != p.dimension() || fs[i].size() != objectives) {
+            throw damaged("island " + std::to_string(islands[k]) + ", individual " + std::to_string(i) + ": " +
+                          std::to_string(xs[i].size()) + " values and " + std::to_string(fs[i].size()) +
+                          " fitness values (the design has " + std::to_string(p.dimension()) + " variables and " +
+                          std::to_string(objectives) + " objectives)");
+          }
+          pop.push_back(xs[i], fs[i]);
+        }
         pops.push_back(std::move(pop));
       }
     } catch (const InputError&) {
@@ -650,12 +686,23 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       return finish(p, design, std::move(all), options, r, options.shards == 1, 0.0);
     }
   }
+  // Every input checked (the checkpoint too): only now is anything created (issue 31 family 3).
+  make_directories(options.out_dir);
   // pagmo's populations hold their own copies of the problem: point them at this run's logs.
   // (A population built above already does; after a resume the same.)
 
   OptimizeResult r;
   r.algorithm = alg;
   auto front_size = [&] { return optimize_front(p, all).size(); };
+  double checkpoint_at = 0.0, checkpoint_cost = 0.0;  // when the last was written, and how long it took
+  std::uint32_t checkpoint_round = round;
+  auto write_checkpoint = [&] {
+    const double start = elapsed();
+    write_file_atomic(checkpoint, checkpoint_json(p, options, round, prior_seconds + start, islands, pops, all).dump() + "\n");
+    checkpoint_at = elapsed();
+    checkpoint_cost = checkpoint_at - start;
+    checkpoint_round = round;
+  };
   if (options.progress) options.progress(all.size(), budget, prior_seconds + elapsed(), front_size());
   const std::uint64_t per_generation = std::uint64_t(s.population) * n;
   while (true) {
@@ -713,12 +760,14 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
         }
       }
     }
-    write_file_atomic(checkpoint, checkpoint_json(p, options, round, prior_seconds + elapsed(), islands, pops, all).dump() + "\n");
+    // The checkpoint holds every candidate so far, so writing it after every round made a long run
+    // quadratic (issue 31 family 2). It is written when at least kCheckpointSeconds and ten times
+    // its own last writing time have passed since the last one: checkpoints take at most about a
+    // tenth of the run (linear in it); an interrupted or finished run always writes its last round.
+    if (elapsed() - checkpoint_at >= std::max(kCheckpointSeconds, 10.0 * checkpoint_cost)) write_checkpoint();
     if (options.progress) options.progress(all.size(), budget, prior_seconds + elapsed(), front_size());
   }
-  if (round == 0 || r.interrupted) {
-    write_file_atomic(checkpoint, checkpoint_json(p, options, round, prior_seconds + elapsed(), islands, pops, all).dump() + "\n");
-  }
+  if (round == 0 || r.interrupted || checkpoint_round != round) write_checkpoint();
   r.rounds = round;
   r.seconds = prior_seconds + elapsed();
   OptimizeResult out = finish(p, design, std::move(all), options, r, options.shards == 1, seconds_budget - r.seconds);
@@ -744,11 +793,37 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
     if (j.value("format", "") != kShardFormat || j.value("design_hash", "") != design_hash(p)) {
       throw InputError(path.string() + ": a shard of another design or other optimize: settings");
     }
+    // Identity and sizes before use (issue 31 family 4): the file must say it is shard k of
+    // `shards`, finished, with as many candidates as it holds.
     try {
-      for (const Json& c : j.at("candidates")) all.push_back(candidate_from(c));
+      const std::uint64_t says = j.at("shard").get<std::uint64_t>(), of = j.at("shards").get<std::uint64_t>();
+      if (says != k || of != shards) {
+        throw InputError(path.string() + ": holds shard " + std::to_string(says) + " of " + std::to_string(of) +
+                         ", not shard " + std::to_string(k) + " of " + std::to_string(shards));
+      }
+      if (j.at("interrupted").get<bool>()) {
+        throw InputError(path.string() + ": shard " + std::to_string(k) + " of " + std::to_string(shards) +
+                         " was interrupted: finish it first (fivebar optimize --shard " + std::to_string(k) + "/" +
+                         std::to_string(shards) + " --resume), then merge");
+      }
+      const Json& cs = j.at("candidates");
+      if (j.contains("candidate_count") && j.at("candidate_count").get<std::uint64_t>() != cs.size()) {
+        throw InputError(path.string() + ": says " + std::to_string(j.at("candidate_count").get<std::uint64_t>()) +
+                         " candidates but holds " + std::to_string(cs.size()));
+      }
+      for (const Json& c : cs) {
+        OptimizeCandidate cand = candidate_from(c);
+        if (cand.x.size() != p.dimension() || cand.figures.size() != optimize_figures().size()) {
+          throw InputError(path.string() + ": a candidate with " + std::to_string(cand.x.size()) + " values and " +
+                           std::to_string(cand.figures.size()) + " figures (the design has " + std::to_string(p.dimension()) +
+                           " variables and " + std::to_string(optimize_figures().size()) + " figures)");
+        }
+        all.push_back(std::move(cand));
+      }
       r.seconds = std::max(r.seconds, j.at("seconds").get<double>());
       r.rounds = std::max<std::uint64_t>(r.rounds, j.at("rounds").get<std::uint64_t>());
-      r.interrupted = r.interrupted || j.at("interrupted").get<bool>();
+    } catch (const InputError&) {
+      throw;
     } catch (const std::exception& e) {
       throw InputError(path.string() + ": a damaged shard file (" + e.what() + ")");
     }

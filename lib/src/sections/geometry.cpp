@@ -1,6 +1,8 @@
 // The `geometry:` section (fivebar/sections/geometry.hpp): link outlines, pins and layers.
 #include "fivebar/sections/geometry.hpp"
 
+#include "fivebar/design/edit.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -85,20 +87,13 @@ void validate(const Design& design) {
   const Geometry* g = design.get<Geometry>();
   if (g == nullptr) return;
   rules::validate_nested("geometry", [&] { g->validate(); });
-  // Every link must hold its two pin bosses apart: shorter links cannot be printed.
+  // Every link must hold its two pin bosses apart: shorter links cannot be printed (the rule is
+  // stated once, in fivebar/design/edit.hpp check_printable_links, for the sweep and the optimiser too).
   for (const Station& station : design.stations) {
-    for (const Mechanism* m : station.mechanisms()) {
-      for (std::size_t i = 0; i < 4; ++i) {
-        if (m->L[i] < g->boss_diameter) {
-          std::ostringstream s;
-          s << "= " << m->L[i] << " mm: shorter than geometry.boss_diameter (" << g->boss_diameter
-            << " mm): the pin bosses at its ends would overlap";
-          throw ValidationError(detail::key_index(detail::key_join(detail::key_child("stations", station.name),
-                                                                   "mechanisms." + m->name + ".links"),
-                                                  i),
-                                s.str());
-        }
-      }
+    try {
+      check_printable_links(station, *g);
+    } catch (const ValidationError& e) {
+      throw ValidationError(detail::key_join(detail::key_child("stations", station.name), e.key()), e.rule());
     }
   }
 }

@@ -4,8 +4,10 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <map>
 #include <set>
 
+#include "fivebar/design/edit.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/motor.hpp"
@@ -165,23 +167,12 @@ void OptimizeSettings::validate() const {
 std::vector<std::string> optimize_station_names(const Design& design, const OptimizeSettings& settings) {
   std::set<std::string> named;
   bool every = false;
-  for (const OptimizeVariable& v : settings.variables) {
-    for (const std::string& k : v.keys) {
-      if (!k.starts_with("stations.")) {
-        every = true;
-        continue;
-      }
-      const std::string_view rest = std::string_view(k).substr(9);
-      std::string best;
-      for (const Station& s : design.stations) {
-        if (rest.starts_with(s.name) && (rest.size() == s.name.size() || rest[s.name.size()] == '.') &&
-            s.name.size() > best.size()) {
-          best = s.name;
-        }
-      }
-      if (best.empty()) every = true;
-      else named.insert(best);
-    }
+  std::vector<std::string> keys;
+  for (const OptimizeVariable& v : settings.variables) keys.insert(keys.end(), v.keys.begin(), v.keys.end());
+  // Resolved once (any spelling of a station's key names the station; fivebar/design/edit.hpp).
+  for (const DesignKey& k : design_keys(design, keys)) {
+    if (k.station.empty()) every = true;
+    else named.insert(k.station);
   }
   std::vector<std::string> out;
   for (const Station& s : design.stations) {
@@ -300,17 +291,32 @@ void validate(const Design& design) {
   const OptimizeSettings* o = design.get<OptimizeSettings>();
   if (o == nullptr) return;
   rules::validate_nested("optimize", [&] { o->validate(); });
-  // Every key leads to a number of this design, and the bounds are numbers the key accepts (the
-  // loader's rules are checked on the design at lo and at hi of each variable alone).
+  // Every key leads to a number of this design, resolved once in one reading of the design (time
+  // linear in the keys), and each number is set by one variable only whatever the spelling
+  // (links[2], links[02], stations["index"]...: one canonical key, fivebar/design/edit.hpp).
+  std::vector<std::string> keys, labels;
   for (const OptimizeVariable& v : o->variables) {
+    const std::string var = detail::key_child("optimize.variables", v.name);
     for (std::size_t i = 0; i < v.keys.size(); ++i) {
-      const std::string key = v.keys.size() > 1 ? detail::key_index(detail::key_child("optimize.variables", v.name) + ".keys", i)
-                                                : detail::key_child("optimize.variables", v.name) + ".key";
-      try {
-        (void)design_number(design, v.keys[i]);
-      } catch (const ValidationError& e) {
-        throw ValidationError(key, "= " + detail::quoted(v.keys[i]) + ": " + e.rule());
-      }
+      keys.push_back(v.keys[i]);
+      labels.push_back(v.keys.size() > 1 ? detail::key_index(var + ".keys", i) : var + ".key");
+    }
+  }
+  std::vector<DesignKey> resolved;
+  try {
+    resolved = design_keys(design, keys);
+  } catch (const ValidationError& e) {
+    const auto at = std::find(keys.begin(), keys.end(), e.key());
+    const std::string label = at == keys.end() ? std::string("optimize.variables") : labels[std::size_t(at - keys.begin())];
+    throw ValidationError(label, "= " + detail::quoted(e.key()) + ": " + e.rule());
+  }
+  std::map<std::string, std::size_t> first;  // canonical key -> its first label
+  for (std::size_t i = 0; i < resolved.size(); ++i) {
+    const auto [it, fresh] = first.emplace(resolved[i].path, i);
+    if (!fresh) {
+      throw ValidationError(labels[i], "= " + detail::quoted(keys[i]) + ": the number " + detail::quoted(resolved[i].path) +
+                                           ", already set by " + labels[it->second] + " = " + detail::quoted(keys[it->second]) +
+                                           " (each number in one variable only)");
     }
   }
   const std::vector<std::string> stations = optimize_station_names(design, *o);

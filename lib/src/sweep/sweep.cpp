@@ -3,6 +3,8 @@
 // output does not depend on the number of threads.
 #include "fivebar/format.hpp"
 #include "fivebar/sweep.hpp"
+
+#include "fivebar/design/edit.hpp"
 #include "csv.hpp"
 
 #include <boost/random/sobol.hpp>
@@ -135,12 +137,20 @@ Station apply_sweep(const Design& design, const SweepSettings& s, const std::vec
       st.upper->O2.y() = v;
     } else {
       for (Mechanism* m : targets) {
-        if (name == "L1") m->L[0] = v;
-        if (name == "L2") m->L[1] = v;
-        if (name == "L3") m->L[2] = v;
-        if (name == "L4") m->L[3] = v;
-        if (name == "L12") m->L[0] = m->L[1] = v;
-        if (name == "L34") m->L[2] = m->L[3] = v;
+        // The links through the one design-edit API (fivebar/design/edit.hpp): L1..L4 are
+        // stations.<s>.mechanisms.<m>.links[0..3].
+        DesignKey key;
+        key.field = DesignKey::Field::link;
+        key.upper = m == (st.upper ? &*st.upper : nullptr);
+        const int first = name == "L1" || name == "L12" ? 0 : name == "L2" ? 1 : name == "L3" || name == "L34" ? 2 : name == "L4" ? 3 : -1;
+        if (first >= 0) {
+          key.i = first;
+          set_station_number(st, key, v);
+        }
+        if (name == "L12" || name == "L34") {
+          key.i = first + 1;
+          set_station_number(st, key, v);
+        }
         if (name == "spacing") {
           const Vec2 dir = m->O2 != m->O1 ? Vec2((m->O2 - m->O1).normalized()) : kX;
           m->O2 = m->O1 + v * dir;
@@ -148,17 +158,7 @@ Station apply_sweep(const Design& design, const SweepSettings& s, const std::vec
       }
     }
   }
-  st.validate();
-  if (design.get<Geometry>()) {
-    for (const Mechanism* m : targets) {
-      for (std::size_t i = 0; i < 4; ++i) {
-        if (m->L[i] < design.get<Geometry>()->boss_diameter) {
-          throw ValidationError("mechanisms." + m->name + ".links[" + std::to_string(i) + "]",
-                                "= " + num(m->L[i]) + " mm: shorter than geometry.boss_diameter");
-        }
-      }
-    }
-  }
+  check_station_edit(st, design.get<Geometry>());  // the rules of an edited station, stated once
   return st;
 }
 

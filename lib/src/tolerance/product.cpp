@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/resources/estimates.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 #include "products/markdown.hpp"
@@ -33,6 +34,10 @@ Product tolerance_product() {
   p.title = "Manufacturing tolerance and sensing error";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<ToleranceSettings>()) return "the design has no `tolerance:` section (the printer's and sensors' errors)";
+    // The one resource rule (fivebar/resources/budget.hpp): beyond the bounds only `fivebar tolerance --yes` runs it.
+    if (const ResourceEstimate e = tolerance_estimate(d, {}); !within_bounds(e)) {
+      return e.what + " is large: " + e.text() + "; run it alone with `fivebar tolerance --yes`, or lower tolerance.samples";
+    }
     return without_mechanisms(d);
   };
   p.build = [](Context& ctx) {

@@ -457,6 +457,23 @@ Json to_json(const ToleranceMap& map) {
   j["target_worst_play_at_mm"] = xy(map.worst_play_at);
   j["robust_coverage"] = to_json(map.robust);
   j["grid"] = {{"origin_mm", xy(Vec2(map.x0, map.y0))}, {"spacing_mm", map.spacing_mm}, {"nx", map.nx}, {"ny", map.ny}};
+  // Quantities that do not exist are null, never 0 mm at (0, 0) (docs/conventions.md; issue 31
+  // family 5): no first-order estimate at the centre, no regular point of the target.
+  if (map.centre.status != Status::ok) {
+    for (const char* key : {"centre_3sigma_mm", "centre_3sigma_minor_mm", "centre_3sigma_angle_deg", "centre_worst_case_mm",
+                            "centre_resolution_um"}) {
+      j[key] = nullptr;
+    }
+  }
+  if (map.centre_monte_carlo.used == 0) j["centre_monte_carlo_3sigma_mm"] = nullptr;
+  if (map.centre_play.status != Status::ok) j["centre_play_mm"] = j["centre_play_first_order_mm"] = nullptr;
+  if (map.target_not_ok >= map.target_points) {
+    for (const char* key : {"target_worst_3sigma_mm", "target_worst_3sigma_at_mm", "target_worst_case_mm", "target_worst_case_at_mm",
+                            "target_worst_resolution_um", "target_worst_resolution_at_mm", "target_worst_play_mm",
+                            "target_worst_play_at_mm"}) {
+      j[key] = nullptr;
+    }
+  }
   return j;
 }
 

@@ -1,0 +1,19 @@
+#pragma once
+/// Key paths followed through a design file's YAML tree (lib/src/design/edit.cpp), for the
+/// functions that change that tree (lib/src/yaml/design_numbers.cpp). Private to lib.
+
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <string_view>
+
+#include "fivebar/design/edit.hpp"
+
+namespace fivebar::detail {
+
+/// Follows `key` from `root` (to_yaml of a design), fills `k` (canonical path, number, station
+/// field) and returns the number's node. ValidationError naming `key` when it leads nowhere or
+/// to something that is not a number.
+std::optional<YAML::Node> resolve_design_key(const YAML::Node& root, std::string_view key, DesignKey& k);
+
+}  // namespace fivebar::detail
