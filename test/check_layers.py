@@ -29,7 +29,7 @@ CORE_HEADERS = [
     "lib/include/fivebar/coverage/coverage.hpp", "lib/include/fivebar/sections/*.hpp",
     "lib/include/fivebar/design/*.hpp", "lib/include/fivebar/resources/budget.hpp",
     "lib/src/design/*.hpp", "lib/src/kinematics/*.hpp", "lib/src/sections/*.hpp", "lib/src/sections/*.def",
-    "lib/src/cgal/exact_region.hpp",
+    "lib/src/cgal/exact_region.hpp", "lib/src/yaml/key_path.hpp",
 ]
 
 # Heavy dependencies: the include prefix and the only files that may include it.

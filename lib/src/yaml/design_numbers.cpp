@@ -1,6 +1,6 @@
 // Numbers of a design by key path (fivebar/design.hpp design_number(), with_design_numbers()): the
 // design is written as its file (to_yaml), the key path is followed through that tree (one
-// resolution of key paths for every caller: lib/src/design/edit.cpp), and a changed tree is read
+// resolution of key paths for every caller: lib/src/yaml/design_edit.cpp), and a changed tree is read
 // back by the loader, so every rule of the file applies to the result.
 #include <yaml-cpp/yaml.h>
 
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "design/design_keys.hpp"
-#include "design/key_path.hpp"
+#include "yaml/key_path.hpp"
 #include "fivebar/design.hpp"
 #include "sections/section.hpp"
 

@@ -13,7 +13,7 @@
 #include <variant>
 #include <vector>
 
-#include "design/key_path.hpp"
+#include "yaml/key_path.hpp"
 #include "design/design_keys.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/sections/geometry.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-/// Key paths followed through a design file's YAML tree (lib/src/design/edit.cpp), for the
+/// Key paths followed through a design file's YAML tree (lib/src/yaml/design_edit.cpp), for the
 /// functions that change that tree (lib/src/yaml/design_numbers.cpp). Private to lib.
 
 #include <yaml-cpp/yaml.h>
