@@ -124,7 +124,6 @@ int run_sil(const ReplayOptions& opt) {
       AtomicFile file(csv);
       bool header = false;
       SimulationOptions so;
-      so.record = false;
       so.controller_log = [&](double t, const std::vector<double>& readings, runtime::Reading k,
                               const std::vector<double>& targets, const runtime::Controller& ctl) {
         if (!header) write_replay_header(file.stream(), ctl.config(), k), header = true;
