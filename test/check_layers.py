@@ -13,6 +13,8 @@ Rules:
              glue (lib/src/<study>/product.cpp), the registry itself and the scene: no study calls
              the scene, and no study or product reaches into another product's glue;
   walls      each heavy dependency's headers are included only in the files of its wall;
+  runtime    the device's loop (lib/src/runtime/, fivebar/runtime/) includes nothing of the project
+             outside itself: it builds and installs alone (docs/runtime.md);
   cycles     no include cycle among the project's files.
 """
 import os
@@ -121,6 +123,14 @@ def main():
             reaches = q.startswith("lib/src/products/") or q in scene_files or re.fullmatch(r"lib/src/[^/]+/product\.cpp", q)
             if reaches and not glue:
                 errors.append("scene: " + p + " includes " + q + " (only product glue, the registry and the scene may)")
+
+    # runtime
+    in_runtime = lambda p: p.startswith(("lib/src/runtime/", "lib/include/fivebar/runtime"))
+    for p in files:
+        if in_runtime(p):
+            for q in quoted[p]:
+                if not in_runtime(q):
+                    errors.append("runtime: " + p + " includes " + q)
 
     # walls
     for p, names in system.items():

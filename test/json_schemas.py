@@ -148,6 +148,9 @@ def main():
     run("report accuracy", "report-accuracy", ["report", "accuracy", DESIGN, "-s", "index", "--quick", "-q", "--out", out])
     run("simulate", "simulate", ["simulate", DESIGN, "-s", "index", "--pattern", "stretch", "--no-render", "--out", out + "/sim"])
     run("simulate --step", "simulate", ["simulate", DESIGN, "-s", "index", "--step", "--no-render", "--out", out + "/sim"])
+    sil = run("replay --sil", "replay", ["replay", DESIGN, "--sil", "-s", "index", "--pattern", "stretch", "--out", out + "/replay"])
+    if sil is not None and sil.get("runs"):
+        run("replay LOG", "replay", ["replay", sil["runs"][0]["log"], "--config", out + "/export/iros2022_controller.json"])
     run("tolerance", "tolerance", ["tolerance", DESIGN, "--out", out + "/tol"])
     run("control", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--out", out + "/control"])
     run("control --tune", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--tune",

@@ -537,16 +537,19 @@ TEST(Dynamics, DiscretePidFollowsAHandComputedSequence) {
 }
 
 TEST(Dynamics, AdcQuantisesToTheNearestLevelAndClamps) {
+  // The export's ADC model (fivebar/export/export.hpp adc.volts_per_count): 2^bits codes range / 2^bits
+  // apart from the range's low end, the top code one step below its high end.
   Potentiometer pot;  // 2.5 V at 0, pi/3 rad per V
   const std::array<double, 2> range{-10.0, 10.0};
-  const double q = 20.0 / 65535.0;  // V per level
+  const double q = 20.0 / 65536.0;  // V per code
   for (double theta : {0.0, 0.1234567, -1.0, 2.0}) {
     const double read = adc_reading(theta, pot, 16, range);
     EXPECT_LE(std::abs(read - theta), 0.5 * q * pot.rad_per_volt * (1 + 1e-9)) << theta;
   }
-  // 8 bits: levels 20/255 V apart; 40 rad is 40.7 V, beyond the range: reads the top level (10 V).
-  EXPECT_NEAR(adc_reading(40.0, pot, 8, range), pot.rad_per_volt * (10.0 - 2.5), 1e-12);
-  EXPECT_NEAR(adc_reading(0.0, pot, 8, range), pot.rad_per_volt * (-10.0 + std::round(12.5 / (20.0 / 255)) * (20.0 / 255) - 2.5),
+  // 8 bits: codes 20/256 V apart; 40 rad is 40.7 V, beyond the range: reads the top code, 255.
+  EXPECT_NEAR(adc_reading(40.0, pot, 8, range), pot.rad_per_volt * (-10.0 + 255 * (20.0 / 256) - 2.5), 1e-12);
+  EXPECT_NEAR(adc_reading(-40.0, pot, 8, range), pot.rad_per_volt * (-10.0 - 2.5), 1e-12);
+  EXPECT_NEAR(adc_reading(0.0, pot, 8, range), pot.rad_per_volt * (-10.0 + std::round(12.5 / (20.0 / 256)) * (20.0 / 256) - 2.5),
               1e-12);
 }
 

@@ -47,14 +47,14 @@
 /// (the averaged effect of a cycle-by-cycle limiter: the current relaxes to at most I_max in
 /// L/R), then |V| <= V_supply. A locked rotor (w = 0) settles at i = V / R.
 ///
-/// Controller as on the device (fivebar/sections/controller.hpp, the exported PID): every
+/// Controller: the device's own loop, fivebar::runtime::Controller (fivebar/runtime/controller.hpp,
+/// docs/runtime.md), configured by the design's export (SimulationInput::runtime). Every
 /// T = 1 / loop_rate_hz the potentiometer voltage v = volts_at_zero + theta / rad_per_volt is read
-/// through the ADC (round to the nearest of 2^bits levels over range_v, clamped), converted back
-/// to an angle, and DiscretePid gives a duty; that duty is applied one period later (the
-/// computation delay of a ROS loop) and held constant until the next (zero-order hold). The
-/// reference is the IK of the pattern's commanded points (fivebar/pattern.hpp check_pattern, with
-/// the upper mechanism's priority rule applied to the targets once per sample, as `fivebar pattern`
-/// checks it; the device applies it to the measured pose, which this model does not).
+/// through the ADC (adc.volts_per_count = range / 2^bits: the nearest code, clamped to
+/// 0 .. 2^bits - 1) and the runtime turns the codes and the pattern's reference points into duties
+/// (FK of the measured joints, IK, the upper mechanism's priority rule on the commanded poses,
+/// the joint limits less the margin, the PID); that duty is applied one period later (the
+/// computation delay of a ROS loop) and held constant until the next (zero-order hold).
 ///
 /// Skin contact per tactor (a reset-integrator friction model: Haessig & Friedland, "On the
 /// Modeling and Simulation of Friction", ASME J. Dyn. Syst. Meas. Control 113(3), 1991; the
@@ -90,7 +90,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -107,6 +109,8 @@
 #include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/print.hpp"
+#include "fivebar/runtime/config.hpp"
+#include "fivebar/runtime/controller.hpp"
 
 namespace fivebar {
 
@@ -202,23 +206,24 @@ inline constexpr double kCoulombSmoothingSpeed = 1e-3;
 ///   s_k = s_{k-1} + e_k T, clamped so that |ki s_k| <= i_clamp (no wind-up beyond the clamp);
 ///   d_k = (e_k - e_{k-1}) / T (0 at the first sample);
 ///   duty_k = clamp(kp e_k + ki s_k + kd d_k, -1, 1).
+/// The runtime's own step (fivebar::runtime::pid_update): one implementation.
 class DiscretePid {
  public:
-  DiscretePid(const PidGains& gains, double period_s) : gains_(gains), period_(period_s) {}
+  DiscretePid(const PidGains& gains, double period_s)
+      : gains_{gains.kp, gains.ki, gains.kd, gains.i_clamp}, period_(period_s) {}
   /// The duty for error `e` (rad) at this sample.
-  double update(double error_rad);
-  double integral() const { return sum_; }
+  double update(double error_rad) { return runtime::pid_update(gains_, period_, state_, error_rad); }
+  double integral() const { return state_.sum; }
 
  private:
-  PidGains gains_;
+  runtime::Gains gains_;
   double period_ = 0.0;
-  double sum_ = 0.0;
-  double previous_ = 0.0;
-  bool first_ = true;
+  runtime::PidState state_;
 };
 
 /// The angle the controller reads for a true angle `theta` (rad): the potentiometer voltage,
-/// quantised by an ADC of `bits` over `range_v` (nearest level, clamped to the range), converted back.
+/// quantised by an ADC of `bits` over `range_v` (the export's model: 2^bits codes range / 2^bits
+/// apart from range_v[0], the nearest one, clamped to 0 .. 2^bits - 1), converted back.
 double adc_reading(double theta, const Potentiometer& pot, int bits, const std::array<double, 2>& range_v);
 
 // --- Simulation -----------------------------------------------------------------------------------
@@ -232,6 +237,9 @@ struct SimulatedMechanism {
   std::vector<std::array<double, 2>> reference;
   /// The commanded tactor points of those samples (mm), for the tracking error.
   std::vector<Vec2> reference_point_mm;
+  /// The reference points the device's runtime receives at those samples (mm), before its priority
+  /// rule; empty: reference_point_mm.
+  std::vector<Vec2> target_mm;
   std::array<double, 2> theta0{0.0, 0.0};  ///< initial joint angles (rad); default the first reference
   std::array<double, 2> w0{0.0, 0.0};      ///< initial joint rates (rad/s)
 };
@@ -293,6 +301,12 @@ struct SimulationOptions {
   std::size_t max_steps = 5'000'000;  ///< integrator steps in all
   double max_wall_s = 120.0;          ///< wall time in all
   bool record = true;           ///< keep the time series (at the loop rate)
+  /// Called after every controller cycle at t_k with the runtime's inputs (the readings in its
+  /// joint order, their kind, the reference points in m, 2 per runtime mechanism) and the
+  /// controller itself: what the device's log holds (test/test_runtime.cpp, `fivebar replay`).
+  std::function<void(double t_s, const std::vector<double>& readings, runtime::Reading kind,
+                     const std::vector<double>& targets_m, const runtime::Controller& controller)>
+      controller_log;
 };
 
 enum class SimStatus : std::uint8_t {
@@ -345,6 +359,12 @@ struct SimulationInput {
   std::vector<SimulatedMechanism> mechanisms;
   ControllerSettings controller;
   ContactSettings contact;
+  /// The device's configuration as exported (fivebar/export/export.hpp), read by the runtime's own JSON
+  /// reader; the gains and potentiometers of `mechanisms[k].control` override its joints' (a
+  /// tuner varies them). Null: runtime_config(*this), without collision outlines or joint limits.
+  std::shared_ptr<const runtime::Config> runtime;
+  /// False: `runtime` as given, its gains and calibration too (`fivebar replay --sil --config`).
+  bool override_runtime_joints = true;
   /// Non-empty when the reference cannot be followed (a sample unreachable or singular): the
   /// reason; such an input is reported, not simulated.
   std::string unusable;
@@ -364,6 +384,11 @@ struct SimulationResult {
   std::vector<MechanismSummary> summary;
   bool ok() const { return status == SimStatus::ok; }
 };
+
+/// The runtime configuration of an input without an export: one station per mechanism, named
+/// `<station>_<k>`, its mechanism "lower" with the model's geometry (m), the controller's ADC and
+/// loop rate, the mechanisms' gains and potentiometers; no collision outlines, no joint limits.
+runtime::Config runtime_config(const SimulationInput& input);
 
 /// Runs the simulation (CVODE or ARKODE as options.integrator says). Never throws on
 /// non-convergence: the status says why and where.

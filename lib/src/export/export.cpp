@@ -480,6 +480,8 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
   p["adc"] = {{"bits", c.adc_bits},
               {"range_v", Json::array({c.adc_range_v[0], c.adc_range_v[1]})},
               {"volts_per_count", (c.adc_range_v[1] - c.adc_range_v[0]) / std::ldexp(1.0, c.adc_bits)}};
+  // The runtime keeps commanded joint angles this far inside the usable ranges (fivebar/runtime).
+  p["joint_margin_rad"] = c.joint_margin;
   p["station_names"] = stations;
   Json joint_names = Json::array();
   Json station_tree = Json::object();

@@ -9,6 +9,8 @@
 #include "fivebar/format.hpp"
 #include "fivebar/numerics.hpp"
 #include "fivebar/pattern.hpp"
+#include "fivebar/export/export.hpp"
+#include "fivebar/runtime/json_config.hpp"
 
 namespace fivebar {
 
@@ -39,7 +41,54 @@ SimulatedMechanism base_mechanism(const Design& design, const Station& station, 
   return sm;
 }
 
+/// The station's export (fivebar/export/export.hpp controller_parameters), read back by the runtime's
+/// own JSON reader: the configuration the device would receive, bit for bit.
+std::shared_ptr<const runtime::Config> exported_config(const Design& design, const std::string& station) {
+  const std::string text = render_json(controller_parameters(design, {station}));
+  try {
+    return std::make_shared<const runtime::Config>(runtime::parse_config_json(text, "export of station " + station));
+  } catch (const runtime::ConfigError& e) {
+    throw InputError(std::string("simulate: the runtime refuses the export: ") + e.what());
+  }
+}
+
 }  // namespace
+
+runtime::Config runtime_config(const SimulationInput& input) {
+  runtime::Config c;
+  const ControllerSettings& ctl = input.controller;
+  c.loop_rate_hz = ctl.loop_rate_hz;
+  c.adc_bits = ctl.adc_bits;
+  c.adc_range_v = ctl.adc_range_v;
+  c.volts_per_count = (ctl.adc_range_v[1] - ctl.adc_range_v[0]) / std::ldexp(1.0, ctl.adc_bits);
+  c.joint_margin = 0.0;
+  for (std::size_t k = 0; k < input.mechanisms.size(); ++k) {
+    const SimulatedMechanism& sm = input.mechanisms[k];
+    const Mechanism& m = sm.model.mechanism;
+    runtime::StationConfig st;
+    st.name = input.station + "_" + std::to_string(k);
+    runtime::MechanismConfig mc;
+    mc.name = "lower";
+    mc.o1 = {m.O1.x() / 1000.0, m.O1.y() / 1000.0};
+    mc.o2 = {m.O2.x() / 1000.0, m.O2.y() / 1000.0};
+    for (std::size_t i = 0; i < 4; ++i) mc.L[i] = m.L[i] / 1000.0;
+    mc.working_mode = {m.working_mode.sign1, m.working_mode.sign2};
+    mc.assembly = m.assembly_mode == AssemblyMode::Plus    ? runtime::Assembly::plus
+                  : m.assembly_mode == AssemblyMode::Minus ? runtime::Assembly::minus
+                                                           : runtime::Assembly::any;
+    for (std::size_t j = 0; j < 2; ++j) {
+      runtime::JointConfig& jc = mc.joints[j];
+      jc.name = st.name + "_lower_theta" + std::to_string(j + 1);
+      const JointControl& ctlj = sm.control[j];
+      jc.gains = {ctlj.pid.kp, ctlj.pid.ki, ctlj.pid.kd, ctlj.pid.i_clamp};
+      jc.volts_at_zero = ctlj.potentiometer.volts_at_zero;
+      jc.rad_per_volt = ctlj.potentiometer.rad_per_volt;
+    }
+    st.mechanisms.push_back(std::move(mc));
+    c.stations.push_back(std::move(st));
+  }
+  return c;
+}
 
 std::vector<SimulationInput> simulation_inputs(const Design& design, const SimulationRequest& request,
                                                const std::map<std::string, MechanismInertia>& inertia) {
@@ -61,12 +110,14 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
   const Geometry& g = *design.get<Geometry>();
   const double rate = controller.loop_rate_hz;
 
+  const std::shared_ptr<const runtime::Config> runtime = exported_config(design, station.name);
   const auto make = [&](const std::string& name) {
     SimulationInput in;
     in.station = station.name;
     in.reference_name = name;
     in.controller = controller;
     in.contact = contact;
+    in.runtime = runtime;
     in.mechanisms.push_back(base_mechanism(design, station, *station.lower, inertia));
     in.mechanisms.push_back(base_mechanism(design, station, *station.upper, inertia));
     return in;
@@ -167,6 +218,8 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
       }
       in.mechanisms[0].reference.push_back(s.lower.theta);
       in.mechanisms[0].reference_point_mm.push_back(s.lower.point);
+      in.mechanisms[0].target_mm.push_back(s.lower.target);
+      in.mechanisms[1].target_mm.push_back(s.upper.target);
       in.mechanisms[1].reference.push_back(s.upper.theta);
       in.mechanisms[1].reference_point_mm.push_back(s.upper.point);
     }

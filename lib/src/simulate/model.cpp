@@ -278,25 +278,11 @@ double kinetic_energy(const MechanismModel& model, const Eigen::Vector2d& theta,
   return 0.5 * w.dot(t.M * w);
 }
 
-double DiscretePid::update(double e) {
-  const double T = period_;
-  sum_ += e * T;
-  if (gains_.ki > 0.0) {
-    const double bound = gains_.i_clamp / gains_.ki;
-    sum_ = std::clamp(sum_, -bound, bound);
-  }
-  const double d = first_ ? 0.0 : (e - previous_) / T;
-  first_ = false;
-  previous_ = e;
-  return std::clamp(gains_.kp * e + gains_.ki * sum_ + gains_.kd * d, -1.0, 1.0);
-}
-
 double adc_reading(double theta, const Potentiometer& pot, int bits, const std::array<double, 2>& range_v) {
-  const double v = pot.volts_at_zero + theta / pot.rad_per_volt;
-  const double levels = std::ldexp(1.0, bits) - 1.0;  // codes 0 ... 2^bits - 1
-  const double q = (range_v[1] - range_v[0]) / levels;
-  const double code = std::clamp(std::round((v - range_v[0]) / q), 0.0, levels);
-  return pot.rad_per_volt * (range_v[0] + code * q - pot.volts_at_zero);
+  // The runtime's sensor model and conversion (fivebar/runtime/controller.hpp).
+  const double vpc = (range_v[1] - range_v[0]) / std::ldexp(1.0, bits);
+  const double code = runtime::adc_code(pot.volts_at_zero + theta / pot.rad_per_volt, bits, range_v, vpc);
+  return pot.rad_per_volt * ((range_v[0] + code * vpc) - pot.volts_at_zero);
 }
 
 }  // namespace fivebar

@@ -12,6 +12,7 @@
 #include "simulate/stepper.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/numerics.hpp"
+#include "fivebar/runtime/controller.hpp"
 
 namespace fivebar {
 
@@ -174,11 +175,54 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
     return n_roots > 0 ? dynamics_detail::root_directions(sys) : std::vector<int>{};
   };
 
-  // Controllers, per mechanism and joint.
-  std::vector<std::array<DiscretePid, 2>> pids;
-  for (const SimulatedMechanism& m : input.mechanisms) {
-    pids.push_back({DiscretePid(m.control[0].pid, T), DiscretePid(m.control[1].pid, T)});
+  // The device's controller (fivebar/runtime/controller.hpp), configured as exported; the
+  // simulated mechanisms' gains and potentiometers override their joints' (a tuner varies them).
+  runtime::Config rt_config = input.runtime ? *input.runtime : runtime_config(input);
+  std::vector<std::size_t> rt_index(nm, 0);
+  {
+    std::size_t station_base = 0;
+    std::vector<bool> found(nm, false);
+    for (const runtime::StationConfig& st : rt_config.stations) {
+      for (std::size_t i = 0; i < st.mechanisms.size(); ++i) {
+        for (std::size_t k = 0; k < nm; ++k) {
+          const bool named = input.runtime ? st.name == input.station && st.mechanisms[i].name == input.mechanisms[k].name
+                                           : st.name == input.station + "_" + std::to_string(k);
+          if (named && !found[k]) found[k] = true, rt_index[k] = station_base + i;
+        }
+      }
+      station_base += st.mechanisms.size();
+    }
+    for (std::size_t k = 0; k < nm; ++k) {
+      if (!found[k]) throw InputError("simulate: the runtime configuration has no " + input.mechanisms[k].name + " mechanism of station " + input.station);
+    }
+    std::size_t base = 0;
+    for (runtime::StationConfig& st : rt_config.stations) {
+      if (!input.override_runtime_joints) break;
+      for (runtime::MechanismConfig& mc : st.mechanisms) {
+        for (std::size_t k = 0; k < nm; ++k) {
+          if (rt_index[k] != base) continue;
+          for (std::size_t j = 0; j < 2; ++j) {
+            const JointControl& jc = input.mechanisms[k].control[j];
+            mc.joints[j].gains = {jc.pid.kp, jc.pid.ki, jc.pid.kd, jc.pid.i_clamp};
+            mc.joints[j].volts_at_zero = jc.potentiometer.volts_at_zero;
+            mc.joints[j].rad_per_volt = jc.potentiometer.rad_per_volt;
+          }
+        }
+        ++base;
+      }
+    }
   }
+  runtime::Controller controller = [&] {
+    try {
+      return runtime::Controller(std::move(rt_config));
+    } catch (const runtime::ConfigError& e) {
+      throw InputError(std::string("simulate: the runtime refuses the configuration: ") + e.what());
+    }
+  }();
+  const runtime::Config& rt = controller.config();
+  const runtime::Reading reading_kind = options.quantise ? runtime::Reading::counts : runtime::Reading::radians;
+  std::vector<double> readings(controller.joint_count(), 0.0);
+  std::vector<double> targets(2 * controller.mechanism_count(), 0.0);
   std::vector<std::array<double, 2>> pending(nm, {0.0, 0.0});
   std::vector<MechanismSummary> summary(nm);
   std::vector<double> sum_err2(nm, 0.0), sum_i2(nm, 0.0);
@@ -232,14 +276,24 @@ SimulationResult simulate(const SimulationInput& given, const SimulationOptions&
     // The controller at t_k: read, compute, and choose what is applied over [t_k, t_k+1).
     for (std::size_t k = 0; k < nm; ++k) {
       const SimulatedMechanism& m = input.mechanisms[k];
-      const auto& ref = m.reference[std::min(s, m.reference.size() - 1)];
-      std::array<double, 2> fresh{0.0, 0.0};
+      const std::size_t r = std::min(s, m.reference.size() - 1);
+      const Vec2& p = m.target_mm.empty() ? m.reference_point_mm[r] : m.target_mm[std::min(s, m.target_mm.size() - 1)];
+      const std::size_t q = rt_index[k];
+      targets[2 * q] = p.x() / 1000.0;  // mm -> m, as the export converts
+      targets[2 * q + 1] = p.y() / 1000.0;
       for (std::size_t j = 0; j < 2; ++j) {
         const double theta = y[kStateSize * k + j];
-        const double measured =
-            options.quantise ? adc_reading(theta, m.control[j].potentiometer, ctl.adc_bits, ctl.adc_range_v) : theta;
-        fresh[j] = pids[k][j].update(ref[j] - measured);
+        const Potentiometer& pot = m.control[j].potentiometer;
+        readings[2 * q + j] = options.quantise ? runtime::adc_code(pot.volts_at_zero + theta / pot.rad_per_volt, rt.adc_bits,
+                                                                   rt.adc_range_v, rt.volts_per_count)
+                                               : theta;
       }
+    }
+    controller.cycle(readings.data(), reading_kind, targets.data());
+    if (options.controller_log) options.controller_log(tk, readings, reading_kind, targets, controller);
+    for (std::size_t k = 0; k < nm; ++k) {
+      const std::size_t q = rt_index[k];
+      const std::array<double, 2> fresh{controller.duties()[2 * q], controller.duties()[2 * q + 1]};
       if (options.drive == Drive::constant_duty) {
         sys.duty[k] = {options.duty, options.duty};
       } else if (options.drive == Drive::open_circuit) {

@@ -13,7 +13,8 @@
 /// Content (controller_parameters()), SI units as ROS expects (REP 103: m, rad, s, V, Hz), unit
 /// suffixes on fivebar's own keys:
 ///   fivebar: {design, design_hash, hash_algorithm, tool_version, format_version, units}
-///   loop_rate_hz, pwm_hz, adc: {bits, range_v [lo, hi], volts_per_count}
+///   loop_rate_hz, pwm_hz, adc: {bits, range_v [lo, hi], volts_per_count}, joint_margin_rad (the
+///     runtime's margin inside the usable ranges, controller.joint_margin_deg)
 ///   station_names [..], joint_names [..] (every joint, station and mechanism order)
 ///   stations.<station>: {target: {center_m, axes_m (full lengths), angle_rad}, mechanisms [..],
 ///     <lower|upper>: {joint_names, o1_m, o2_m, link_lengths_m [L1..L4], working_mode,

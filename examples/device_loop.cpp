@@ -1,0 +1,143 @@
+// The device's control loop around fivebar::runtime (docs/runtime.md "Device loop"): the starting
+// point of the device's ROS 2 node. It reads the exported configuration, then every period reads the
+// joints and the reference points from an I/O backend, runs one cycle, and writes the duties.
+//
+//   device_loop CONFIG.json [IN.csv|-] [--realtime]
+//
+// The backend here is a CSV stream standing in for the DAQ and the motor drivers: each input row
+// holds time_s, per joint <joint>_counts (or _volts, _theta_rad), per mechanism
+// <station>_<mechanism>_x_ref_mm and _y_ref_mm (the log format of `fivebar replay`; other columns,
+// such as logged duties, are ignored); each output row (stdout) holds time_s, the duties
+// <joint>_duty and the statuses <station>_<mechanism>_status. A ROS node replaces CsvIo by an
+// implementation of DeviceIo over its DAQ driver, its PWM outputs and its reference topic, and the
+// loop by a wall timer at loop_rate_hz. Nothing in the loop allocates after the controller is built.
+
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "fivebar/runtime.hpp"
+
+namespace rt = fivebar::runtime;
+
+/// What the loop needs from the hardware (or its stand-in).
+class DeviceIo {
+ public:
+  virtual ~DeviceIo() = default;
+  /// The next sample: readings (joint order) and reference points (m, 2 per mechanism); false at the end.
+  virtual bool read(double& t_s, double* readings, double* targets_m) = 0;
+  /// The duties (joint order) and statuses (mechanism order) of this cycle.
+  virtual void write(double t_s, const double* duties, const rt::Status* statuses) = 0;
+  virtual rt::Reading kind() const = 0;
+};
+
+/// CSV on streams: a recorded or piped log in, duties out.
+class CsvIo : public DeviceIo {
+ public:
+  CsvIo(std::istream& in, std::ostream& out, const rt::Config& c) : in_(in), out_(out) {
+    std::string line;
+    if (!std::getline(in_, line)) throw std::runtime_error("input: no header row");
+    const std::vector<std::string> header = split(line);
+    std::map<std::string, std::size_t> at;
+    for (std::size_t i = 0; i < header.size(); ++i) at[header[i]] = i;
+    const auto column = [&](const std::string& name) {
+      const auto it = at.find(name);
+      if (it == at.end()) throw std::runtime_error("input: column " + name + " is missing");
+      return it->second;
+    };
+    const std::string first = c.stations.front().mechanisms.front().joints[0].name;
+    kind_ = at.count(first + "_counts") ? rt::Reading::counts : at.count(first + "_volts") ? rt::Reading::volts : rt::Reading::radians;
+    const char* suffix = kind_ == rt::Reading::counts ? "_counts" : kind_ == rt::Reading::volts ? "_volts" : "_theta_rad";
+    time_ = column("time_s");
+    out_ << "time_s";
+    for (const auto& s : c.stations)
+      for (const auto& m : s.mechanisms) {
+        for (const auto& j : m.joints) {
+          reading_.push_back(column(j.name + suffix));
+          out_ << "," << j.name << "_duty";
+        }
+        target_.push_back(column(s.name + "_" + m.name + "_x_ref_mm"));
+        target_.push_back(column(s.name + "_" + m.name + "_y_ref_mm"));
+      }
+    for (const auto& s : c.stations)
+      for (const auto& m : s.mechanisms) out_ << "," << s.name << "_" << m.name << "_status";
+    out_ << "\n";
+    out_.precision(17);
+  }
+  bool read(double& t, double* readings, double* targets) override {
+    std::string line;
+    if (!std::getline(in_, line)) return false;
+    const std::vector<std::string> cells = split(line);
+    const auto cell = [&](std::size_t i) { return i < cells.size() ? std::strtod(cells[i].c_str(), nullptr) : 0.0; };
+    t = cell(time_);
+    for (std::size_t i = 0; i < reading_.size(); ++i) readings[i] = cell(reading_[i]);
+    for (std::size_t i = 0; i < target_.size(); ++i) targets[i] = cell(target_[i]) / 1000.0;
+    return true;
+  }
+  void write(double t, const double* duties, const rt::Status* statuses) override {
+    out_ << t;
+    for (std::size_t i = 0; i < reading_.size(); ++i) out_ << "," << duties[i];
+    for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << "," << rt::to_string(statuses[k]);
+    out_ << "\n";
+  }
+  rt::Reading kind() const override { return kind_; }
+
+ private:
+  static std::vector<std::string> split(const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream s(line);
+    for (std::string cell; std::getline(s, cell, ',');) out.push_back(cell);
+    return out;
+  }
+  std::istream& in_;
+  std::ostream& out_;
+  rt::Reading kind_ = rt::Reading::counts;
+  std::size_t time_ = 0;
+  std::vector<std::size_t> reading_, target_;
+};
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    std::cerr << "usage: device_loop CONFIG.json [IN.csv|-] [--realtime]\n";
+    return 2;
+  }
+  bool realtime = false;
+  std::string input = "-";
+  for (int i = 2; i < argc; ++i) {
+    if (std::string(argv[i]) == "--realtime") realtime = true;
+    else input = argv[i];
+  }
+  try {
+    rt::Controller controller(rt::load_config_json(argv[1]));  // refuses a bad configuration, naming the key
+    std::ifstream file;
+    if (input != "-") {
+      file.open(input);
+      if (!file) throw std::runtime_error(input + ": cannot be read");
+    }
+    CsvIo io(input == "-" ? std::cin : file, std::cout, controller.config());
+    // Buffers sized once: the loop below does not allocate.
+    std::vector<double> readings(controller.joint_count()), targets(2 * controller.mechanism_count());
+    std::vector<rt::Status> statuses(controller.mechanism_count());
+    const auto period = std::chrono::duration<double>(1.0 / controller.config().loop_rate_hz);
+    auto next = std::chrono::steady_clock::now();
+    double t = 0.0;
+    while (io.read(t, readings.data(), targets.data())) {
+      controller.cycle(readings.data(), io.kind(), targets.data());
+      for (std::size_t k = 0; k < statuses.size(); ++k) statuses[k] = controller.mechanism(k).status;
+      io.write(t, controller.duties(), statuses.data());
+      if (realtime) {
+        next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+        std::this_thread::sleep_until(next);
+      }
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "device_loop: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,74 @@
+#pragma once
+/// `fivebar replay` (docs/runtime.md "Replay"): a recorded log of the device's measured joints and
+/// duties fed through fivebar::runtime, its duties compared with the logged ones (a field check that
+/// the device runs this configuration), and the log format the software-in-the-loop run writes.
+///
+/// Log (CSV, header row, docs/conventions.md bench files): `time_s`; per joint of the configuration
+/// `<joint>_counts`, `<joint>_volts` or `<joint>_theta_rad` (one kind for the whole log) and
+/// `<joint>_duty`; per mechanism the reference point it was given, `<station>_<mechanism>_x_ref_mm`
+/// and `_y_ref_mm`. Other columns are ignored.
+
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "fivebar/json.hpp"
+#include "fivebar/runtime/controller.hpp"
+
+namespace fivebar {
+
+struct ReplayLog {
+  /// The configuration's stations the log has columns for (a station without any is left out:
+  /// a log of one station replays against the export of several).
+  std::vector<std::string> stations;
+  runtime::Reading kind = runtime::Reading::counts;
+  std::vector<double> time_s;
+  std::vector<std::vector<double>> readings;  ///< per row, in the runtime's joint order
+  std::vector<std::vector<double>> targets_m; ///< per row, 2 per mechanism
+  std::vector<std::vector<double>> duties;    ///< per row, logged
+};
+
+/// Reads a log for `config` (its joints and mechanisms). InputError "FILE:LINE: column ..." naming
+/// a missing column, a cell that is not a number, a row of the wrong length, mixed reading kinds.
+ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const std::string& origin);
+
+/// Header and one row of a log (numbers in their shortest round-trip form).
+void write_replay_header(std::ostream& out, const runtime::Config& config, runtime::Reading kind);
+void write_replay_row(std::ostream& out, double t_s, const std::vector<double>& readings,
+                      const std::vector<double>& targets_m, const double* duties, std::size_t joints);
+
+struct ReplayJoint {
+  std::string joint;
+  double max_difference = 0.0;  ///< max |runtime duty - logged duty|
+  std::size_t mismatches = 0;   ///< rows beyond the tolerance
+};
+
+struct ReplayResult {
+  std::size_t rows = 0;
+  double tolerance = 0.0;
+  double max_difference = 0.0;
+  std::size_t mismatches = 0;
+  bool first_mismatch = false;
+  std::size_t first_row = 0;    ///< 0-based data row
+  double first_time_s = 0.0;
+  std::string first_joint;
+  double first_logged = 0.0, first_runtime = 0.0;
+  std::vector<ReplayJoint> joints;
+  /// Per mechanism (runtime order): "station/mechanism" and the count of each status.
+  std::vector<std::string> mechanisms;
+  std::vector<std::array<std::size_t, 6>> status_counts;
+  bool passed() const { return mismatches == 0; }
+};
+
+/// `config` with only the log's stations.
+runtime::Config config_for_log(const runtime::Config& config, const ReplayLog& log);
+
+/// Runs a fresh runtime of config_for_log(config, log) over the log's rows, in order.
+ReplayResult replay_log(const runtime::Config& config, const ReplayLog& log, double tolerance);
+
+Json to_json(const ReplayResult& result);
+
+}  // namespace fivebar

@@ -1,0 +1,232 @@
+// `fivebar replay`: a device log through the runtime (fivebar/replay.hpp).
+
+#include "fivebar/replay.hpp"
+
+#include <cmath>
+#include <istream>
+#include <map>
+#include <ostream>
+
+#include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
+
+namespace fivebar {
+
+namespace {
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  for (char c : line) {
+    if (c == ',') {
+      out.push_back(cell);
+      cell.clear();
+    } else if (c != '\r') {
+      cell.push_back(c);
+    }
+  }
+  out.push_back(cell);
+  for (std::string& s : out) {
+    const auto a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
+    s = a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+  }
+  return out;
+}
+
+const char* kind_suffix(runtime::Reading k) {
+  return k == runtime::Reading::counts ? "_counts" : k == runtime::Reading::volts ? "_volts" : "_theta_rad";
+}
+
+struct Columns {
+  std::vector<std::string> joints, mechanisms;  // joint names; "<station>_<mechanism>"
+};
+
+Columns columns_of(const runtime::Config& c) {
+  Columns out;
+  for (const auto& s : c.stations)
+    for (const auto& m : s.mechanisms) {
+      out.mechanisms.push_back(s.name + "_" + m.name);
+      for (const auto& j : m.joints) out.joints.push_back(j.name);
+    }
+  return out;
+}
+
+}  // namespace
+
+ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const std::string& origin) {
+  std::string line;
+  if (!std::getline(in, line)) throw InputError(origin + ":1: empty log (a header row is needed)");
+  const std::vector<std::string> header = split_csv(line);
+  std::map<std::string, std::size_t> at;
+  for (std::size_t i = 0; i < header.size(); ++i) at[header[i]] = i;
+  const auto column = [&](const std::string& name) {
+    const auto it = at.find(name);
+    if (it == at.end()) throw InputError(origin + ":1: column " + name + " is missing");
+    return it->second;
+  };
+  ReplayLog log;
+  runtime::Config present = config;
+  present.stations.clear();
+  for (const auto& st : config.stations) {
+    const std::string& j = st.mechanisms.front().joints[0].name;
+    if (at.count(j + "_counts") || at.count(j + "_volts") || at.count(j + "_theta_rad")) {
+      present.stations.push_back(st);
+      log.stations.push_back(st.name);
+    }
+  }
+  if (present.stations.empty()) {
+    const std::string& j = config.stations.front().mechanisms.front().joints[0].name;
+    throw InputError(origin + ":1: column " + j + "_counts (or _volts, _theta_rad) is missing: the log has no joint of the configuration");
+  }
+  const Columns cols = columns_of(present);
+  bool kind_found = false;
+  for (runtime::Reading k : {runtime::Reading::counts, runtime::Reading::volts, runtime::Reading::radians}) {
+    if (at.count(cols.joints.front() + kind_suffix(k))) {
+      if (kind_found) throw InputError(origin + ":1: " + cols.joints.front() + ": more than one reading column (counts, volts, theta_rad)");
+      log.kind = k;
+      kind_found = true;
+    }
+  }
+  if (!kind_found) {
+    throw InputError(origin + ":1: column " + cols.joints.front() + "_counts (or _volts, _theta_rad) is missing");
+  }
+  const std::size_t t_col = column("time_s");
+  std::vector<std::size_t> reading_col, duty_col, target_col;
+  for (const std::string& j : cols.joints) {
+    reading_col.push_back(column(j + kind_suffix(log.kind)));
+    duty_col.push_back(column(j + "_duty"));
+  }
+  for (const std::string& m : cols.mechanisms) {
+    target_col.push_back(column(m + "_x_ref_mm"));
+    target_col.push_back(column(m + "_y_ref_mm"));
+  }
+  std::size_t line_no = 1;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    const std::vector<std::string> cells = split_csv(line);
+    if (cells.size() != header.size()) {
+      throw InputError(origin + ":" + std::to_string(line_no) + ": " + std::to_string(cells.size()) + " cells, the header has " +
+                       std::to_string(header.size()));
+    }
+    const auto number = [&](std::size_t c) {
+      const std::string& s = cells[c];
+      std::size_t used = 0;
+      double v = 0.0;
+      try {
+        v = std::stod(s, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (s.empty() || used != s.size() || !std::isfinite(v)) {
+        throw InputError(origin + ":" + std::to_string(line_no) + ": column " + header[c] + ": '" + s + "' is not a finite number");
+      }
+      return v;
+    };
+    log.time_s.push_back(number(t_col));
+    std::vector<double> r, t, d;
+    for (std::size_t c : reading_col) r.push_back(number(c));
+    for (std::size_t c : duty_col) d.push_back(number(c));
+    for (std::size_t i = 0; i < target_col.size(); ++i) t.push_back(number(target_col[i]) / 1000.0);
+    log.readings.push_back(std::move(r));
+    log.duties.push_back(std::move(d));
+    log.targets_m.push_back(std::move(t));
+  }
+  if (log.time_s.empty()) throw InputError(origin + ": the log has no data row");
+  return log;
+}
+
+void write_replay_header(std::ostream& out, const runtime::Config& config, runtime::Reading kind) {
+  const Columns cols = columns_of(config);
+  out << "time_s";
+  for (const std::string& j : cols.joints) out << "," << j << kind_suffix(kind) << "," << j << "_duty";
+  for (const std::string& m : cols.mechanisms) out << "," << m << "_x_ref_mm," << m << "_y_ref_mm";
+  out << "\n";
+}
+
+void write_replay_row(std::ostream& out, double t, const std::vector<double>& readings, const std::vector<double>& targets,
+                      const double* duties, std::size_t joints) {
+  out << format::shortest(t);
+  for (std::size_t j = 0; j < joints; ++j) out << "," << format::shortest(readings[j]) << "," << format::shortest(duties[j]);
+  for (double v : targets) out << "," << format::shortest(v * 1000.0);
+  out << "\n";
+}
+
+runtime::Config config_for_log(const runtime::Config& config, const ReplayLog& log) {
+  runtime::Config c = config;
+  c.stations.clear();
+  for (const auto& st : config.stations)
+    for (const std::string& name : log.stations)
+      if (st.name == name) c.stations.push_back(st);
+  return c;
+}
+
+ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, double tolerance) {
+  const runtime::Config config = config_for_log(full, log);
+  runtime::Controller ctl(config);
+  const Columns cols = columns_of(config);
+  ReplayResult r;
+  r.tolerance = tolerance;
+  r.rows = log.time_s.size();
+  for (const std::string& j : cols.joints) r.joints.push_back({j, 0.0, 0});
+  for (const auto& s : config.stations)
+    for (const auto& m : s.mechanisms) r.mechanisms.push_back(s.name + "/" + m.name);
+  r.status_counts.assign(r.mechanisms.size(), {});
+  for (std::size_t row = 0; row < r.rows; ++row) {
+    ctl.cycle(log.readings[row].data(), log.kind, log.targets_m[row].data());
+    for (std::size_t k = 0; k < r.mechanisms.size(); ++k) ++r.status_counts[k][static_cast<std::size_t>(ctl.mechanism(k).status)];
+    for (std::size_t j = 0; j < cols.joints.size(); ++j) {
+      // A logged duty may be rounded by the device's logger: the difference, not bits, is compared.
+      const double diff = std::fabs(ctl.duties()[j] - log.duties[row][j]);
+      ReplayJoint& rj = r.joints[j];
+      rj.max_difference = std::max(rj.max_difference, diff);
+      r.max_difference = std::max(r.max_difference, diff);
+      if (diff > tolerance) {
+        ++rj.mismatches;
+        ++r.mismatches;
+        if (!r.first_mismatch) {
+          r.first_mismatch = true;
+          r.first_row = row;
+          r.first_time_s = log.time_s[row];
+          r.first_joint = cols.joints[j];
+          r.first_logged = log.duties[row][j];
+          r.first_runtime = ctl.duties()[j];
+        }
+      }
+    }
+  }
+  return r;
+}
+
+Json to_json(const ReplayResult& r) {
+  Json j;
+  j["rows"] = r.rows;
+  j["tolerance"] = r.tolerance;
+  j["max_duty_difference"] = r.max_difference;
+  j["mismatches"] = r.mismatches;
+  j["passed"] = r.passed();
+  j["first_mismatch"] = r.first_mismatch ? Json{{"row", r.first_row},
+                                                {"time_s", r.first_time_s},
+                                                {"joint", r.first_joint},
+                                                {"logged_duty", r.first_logged},
+                                                {"runtime_duty", r.first_runtime}}
+                                         : Json(nullptr);
+  Json joints = Json::array();
+  for (const ReplayJoint& rj : r.joints) {
+    joints.push_back({{"joint", rj.joint}, {"max_duty_difference", rj.max_difference}, {"mismatches", rj.mismatches}});
+  }
+  j["joints"] = joints;
+  Json mechs = Json::array();
+  for (std::size_t k = 0; k < r.mechanisms.size(); ++k) {
+    const auto slash = r.mechanisms[k].find('/');
+    Json counts = Json::object();
+    for (std::size_t s = 0; s < 6; ++s) counts[runtime::to_string(static_cast<runtime::Status>(s))] = r.status_counts[k][s];
+    mechs.push_back({{"station", r.mechanisms[k].substr(0, slash)},
+                     {"mechanism", r.mechanisms[k].substr(slash + 1)},
+                     {"statuses", counts}});
+  }
+  j["mechanisms"] = mechs;
+  return j;
+}
+
+}  // namespace fivebar

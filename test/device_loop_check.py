@@ -1,0 +1,50 @@
+#!/usr/bin/env python3
+"""examples/device_loop.cpp against the simulator: the software-in-the-loop log of a pattern
+(`fivebar replay --sil`) fed to the example through its CSV stand-in for the DAQ gives, row by row,
+the duties the simulator's runtime computed (printed with 17 digits: read back bit for bit), and
+every status is ok.
+
+    device_loop_check.py FIVEBAR DEVICE_LOOP SOURCE_DIR WORK_DIR
+"""
+import csv
+import pathlib
+import shutil
+import subprocess
+import sys
+
+FIVEBAR, LOOP, SOURCE, WORK = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3]), pathlib.Path(sys.argv[4])
+DESIGN = str(SOURCE / "designs" / "iros2022.yaml")
+if WORK.exists():
+    shutil.rmtree(WORK)
+WORK.mkdir(parents=True)
+subprocess.run([FIVEBAR, "export", DESIGN, "-s", "index", "--format", "json", "--out", str(WORK / "export")], check=True,
+               stdout=subprocess.DEVNULL)
+config = next((WORK / "export").glob("*.json"))
+subprocess.run([FIVEBAR, "replay", DESIGN, "--sil", "-s", "index", "--pattern", "twist", "--out", str(WORK / "sil")],
+               check=True, stdout=subprocess.DEVNULL)
+log = next((WORK / "sil").glob("*-sil.csv"))
+out = subprocess.run([LOOP, str(config), str(log)], check=True, capture_output=True, text=True).stdout
+logged = list(csv.DictReader(log.open()))
+looped = list(csv.DictReader(out.splitlines()))
+failures = []
+if len(logged) != len(looped) or not logged:
+    failures.append(f"{len(looped)} rows out for {len(logged)} in")
+duty_cols = [c for c in logged[0] if c.endswith("_duty")]
+status_cols = [c for c in looped[0] if c.endswith("_status")]
+if len(duty_cols) != 4 or len(status_cols) != 2:
+    failures.append(f"columns: {duty_cols} {status_cols}")
+nonzero = 0
+for i, (a, b) in enumerate(zip(logged, looped)):
+    for c in duty_cols:
+        if float(a[c]) != float(b[c]):
+            failures.append(f"row {i + 1} {c}: logged {a[c]}, device_loop {b[c]}")
+        nonzero += float(b[c]) != 0.0
+    for c in status_cols:
+        if b[c] != "ok":
+            failures.append(f"row {i + 1} {c}: {b[c]}")
+if nonzero < len(logged):
+    failures.append(f"only {nonzero} non-zero duties: the pattern does not drive the motors")
+for f in failures[:20]:
+    print("FAIL", f)
+print(f"{len(logged)} cycles, {len(failures)} failures")
+sys.exit(1 if failures else 0)

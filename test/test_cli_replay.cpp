@@ -1,0 +1,149 @@
+// End-to-end tests of `fivebar replay`: the software-in-the-loop run reports simulate's figures to
+// the last digit; its log, replayed against the exported JSON file (a second reading of the
+// configuration, from disk), gives the logged duties exactly; a changed duty or gain is caught and
+// named; bad logs and configurations are exit 2 naming the column or key.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_test.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using ft::slurp;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+class CliReplay : public ft::CliTest {
+ protected:
+  CliReplay() : CliTest("fivebar_test_cli_replay") {}
+
+  /// The index station's export (JSON) and a SIL log of its stretch pattern, once per test.
+  void prepare() {
+    const Outcome e = run({"export", kDesign, "-s", "index", "--format", "json", "--out", "export"});
+    ASSERT_EQ(e.code, 0) << e.err;
+    for (const auto& f : fs::directory_iterator(dir_ / "export"))
+      if (f.path().extension() == ".json") config_ = f.path().string();
+    ASSERT_FALSE(config_.empty());
+    const Outcome s = run({"replay", kDesign, "--sil", "-s", "index", "--pattern", "stretch", "--out", "sil", "--json"});
+    ASSERT_EQ(s.code, 0) << s.err;
+    sil_ = parse(s);
+    log_ = sil_["runs"][0]["log"].get<std::string>();
+    if (fs::path(log_).is_relative()) log_ = (dir_ / log_).string();
+  }
+  std::string config_, log_;
+  json sil_;
+};
+
+TEST_F(CliReplay, SoftwareInTheLoopReportsSimulatesFiguresAndItsLogReplaysExactly) {
+  prepare();
+  ASSERT_FALSE(HasFailure());
+  // The same figures as `fivebar simulate` (closed-form masses: --no-render).
+  const Outcome sim = run({"simulate", kDesign, "-s", "index", "--pattern", "stretch", "--no-render", "--out", "sim", "--json"});
+  ASSERT_EQ(sim.code, 0) << sim.err;
+  const json a = parse(sim)["runs"][0], b = sil_["runs"][0];
+  ASSERT_EQ(a["mechanisms"].size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (const char* key : {"max_error_mm", "rms_error_mm", "peak_duty", "saturation_s", "peak_current_A"}) {
+      EXPECT_EQ(a["mechanisms"][k][key], b["mechanisms"][k][key]) << key;
+    }
+  }
+  EXPECT_EQ(a["samples"], b["samples"]);
+  // The log through a runtime read from the exported file: every duty bit for bit.
+  const Outcome r = run({"replay", log_, "--config", config_, "--tolerance", "0", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err << r.out;
+  const json j = parse(r);
+  EXPECT_EQ(j["mode"], "log");
+  EXPECT_EQ(j["mismatches"], 0);
+  EXPECT_EQ(j["max_duty_difference"], 0.0);
+  EXPECT_EQ(j["rows"], b["samples"]);
+  EXPECT_EQ(j["joints"].size(), 4u);
+  for (const json& m : j["mechanisms"]) EXPECT_EQ(m["statuses"]["ok"], j["rows"]) << m.dump();
+}
+
+TEST_F(CliReplay, AChangedDutyOrGainIsAMismatchNamedByRowAndJoint) {
+  prepare();
+  ASSERT_FALSE(HasFailure());
+  // One logged duty changed: row 31, index_upper_theta2.
+  std::istringstream in(slurp(log_));
+  std::string header, line, text;
+  std::getline(in, header);
+  text = header + "\n";
+  std::vector<std::string> cols;
+  {
+    std::stringstream h(header);
+    for (std::string c; std::getline(h, c, ',');) cols.push_back(c);
+  }
+  std::size_t duty_col = 0;
+  for (std::size_t i = 0; i < cols.size(); ++i)
+    if (cols[i] == "index_upper_theta2_duty") duty_col = i;
+  ASSERT_GT(duty_col, 0u);
+  for (int row = 1; std::getline(in, line); ++row) {
+    if (row == 31) {
+      std::vector<std::string> cells;
+      std::stringstream s(line);
+      for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+      cells[duty_col] = std::to_string(std::stod(cells[duty_col]) + 0.01);
+      line.clear();
+      for (std::size_t i = 0; i < cells.size(); ++i) line += (i ? "," : "") + cells[i];
+    }
+    text += line + "\n";
+  }
+  const fs::path changed = write("changed.csv", text);
+  Outcome r = run({"replay", changed.string(), "--config", config_, "--json"});
+  ASSERT_EQ(r.code, 1) << r.err;
+  json j = parse(r);
+  EXPECT_EQ(j["mismatches"], 1);
+  EXPECT_EQ(j["first_mismatch"]["row"], 30);
+  EXPECT_EQ(j["first_mismatch"]["joint"], "index_upper_theta2");
+  EXPECT_NEAR(j["max_duty_difference"].get<double>(), 0.01, 1e-6);
+  // A configuration with another gain: the device does not run it.
+  std::string cfg = slurp(config_);
+  // gains.index_lower_theta1.d (gains come first of the joint-keyed maps: keys are sorted).
+  const auto joint = cfg.find("\"index_lower_theta1\": {", cfg.find("\"gains\""));
+  ASSERT_NE(joint, std::string::npos);
+  const std::string key = "\"d\": ";
+  const auto pos = cfg.find(key, joint);
+  ASSERT_NE(pos, std::string::npos);
+  const auto end = cfg.find_first_of(",\n", pos + key.size());
+  cfg.replace(pos + key.size(), end - pos - key.size(), "0.5");
+  const fs::path other = write("other.json", cfg);
+  r = run({"replay", log_, "--config", other.string(), "--json"});
+  ASSERT_EQ(r.code, 1) << r.err;
+  j = parse(r);
+  EXPECT_GT(j["mismatches"].get<int>(), 0);
+  EXPECT_EQ(j["first_mismatch"]["joint"], "index_lower_theta1");
+}
+
+TEST_F(CliReplay, BadLogsAndConfigurationsAreExitTwoNamingTheColumnOrKey) {
+  const fs::path cfg = write("bad.json", "{\"n\": {\"ros__parameters\": {\"loop_rate_hz\": 100.0}}}");
+  const fs::path log = write("log.csv", "time_s,index_lower_theta1_counts\n0,1\n");
+  Outcome r = run({"replay", log.string(), "--config", cfg.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("adc: missing key"));
+  r = run({"replay", log.string()});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("--config"));
+  const Outcome e = run({"export", kDesign, "-s", "index", "--format", "json", "--out", "export"});
+  ASSERT_EQ(e.code, 0) << e.err;
+  std::string good;
+  for (const auto& f : fs::directory_iterator(dir_ / "export")) good = f.path().string();
+  r = run({"replay", log.string(), "--config", good});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("column index_lower_theta1_duty is missing"));
+  const fs::path nan = write("nan.csv", slurp(log).substr(0, slurp(log).find('\n') + 1) + "0,abc\n");
+  r = run({"replay", nan.string(), "--config", good});
+  EXPECT_EQ(r.code, 2);
+}
+
+}  // namespace

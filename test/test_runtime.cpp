@@ -1,0 +1,517 @@
+// fivebar::runtime (fivebar/runtime/controller.hpp): against the library's own kinematics and
+// collision model (an independent formulation in mm on Eigen), a hand-stepped PID, the export read
+// back by the runtime's JSON reader, the simulator's recorded loop (bit for bit), its refusal of
+// bad configurations and measurements, and the real-time properties (no allocation in 10^6 cycles,
+// determinism).
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <limits>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <random>
+#include <string>
+#include <type_traits>
+
+#include "fivebar/collision.hpp"
+#include "fivebar/dynamics.hpp"
+#include "fivebar/export/export.hpp"
+#include "fivebar/runtime.hpp"
+#include "paper.hpp"
+
+// --- Allocation counter: every global operator new of this executable --------------------------
+namespace {
+std::atomic<long long> g_allocations{0};
+}
+void* operator new(std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t n) {
+  ++g_allocations;
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace fivebar {
+namespace {
+
+using ::testing::HasSubstr;
+namespace rt = fivebar::runtime;
+
+const Design& paper() {
+  static const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  return d;
+}
+
+std::string export_text(const std::vector<std::string>& stations = {}) {
+  return render_json(controller_parameters(paper(), stations));
+}
+
+rt::Config paper_config() { return rt::parse_config_json(export_text(), "iros2022.json"); }
+
+/// Index of mechanism `name` of `station` in the runtime's order.
+std::size_t index_of(const rt::Config& c, const std::string& station, const std::string& name) {
+  std::size_t k = 0;
+  for (const auto& s : c.stations)
+    for (const auto& m : s.mechanisms) {
+      if (s.name == station && m.name == name) return k;
+      ++k;
+    }
+  ADD_FAILURE() << station << "/" << name;
+  return 0;
+}
+
+/// Radians readings that put every mechanism at the IK of `points_mm` (the design's own IK).
+struct Scene {
+  std::vector<double> readings, targets;
+};
+
+Scene at_points(const rt::Config& c, const std::vector<Vec2>& points_mm) {
+  Scene s;
+  std::size_t k = 0;
+  for (const auto& st : c.stations) {
+    const Station& station = paper().require_station(st.name);
+    for (const auto& m : st.mechanisms) {
+      const Mechanism& mech = m.name == "lower" ? *station.lower : *station.upper;
+      const Pose pose = ik(mech, points_mm[k]);
+      s.readings.push_back(pose.theta1);
+      s.readings.push_back(pose.theta2);
+      s.targets.push_back(points_mm[k].x() / 1000.0);
+      s.targets.push_back(points_mm[k].y() / 1000.0);
+      ++k;
+    }
+  }
+  return s;
+}
+
+std::vector<Vec2> centres(const rt::Config& c, double separation_mm = 6.0) {
+  std::vector<Vec2> p;
+  for (const auto& st : c.stations) {
+    const Vec2 centre = paper().require_station(st.name).target.center;
+    for (const auto& m : st.mechanisms) p.push_back(centre + Vec2(0.0, (m.name == "lower" ? -0.5 : 0.5) * separation_mm));
+  }
+  return p;
+}
+
+TEST(Runtime, ReadsTheExportAndRefusesNothingOfIt) {
+  const rt::Config c = paper_config();
+  EXPECT_EQ(c.design, "iros2022");
+  EXPECT_EQ(c.stations.size(), paper().stations.size());
+  EXPECT_EQ(c.mechanism_count(), 4u);
+  EXPECT_TRUE(c.collision.checked);
+  const ControllerSettings& ctl = *paper().get<ControllerSettings>();
+  EXPECT_EQ(c.loop_rate_hz, ctl.loop_rate_hz);
+  EXPECT_EQ(c.joint_margin, ctl.joint_margin);
+  EXPECT_EQ(c.volts_per_count, (ctl.adc_range_v[1] - ctl.adc_range_v[0]) / 65536.0);
+  const Mechanism& low = *paper().require_station("index").lower;
+  const rt::MechanismConfig& m = c.stations[0].mechanisms[0];
+  EXPECT_EQ(m.name, "lower");
+  EXPECT_EQ(m.L[2], low.L[2] / 1000.0);  // bit for bit: the export's shortest round-trip text
+  EXPECT_EQ(m.joints[0].name, "index_lower_theta1");
+  EXPECT_EQ(m.joints[0].gains.p, ctl.joint("index", "lower", 1).pid.kp);
+}
+
+TEST(Runtime, CommandsTheDesignsInverseKinematicsAtRandomReachablePoints) {
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  std::mt19937_64 rng(testing::test_seed());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    std::vector<Vec2> pts;
+    for (const auto& st : c.stations) {
+      const Ellipse& e = paper().require_station(st.name).target;
+      for (const auto& mech : st.mechanisms) {
+        (void)mech;
+        pts.push_back(e.center + Vec2(0.5 * e.axes.x() * u(rng), 0.5 * e.axes.y() * u(rng)));
+      }
+    }
+    ctl.reset();
+    const Scene s = at_points(c, centres(c));
+    std::vector<double> targets(s.targets.size());
+    for (std::size_t k = 0; k < pts.size(); ++k) targets[2 * k] = pts[k].x() / 1000, targets[2 * k + 1] = pts[k].y() / 1000;
+    ctl.cycle(s.readings.data(), rt::Reading::radians, targets.data());
+    std::size_t k = 0;
+    for (const auto& st : c.stations) {
+      const Station& station = paper().require_station(st.name);
+      for (const auto& mc : st.mechanisms) {
+        const Mechanism& mech = mc.name == "lower" ? *station.lower : *station.upper;
+        const rt::MechanismState& ms = ctl.mechanism(k);
+        const Pose pose = ik(mech, pts[k]);
+        SCOPED_TRACE(st.name + "/" + mc.name + " at " + std::to_string(pts[k].x()) + ", " + std::to_string(pts[k].y()));
+        if (ms.status == rt::Status::ok && usable(mech, pose)) {
+          // Same angle modulo a turn, to the accuracy of the closed form at this scale.
+          for (int j = 0; j < 2; ++j) {
+            const double d = std::remainder(ms.theta_command[std::size_t(j)] - (j ? pose.theta2 : pose.theta1), 2 * M_PI);
+            EXPECT_LT(std::abs(d), 1e-12);
+          }
+          ++checked;
+        }
+        for (double v : {ms.duty[0], ms.duty[1], ms.point_command[0], ms.point_command[1]}) EXPECT_TRUE(std::isfinite(v));
+        ++k;
+      }
+    }
+  }
+  EXPECT_GT(checked, 400);
+}
+
+TEST(Runtime, MeasuredPointsAreTheDesignsForwardKinematics) {
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  const std::vector<Vec2> pts = centres(c, 7.0);
+  const Scene s = at_points(c, pts);
+  ctl.cycle(s.readings.data(), rt::Reading::radians, s.targets.data());
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    ASSERT_TRUE(ctl.mechanism(k).measured_pose);
+    EXPECT_NEAR(ctl.mechanism(k).point_measured[0] * 1000, pts[k].x(), 1e-9);
+    EXPECT_NEAR(ctl.mechanism(k).point_measured[1] * 1000, pts[k].y(), 1e-9);
+    // At the reference: zero error, zero duty.
+    EXPECT_NEAR(ctl.mechanism(k).duty[0], 0.0, 1e-9);
+  }
+  // The measured clearance is the library's (fivebar/collision.hpp interference).
+  const Station& st = paper().require_station("index");
+  const Interference in = interference(*st.upper, ik(*st.upper, pts[1]), *st.lower, ik(*st.lower, pts[0]), *paper().get<Geometry>());
+  ASSERT_TRUE(ctl.station(0).checked);
+  EXPECT_NEAR(ctl.station(0).measured_clearance * 1000, in.min_clearance_mm, 1e-9);
+  EXPECT_EQ(ctl.station(0).measured_collision, in.collides);
+}
+
+TEST(Runtime, ThePriorityRuleMovesTheLowerTargetToAFreePointAsCloseAsTheLibrarysSearch) {
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  const Station& st = paper().require_station("index");
+  const Geometry& g = *paper().get<Geometry>();
+  const std::size_t lo = index_of(c, "index", "lower"), up = index_of(c, "index", "upper");
+  int moved = 0;
+  for (double sep : {0.0, 1.0, 2.0, 3.0}) {
+    SCOPED_TRACE(sep);
+    std::vector<Vec2> pts = centres(c, 8.0);
+    pts[up] = st.target.center + Vec2(0.0, 0.5 * sep);
+    pts[lo] = st.target.center - Vec2(0.0, 0.5 * sep);
+    const Scene s = at_points(c, centres(c, 8.0));
+    std::vector<double> targets = s.targets;
+    for (std::size_t k : {lo, up}) targets[2 * k] = pts[k].x() / 1000, targets[2 * k + 1] = pts[k].y() / 1000;
+    ctl.reset();
+    ctl.cycle(s.readings.data(), rt::Reading::radians, targets.data());
+    const PriorityResult ref = apply_priority(*st.upper, *st.lower, g, pts[up], pts[lo]);
+    const rt::MechanismState& l = ctl.mechanism(lo);
+    EXPECT_EQ(ctl.mechanism(up).status, rt::Status::ok);
+    if (ref.status == PriorityStatus::moved) {
+      ASSERT_EQ(l.status, rt::Status::moved_by_priority);
+      ++moved;
+      const Vec2 p(l.point_command[0] * 1000, l.point_command[1] * 1000);
+      // Free by the library's exact check, and no farther than its search's point plus the ray
+      // spacing's chord (32 rays: 1 - cos(pi / 32) = 0.5 %) and its tolerance.
+      const Interference after = interference(*st.upper, ik(*st.upper, pts[up]), *st.lower, ik(*st.lower, p), g);
+      EXPECT_FALSE(after.collides) << after.min_clearance_mm;
+      EXPECT_NEAR(l.moved * 1000, (p - pts[lo]).norm(), 1e-9);
+      EXPECT_LE(l.moved * 1000, ref.moved_mm * 1.01 + 1e-3);
+      EXPECT_GE(l.moved * 1000, ref.moved_mm - 1e-3);
+      for (double d : l.duty) EXPECT_TRUE(std::isfinite(d));
+    } else {
+      EXPECT_EQ(l.status, rt::Status::ok);
+    }
+  }
+  EXPECT_GT(moved, 0);
+}
+
+TEST(Runtime, ThePidFollowsTheHandComputedSequenceThroughTheWholeCycle) {
+  // A one-mechanism configuration with hand-set gains; the reading is the commanded angle minus e.
+  rt::Config c = paper_config();
+  c.stations.resize(1);
+  c.stations[0].mechanisms.resize(1);
+  for (auto& j : c.stations[0].mechanisms[0].joints) j.gains = {0.1, 10.0, 0.02, 0.05};
+  rt::Controller ctl(c);
+  const Vec2 p = paper().require_station("index").target.center;
+  const double target[2] = {p.x() / 1000, p.y() / 1000};
+  double readings[2] = {0.0, 0.0};
+  (void)ctl;
+  // As test_dynamics' DiscretePid sequence (T = 10 ms): e -> duty.
+  const double e[5] = {0.2, 0.3, 0.3, -0.4, -0.4};
+  const double expected[5] = {0.04, 0.28, 0.08, -1.0, -0.07};
+  rt::PidState s;
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(rt::pid_update(c.stations[0].mechanisms[0].joints[0].gains, 0.01, s, e[k]), expected[k], 1e-12);
+  // Through the cycle: readings theta_command - e give exactly those duties.
+  rt::Controller fresh(c);
+  fresh.cycle(readings, rt::Reading::radians, target);
+  const std::array<double, 2> cmd = fresh.mechanism(0).theta_command;
+  fresh.reset();
+  for (int k = 0; k < 5; ++k) {
+    const double r[2] = {cmd[0] - e[k], cmd[1]};
+    fresh.cycle(r, rt::Reading::radians, target);
+    EXPECT_NEAR(fresh.duties()[0], expected[k], 1e-12) << k;
+  }
+}
+
+TEST(Runtime, BadMeasurementsGiveASensorFaultAndZeroDutyNeverACrash) {
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  const Scene s = at_points(c, centres(c));
+  // Counts of the same angles.
+  std::vector<double> counts(s.readings.size());
+  std::size_t q = 0;
+  for (const auto& st : c.stations)
+    for (const auto& m : st.mechanisms)
+      for (const auto& j : m.joints) {
+        counts[q] = rt::adc_code(j.volts_at_zero + s.readings[q] / j.rad_per_volt, c.adc_bits, c.adc_range_v, c.volts_per_count);
+        ++q;
+      }
+  std::vector<double> targets = s.targets;
+  for (std::size_t k = 0; k < targets.size(); k += 2) targets[k] += 0.5e-3;  // a 0.5 mm step: non-zero duties
+  ctl.cycle(counts.data(), rt::Reading::counts, targets.data());
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(ctl.mechanism(k).status, rt::Status::ok);
+    EXPECT_NE(ctl.duties()[2 * k], 0.0);
+  }
+  const double top = 65535.0;
+  for (double bad : {0.0, top, -5.0, top + 10.0, std::nan(""), std::numeric_limits<double>::infinity(), 1.5e300}) {
+    SCOPED_TRACE(bad);
+    std::vector<double> r = counts;
+    r[2] = bad;  // index upper theta1
+    ctl.cycle(r.data(), rt::Reading::counts, targets.data());
+    EXPECT_EQ(ctl.mechanism(1).status, rt::Status::sensor_fault);
+    EXPECT_EQ(ctl.duties()[2], 0.0);
+    EXPECT_EQ(ctl.duties()[3], 0.0);
+    EXPECT_EQ(ctl.mechanism(0).status, rt::Status::ok);  // the other mechanism runs on
+    for (std::size_t i = 0; i < 8; ++i) EXPECT_TRUE(std::isfinite(ctl.duties()[i]));
+  }
+  // Volts at or beyond the rails.
+  std::vector<double> volts(counts.size());
+  for (std::size_t i = 0; i < counts.size(); ++i) volts[i] = c.adc_range_v[0] + counts[i] * c.volts_per_count;
+  for (double bad : {c.adc_range_v[0], c.adc_range_v[1], 11.0, -10.5}) {
+    std::vector<double> r = volts;
+    r[0] = bad;
+    ctl.cycle(r.data(), rt::Reading::volts, targets.data());
+    EXPECT_EQ(ctl.mechanism(0).status, rt::Status::sensor_fault) << bad;
+    EXPECT_EQ(ctl.duties()[0], 0.0);
+  }
+  // Null pointers and non-finite targets.
+  ctl.cycle(nullptr, rt::Reading::counts, targets.data());
+  for (std::size_t k = 0; k < 4; ++k) EXPECT_EQ(ctl.mechanism(k).status, rt::Status::sensor_fault);
+  ctl.reset();
+  std::vector<double> nan_targets(targets.size(), std::nan(""));
+  ctl.cycle(counts.data(), rt::Reading::counts, nan_targets.data());
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(ctl.mechanism(k).status, rt::Status::unreachable);
+    EXPECT_EQ(ctl.duties()[2 * k], 0.0);  // no command yet: motors off
+  }
+  ctl.cycle(counts.data(), rt::Reading::counts, nullptr);
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_TRUE(std::isfinite(ctl.duties()[i]));
+  // After a fault the loop recovers and holds the last valid command when the reference fails.
+  ctl.cycle(counts.data(), rt::Reading::counts, targets.data());
+  EXPECT_EQ(ctl.mechanism(0).status, rt::Status::ok);
+  std::vector<double> far = targets;
+  far[0] = 1.0;  // a metre away: unreachable
+  ctl.cycle(counts.data(), rt::Reading::counts, far.data());
+  EXPECT_EQ(ctl.mechanism(0).status, rt::Status::unreachable);
+  EXPECT_TRUE(ctl.mechanism(0).command);
+  EXPECT_NEAR(ctl.mechanism(0).point_command[0], targets[0], 1e-12);
+}
+
+TEST(Runtime, ATargetBeyondTheJointLimitsLessTheMarginIsHeld) {
+  rt::Config c = paper_config();
+  rt::Controller probe(c);
+  const Scene s = at_points(c, centres(c));
+  probe.cycle(s.readings.data(), rt::Reading::radians, s.targets.data());
+  ASSERT_EQ(probe.mechanism(0).status, rt::Status::ok);
+  const double th = probe.mechanism(0).theta_command[0];
+  // Limits of index_lower_theta1 so that the centre's angle sits inside the range but within the margin.
+  rt::JointConfig& j = c.stations[0].mechanisms[0].joints[0];
+  j.has_position_limits = true;
+  j.min_position = th - 0.5 * c.joint_margin;
+  j.max_position = th + 1.0;
+  rt::Controller ctl(c);
+  ctl.cycle(s.readings.data(), rt::Reading::radians, s.targets.data());
+  EXPECT_EQ(ctl.mechanism(0).status, rt::Status::limit);
+  EXPECT_FALSE(ctl.mechanism(0).command);
+  EXPECT_EQ(ctl.duties()[0], 0.0);
+}
+
+TEST(Runtime, RefusesBadConfigurationsNamingTheKey) {
+  const std::string good = export_text();
+  const auto refuse = [](const std::string& text, const std::string& key) {
+    SCOPED_TRACE(key);
+    EXPECT_THAT([&] { (void)rt::parse_config_json(text, "x.json"); }, ::testing::ThrowsMessage<rt::ConfigError>(HasSubstr(key)));
+  };
+  const auto without = [&](const std::string& key) {
+    nlohmann::json j = nlohmann::json::parse(good);
+    auto& p = j.begin().value()["ros__parameters"];
+    nlohmann::json* at = &p;
+    std::string rest = key;
+    for (std::size_t dot; (dot = rest.find('.')) != std::string::npos; rest = rest.substr(dot + 1)) at = &(*at)[rest.substr(0, dot)];
+    at->erase(rest);
+    return j.dump(2);
+  };
+  refuse(without("loop_rate_hz"), "loop_rate_hz: missing key");
+  refuse(without("joint_margin_rad"), "joint_margin_rad: missing key");
+  refuse(without("adc.volts_per_count"), "adc.volts_per_count: missing key");
+  refuse(without("potentiometers.index_lower_theta1"), "potentiometers.index_lower_theta1: missing key");
+  refuse(without("gains.thumb_upper_theta2.i_clamp"), "gains.thumb_upper_theta2.i_clamp: missing key");
+  refuse(without("collision.min_clearance_m"), "collision.min_clearance_m: missing key");
+  refuse(without("stations.index.lower.link_lengths_m"), "stations.index.lower.link_lengths_m: missing key");
+  {
+    nlohmann::json j = nlohmann::json::parse(good);
+    j.begin().value()["ros__parameters"]["gains"]["index_lower_theta1"]["p"] = std::nan("");  // dumps as null
+    refuse(j.dump(), "gains.index_lower_theta1.p: expected a number, found null");
+  }
+  {
+    nlohmann::json j = nlohmann::json::parse(good);
+    j.begin().value()["ros__parameters"]["potentiometers"]["index_upper_theta2"]["rad_per_volt"] = 0.0;
+    refuse(j.dump(), "potentiometers.index_upper_theta2.rad_per_volt: must be finite and not 0");
+  }
+  {
+    nlohmann::json j = nlohmann::json::parse(good);
+    j.begin().value()["ros__parameters"]["stations"]["index"]["lower"]["link_lengths_m"][2] = -0.015;
+    refuse(j.dump(), "stations.index.lower.link_lengths_m[2]: must be > 0");
+  }
+  refuse("{\"a\": NaN}", "x.json:1: unexpected character 'N'");
+  refuse(good.substr(0, good.size() / 2), "x.json:");
+  EXPECT_THROW((void)rt::load_config_json("/nonexistent/controller.json"), rt::ConfigError);
+}
+
+TEST(Runtime, SameInputsGiveTheSameDutiesBitForBit) {
+  const rt::Config c = paper_config();
+  rt::Controller a(c), b(c);
+  std::mt19937_64 rng(testing::test_seed());
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const Scene s = at_points(c, centres(c));
+  for (int k = 0; k < 2000; ++k) {
+    std::vector<double> r = s.readings;
+    for (double& v : r) v += noise(rng);
+    a.cycle(r.data(), rt::Reading::radians, s.targets.data());
+    b.cycle(r.data(), rt::Reading::radians, s.targets.data());
+    ASSERT_EQ(std::memcmp(a.duties(), b.duties(), 8 * sizeof(double)), 0) << k;
+  }
+}
+
+TEST(Runtime, NoAllocationAndNoExceptionInAMillionCycles) {
+  static_assert(noexcept(std::declval<rt::Controller&>().cycle(nullptr, rt::Reading::counts, nullptr)));
+#ifdef FIVEBAR_SANITIZE
+  const int cycles = 20'000;
+#else
+  const int cycles = 1'000'000;
+#endif
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  // Every branch: moving references (a circle of 3 mm about each centre), noise, faults, a
+  // collision that moves the lower target (every 5000th cycle: a full priority search), nulls.
+  const std::vector<Vec2> base = centres(c);
+  Scene s = at_points(c, base);
+  std::vector<double> readings = s.readings, targets = s.targets;
+  const std::size_t lo = index_of(c, "index", "lower"), up = index_of(c, "index", "upper");
+  const Vec2 centre = paper().require_station("index").target.center;
+  double checksum = 0.0;
+  const long long before = g_allocations.load();
+  for (int k = 0; k < cycles; ++k) {
+    const double phase = 2 * M_PI * (k % 400) / 400.0;
+    for (std::size_t m = 0; m < base.size(); ++m) {
+      targets[2 * m] = (base[m].x() + 1.5 * std::cos(phase)) / 1000;
+      targets[2 * m + 1] = (base[m].y() + 1.5 * std::sin(phase)) / 1000;
+    }
+    for (std::size_t i = 0; i < readings.size(); ++i) readings[i] = s.readings[i] + 1e-3 * std::sin(0.37 * k + double(i));
+    if (k % 5000 == 17) {
+      targets[2 * lo] = targets[2 * up] = centre.x() / 1000;
+      targets[2 * lo + 1] = targets[2 * up + 1] = centre.y() / 1000;
+    }
+    if (k % 977 == 3) readings[5] = std::nan("");
+    ctl.cycle(k % 10007 == 5 ? nullptr : readings.data(), rt::Reading::radians, targets.data());
+    checksum += ctl.duties()[k % 8];
+  }
+  const long long allocations = g_allocations.load() - before;
+  EXPECT_EQ(allocations, 0);
+  EXPECT_TRUE(std::isfinite(checksum));
+  std::printf("[runtime] %d cycles, %lld allocations\n", cycles, allocations);
+}
+
+TEST(Runtime, TheSimulatorsDutiesAreTheStandaloneRuntimesBitForBit) {
+  // The simulator drives its runtime with the ADC codes of the simulated joints; a runtime built
+  // from the exported JSON text alone, fed the same codes and reference points, computes the same
+  // duties to the last bit, and those are the duties the simulated motors got one period later.
+  const Design& d = paper();
+  SimulationRequest request;
+  request.station = "index";
+  request.pattern = PatternKind::twist;
+  const SimulationInput in = simulation_inputs(d, request, station_inertia(d, d.require_station("index"), nullptr, {})).front();
+  struct Cycle {
+    std::vector<double> readings, targets, duties;
+  };
+  std::vector<Cycle> log;
+  SimulationOptions o;
+  o.controller_log = [&](double, const std::vector<double>& r, rt::Reading kind, const std::vector<double>& t,
+                         const rt::Controller& ctl) {
+    EXPECT_EQ(kind, rt::Reading::counts);
+    log.push_back({r, t, std::vector<double>(ctl.duties(), ctl.duties() + ctl.joint_count())});
+  };
+  const SimulationResult r = simulate(in, o);
+  ASSERT_TRUE(r.ok()) << r.reason;
+  ASSERT_EQ(log.size(), r.samples.size());
+
+  rt::Controller standalone(rt::parse_config_json(export_text({"index"}), "iros2022_controller.json"));
+  std::size_t nonzero = 0;
+  for (std::size_t s = 0; s < log.size(); ++s) {
+    standalone.cycle(log[s].readings.data(), rt::Reading::counts, log[s].targets.data());
+    ASSERT_EQ(std::memcmp(standalone.duties(), log[s].duties.data(), 4 * sizeof(double)), 0) << "cycle " << s;
+    if (s + 1 < r.samples.size()) {
+      for (std::size_t k = 0; k < 2; ++k)
+        for (std::size_t j = 0; j < 2; ++j) {
+          const double applied = r.samples[s + 1].mechanisms[k].duty[j];  // one period of delay
+          ASSERT_EQ(std::memcmp(&applied, &log[s].duties[2 * k + j], sizeof(double)), 0) << s;
+          nonzero += applied != 0.0;
+        }
+    }
+  }
+  EXPECT_GT(nonzero, log.size());  // the pattern really drives the motors
+}
+
+}  // namespace
+}  // namespace fivebar
+
+namespace fivebar_test {
+fivebar::runtime::Config runtime_config_from_header();
+}
+
+namespace fivebar {
+namespace {
+
+TEST(Runtime, TheExportedHeaderConfiguresTheSameController) {
+  const rt::Config json = paper_config();
+  const rt::Config header = fivebar_test::runtime_config_from_header();
+  ASSERT_EQ(header.mechanism_count(), json.mechanism_count());
+  EXPECT_EQ(header.design_hash, json.design_hash);
+  EXPECT_EQ(header.joint_margin, json.joint_margin);
+  EXPECT_EQ(header.collision.link_widths, json.collision.link_widths);
+  for (std::size_t s = 0; s < json.stations.size(); ++s)
+    for (std::size_t m = 0; m < json.stations[s].mechanisms.size(); ++m) {
+      const rt::MechanismConfig &a = json.stations[s].mechanisms[m], &b = header.stations[s].mechanisms[m];
+      EXPECT_EQ(a.L, b.L);
+      EXPECT_EQ(a.working_mode, b.working_mode);
+      for (std::size_t j = 0; j < 2; ++j) {
+        EXPECT_EQ(a.joints[j].name, b.joints[j].name);
+        EXPECT_EQ(a.joints[j].rad_per_volt, b.joints[j].rad_per_volt);
+        EXPECT_EQ(a.joints[j].max_position, b.joints[j].max_position);
+        EXPECT_EQ(a.joints[j].gains.d, b.joints[j].gains.d);
+      }
+    }
+  rt::Controller x(json), y(header);
+  const Scene s = at_points(json, centres(json, 5.0));
+  for (int k = 0; k < 200; ++k) {
+    std::vector<double> r = s.readings;
+    for (std::size_t i = 0; i < r.size(); ++i) r[i] += 0.02 * std::sin(0.3 * k + double(i));
+    x.cycle(r.data(), rt::Reading::radians, s.targets.data());
+    y.cycle(r.data(), rt::Reading::radians, s.targets.data());
+    ASSERT_EQ(std::memcmp(x.duties(), y.duties(), 8 * sizeof(double)), 0) << k;
+  }
+}
+
+}  // namespace
+}  // namespace fivebar
