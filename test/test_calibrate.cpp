@@ -182,13 +182,23 @@ TEST(Calibrate, FrameFitNamesO1AndTheFrameTranslationAsOneCombination) {
   const CalibrationResult r = calibrate(paper(), rows, o, "synthetic");
   std::vector<std::string> names;
   for (const auto& u : r.unidentifiable) names.push_back(u.parameter);
-  // Translation: each mechanism's O1 with the frame's; rotation: the lower O2 - O1 y.
-  EXPECT_THAT(names, ::testing::UnorderedElementsAre("upper.O1x", "upper.O1y", "lower.O1x", "lower.O1y", "lower.O2y"));
+  // Translating the instrument is translating both mechanisms (both O1 together): one O1 is held,
+  // the lower's (the station frame's origin); its rotation is held by the lower O2 - O1 y.
+  EXPECT_THAT(names, ::testing::UnorderedElementsAre("lower.O1x", "lower.O1y", "lower.O2y"));
   for (const auto& u : r.unidentifiable) {
     if (u.parameter == "lower.O1x") {
       EXPECT_THAT(u.combination, ::testing::HasSubstr("frame.x"));
+      EXPECT_THAT(u.combination, ::testing::HasSubstr("upper.O1x"));
     }
     if (u.parameter == "lower.O2y") EXPECT_THAT(u.combination, ::testing::HasSubstr("frame.rotation"));
+  }
+  // The upper O1 is then known relative to the lower one: within 3 sigma of the truth's offset.
+  for (const Parameter& p : r.parameters) {
+    if (p.mechanism == "upper" && p.name == "O1x") {
+      ASSERT_TRUE(p.identified);
+      const double truth = upper.q[4] - lower.q[4];  // the lower O1 held at the design's x = 0
+      EXPECT_NEAR(p.value - paper().station("index")->lower->O1.x(), truth, 3.0 * p.sigma + 1e-3);
+    }
   }
   EXPECT_FALSE(r.requested_unidentifiable);
   // Asking for them by name is a failed check.
@@ -209,6 +219,7 @@ TEST(Calibrate, HoldoutErrorIsAtTheNoiseLevelAndRobustLossResistsOutliers) {
   EXPECT_LT(r.holdout_after.rms_mm, 2.0 * std::sqrt(2.0) * 0.02);
   EXPECT_GT(r.holdout_before.rms_mm, 3.0 * r.holdout_after.rms_mm);
   // Five gross outliers (2 mm): least squares is pulled, Huber is not.
+  const auto measure_clean = rows;
   for (int i = 0; i < 5; ++i) rows[static_cast<std::size_t>(i * 13)].point.x() += 2.0;
   CalibrateOptions plain, huber;
   huber.loss = Loss::huber;
@@ -221,8 +232,10 @@ TEST(Calibrate, HoldoutErrorIsAtTheNoiseLevelAndRobustLossResistsOutliers) {
   };
   const double e_plain = err(calibrate(paper(), rows, plain, "synthetic"));
   const double e_huber = err(calibrate(paper(), rows, huber, "synthetic"));
-  EXPECT_LT(e_huber, 0.5 * e_plain);
-  EXPECT_LT(e_huber, 0.05);
+  const double e_clean = err(calibrate(paper(), measure_clean, plain, "synthetic"));
+  std::printf("[calibrate] largest length error: clean %.4f mm, 5 outliers least squares %.4f mm, Huber %.4f mm\n", e_clean, e_plain, e_huber);
+  EXPECT_LT(e_huber, 0.25 * e_plain);
+  EXPECT_LT(e_huber, 3.0 * e_clean);
 }
 
 TEST(Calibrate, BadRequestsNameTheProblem) {
@@ -291,20 +304,31 @@ TEST(CalibrateHardStops, OffsetsFromTwoStopsRecoverTheTruth) {
   const Design& d = paper();
   const Station& st = *d.station("index");
   std::string csv = "station,mechanism,joint,stop,volts\n";
-  const double v0 = 0.31, k = 1.0 / 0.93;
+  // A joint with both stops gets V0 and k; with one, V0 at the design's k.
+  const double v0 = 0.31, k_true = 1.0 / 0.93;
+  const double k_design = d.get<ControllerSettings>()->joint("index", "lower", 1).potentiometer.rad_per_volt;
+  std::array<double, 2> k_used{};
   int stops = 0;
   for (int j = 1; j <= 2; ++j) {
     const auto range = usable_ranges(d, st, *st.lower)[static_cast<std::size_t>(j - 1)];
-    if (range.lo_by.rfind("hard stop", 0) == 0) csv += "index,lower," + std::to_string(j) + ",lo," + format::shortest(v0 + range.lo / k) + "\n", ++stops;
-    if (range.hi_by.rfind("hard stop", 0) == 0) csv += "index,lower," + std::to_string(j) + ",hi," + format::shortest(v0 + range.hi / k) + "\n", ++stops;
+    const bool lo = range.lo_by.rfind("hard stop", 0) == 0, hi = range.hi_by.rfind("hard stop", 0) == 0;
+    const double k = lo && hi ? k_true : k_design;
+    k_used[static_cast<std::size_t>(j - 1)] = k;
+    if (lo) csv += "index,lower," + std::to_string(j) + ",lo," + format::shortest(v0 + range.lo / k) + "\n", ++stops;
+    if (hi) csv += "index,lower," + std::to_string(j) + ",hi," + format::shortest(v0 + range.hi / k) + "\n", ++stops;
   }
   if (stops == 0) GTEST_SKIP() << "no hard stop in the paper design";
   const CalibrationResult r = hard_stop_calibration(d, csv, "stops.csv");
   bool any = false;
   for (const Parameter& p : r.parameters) {
-    if (!p.identified) continue;
-    any = true;
-    EXPECT_NEAR(p.value, p.unit == "V" ? v0 : k, p.unit == "V" ? 0.05 : 1e-9) << p.key;
+    const std::size_t j = p.name.starts_with("theta1") ? 0 : 1;
+    if (p.unit == "V") {
+      any = true;
+      EXPECT_TRUE(p.identified);
+      EXPECT_NEAR(p.value, v0, 1e-9) << p.key;
+    } else {
+      EXPECT_NEAR(p.value, k_used[j], 1e-9 * k_used[j]) << p.key;
+    }
   }
   EXPECT_TRUE(any);
   EXPECT_THAT([&] { hard_stop_calibration(d, "station,mechanism,joint,stop,volts\nindex,lower,3,lo,1\n", "s.csv"); },

@@ -188,6 +188,12 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
   };
   for (std::size_t i : rows) fit_rows += held_out[i] ? 0 : 1;
 
+  const auto unknowns = static_cast<int>(std::count(requested.begin(), requested.end(), true));
+  if (2 * fit_rows < unknowns) {
+    throw InputError(origin + ": " + std::to_string(fit_rows) + " poses give " + std::to_string(2 * fit_rows) + " equations for " +
+                     std::to_string(unknowns) + " unknowns: measure at least " + std::to_string((unknowns + 1) / 2) + " poses");
+  }
+
   // Identifiability at the design values: greedy in the order of preference (fit.hpp).
   std::vector<int> order;
   for (int b = 0; b < nb; ++b) {
@@ -241,10 +247,6 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     }
     out.unidentifiable.push_back(u);
     if (opt.fit_given) out.requested_unidentifiable = true;
-  }
-  if (2 * fit_rows < static_cast<int>(kept.size())) {
-    throw InputError(origin + ": " + std::to_string(fit_rows) + " poses give " + std::to_string(2 * fit_rows) + " equations for " +
-                     std::to_string(kept.size()) + " unknowns: measure at least " + std::to_string((kept.size() + 1) / 2) + " poses");
   }
 
   // Figures at the design values.

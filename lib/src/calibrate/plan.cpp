@@ -2,6 +2,7 @@
 #include "fivebar/calibrate/plan.hpp"
 
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/SVD>
 
 #include <algorithm>
