@@ -19,7 +19,7 @@ Json to_json(const CalibrationResult& r) {
   for (const Parameter& p : r.parameters) {
     Json j = {{"parameter", p.key},  {"value", p.value},           {"sigma", p.sigma},
               {"identified", p.identified}, {"unit", p.unit},        {"design", p.design},
-              {"mechanism", p.mechanism}, {"requested", p.requested}};
+              {"mechanism", p.mechanism.empty() ? Json(nullptr) : Json(p.mechanism)}, {"requested", p.requested}};
     if (!p.note.empty()) j["note"] = p.note;
     params.push_back(std::move(j));
   }
