@@ -11,10 +11,12 @@
 #include <filesystem>
 #include <random>
 #include <string>
+#include <tuple>
 
 #include "cli_test.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/format.hpp"
+#include "fivebar/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/provenance.hpp"
 #include "fivebar/sections/controller.hpp"
@@ -151,6 +153,39 @@ TEST_F(CliCalibrate, RequireMeasuredMakesTheExportGateRefuseAssumedPotentiometer
   const ft::Outcome r = run({"export", design.string(), "--json", "--out", "exp", "--station", "index"});
   EXPECT_EQ(r.code, 1) << r.err;
   EXPECT_THAT(r.out, HasSubstr("controller.require_measured"));
+}
+
+TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
+  const fivebar::Design d = fivebar::load_design(kDesign);
+  const fivebar::Station& st = *d.station("index");
+  const double k = d.get<fivebar::ControllerSettings>()->joint("index", "lower", 1).potentiometer.rad_per_volt;
+  std::string text = "station,mechanism,joint,stop,volts\n";
+  std::string key;
+  for (int j = 1; j <= 2 && key.empty(); ++j) {
+    const auto range = fivebar::usable_ranges(d, st, *st.lower)[static_cast<std::size_t>(j - 1)];
+    for (const auto& [end, by, theta] : {std::tuple{"lo", range.lo_by, range.lo}, std::tuple{"hi", range.hi_by, range.hi}}) {
+      if (by.rfind("hard stop", 0) != 0 || !key.empty()) continue;
+      text += "index,lower," + std::to_string(j) + "," + end + "," + fivebar::format::shortest(0.3 + theta / k) + "\n";
+      key = "controller.stations.index.lower.theta" + std::to_string(j) + ".potentiometer.volts_at_zero";
+    }
+  }
+  if (key.empty()) GTEST_SKIP() << "no hard stop on the paper's lower index mechanism";
+  write("stops.csv", text);
+  const ft::Outcome r = run({"calibrate", kDesign, "--hard-stops", "stops.csv", "--json", "--out", "cal"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  const json* p = param(doc["hard_stops"], key);
+  ASSERT_NE(p, nullptr);
+  EXPECT_NEAR((*p)["value"].get<double>(), 0.3, 1e-9);
+  const fivebar::Design patched = fivebar::load_design(dir_ / "cal" / "iros2022-calibrated.yaml");
+  EXPECT_NEAR(fivebar::design_number(patched, key), 0.3, 1e-9);
+  EXPECT_TRUE(fivebar::is_measured(patched, key));
+  // A stop the geometry does not define is bad input, nothing written.
+  write("bad.csv", "station,mechanism,joint,stop,volts\nindex,lower,1,sideways,1\n");
+  const ft::Outcome bad = run({"calibrate", kDesign, "--hard-stops", "bad.csv", "--out", "cal2"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("bad.csv:2: column 'stop'"));
+  EXPECT_FALSE(fs::exists(dir_ / "cal2"));
 }
 
 }  // namespace
