@@ -126,5 +126,6 @@ void setup_tolerance(CLI::App& app);
 void setup_animate(CLI::App& app);
 void setup_control(CLI::App& app);
 void setup_replay(CLI::App& app);
+void setup_calibrate(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -155,6 +155,18 @@ def main():
     run("control", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--out", out + "/control"])
     run("control --tune", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--tune",
                                       "--tune-evaluations", "2", "--out", out + "/tune"], (0, 1))
+    # calibrate: a plan, then "measurements" at the planned poses (their expected points, 0.01 mm
+    # apart from the model), fitted with the instrument's pose (a shape with unidentifiable entries).
+    plan = run("calibrate --plan", "calibrate", ["calibrate", DESIGN, "-s", "index", "--plan", "12", "--out", out + "/cal"])
+    if plan is not None:
+        rows = (pathlib.Path(out) / "cal" / "calibration-plan.csv").read_text().splitlines()[1:]
+        meas = ["station,mechanism,volts1,volts2,x_mm,y_mm"]
+        for i, row in enumerate(rows):
+            c = row.split(",")
+            meas.append(f"{c[0]},{c[1]},{c[5]},{c[6]},{float(c[7]) + 0.01 * ((i % 3) - 1)},{float(c[8]) - 0.01 * ((i % 5) - 2)}")
+        (WORK / "meas.csv").write_text("\n".join(meas) + "\n")
+        run("calibrate", "calibrate", ["calibrate", DESIGN, str(WORK / "meas.csv"), "--frame", "fit", "--holdout", "2",
+                                       "--out", out + "/cal"])
     run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/twist.svg"])
     # Issue 31 family 5: the hostile and partial shapes validate too, and keep the conventions.
     if keyed_by_name({"a": {"lower": 1.0, "upper": None}}) != ["$.a"] or keyed_by_name({"lower": 1, "x": 2}):

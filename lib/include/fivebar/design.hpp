@@ -197,6 +197,9 @@ double design_number(const Design& design, std::string_view key);
 /// The design with the numbers at the key paths replaced (file units), read back by the loader:
 /// every rule of a design file applies (InputError / ValidationError otherwise).
 Design with_design_numbers(const Design& design, const std::vector<std::pair<std::string, double>>& values);
+/// Every key path under `prefix` (as design_number() takes them) that leads to a number of
+/// to_yaml(design), in file order; empty when the prefix leads nowhere.
+std::vector<std::string> design_number_keys(const Design& design, std::string_view prefix);
 /// Limits on design files (README "Hardening"), checked before the YAML parser sees the text so
 /// that no file can exhaust the stack or the memory: larger files, deeper nesting, bytes that are
 /// not UTF-8 or characters YAML forbids (control characters) are refused with an InputError.

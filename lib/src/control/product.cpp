@@ -12,6 +12,8 @@
 #include "fivebar/control.hpp"
 #include "fivebar/error.hpp"
 #include "products/markdown.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/format.hpp"
 #include "products/product.hpp"
 
 namespace fivebar::products {
@@ -123,8 +125,11 @@ Product control_product() {
       studies.push_back(to_json(study));
     }
     Built b;
-    b.result = {{"stations", studies}, {"stable", stable}};
-    b.markdown = std::string(kPreamble) + table.str() + "\n" + kPerformance + performance.str() + "\n" + files;
+    const std::vector<std::string> assumed = assumed_groups(d);
+    b.result = {{"stations", studies}, {"stable", stable}, {"assumed", assumed}};
+    b.markdown = std::string(kPreamble) + table.str() + "\n" + kPerformance + performance.str() + "\n" + files +
+                 "\nRests on assumed values (no `provenance:` entry, docs/calibrate.md): " +
+                 (assumed.empty() ? std::string("none") : format::join(assumed)) + ".\n";
     b.passed = stable;
     b.check = stable ? "stable over every target (" + std::to_string(maps) + " mechanisms)"
                      : "the loop is unstable somewhere on a target";

@@ -4,6 +4,7 @@
 
 #include "fivebar/format.hpp"
 #include "fivebar/export/export.hpp"
+#include "fivebar/provenance.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 
@@ -412,6 +413,17 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
   detail::ControlGate loop = detail::control_gate(d, gate.stations, options.progress);
   for (GateCheck& check : loop.checks) gate.checks.push_back(std::move(check));
   gate.validation = std::move(loop.figures);
+
+  // Measured or assumed (fivebar/provenance.hpp): what the validated figures rest on, and the
+  // groups controller.require_measured wants measured.
+  gate.assumed = assumed_groups(d);
+  for (const std::string& group : c.require_measured) {
+    const std::vector<std::string> assumed = assumed_values(d, group);
+    add("provenance", group, assumed.empty(),
+        assumed.empty() ? "every value measured (provenance:)"
+                        : std::to_string(assumed.size()) + " value(s) without a provenance: entry, e.g. " + assumed.front() +
+                              " (controller.require_measured)");
+  }
   return gate;
 }
 
@@ -428,7 +440,8 @@ Json to_json(const ExportGate& gate) {
           {"stations", gate.stations},
           {"reasons", gate.reasons()},
           {"checks", checks},
-          {"joints", joints}};
+          {"joints", joints},
+          {"assumed", gate.assumed}};
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -69,6 +69,8 @@ Product export_product() {
       }
       markdown += joints.str() + "\n";
     }
+    markdown += "Rests on assumed values (no `provenance:` entry, docs/calibrate.md): " +
+                (r.gate.assumed.empty() ? std::string("none") : format::join(r.gate.assumed)) + ".\n\n";
     Json files = Json::array();
     if (r.gate.passed()) {
       markdown += "Files:";

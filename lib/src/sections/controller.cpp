@@ -166,6 +166,14 @@ void ControllerSettings::validate() const {
     throw ValidationError("max_velocity_deg_s", "= " + format_degrees(max_velocity) +
                                                     " deg/s: must be > 0 and <= 1000000 deg/s");
   }
+  static const std::array<std::string_view, 6> groups{"kinematics", "potentiometer", "motor", "contact", "density", "tolerance"};
+  for (std::size_t i = 0; i < require_measured.size(); ++i) {
+    if (std::find(groups.begin(), groups.end(), require_measured[i]) == groups.end()) {
+      throw ValidationError("require_measured[" + std::to_string(i) + "]",
+                            "= " + detail::quoted(require_measured[i]) +
+                                ": must be one of kinematics, potentiometer, motor, contact, density, tolerance");
+    }
+  }
   if (collision_priority != "upper") {
     throw ValidationError("collision_priority",
                           "= " + detail::quoted(collision_priority) +
@@ -248,10 +256,16 @@ void load(const Value& v, Design& design) {
   if (v.is_null()) return;  // `controller:` alone: every default
   const auto all = v.entries({"node", "loop_rate_hz", "pwm_hz", "adc", "max_velocity_deg_s", "collision_priority",
                               "min_lci", "joint_margin_deg", "max_tracking_error_mm", "max_saturation_fraction",
-                              "target_stiffness_N_per_mm", "pid", "potentiometer", "tune", "mechanisms", "stations"},
+                              "target_stiffness_N_per_mm", "pid", "potentiometer", "tune", "mechanisms", "stations",
+                              "require_measured"},
                              "(node, loop_rate_hz, pwm_hz, adc, max_velocity_deg_s, collision_priority, min_lci, "
                              "joint_margin_deg, max_tracking_error_mm, max_saturation_fraction, "
-                             "target_stiffness_N_per_mm, pid, potentiometer, tune, mechanisms, stations)");
+                             "target_stiffness_N_per_mm, pid, potentiometer, tune, mechanisms, stations, require_measured)");
+  if (const Value* r = find(all, "require_measured")) {
+    for (const Value& g : r->list("must be a list of groups (kinematics, potentiometer, motor, contact, density, tolerance)")) {
+      c.require_measured.push_back(g.text("must be a group name"));
+    }
+  }
   if (const Value* n = find(all, "node")) c.node = n->text("must be a ROS 2 node name");
   c.loop_rate_hz = number_or(all, "loop_rate_hz", c.loop_rate_hz, "Hz");
   c.pwm_hz = number_or(all, "pwm_hz", c.pwm_hz, "Hz");
@@ -406,6 +420,10 @@ void write(const Design& d, Out& top) {
   out.add("max_tracking_error_mm", Out::number(c.max_tracking_error_mm));
   out.add("max_saturation_fraction", Out::number(c.max_saturation_fraction));
   out.add("target_stiffness_N_per_mm", Out::number(c.target_stiffness_N_per_mm));
+  if (!c.require_measured.empty()) {
+    Out& r = out.add("require_measured", Out::list());
+    for (const std::string& g : c.require_measured) r.push(Out::plain(g));
+  }
   ControlOverride defaults;
   defaults.kp = c.pid.kp, defaults.ki = c.pid.ki, defaults.kd = c.pid.kd, defaults.i_clamp = c.pid.i_clamp;
   defaults.volts_at_zero = c.potentiometer.volts_at_zero, defaults.rad_per_volt = c.potentiometer.rad_per_volt;

@@ -36,3 +36,29 @@ Design with_design_numbers(const Design& design, const std::vector<std::pair<std
 }
 
 }  // namespace fivebar
+
+namespace fivebar {
+
+namespace {
+void number_leaves(const YAML::Node& node, const std::string& path, std::vector<std::string>& out) {
+  double v = 0.0;
+  if (node.IsMap()) {
+    for (const auto& e : node) number_leaves(e.second, path + (path.empty() ? "" : ".") + e.first.as<std::string>(), out);
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) number_leaves(node[i], path + "[" + std::to_string(i) + "]", out);
+  } else if (scalar_number(node, v)) {
+    out.push_back(path);
+  }
+}
+}  // namespace
+
+std::vector<std::string> design_number_keys(const Design& design, std::string_view prefix) {
+  YAML::Node root = YAML::Load(to_yaml(design));
+  std::string why;
+  std::optional<YAML::Node> node = follow(root, prefix, why);
+  std::vector<std::string> out;
+  if (node) number_leaves(*node, std::string(prefix), out);
+  return out;
+}
+
+}  // namespace fivebar

@@ -109,6 +109,9 @@ struct ExportGate {
   std::vector<GateCheck> checks;      ///< in a fixed order: names, geometry, per station, patterns
   std::vector<JointSweep> joints;     ///< ranges over the ellipses, for reports
   Json validation = Json::object();   ///< the loop checks' figures (above); empty without `motor:`
+  /// The groups of values the figures rest on that are assumptions (fivebar/provenance.hpp
+  /// assumed_groups(): no `provenance:` entry), e.g. {"motor", "contact"}.
+  std::vector<std::string> assumed;
   bool passed() const;
   /// "subject kind: detail" of every failed check.
   std::vector<std::string> reasons() const;

@@ -119,6 +119,10 @@ struct ControllerSettings {
   /// surface needs at least 0.8-1.0 N/mm (Choi & Tan, "Effect of update rate on perceived
   /// instability of virtual haptic texture", IROS 2004), the fingertip-device literature's figure.
   double target_stiffness_N_per_mm = 1.0;
+  /// Export gate: these groups of values (fivebar/provenance.hpp: kinematics, potentiometer,
+  /// motor, contact, density, tolerance) must be measured, i.e. carry `provenance:` entries;
+  /// empty: assumptions are allowed (the gate only lists them).
+  std::vector<std::string> require_measured;
   PidGains pid;                   ///< every joint, unless overridden
   Potentiometer potentiometer;    ///< every joint, unless overridden
   std::optional<TuneSettings> tune;  ///< `tune:`; none: the `control` product does not tune

@@ -1,0 +1,32 @@
+#pragma once
+/// The `provenance:` section of a design file (issue 28 section 3; docs/calibrate.md
+/// "Measured or assumed"): where a value came from. A map from a key path of the design
+/// (`stations.index.mechanisms.lower.links[2]`, `controller.stations.index.lower.theta1.potentiometer.volts_at_zero`,
+/// as design_number() takes them; a path that leads to a map or list covers every number below it)
+/// to the measurement that set it. A value without an entry is an assumption. One module of the
+/// design (docs/architecture.md "Design sections"); helpers in fivebar/provenance.hpp.
+
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace fivebar {
+
+/// One measured value's origin.
+struct ProvenanceEntry {
+  std::string source;          ///< the file the value was fitted from (as given on the command line)
+  std::string sha256;          ///< SHA-256 of that file, 64 lowercase hex digits
+  std::string date;            ///< YYYY-MM-DD (UTC)
+  std::string method;          ///< "fivebar calibrate (Ceres, Levenberg-Marquardt)", "datasheet", ...
+  std::optional<double> sigma; ///< standard deviation, in the key's file unit
+  void validate() const;
+};
+
+struct ProvenanceSettings {
+  static constexpr std::string_view kKey = "provenance";
+  std::map<std::string, ProvenanceEntry, std::less<>> entries;  ///< key path -> origin
+  void validate() const;
+};
+
+}  // namespace fivebar

@@ -1,0 +1,121 @@
+// The calibration's outputs (fivebar/calibrate/report.hpp).
+#include "fivebar/calibrate/report.hpp"
+
+#include <cmath>
+
+#include "fivebar/format.hpp"
+#include "fivebar/sections/provenance.hpp"
+
+namespace fivebar::calibrate {
+
+namespace {
+const char* kMethod = "fivebar calibrate: nonlinear least squares (Ceres, Levenberg-Marquardt), posterior sigma";
+Json finite_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json figures(const Figures& f) { return {{"rms_mm", finite_or_null(f.rms_mm)}, {"max_mm", finite_or_null(f.max_mm)}}; }
+}  // namespace
+
+Json to_json(const CalibrationResult& r) {
+  Json params = Json::array();
+  for (const Parameter& p : r.parameters) {
+    Json j = {{"parameter", p.key},  {"value", p.value},           {"sigma", p.sigma},
+              {"identified", p.identified}, {"unit", p.unit},        {"design", p.design},
+              {"mechanism", p.mechanism.empty() ? Json(nullptr) : Json(p.mechanism)}, {"requested", p.requested}};
+    if (!p.note.empty()) j["note"] = p.note;
+    params.push_back(std::move(j));
+  }
+  Json unid = Json::array();
+  for (const Unidentifiable& u : r.unidentifiable) unid.push_back({{"parameter", u.parameter}, {"combination", u.combination}});
+  Json poses = Json::array();
+  for (const PoseResidual& p : r.residuals) {
+    poses.push_back({{"line", p.line}, {"mechanism", p.mechanism}, {"holdout", p.holdout},
+                     {"before_mm", finite_or_null(p.before_mm)}, {"after_mm", finite_or_null(p.after_mm)}});
+  }
+  return {{"station", r.station},
+          {"mechanisms", r.mechanisms},
+          {"poses", r.poses},
+          {"holdout_poses", r.holdout_poses},
+          {"parameters", params},
+          {"identifiability",
+           {{"singular_values", r.singular_values},
+            {"condition_number", finite_or_null(r.condition_number)},
+            {"observability_index", r.observability_index},
+            {"unidentifiable", unid},
+            {"requested_unidentifiable", r.requested_unidentifiable}}},
+          {"sigma_mm", r.sigma_mm},
+          {"sigma_estimated", r.sigma_estimated},
+          {"residuals", {{"before", figures(r.before)}, {"after", figures(r.after)}}},
+          {"holdout", {{"before", figures(r.holdout_before)}, {"after", figures(r.holdout_after)}}},
+          {"per_pose", poses},
+          {"solver", {{"iterations", r.iterations}, {"converged", r.converged}, {"report", r.solver_report}}}};
+}
+
+std::string report_markdown(const CalibrationResult& r, const Source& source) {
+  using format::fixed;
+  std::string md = "# Kinematic calibration of station " + r.station + "\n\n";
+  md += "Measurements `" + source.file + "` (sha256 `" + source.sha256 + "`), " + std::to_string(r.poses) + " poses fitted";
+  if (r.holdout_poses > 0) md += ", " + std::to_string(r.holdout_poses) + " held out";
+  md += "; " + format::join(r.mechanisms) + "; " + source.date + ".\n\n";
+  md += "| parameter | design | estimate | sigma | unit | |\n|---|---:|---:|---:|---|---|\n";
+  for (const Parameter& p : r.parameters) {
+    md += "| `" + p.key + "` | " + format::shortest(p.design) + " | " + fixed(p.value, 6) + " | " +
+          (p.identified ? fixed(p.sigma, 6) : std::string("-")) + " | " + p.unit + " | " +
+          (p.identified ? std::string("fitted") : p.note) + " |\n";
+  }
+  md += "\nResiduals (|measured - model|, mm): before RMS " + fixed(r.before.rms_mm, 4) + ", max " + fixed(r.before.max_mm, 4) +
+        "; after RMS " + fixed(r.after.rms_mm, 4) + ", max " + fixed(r.after.max_mm, 4);
+  if (r.holdout_poses > 0) md += "; held-out poses RMS " + fixed(r.holdout_after.rms_mm, 4) + ", max " + fixed(r.holdout_after.max_mm, 4);
+  md += ".\nMeasurement sigma " + fixed(r.sigma_mm, 4) + " mm (" + (r.sigma_estimated ? "estimated from the residuals" : "given") + ").\n\n";
+  md += "Identifiability: condition number " + fixed(r.condition_number, 1) + ", observability index O1 " +
+        fixed(r.observability_index, 4) + " (a-priori scales, docs/calibrate.md).\n";
+  for (const Unidentifiable& u : r.unidentifiable) md += "- `" + u.parameter + "` not identifiable: " + u.combination + "\n";
+  md += "\nSolver: " + r.solver_report + "\n";
+  return md;
+}
+
+Design with_provenance(const Design& patched, const CalibrationResult& r, const Source& source) {
+  Design d = patched;
+  ProvenanceSettings p = d.get<ProvenanceSettings>() ? *d.get<ProvenanceSettings>() : ProvenanceSettings{};
+  for (const Parameter& q : r.parameters) {
+    if (!q.identified || q.mechanism.empty()) continue;
+    ProvenanceEntry e;
+    e.source = source.file;
+    e.sha256 = source.sha256;
+    e.date = source.date;
+    e.method = kMethod;
+    e.sigma = q.sigma;
+    p.entries[q.key] = e;
+  }
+  d.set(std::move(p));
+  d.validate();
+  return d;
+}
+
+Json to_json(const std::vector<MechanismPlan>& plans, const PlanOptions& o) {
+  Json out = Json::array();
+  for (const MechanismPlan& p : plans) {
+    Json sig = Json::array();
+    for (std::size_t k = 0; k < p.names.size() && k < p.expected_sigma.size(); ++k) {
+      sig.push_back({{"parameter", p.names[k]}, {"planned", finite_or_null(p.expected_sigma[k])}, {"random", finite_or_null(p.random_sigma[k])}});
+    }
+    out.push_back({{"station", p.station}, {"mechanism", p.mechanism}, {"poses", p.poses.size()}, {"candidates", p.candidates},
+                   {"measurement_sigma_mm", o.sigma_mm}, {"observability_index", p.observability_index},
+                   {"random_observability_index", p.random_observability_index}, {"expected_sigma", sig},
+                   {"problem", p.problem}});
+  }
+  return out;
+}
+
+std::string plan_csv(const std::vector<MechanismPlan>& plans) {
+  std::string csv = "station,mechanism,pose,theta1_deg,theta2_deg,volts1,volts2,x_mm,y_mm\n";
+  for (const MechanismPlan& p : plans) {
+    for (std::size_t i = 0; i < p.poses.size(); ++i) {
+      const PlannedPose& q = p.poses[i];
+      csv += p.station + "," + p.mechanism + "," + std::to_string(i + 1) + "," + format::shortest(q.theta1 * format::kDegPerRad) + "," +
+             format::shortest(q.theta2 * format::kDegPerRad) + "," + format::shortest(q.volts1) + "," + format::shortest(q.volts2) + "," +
+             format::shortest(q.point.x()) + "," + format::shortest(q.point.y()) + "\n";
+    }
+  }
+  return csv;
+}
+
+}  // namespace fivebar::calibrate

@@ -1,0 +1,78 @@
+// The `provenance:` section (fivebar/sections/provenance.hpp): key path -> where the value came from.
+#include "fivebar/sections/provenance.hpp"
+
+#include <cmath>
+
+#include "fivebar/design.hpp"
+#include "sections/rules.hpp"
+#include "sections/section.hpp"
+
+namespace fivebar {
+
+void ProvenanceEntry::validate() const {
+  if (source.empty()) throw ValidationError("source", "must not be empty");
+  if (method.empty()) throw ValidationError("method", "must not be empty");
+  bool hex = sha256.size() == 64;
+  for (const char c : sha256) hex = hex && ((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'));
+  if (!hex) throw ValidationError("sha256", "= " + sha256 + ": must be 64 lowercase hex digits");
+  bool date_ok = date.size() == 10 && date[4] == '-' && date[7] == '-';
+  for (std::size_t i = 0; i < date.size() && date_ok; ++i) date_ok = i == 4 || i == 7 || (date[i] >= '0' && date[i] <= '9');
+  if (!date_ok) throw ValidationError("date", "= " + date + ": must be YYYY-MM-DD");
+  if (sigma && !(*sigma >= 0.0 && std::isfinite(*sigma))) {
+    throw ValidationError("sigma", "= " + rules::plain_number(*sigma) + ": must be >= 0");
+  }
+}
+
+void ProvenanceSettings::validate() const {
+  for (const auto& [key, entry] : entries) rules::validate_nested(key, [&] { entry.validate(); });
+}
+
+namespace sections {
+namespace {
+
+void load(const Value& v, Design& design) {
+  ProvenanceSettings& p = design.set(ProvenanceSettings{});
+  if (v.is_null()) return;
+  for (const Value& e : v.entries({}, "from key paths of the design to {source, sha256, date, method, sigma}", /*any_key=*/true)) {
+    const auto all = e.entries({"source", "sha256", "date", "method", "sigma"}, "(source, sha256, date, method, sigma)");
+    ProvenanceEntry entry;
+    entry.source = require(all, "source", e).text("must be text (a file name)");
+    entry.sha256 = require(all, "sha256", e).text("must be text (64 hex digits)");
+    entry.date = require(all, "date", e).text("must be text (YYYY-MM-DD)");
+    entry.method = require(all, "method", e).text("must be text");
+    if (const Value* s = find(all, "sigma")) entry.sigma = s->number("");
+    p.entries[e.name()] = std::move(entry);
+  }
+}
+
+void validate(const Design& design) {
+  const ProvenanceSettings* p = design.get<ProvenanceSettings>();
+  if (p == nullptr) return;
+  rules::validate_nested("provenance", [&] { p->validate(); });
+  for (const auto& [key, entry] : p->entries) {
+    if (design_number_keys(design, key).empty()) {
+      throw ValidationError("provenance." + key, "is not a key path of the design that leads to a number");
+    }
+  }
+}
+
+void write(const Design& design, Out& top) {
+  const ProvenanceSettings* p = design.get<ProvenanceSettings>();
+  if (p == nullptr) return;
+  Out& o = top.add("provenance", Out::map());
+  for (const auto& [key, e] : p->entries) {
+    Out& m = o.add(key, Out::map(/*flow=*/true));
+    m.add("source", Out::quoted(e.source));
+    m.add("sha256", Out::plain(e.sha256));
+    m.add("date", Out::quoted(e.date));
+    m.add("method", Out::quoted(e.method));
+    if (e.sigma) m.add("sigma", Out::number(*e.sigma));
+  }
+}
+
+}  // namespace
+
+Section provenance_section() { return {ProvenanceSettings::kKey, &load, &validate, &write}; }
+
+}  // namespace sections
+}  // namespace fivebar

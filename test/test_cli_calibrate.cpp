@@ -1,0 +1,191 @@
+// End-to-end tests of `fivebar calibrate`: real processes, exit codes, JSON, files. The measurement
+// files are made here from a device whose parameters are known (the paper's lower index mechanism
+// with a longer L3, a shifted O2 and another potentiometer offset), by the library's IK and FK.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <tuple>
+
+#include "cli_test.hpp"
+#include "fivebar/design.hpp"
+#include "fivebar/format.hpp"
+#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/kinematics.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sha256.hpp"
+
+namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+namespace {
+
+class CliCalibrate : public ft::CliTest {
+ protected:
+  CliCalibrate() : CliTest("fivebar_test_cli_calibrate") {}
+
+  static constexpr double kL3 = 15.2, kO2x = 12.4, kV0 = 0.27;
+
+  /// `n` poses of the true lower index mechanism, noise 0.01 mm, header `header`.
+  std::string csv(int n, bool sigma = false) {
+    const fivebar::Design d = fivebar::load_design(kDesign);
+    fivebar::Mechanism truth = *d.station("index")->lower;
+    truth.L[2] = kL3;
+    truth.O2.x() = kO2x;
+    const auto* c = d.get<fivebar::ControllerSettings>();
+    const auto p1 = c->joint("index", "lower", 1).potentiometer, p2 = c->joint("index", "lower", 2).potentiometer;
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::normal_distribution<double> noise(0.0, 0.01);
+    std::string text = std::string("station,mechanism,volts1,volts2,x_mm,y_mm") + (sigma ? ",sigma_mm" : "") + "\n";
+    const auto& t = d.station("index")->target;
+    for (int i = 0; i < n;) {
+      const fivebar::Vec2 p = t.center + fivebar::Vec2(u(rng) * t.axes.x() / 2, u(rng) * t.axes.y() / 2);
+      const fivebar::Pose pose = fivebar::ik(truth, p);
+      if (pose.status != fivebar::Status::ok) continue;
+      const double v1 = kV0 + pose.theta1 / p1.rad_per_volt, v2 = p2.volts_at_zero + pose.theta2 / p2.rad_per_volt;
+      text += "index,lower," + fivebar::format::shortest(v1) + "," + fivebar::format::shortest(v2) + "," +
+              fivebar::format::shortest(p.x() + noise(rng)) + "," + fivebar::format::shortest(p.y() + noise(rng)) +
+              (sigma ? ",0.01" : "") + "\n";
+      ++i;
+    }
+    return text;
+  }
+
+  static const json* param(const json& cal, const std::string& key) {
+    for (const json& p : cal["parameters"]) {
+      if (p["parameter"] == key) return &p;
+    }
+    return nullptr;
+  }
+};
+
+TEST_F(CliCalibrate, FitsTheTrueDeviceAndWritesThePatchWithProvenance) {
+  const fs::path meas = write("m.csv", csv(60));
+  const ft::Outcome r = run({"calibrate", kDesign, meas.string(), "--json", "--out", "cal", "--holdout", "6"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  const json& cal = doc["calibration"];
+  EXPECT_EQ(cal["poses"], 54);
+  const auto check = [&](const std::string& key, double truth) {
+    const json* p = param(cal, key);
+    ASSERT_NE(p, nullptr) << key;
+    EXPECT_TRUE((*p)["identified"].get<bool>()) << key;
+    EXPECT_NEAR((*p)["value"].get<double>(), truth, 4.0 * (*p)["sigma"].get<double>() + 1e-9) << key;
+    EXPECT_LT((*p)["sigma"].get<double>(), 0.05) << key;
+  };
+  check("stations.index.mechanisms.lower.links[2]", kL3);
+  check("stations.index.mechanisms.lower.bases[1][0]", kO2x);
+  check("controller.stations.index.lower.theta1.potentiometer.volts_at_zero", kV0);
+  EXPECT_LT(cal["residuals"]["after"]["rms_mm"].get<double>(), 0.03);
+  EXPECT_GT(cal["residuals"]["before"]["rms_mm"].get<double>(), 0.1);
+  EXPECT_LT(cal["holdout"]["after"]["rms_mm"].get<double>(), 0.05);
+  // The patch: loads, carries the estimates, and names its source by hash.
+  const fs::path patched = dir_ / "cal" / "iros2022-calibrated.yaml";
+  ASSERT_TRUE(fs::exists(patched));
+  EXPECT_TRUE(fs::exists(dir_ / "cal" / "calibration-summary.md"));
+  const fivebar::Design d = fivebar::load_design(patched);
+  EXPECT_NEAR(d.station("index")->lower->L[2], param(cal, "stations.index.mechanisms.lower.links[2]")->at("value").get<double>(), 1e-12);
+  EXPECT_TRUE(fivebar::is_measured(d, "stations.index.mechanisms.lower.links[2]"));
+  EXPECT_THAT(ft::slurp(patched), HasSubstr(fivebar::sha256_file(meas)));
+}
+
+TEST_F(CliCalibrate, AskingForAnUnidentifiableParameterExitsOneAndWritesNothing) {
+  const fs::path meas = write("m.csv", csv(40));
+  const ft::Outcome r = run({"calibrate", kDesign, meas.string(), "--frame", "fit", "--fit", "L3,O1x,frame.x", "--out", "cal"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("not identifiable: lower.O1x"));
+  EXPECT_FALSE(fs::exists(dir_ / "cal"));
+  // Without --fit the same poses fit, holding O1 at the design and naming why.
+  const ft::Outcome ok = run({"calibrate", kDesign, meas.string(), "--frame", "fit", "--json"});
+  EXPECT_EQ(ok.code, 0) << ok.err;
+  const json doc = parse(ok);
+  std::vector<std::string> held;
+  for (const json& u : doc["calibration"]["identifiability"]["unidentifiable"]) held.push_back(u["parameter"]);
+  EXPECT_THAT(held, ::testing::UnorderedElementsAre("lower.O1x", "lower.O1y", "lower.O2y"));
+}
+
+TEST_F(CliCalibrate, BadInputNamesFileLineAndColumnAndWritesNothing) {
+  struct Case {
+    std::string text, message;
+  };
+  const std::vector<Case> cases = {
+      {"station,mechanism,volts1,volts2,x_mm\nindex,lower,1,2,3\n", "m.csv:1: column 'y_mm' is missing"},
+      {"station,mechanism,volts1,volts2,x_mm,y_mm,z_mm\n", "m.csv:1: column 7 'z_mm': unknown column"},
+      {"station,mechanism,volts1,volts2,x_mm,y_mm\nindex,lower,1,nan,3,4\n", "m.csv:2: column 'volts2' = 'nan'"},
+      {"station,mechanism,volts1,volts2,x_mm,y_mm\nindex,middle,1,2,3,4\n", "m.csv:2: column 'mechanism' = 'middle'"},
+      {csv(3), "6 equations for 12 unknowns"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.message);
+    write("m.csv", c.text);
+    const ft::Outcome r = run({"calibrate", kDesign, "m.csv", "--out", "cal"});
+    EXPECT_EQ(r.code, 2) << r.out;
+    EXPECT_THAT(r.err, HasSubstr(c.message));
+    EXPECT_FALSE(fs::exists(dir_ / "cal"));
+  }
+}
+
+TEST_F(CliCalibrate, PlanWritesJointTargetsThatBeatRandomPoses) {
+  const ft::Outcome r = run({"calibrate", kDesign, "--plan", "15", "--station", "index", "--mechanism", "lower", "--json", "--out", "plan"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  ASSERT_EQ(doc["plan"].size(), 1u);
+  const json& p = doc["plan"][0];
+  EXPECT_EQ(p["poses"], 15);
+  EXPECT_GT(p["observability_index"].get<double>(), p["random_observability_index"].get<double>());
+  const std::string plan = ft::slurp(dir_ / "plan" / "calibration-plan.csv");
+  EXPECT_EQ(std::count(plan.begin(), plan.end(), '\n'), 16);
+  EXPECT_THAT(plan, HasSubstr("station,mechanism,pose,theta1_deg,theta2_deg,volts1,volts2,x_mm,y_mm"));
+}
+
+TEST_F(CliCalibrate, RequireMeasuredMakesTheExportGateRefuseAssumedPotentiometers) {
+  const fs::path design = design_with("d.yaml", "  joint_margin_deg: 5 ", "  require_measured: [potentiometer]\n  joint_margin_deg: 5 ");
+  const ft::Outcome r = run({"export", design.string(), "--json", "--out", "exp", "--station", "index"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("controller.require_measured"));
+}
+
+TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
+  const fivebar::Design d = fivebar::load_design(kDesign);
+  const fivebar::Station& st = *d.station("index");
+  const double k = d.get<fivebar::ControllerSettings>()->joint("index", "lower", 1).potentiometer.rad_per_volt;
+  std::string text = "station,mechanism,joint,stop,volts\n";
+  std::string key;
+  for (int j = 1; j <= 2 && key.empty(); ++j) {
+    const auto range = fivebar::usable_ranges(d, st, *st.lower)[static_cast<std::size_t>(j - 1)];
+    for (const auto& [end, by, theta] : {std::tuple{"lo", range.lo_by, range.lo}, std::tuple{"hi", range.hi_by, range.hi}}) {
+      if (by.rfind("hard stop", 0) != 0 || !key.empty()) continue;
+      text += "index,lower," + std::to_string(j) + "," + end + "," + fivebar::format::shortest(0.3 + theta / k) + "\n";
+      key = "controller.stations.index.lower.theta" + std::to_string(j) + ".potentiometer.volts_at_zero";
+    }
+  }
+  if (key.empty()) GTEST_SKIP() << "no hard stop on the paper's lower index mechanism";
+  write("stops.csv", text);
+  const ft::Outcome r = run({"calibrate", kDesign, "--hard-stops", "stops.csv", "--json", "--out", "cal"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json doc = parse(r);
+  const json* p = param(doc["hard_stops"], key);
+  ASSERT_NE(p, nullptr);
+  EXPECT_NEAR((*p)["value"].get<double>(), 0.3, 1e-9);
+  const fivebar::Design patched = fivebar::load_design(dir_ / "cal" / "iros2022-calibrated.yaml");
+  EXPECT_NEAR(fivebar::design_number(patched, key), 0.3, 1e-9);
+  EXPECT_TRUE(fivebar::is_measured(patched, key));
+  // A stop the geometry does not define is bad input, nothing written.
+  write("bad.csv", "station,mechanism,joint,stop,volts\nindex,lower,1,sideways,1\n");
+  const ft::Outcome bad = run({"calibrate", kDesign, "--hard-stops", "bad.csv", "--out", "cal2"});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("bad.csv:2: column 'stop'"));
+  EXPECT_FALSE(fs::exists(dir_ / "cal2"));
+}
+
+}  // namespace
