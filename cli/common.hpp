@@ -125,5 +125,6 @@ void setup_simulate(CLI::App& app);
 void setup_tolerance(CLI::App& app);
 void setup_animate(CLI::App& app);
 void setup_control(CLI::App& app);
+void setup_identify(CLI::App& app);
 
 }  // namespace fivebar::cli

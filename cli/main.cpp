@@ -103,6 +103,7 @@ int run(int argc, char** argv) {
   setup_tolerance(app);
   setup_animate(app);
   setup_control(app);
+  setup_identify(app);
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);
