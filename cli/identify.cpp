@@ -3,6 +3,8 @@
 // (fivebar/identify.hpp, docs/identify.md).
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -26,6 +28,13 @@ namespace fivebar::cli {
 namespace {
 
 namespace id = fivebar::identify;
+
+/// `value` to 5 significant digits, in its shortest text.
+std::string sig(double value) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.5g", value);
+  return format::shortest(std::strtod(buf, nullptr));
+}
 
 struct IdentifyCliOptions {
   std::string design;
@@ -90,9 +99,9 @@ id::JointPrior prior_of(const Design& design, const std::string& station, const 
 void print_estimate_table(const id::JointIdentification& r) {
   std::cout << "  parameters (" << (r.output_error && false ? "output error" : "IDIM-LS unless noted") << "):\n";
   for (const id::Parameter& p : r.parameters) {
-    std::cout << "    " << p.key << " = " << format::shortest(p.value);
+    std::cout << "    " << p.key << " = " << sig(p.value);
     if (p.identified) {
-      std::cout << " +- " << format::shortest(p.sigma);
+      std::cout << " +- " << sig(p.sigma);
       if (p.value != 0.0) std::cout << " (" << fixed(100.0 * p.sigma / std::abs(p.value), 2) << " %)";
     } else {
       std::cout << " HELD";
@@ -129,8 +138,8 @@ void print_joint(const id::JointIdentification& r) {
     std::cout << ":";
     for (std::size_t i = 0; i < r.output_error->names.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
-      std::cout << " " << r.output_error->names[i] << " = " << format::shortest(r.output_error->value[k]);
-      if (r.output_error->identified[i]) std::cout << " +- " << format::shortest(r.output_error->sigma[k]);
+      std::cout << " " << r.output_error->names[i] << " = " << sig(r.output_error->value[k]);
+      if (r.output_error->identified[i]) std::cout << " +- " << sig(r.output_error->sigma[k]);
     }
   }
   std::cout << "\n";
@@ -235,7 +244,7 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   std::cout << "expected sigmas (IDIM-LS, drive noise " << format::shortest(opt.drive_noise_mNm) << " mNm, decimation 10):\n";
   for (std::size_t i = 0; i < plan.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
-    std::cout << "  " << plan.names[i] << ": prior " << format::shortest(plan.truth[k]) << ", sigma " << format::shortest(plan.expected_sigma[k]) << "\n";
+    std::cout << "  " << plan.names[i] << ": prior " << sig(plan.truth[k]) << ", sigma " << sig(plan.expected_sigma[k]) << "\n";
   }
   for (const std::string& f : files) std::cout << "wrote " << f << "\n";
   return kOk;

@@ -165,7 +165,7 @@ RenderedPlot identify_plot(const JointIdentification& r, bool validation) {
          line(s.time, s.position_idim, kLowerColour, 1.0, false, "IDIM-LS model"),
          line(s.time, s.position_oe, kUpperColour, 1.0, true, "output-error model")},
         t_end);
-  chart(cr, 90.0, 430.0, kWidth - 120.0, 270.0, "drive: measured (filtered, decimated) and predicted by the inverse model",
+  chart(cr, 90.0, 430.0, kWidth - 120.0, 270.0, "drive: measured (decimated) and predicted by the inverse model",
         drive_unit,
         {line(s.drive_time, s.drive, kInk, 1.2, false, "measured"),
          line(s.drive_time, s.drive_idim, kLowerColour, 1.0, false, "IDIM-LS prediction")},
