@@ -72,7 +72,11 @@ id::JointPrior prior_of(const Design& design, const std::string& station, const 
   }
   const ControllerSettings* cs = design.get<ControllerSettings>();
   if (!station.empty()) {
-    design.require_station(station);
+    const Station& s = design.require_station(station);
+    if (s.mechanism(mechanism) == nullptr) {
+      throw InputError("joint '" + station + "_" + mechanism + "_theta" + std::to_string(joint) + "': station '" + station +
+                       "' has no mechanism '" + mechanism + "'");
+    }
     if (ms) p.motor = ms->joint(station, mechanism, joint);
     if (cs) {
       const JointControl jc = cs->joint(station, mechanism, joint);

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -321,6 +322,50 @@ TEST(IdentifyPlan, StaysWithinItsLimitsWithALowCrestFactor) {
   EXPECT_LT(plan.crest_factor, 2.5);  // Schroeder phases: a low crest factor
   ASSERT_EQ(plan.expected_sigma.size(), 4);
   for (int k = 0; k < 4; ++k) EXPECT_GT(plan.expected_sigma[k], 0.0);
+}
+
+TEST(IdentifyPlan, ExpectedSigmasMatchTheSpreadOfFitsToLogsOfThePlan) {
+  // Logs of the plan played perfectly by the prior model, with white noise of the stated sigma on
+  // the logged drive torque: the spread of the IDIM-LS estimates over 40 seeds is what the plan's
+  // information matrix predicts.
+  id::JointPrior prior;
+  id::PlanOptions po;
+  po.range_lo = -1.0;
+  po.range_hi = 1.0;
+  po.drive_noise = 2e-3;
+  const id::ExcitationPlan plan = id::plan_excitation(prior, po);
+  const MotorParams& m = prior.motor;
+  const double K = m.gearbox_efficiency * m.gear_ratio * m.torque_constant();
+  id::IdentifyOptions o;
+  o.output_error = false;
+  o.zero_order_hold = false;  // the logged drive is the instantaneous torque
+  const int seeds = 40;
+  std::vector<Eigen::VectorXd> estimates;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int s = 0; s < seeds; ++s) {
+    id::JointLog j;
+    j.drive = id::DriveKind::current;
+    j.drive_column = "current_A";
+    j.reading_column = "theta_rad";
+    j.reading_values = plan.position;
+    for (std::size_t i = 0; i < plan.time.size(); ++i) {
+      const double w = plan.velocity[i];
+      const double tau = plan.truth[0] * plan.acceleration[i] + plan.truth[1] * w + plan.truth[2] * (w > 0 ? 1.0 : w < 0 ? -1.0 : 0.0);
+      j.drive_values.push_back((tau + po.drive_noise * noise(rng)) / K);
+    }
+    estimates.push_back(id::identify_joint(j, plan.time, prior, nullptr, nullptr, o).idim.value);
+  }
+  for (int k = 0; k < 4; ++k) {
+    double mean = 0.0, var = 0.0;
+    for (const auto& e : estimates) mean += e[k] / seeds;
+    for (const auto& e : estimates) var += (e[k] - mean) * (e[k] - mean) / (seeds - 1);
+    const double ratio = std::sqrt(var) / plan.expected_sigma[k];
+    // 40 samples give the standard deviation to about +-11 % (1 sigma): a factor 1.5 either way.
+    EXPECT_GT(ratio, 1.0 / 1.5) << plan.names[static_cast<std::size_t>(k)];
+    EXPECT_LT(ratio, 1.5) << plan.names[static_cast<std::size_t>(k)];
+    std::cout << plan.names[static_cast<std::size_t>(k)] << ": spread / expected sigma " << ratio << "\n";
+  }
 }
 
 // --- EMPS: real measurements --------------------------------------------------------------------------
