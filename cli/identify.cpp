@@ -139,7 +139,7 @@ void print_joint(const id::JointIdentification& r) {
   }
   std::cout << "  output error: " << r.output_error_status;
   if (r.output_error) {
-    std::cout << ":";
+    std::cout << " (sigmas assume white output noise: optimistic for an open-loop drift):";
     for (std::size_t i = 0; i < r.output_error->names.size(); ++i) {
       const auto k = static_cast<Eigen::Index>(i);
       std::cout << " " << r.output_error->names[i] << " = " << sig(r.output_error->value[k]);
