@@ -134,6 +134,12 @@ TEST(IdentifyLog, RefusesBadInputNamingFileLineAndColumn) {
     EXPECT_NE(e.find("does not increase"), std::string::npos) << e;
   }
   {
+    std::string t = rows("time_s,torque_Nm,theta_rad", 20, ",1,2");
+    t.replace(t.find("0.005000,1,2"), 12, "0.005000,1e300,2");
+    const std::string e = error_of(t);
+    EXPECT_NE(e.find("bench.csv:7: column 'torque_Nm': 1e300 is outside"), std::string::npos) << e;
+  }
+  {
     const std::string e = error_of(rows("time_s,force_N,theta_rad", 20, ",1,2"));
     EXPECT_NE(e.find("units do not match"), std::string::npos) << e;
   }

@@ -317,6 +317,9 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
     mprior[p - 1] = 0.0;
   }
   r.idim = least_squares(est.W, est.Y, names, mprior, o.rank_tolerance);
+  if (!r.idim.value.allFinite() || !r.idim.sigma.allFinite()) {
+    throw InputError("the least-squares fit is not finite: the log's values are out of range for this model");
+  }
   for (std::size_t i = 0; i < names.size(); ++i) {
     if (!r.idim.identified[i]) r.unidentifiable.push_back(names[i]);
   }

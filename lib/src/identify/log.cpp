@@ -222,6 +222,10 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
       if (s.empty() || ec != std::errc() || p != e || !std::isfinite(v[c])) {
         throw InputError(where(path, line_no) + "column '" + header[c] + "': '" + s + "' is not a finite number");
       }
+      if (std::abs(v[c]) > kMaxLogValue) {
+        throw InputError(where(path, line_no) + "column '" + header[c] + "': " + s + " is outside +-" +
+                         format::shortest(kMaxLogValue) + " (no bench quantity is that large in SI units)");
+      }
     }
     const double time = v[static_cast<std::size_t>(time_col)];
     if (!log.time.empty() && !(time > log.time.back())) {

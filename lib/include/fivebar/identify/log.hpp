@@ -22,6 +22,7 @@ enum class ReadingKind { volts, counts, angle };
 inline constexpr std::size_t kMaxLogLine = 4096;                 ///< characters per line
 inline constexpr std::size_t kMaxLogRows = 20'000'000;           ///< data rows
 inline constexpr std::uintmax_t kMaxLogBytes = 1ull << 30;       ///< file size
+inline constexpr double kMaxLogValue = 1e9;                       ///< |cell|, SI (keeps every product finite)
 
 /// One joint's columns, SI (or the linear axis' newtons and metres).
 struct JointLog {
@@ -47,7 +48,7 @@ struct IdentifyLog {
 };
 
 /// Parses a log; InputError naming `path`, the line and the column on any fault (missing or
-/// unknown column, duplicate, empty or non-finite cell, time not increasing or not evenly sampled
+/// unknown column, duplicate, empty, non-finite or out-of-range (kMaxLogValue) cell, time not increasing or not evenly sampled
 /// within 5 %, a line longer than kMaxLogLine, too few rows, a linear drive with a rotary reading).
 IdentifyLog read_identify_log(std::istream& in, const std::string& path);
 /// Same, from a file (InputError when it cannot be opened or exceeds kMaxLogBytes).
