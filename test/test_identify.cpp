@@ -162,6 +162,22 @@ TEST(IdentifyLog, RefusesBadInputNamingFileLineAndColumn) {
   }
 }
 
+TEST(IdentifyLog, VoltsAndCountsBecomeAnglesThroughThePotentiometerAndTheAdc) {
+  id::JointPrior prior;  // potentiometer 2.5 V at 0, 60 deg per volt; 16-bit ADC over -10 ... 10 V
+  id::JointLog j;
+  j.reading = id::ReadingKind::volts;
+  j.reading_values = {2.5, 3.5, 1.0};
+  auto q = id::joint_angle(j, prior);
+  EXPECT_NEAR(q[0], 0.0, 1e-15);
+  EXPECT_NEAR(q[1], std::numbers::pi / 3.0, 1e-12);
+  EXPECT_NEAR(q[2], -std::numbers::pi / 2.0, 1e-12);
+  j.reading = id::ReadingKind::counts;
+  j.reading_values = {40960.0, 65536.0 * 13.5 / 20.0};  // 2.5 V and 3.5 V
+  q = id::joint_angle(j, prior);
+  EXPECT_NEAR(q[0], 0.0, 1e-12);
+  EXPECT_NEAR(q[1], std::numbers::pi / 3.0, 1e-12);
+}
+
 // --- Least squares --------------------------------------------------------------------------------
 
 TEST(IdentifyLeastSquares, RecoversExactParametersAndNamesDependentColumns) {
@@ -417,6 +433,17 @@ TEST(IdentifyEmps, MatchesThePublishedIdimLsParameters) {
   // the reference model's own simulation (91.8 % estimation, 88.8 % validation).
   EXPECT_GT(r.estimation_idim.position_fit_percent, 85.0);
   EXPECT_GT(r.validation_idim->position_fit_percent, 80.0);
+  // Read as what it is, a linear axis (force_N, position_m): the same numbers under the axis' names,
+  // and no design key of a rotary motor.
+  id::JointLog linear = est.joints[0];
+  linear.linear = true;
+  const auto l = id::identify_joint(linear, est.time, id::JointPrior{}, nullptr, nullptr, o);
+  ASSERT_EQ(l.parameters.size(), 4u);
+  EXPECT_EQ(l.parameters[0].key, "mass_kg");
+  EXPECT_EQ(l.parameters[1].key, "viscous_N_s_per_m");
+  EXPECT_EQ(l.parameters[2].key, "coulomb_N");
+  EXPECT_EQ(l.parameters[3].key, "offset_N");
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(l.parameters[static_cast<std::size_t>(k)].value, r.idim.value[k], 1e-9 * std::abs(r.idim.value[k]));
   std::cout << "EMPS IDIM-LS: M " << r.idim.value[0] << " +- " << r.idim.sigma[0] << ", Fv " << r.idim.value[1] << " +- "
             << r.idim.sigma[1] << ", Fc " << r.idim.value[2] << " +- " << r.idim.sigma[2] << ", offset " << r.idim.value[3]
             << " +- " << r.idim.sigma[3] << "; force error " << r.estimation_idim.drive_relative_error_percent << " % / "
