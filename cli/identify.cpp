@@ -19,7 +19,7 @@
 #include "fivebar/format.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/io.hpp"
-#include "fivebar/joint_limits.hpp"
+#include "fivebar/export/joint_limits.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
 

@@ -1,5 +1,5 @@
 #pragma once
-// Private to lib/src/identify/: the output-error refinement (Ceres stays inside output_error.cpp).
+// Private to lib/src/identify/: the output-error refinement (Ceres stays inside ceres_output_error.cpp).
 
 #include <string>
 #include <vector>
