@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string>
 
-namespace fivebar::testing {
+namespace fivebar_test_paths {
 namespace {
 
 namespace fs = std::filesystem;
@@ -57,4 +57,4 @@ const char* source_dir() { return paths().source.c_str(); }
 const char* fivebar_binary() { return paths().binary.c_str(); }
 const char* shared_data_dir() { return paths().shared_data.c_str(); }
 
-}  // namespace fivebar::testing
+}  // namespace fivebar_test_paths

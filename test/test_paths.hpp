@@ -4,7 +4,7 @@
 // compiler command names no checkout path and a second checkout reuses the compiler cache.
 // FIVEBAR_SOURCE_DIR and FIVEBAR_BINARY (test/CMakeLists.txt) expand to these calls.
 
-namespace fivebar::testing {
+namespace fivebar_test_paths {
 
 /// The source tree (CMAKE_HOME_DIRECTORY of the build), e.g. "/work/fivebar".
 const char* source_dir();
@@ -14,4 +14,4 @@ const char* fivebar_binary();
 /// empty when the cache does not set it.
 const char* shared_data_dir();
 
-}  // namespace fivebar::testing
+}  // namespace fivebar_test_paths
