@@ -108,7 +108,7 @@ TEST_F(CliIdentify, PlanWritesAnExcitationWithinTheLimits) {
 }
 
 TEST_F(CliIdentify, EmpsBenchmarkThroughTheCommandLine) {
-  const fs::path dir = fs::path(ft::shared_data_dir()) / "sysid" / "emps";
+  const fs::path dir = fs::path(fivebar_test_paths::shared_data_dir()) / "sysid" / "emps";
   if (!fs::exists(dir / "est.csv")) GTEST_SKIP() << "EMPS data not found under " << dir;
   const Outcome r = run({"identify", kDesign, (dir / "est.csv").string(), "--validation", (dir / "val.csv").string(),
                          "--instant-drive", "--json", "--no-files"});

@@ -398,7 +398,7 @@ TEST(IdentifyPlan, ExpectedSigmasMatchTheSpreadOfFitsToLogsOfThePlan) {
 // published IDIM-LS estimates (PDF section 3.4): M = 95.1089 kg (sigma 0.1085), Fv = 203.5034 N s/m
 // (1.1460), Fc = 20.3935 N (0.1012), offset = -3.1648 N (0.0444); relative force error 4.08 % on
 // estimation, 5.98 % cross-test.
-std::filesystem::path emps_dir() { return std::filesystem::path(fivebar::testing::shared_data_dir()) / "sysid" / "emps"; }
+std::filesystem::path emps_dir() { return std::filesystem::path(fivebar_test_paths::shared_data_dir()) / "sysid" / "emps"; }
 
 TEST(IdentifyEmps, MatchesThePublishedIdimLsParameters) {
   const auto dir = emps_dir();
