@@ -16,7 +16,8 @@ FIVEBAR_PACKAGES=(
   libsundials-dev
   # Optimisation: pagmo2 (multi-objective evolutionary search) and NLopt (derivative-free polish, tuning).
   libpagmo-dev libnlopt-cxx-dev
-  # Kinematic calibration (fivebar calibrate): Ceres Solver's nonlinear least squares.
+  # Kinematic calibration (fivebar calibrate) and identification (fivebar identify): Ceres Solver's
+  # nonlinear least squares.
   libceres-dev
   # Tests of what users open: urdfdom's check_urdf reads the exported URDF, python3-jsonschema
   # validates every command's --json against docs/schemas/, headless Chromium loads the HTML report.

@@ -127,5 +127,6 @@ void setup_animate(CLI::App& app);
 void setup_control(CLI::App& app);
 void setup_replay(CLI::App& app);
 void setup_calibrate(CLI::App& app);
+void setup_identify(CLI::App& app);
 
 }  // namespace fivebar::cli

@@ -150,6 +150,7 @@ int run(int argc, char** argv) {
   setup_tolerance(app);
   setup_animate(app);
   setup_control(app);
+  setup_identify(app);
   setup_calibrate(app);
   setup_replay(app);
   // After every subcommand: their numeric flags refuse NaN, infinities and overflow.

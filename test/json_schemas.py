@@ -18,6 +18,7 @@ reports the test as skipped; ./test.sh installs it).
 """
 import copy
 import json
+import math
 import pathlib
 import shutil
 import subprocess
@@ -152,6 +153,19 @@ def main():
     if sil is not None and sil.get("runs"):
         run("replay LOG", "replay", ["replay", sil["runs"][0]["log"], "--config", out + "/export/iros2022_controller.json"])
     run("tolerance", "tolerance", ["tolerance", DESIGN, "--out", out + "/tol"])
+    # identify: a bench log of a rigid motor under a torque drive, written here (explicit Euler).
+    rows, q, v = ["time_s,torque_Nm,theta_rad"], 0.0, 0.0
+    for k in range(3000):
+        t = k * 1e-3
+        tau = 0.05 * math.sin(2 * math.pi * 1.3 * t) + 0.03 * math.sin(2 * math.pi * 3.1 * t + 1.0)
+        rows.append(f"{t:.6f},{tau!r},{q!r}")
+        v += (tau - 1e-3 * v - 5e-3 * math.tanh(v / 1e-2)) / 2e-3 * 1e-3
+        q += v * 1e-3
+    pathlib.Path(out).mkdir(parents=True, exist_ok=True)
+    bench_log = pathlib.Path(out) / "bench.csv"
+    bench_log.write_text("\n".join(rows) + "\n")
+    run("identify", "identify", ["identify", DESIGN, str(bench_log), "--validation", str(bench_log), "--out", out + "/identify"])
+    run("identify --plan", "identify", ["identify", DESIGN, "--plan", "--out", out + "/identify"])
     run("control", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--out", out + "/control"])
     run("control --tune", "control", ["control", DESIGN, "-s", "index", "--grid", "9", "--field", "9", "--tune",
                                       "--tune-evaluations", "2", "--out", out + "/tune"], (0, 1))

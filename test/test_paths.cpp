@@ -16,6 +16,7 @@ namespace fs = std::filesystem;
 struct Paths {
   std::string source;
   std::string binary;
+  std::string shared_data;
 };
 
 [[noreturn]] void fail(const std::string& why) {
@@ -33,10 +34,15 @@ const Paths& paths() {
       if (fs::exists(cache)) {
         std::ifstream in(cache);
         const std::string key = "CMAKE_HOME_DIRECTORY:INTERNAL=";
+        const std::string data_key = "FIVEBAR_SHARED_DATA_DIR:PATH=";
+        Paths found;
         for (std::string line; std::getline(in, line);) {
-          if (line.rfind(key, 0) == 0) return Paths{line.substr(key.size()), (dir / "fivebar").string()};
+          if (line.rfind(key, 0) == 0) found.source = line.substr(key.size());
+          if (line.rfind(data_key, 0) == 0) found.shared_data = line.substr(data_key.size());
         }
-        fail(cache.string() + " has no CMAKE_HOME_DIRECTORY");
+        if (found.source.empty()) fail(cache.string() + " has no CMAKE_HOME_DIRECTORY");
+        found.binary = (dir / "fivebar").string();
+        return found;
       }
       if (dir == dir.root_path()) break;
     }
@@ -49,5 +55,6 @@ const Paths& paths() {
 
 const char* source_dir() { return paths().source.c_str(); }
 const char* fivebar_binary() { return paths().binary.c_str(); }
+const char* shared_data_dir() { return paths().shared_data.c_str(); }
 
 }  // namespace fivebar_test_paths

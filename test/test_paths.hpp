@@ -10,5 +10,8 @@ namespace fivebar_test_paths {
 const char* source_dir();
 /// The built command-line program, `<build>/fivebar`.
 const char* fivebar_binary();
+/// The public data sets the tests read (the cache variable FIVEBAR_SHARED_DATA_DIR, test/CMakeLists.txt);
+/// empty when the cache does not set it.
+const char* shared_data_dir();
 
 }  // namespace fivebar_test_paths

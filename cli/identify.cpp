@@ -1,0 +1,409 @@
+// fivebar identify: the motor, friction and inertia of a joint from bench logs (IDIM-LS, then an
+// output-error refinement), with the fit on a validation log; or, with --plan, the excitation to log
+// (fivebar/identify.hpp, docs/identify.md).
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
+#include "fivebar/identify.hpp"
+#include "fivebar/io.hpp"
+#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/motor.hpp"
+
+namespace fivebar::cli {
+
+namespace {
+
+namespace id = fivebar::identify;
+
+/// `value` to 5 significant digits, in its shortest text.
+std::string sig(double value) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.5g", value);
+  return format::shortest(std::strtod(buf, nullptr));
+}
+
+struct IdentifyCliOptions {
+  std::string design;
+  std::string log;
+  std::string validation;
+  std::string rig = "motor";
+  std::string joint;
+  std::string out;
+  std::vector<std::string> fit;
+  double load_inertia = 0.0;
+  double cutoff_hz = 0.0;
+  int filter_order = 4;
+  int decimation = 0;
+  bool per_direction = false;
+  bool instant_drive = false;
+  bool no_output_error = false;
+  std::string method = "idim";
+  bool json = false;
+  bool no_files = false;
+  bool plan = false;
+  double plan_duration_s = 10.0;
+  std::vector<double> plan_band_hz{0.2, 5.0};
+  std::vector<double> range_deg;
+  double drive_noise_mNm = 1.0;
+};
+
+/// The priors of a joint: its motor (overrides applied), potentiometer and ADC, and the key path.
+id::JointPrior prior_of(const Design& design, const std::string& station, const std::string& mechanism, int joint,
+                        double load_inertia, bool need_motor) {
+  id::JointPrior p;
+  const MotorSettings* ms = design.get<MotorSettings>();
+  if (ms == nullptr && need_motor) {
+    throw InputError(design.name + ": the design has no `motor:` section (motor.terminal_resistance_ohm, ...): the priors "
+                                   "of a duty, voltage or current drive");
+  }
+  const ControllerSettings* cs = design.get<ControllerSettings>();
+  if (!station.empty()) {
+    const Station& s = design.require_station(station);
+    if (s.mechanism(mechanism) == nullptr) {
+      throw InputError("joint '" + station + "_" + mechanism + "_theta" + std::to_string(joint) + "': station '" + station +
+                       "' has no mechanism '" + mechanism + "'");
+    }
+    if (ms) p.motor = ms->joint(station, mechanism, joint);
+    if (cs) {
+      const JointControl jc = cs->joint(station, mechanism, joint);
+      p.volts_at_zero = jc.potentiometer.volts_at_zero;
+      p.rad_per_volt = jc.potentiometer.rad_per_volt;
+    }
+    p.motor_key = "motor.stations." + station + "." + mechanism + ".theta" + std::to_string(joint);
+  } else {
+    if (ms) p.motor = ms->defaults;
+    if (cs) {
+      p.volts_at_zero = cs->potentiometer.volts_at_zero;
+      p.rad_per_volt = cs->potentiometer.rad_per_volt;
+    }
+  }
+  if (cs) {
+    p.adc_bits = cs->adc_bits;
+    p.adc_lo_v = cs->adc_range_v[0];
+    p.adc_hi_v = cs->adc_range_v[1];
+  }
+  p.load_inertia = load_inertia;
+  return p;
+}
+
+void print_estimate_table(const id::JointIdentification& r) {
+  std::cout << "  parameters (" << (r.output_error && false ? "output error" : "IDIM-LS unless noted") << "):\n";
+  for (const id::Parameter& p : r.parameters) {
+    std::cout << "    " << p.key << " = " << sig(p.value);
+    if (p.identified) {
+      std::cout << " +- " << sig(p.sigma);
+      if (p.value != 0.0) std::cout << " (" << fixed(100.0 * p.sigma / std::abs(p.value), 2) << " %)";
+    } else {
+      std::cout << " HELD";
+    }
+    if (!p.note.empty() && !(p.identified && (p.note == "IDIM-LS" || p.note == "output error"))) std::cout << "  [" << p.note << "]";
+    std::cout << "\n";
+  }
+}
+
+std::string fit_text(const id::Fit& f) {
+  std::string s = "drive fit " + fixed(f.drive_fit_percent, 1) + " % (relative error " + fixed(f.drive_relative_error_percent, 2) + " %)";
+  s += f.simulated ? ", position fit " + fixed(f.position_fit_percent, 1) + " % (relative error " +
+                         fixed(f.position_relative_error_percent, 2) + " %)"
+                   : ", open-loop simulation diverged";
+  return s;
+}
+
+void print_joint(const id::JointIdentification& r) {
+  std::cout << "joint " << r.joint << ": drive " << r.drive_column << ", reading " << r.reading_column << ", "
+            << format::shortest(1.0 / r.sample_time) << " Hz, low-pass " << format::shortest(r.cutoff_hz)
+            << " Hz (Butterworth, zero phase), decimation " << r.decimation << ", " << r.idim.rows << " rows\n";
+  print_estimate_table(r);
+  if (!r.unidentifiable.empty()) {
+    std::cout << "  not identifiable from this log (held at the prior): " << format::join(r.unidentifiable) << "\n";
+  }
+  std::cout << "  correlation (IDIM-LS):\n";
+  for (Eigen::Index a = 0; a < r.idim.correlation.rows(); ++a) {
+    std::cout << "    " << r.idim.names[static_cast<std::size_t>(a)] << ":";
+    for (Eigen::Index b = 0; b < r.idim.correlation.cols(); ++b) std::cout << " " << fixed(r.idim.correlation(a, b), 3);
+    std::cout << "\n";
+  }
+  std::cout << "  output error: " << r.output_error_status;
+  if (r.output_error) {
+    std::cout << " (sigmas assume white output noise: optimistic for an open-loop drift):";
+    for (std::size_t i = 0; i < r.output_error->names.size(); ++i) {
+      const auto k = static_cast<Eigen::Index>(i);
+      std::cout << " " << r.output_error->names[i] << " = " << sig(r.output_error->value[k]);
+      if (r.output_error->identified[i]) std::cout << " +- " << sig(r.output_error->sigma[k]);
+    }
+  }
+  std::cout << "\n";
+  std::cout << "  estimation log: IDIM-LS " << fit_text(r.estimation_idim) << "\n";
+  if (r.output_error) std::cout << "                  output error " << fit_text(r.estimation_oe) << "\n";
+  if (r.validation_idim) {
+    std::cout << "  validation log: IDIM-LS " << fit_text(*r.validation_idim) << "\n";
+    if (r.validation_oe) std::cout << "                  output error " << fit_text(*r.validation_oe) << "\n";
+  }
+}
+
+int run_plan(const IdentifyCliOptions& opt, const Design& design) {
+  std::string station, mechanism;
+  int joint = 0;
+  if (!opt.joint.empty()) {
+    const std::size_t a = opt.joint.find('/'), b = opt.joint.rfind('/');
+    if (a == std::string::npos || a == b || opt.joint.compare(b + 1, 5, "theta") != 0 || opt.joint.size() != b + 7 ||
+        (opt.joint.back() != '1' && opt.joint.back() != '2')) {
+      throw InputError("--joint '" + opt.joint + "': expected STATION/MECHANISM/theta1 or theta2");
+    }
+    station = opt.joint.substr(0, a);
+    mechanism = opt.joint.substr(a + 1, b - a - 1);
+    joint = opt.joint.back() - '0';
+  }
+  const id::JointPrior prior = prior_of(design, station, mechanism, joint, opt.load_inertia, true);
+  id::PlanOptions po;
+  po.duration_s = opt.plan_duration_s;
+  if (opt.plan_band_hz.size() != 2) throw InputError("--plan-band: expected F_MIN,F_MAX in Hz");
+  po.f_min_hz = opt.plan_band_hz[0];
+  po.f_max_hz = opt.plan_band_hz[1];
+  po.current_limit = prior.motor.current_limit_A;
+  po.per_direction = opt.per_direction;
+  po.drive_noise = opt.drive_noise_mNm * 1e-3;
+  const ControllerSettings* cs = design.get<ControllerSettings>();
+  if (cs) po.max_speed = cs->max_velocity;
+  std::string range_source;
+  if (!opt.range_deg.empty()) {
+    if (opt.range_deg.size() != 2 || !(opt.range_deg[1] > opt.range_deg[0])) throw InputError("--range-deg: expected LO,HI with LO < HI");
+    po.range_lo = opt.range_deg[0] * std::numbers::pi / 180.0;
+    po.range_hi = opt.range_deg[1] * std::numbers::pi / 180.0;
+    range_source = "--range-deg";
+  } else if (!station.empty()) {
+    const Station& s = design.require_station(station);
+    const Mechanism* m = nullptr;
+    for (const Mechanism* x : s.mechanisms()) {
+      if (x->name == mechanism) m = x;
+    }
+    if (m == nullptr) throw InputError("--joint: station '" + station + "' has no mechanism '" + mechanism + "'");
+    const UsableRange u = usable_ranges(design, s, *m)[static_cast<std::size_t>(joint - 1)];
+    if (!u.usable) throw InputError("--joint " + opt.joint + ": no usable range (" + u.problem + ")");
+    if (!u.limited) throw InputError("--joint " + opt.joint + ": the joint has no limit; give --range-deg");
+    po.range_lo = u.lo + (cs ? cs->joint_margin : 0.0);
+    po.range_hi = u.hi - (cs ? cs->joint_margin : 0.0);
+    range_source = "usable range of " + u.joint + " less the controller's joint margin";
+  } else {
+    // A bench motor: the default potentiometer's 300 deg travel (controller.potentiometer), centred.
+    po.range_lo = -150.0 * std::numbers::pi / 180.0;
+    po.range_hi = 150.0 * std::numbers::pi / 180.0;
+    range_source = "the potentiometer's 300 deg travel, centred (give --range-deg for another)";
+  }
+  const id::ExcitationPlan plan = id::plan_excitation(prior, po);
+  Json doc = {{"command", "identify"}, {"design", design.name}, {"plan", Json::object()}};
+  Json& jp = doc["plan"];
+  jp["samples"] = plan.time.size();
+  jp["duration_s"] = plan.time.back();
+  jp["band_hz"] = {po.f_min_hz, po.f_max_hz};
+  jp["range_deg"] = {po.range_lo * 180.0 / std::numbers::pi, po.range_hi * 180.0 / std::numbers::pi};
+  jp["range_source"] = range_source;
+  jp["limited_by"] = plan.limited_by;
+  jp["crest_factor"] = plan.crest_factor;
+  jp["drive_noise_mNm"] = opt.drive_noise_mNm;
+  jp["expected"] = Json::array();
+  for (std::size_t i = 0; i < plan.names.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    jp["expected"].push_back({{"parameter", plan.names[i]}, {"prior", plan.truth[k]}, {"sigma", plan.expected_sigma[k]}});
+  }
+  std::vector<std::string> files;
+  if (!opt.no_files) {
+    const std::filesystem::path dir =
+        opt.out.empty() ? resolve_output_dir("outputs", design.name) / "identify" : std::filesystem::path(opt.out);
+    make_directories(dir);
+    WriteFence fence(dir);
+    std::ostringstream csv;
+    csv << "time_s,theta_deg,current_A,duty\n";
+    for (std::size_t i = 0; i < plan.time.size(); ++i) {
+      csv << exact(plan.time[i]) << "," << exact(plan.position[i] * 180.0 / std::numbers::pi) << "," << exact(plan.current[i])
+          << "," << exact(plan.duty[i]) << "\n";
+    }
+    const std::filesystem::path f = dir / "identify-plan.csv";
+    write_file_atomic(f, csv.str());
+    files.push_back(f.generic_string());
+  }
+  doc["files"] = files;
+  if (opt.json) {
+    print_json(doc);
+    return kOk;
+  }
+  std::cout << "excitation: multisine, Schroeder phases, " << format::shortest(po.f_min_hz) << " ... " << format::shortest(po.f_max_hz)
+            << " Hz, " << format::shortest(plan.time.back()) << " s; range " << fixed(po.range_lo * 180.0 / std::numbers::pi, 1)
+            << " ... " << fixed(po.range_hi * 180.0 / std::numbers::pi, 1) << " deg (" << range_source << "), limited by the "
+            << plan.limited_by << " (90 % of each limit)\n";
+  std::cout << "expected sigmas (IDIM-LS, drive noise " << format::shortest(opt.drive_noise_mNm) << " mNm, decimation 10):\n";
+  for (std::size_t i = 0; i < plan.names.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    std::cout << "  " << plan.names[i] << ": prior " << sig(plan.truth[k]) << ", sigma " << sig(plan.expected_sigma[k]) << "\n";
+  }
+  for (const std::string& f : files) std::cout << "wrote " << f << "\n";
+  return kOk;
+}
+
+int run_identify(const IdentifyCliOptions& opt) {
+  const Design design = load(opt.design);
+  if (opt.rig != "motor") {
+    throw InputError("--rig " + opt.rig + ": only `--rig motor` is available (the closed-chain rig is not implemented yet)");
+  }
+  if (opt.plan) return run_plan(opt, design);
+  if (opt.log.empty()) throw InputError("LOG: an identification log is required (or --plan)");
+  const id::IdentifyLog est = id::read_identify_log(std::filesystem::path(opt.log));
+  std::optional<id::IdentifyLog> val;
+  if (!opt.validation.empty()) val = id::read_identify_log(std::filesystem::path(opt.validation));
+  if (!(opt.load_inertia >= 0.0) || !std::isfinite(opt.load_inertia)) throw InputError("--load-inertia: must be >= 0 kg m^2");
+  if (opt.method != "idim" && opt.method != "oe") throw InputError("--method: idim or oe");
+  id::IdentifyOptions o;
+  o.cutoff_hz = opt.cutoff_hz;
+  o.filter_order = opt.filter_order;
+  o.decimation = opt.decimation;
+  o.per_direction = opt.per_direction;
+  o.zero_order_hold = !opt.instant_drive;
+  o.output_error = !opt.no_output_error;
+  o.use_output_error = opt.method == "oe";
+  if (o.use_output_error && !o.output_error) throw InputError("--method oe: needs the output-error refinement (drop --no-output-error)");
+  o.require = opt.fit;
+
+  // Identify every joint (or the one --joint names) before writing anything.
+  std::vector<id::JointIdentification> results;
+  for (const id::JointLog& j : est.joints) {
+    if (!opt.joint.empty() && j.prefix != opt.joint && !(opt.joint == "motor" && j.prefix.empty())) continue;
+    const id::JointLog* vj = nullptr;
+    if (val) {
+      for (const id::JointLog& x : val->joints) {
+        if (x.prefix == j.prefix) vj = &x;
+      }
+      if (vj == nullptr) throw InputError(opt.validation + ": no columns for joint '" + (j.prefix.empty() ? "motor" : j.prefix) + "'");
+      if (vj->drive != j.drive || vj->linear != j.linear) {
+        throw InputError(opt.validation + ": joint '" + (j.prefix.empty() ? "motor" : j.prefix) + "' is driven by '" + vj->drive_column +
+                         "', the estimation log by '" + j.drive_column + "'");
+      }
+    }
+    const bool need_motor = !j.linear && j.drive != id::DriveKind::torque;
+    const id::JointPrior prior = prior_of(design, j.station, j.mechanism, j.joint, opt.load_inertia, need_motor);
+    results.push_back(id::identify_joint(j, est.time, prior, vj, val ? &val->time : nullptr, o));
+  }
+  if (results.empty()) throw InputError("--joint '" + opt.joint + "': the log has no such joint");
+  // Requested parameters that the logs cannot give.
+  std::vector<std::string> refused;
+  for (const std::string& key : opt.fit) {
+    bool known = false;
+    for (const auto& r : results) {
+      for (const id::Parameter& p : r.parameters) {
+        if (p.key != key) continue;
+        known = true;
+        if (!p.identified) refused.push_back(key + " (" + r.joint + "): " + p.note);
+      }
+    }
+    if (!known) {
+      std::vector<std::string> keys;
+      for (const id::Parameter& p : results.front().parameters) keys.push_back(p.key);
+      throw InputError("--fit " + key + ": not a parameter of this rig (parameters: " + format::join(keys) + ")");
+    }
+  }
+  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", opt.rig}, {"log", opt.log}};
+  if (val) doc["validation"] = opt.validation;
+  doc["method"] = opt.method == "oe" ? "output error" : "IDIM-LS";
+  doc["joints"] = Json::array();
+  for (const auto& r : results) doc["joints"].push_back(id::to_json(r));
+  doc["refused"] = refused;
+  std::vector<std::string> files;
+  if (!opt.no_files) {
+    const std::filesystem::path dir =
+        opt.out.empty() ? resolve_output_dir("outputs", design.name) / "identify" : std::filesystem::path(opt.out);
+    make_directories(dir);
+    WriteFence fence(dir);
+    for (const auto& r : results) {
+      const id::JointIdentification& jr = r;
+      for (bool v : {false, true}) {
+        if (v && !jr.validation_idim) continue;
+        const RenderedPlot plot = id::identify_plot(jr, v);
+        const std::string stem = jr.joint + (v ? "-validation" : "-estimation");
+        write_file_atomic(dir / (stem + ".svg"), plot.svg);
+        write_file_atomic(dir / (stem + ".png"), plot.png);
+        files.push_back((dir / (stem + ".svg")).generic_string());
+        files.push_back((dir / (stem + ".png")).generic_string());
+      }
+    }
+    doc["files"] = files;
+    write_file_atomic(dir / "identify.json", doc.dump(2) + "\n");
+    files.push_back((dir / "identify.json").generic_string());
+  }
+  doc["files"] = files;
+  if (opt.json) {
+    print_json(doc);
+  } else {
+    for (const auto& r : results) print_joint(r);
+    for (const std::string& s : refused) std::cout << "NOT IDENTIFIABLE (asked by --fit): " << s << "\n";
+    if (!files.empty()) std::cout << "wrote " << files.size() << " files into " << std::filesystem::path(files.front()).parent_path().generic_string() << "\n";
+  }
+  return refused.empty() ? kOk : kCheckFailed;
+}
+
+}  // namespace
+
+void setup_identify(CLI::App& app) {
+  auto opt = std::make_shared<IdentifyCliOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "identify",
+      "Motor, friction and inertia of a joint from bench logs: the inverse dynamic model by least squares on zero-phase "
+      "filtered data (IDIM-LS) with its standard deviations and the parameters the log cannot separate, an output-error "
+      "refinement by simulation, fit percentages on the estimation and a validation log; or (--plan) the excitation to log");
+  add_design_argument(*sub, opt->design);
+  sub->add_option("log", opt->log, "Estimation log: CSV with time_s and per joint a drive (duty, voltage_V, current_A, "
+                                   "torque_Nm or force_N), a reading (volts, counts, theta_rad or position_m) and optionally current_A")
+      ->type_name("LOG.csv");
+  sub->add_option("--validation", opt->validation, "A second log of the same joints: fit figures only")->type_name("LOG.csv");
+  sub->add_option("--rig", opt->rig, "What the log was taken on: motor (one motor on the bench, optional known load)")
+      ->capture_default_str()
+      ->type_name("motor|mechanism");
+  sub->add_option("--joint", opt->joint,
+                  "Only this joint of the log (its prefix <station>_<mechanism>_theta<j>, or motor); with --plan "
+                  "STATION/MECHANISM/thetaJ: its motor and usable range")
+      ->type_name("JOINT");
+  sub->add_option("--load-inertia", opt->load_inertia, "Known load inertia at the output shaft (kg m^2)")->type_name("KG_M2");
+  sub->add_option("--cutoff", opt->cutoff_hz, "Low-pass cutoff for position and drive (Hz; default a tenth of the sample rate)")
+      ->type_name("HZ");
+  sub->add_option("--filter-order", opt->filter_order, "Butterworth order (run forward and backward)")->capture_default_str();
+  sub->add_option("--decimation", opt->decimation, "Decimation factor (default 10)")->type_name("R");
+  sub->add_flag("--per-direction", opt->per_direction, "Viscous friction per direction of motion");
+  sub->add_flag("--instant-drive", opt->instant_drive,
+                "The drive column is an instantaneous value at each sample (default: a command held over the sample, "
+                "so the regression takes the mean of two consecutive commands)");
+  sub->add_option("--fit", opt->fit, "Parameters that must be identified (exit 1 when the log cannot separate one)")
+      ->delimiter(',')
+      ->type_name("KEY,...");
+  sub->add_option("--method", opt->method, "Reported values: idim (IDIM-LS) or oe (output-error refinement)")->capture_default_str();
+  sub->add_flag("--no-output-error", opt->no_output_error, "IDIM-LS only");
+  sub->add_flag("--plan", opt->plan, "Write an excitation (identify-plan.csv) and the sigmas it is expected to give");
+  sub->add_option("--plan-duration", opt->plan_duration_s, "Length of the excitation (s)")->capture_default_str();
+  sub->add_option("--plan-band", opt->plan_band_hz, "Lowest and highest harmonic (Hz)")->delimiter(',')->type_name("F_MIN,F_MAX");
+  sub->add_option("--range-deg", opt->range_deg, "Joint range for the plan (deg)")->delimiter(',')->type_name("LO,HI");
+  sub->add_option("--drive-noise", opt->drive_noise_mNm, "Noise of the logged drive torque the plan's sigmas assume (mNm)")
+      ->capture_default_str();
+  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/identify)")->type_name("DIR");
+  sub->add_flag("--no-files", opt->no_files, "Print only");
+  sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
+  sub->footer(
+      "Parameters are printed with their design key path (motor.terminal_resistance_ohm, in the design's units) or a "
+      "rig-only name with its unit (inertia_kg_m2, viscous_Nm_s_per_rad, coulomb_Nm, offset_Nm; a linear axis: mass_kg, "
+      "viscous_N_s_per_m, coulomb_N, offset_N). docs/identify.md.\nFiles: <joint>-estimation.svg|.png, "
+      "<joint>-validation.svg|.png, identify.json; with --plan identify-plan.csv.\nExit status: 0 done, 1 a parameter "
+      "named by --fit is not identifiable from the log, 2 bad input, 3 internal error.");
+  sub->callback([opt]() { finish(run_identify(*opt)); });
+}
+
+}  // namespace fivebar::cli

@@ -1,0 +1,35 @@
+#pragma once
+/// Zero-phase filtering for the inverse dynamic model (docs/identify.md "IDIM-LS"): a digital
+/// Butterworth low-pass in second-order sections (bilinear transform with pre-warping), run forward
+/// and backward (filtfilt: odd-reflection padding and steady-state initial conditions, as SciPy's
+/// sosfiltfilt does), central differences and decimation (Chebyshev low-pass at 0.8 of the new Nyquist
+/// frequency, then every R-th sample).
+
+#include <array>
+#include <vector>
+
+namespace fivebar::identify {
+
+/// One biquad, a0 = 1: y = b0 x + b1 x1 + b2 x2 - a1 y1 - a2 y2.
+struct Biquad {
+  std::array<double, 3> b{1.0, 0.0, 0.0};
+  std::array<double, 2> a{0.0, 0.0};
+};
+
+/// Butterworth low-pass of `order` (1 ... 16) with its -3 dB point at `cutoff_hz` < fs/2, unit DC gain.
+/// std::invalid_argument outside those ranges.
+std::vector<Biquad> butterworth_lowpass(int order, double cutoff_hz, double sample_rate_hz);
+/// The filter's gain at `frequency_hz` (one pass).
+double gain(const std::vector<Biquad>& sos, double frequency_hz, double sample_rate_hz);
+/// One forward pass from rest.
+std::vector<double> filter(const std::vector<Biquad>& sos, const std::vector<double>& x);
+/// Forward and backward (zero phase, squared magnitude). Needs at least 2 samples.
+std::vector<double> filtfilt(const std::vector<Biquad>& sos, const std::vector<double>& x);
+/// Central differences (one-sided at the ends), uniform step `dt`.
+std::vector<double> derivative(const std::vector<double>& x, double dt);
+/// Low-pass (8th-order Chebyshev I, 0.05 dB, at 0.8 of fs / (2 factor), zero phase: the filter of
+/// MATLAB's and SciPy's decimate) then every `factor`-th
+/// sample from the first; `factor` 1 returns x.
+std::vector<double> decimate(const std::vector<double>& x, int factor);
+
+}  // namespace fivebar::identify

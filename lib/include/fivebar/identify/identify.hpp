@@ -1,0 +1,115 @@
+#pragma once
+/// Motor, friction and inertia identification from bench logs (docs/identify.md): the inverse
+/// dynamic model by weighted least squares on zero-phase filtered, decimated data (IDIM-LS,
+/// Gautier & Khalil), its base parameters and what the log cannot separate, then an output-error
+/// refinement that simulates the model (Ceres), with the fit figures system identification reports.
+
+#include <Eigen/Dense>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fivebar/identify/log.hpp"
+#include "fivebar/identify/model.hpp"
+#include "fivebar/rendered_plot.hpp"
+
+namespace fivebar::identify {
+
+struct IdentifyOptions {
+  double cutoff_hz = 0.0;        ///< zero-phase low-pass on the position; 0: fs / 10
+  int filter_order = 4;          ///< Butterworth order (run twice: filtfilt)
+  int decimation = 0;            ///< 0: 10, less when the log would keep fewer than 50 rows per unknown
+  bool per_direction = false;    ///< viscous friction per direction of motion
+  /// The logged drive is a command held over each sample (zero-order hold): the regression pairs the
+  /// acceleration at t_k with (d_k-1 + d_k) / 2. false: the drive is an instantaneous value.
+  bool zero_order_hold = true;
+  bool output_error = true;      ///< refine by simulation (Ceres) after IDIM-LS
+  bool use_output_error = false; ///< report the refined values as the parameters (default: IDIM-LS)
+  /// A regressor column whose distance to the span of the earlier ones, relative to its norm, is
+  /// below this is not separable (its parameter is held at its prior).
+  double rank_tolerance = 1e-4;
+  double coulomb_smoothing = 1e-3;  ///< w_s of tanh(w / w_s) in the simulation (fivebar/dynamics.hpp)
+  std::vector<std::string> require;  ///< keys the caller asked to fit: unidentifiable ones are errors
+};
+
+/// One reported parameter: the plain record `calibrate`'s patch writer takes. `key` is a design key
+/// path (`motor.terminal_resistance_ohm`) in the design file's unit, or a rig-only name with its
+/// unit (`inertia_kg_m2`, ...). Held parameters carry their prior, sigma 0 and a note.
+struct Parameter {
+  std::string key;
+  double value = 0.0;
+  double sigma = 0.0;
+  bool identified = false;
+  std::string note;
+};
+
+/// A least-squares estimate with its statistics.
+struct Estimate {
+  std::vector<std::string> names;
+  Eigen::VectorXd value;
+  Eigen::VectorXd sigma;          ///< sqrt(s^2 (W^T W)^-1_ii); 0 for held parameters
+  Eigen::MatrixXd covariance;     ///< of every parameter (zero rows for held ones)
+  Eigen::MatrixXd correlation;    ///< identity on held parameters
+  std::vector<bool> identified;
+  std::vector<std::string> notes; ///< per parameter: why held, or the combination it stands for
+  double residual_sigma = 0.0;    ///< s = ||Y - W theta|| / sqrt(rows - identified)
+  int rows = 0;
+};
+
+/// Fit figures: 100 (1 - ||y - yhat|| / ||y - mean y||); relative error ||y - yhat|| / ||y||.
+struct Fit {
+  double drive_fit_percent = 0.0;          ///< inverse model: the drive predicted from the motion
+  double drive_relative_error_percent = 0.0;
+  double position_fit_percent = 0.0;       ///< open-loop simulation driven by the logged drive
+  double position_relative_error_percent = 0.0;
+  bool simulated = false;                  ///< position figures valid
+};
+
+/// Time series for the plot.
+struct Series {
+  std::vector<double> time, position, position_idim, position_oe;
+  std::vector<double> drive_time, drive, drive_idim;
+};
+
+struct JointIdentification {
+  std::string joint;          ///< the log prefix, or "motor"
+  std::string drive_column, reading_column;
+  bool linear = false;
+  double sample_time = 0.0, cutoff_hz = 0.0;
+  int decimation = 1;
+  Estimate idim;              ///< mechanical base parameters, IDIM-LS
+  std::optional<Estimate> electrical;  ///< R, L, k_e when a voltage drive logs its current
+  std::optional<Estimate> output_error;
+  std::string output_error_status;     ///< "converged", "not run: ...", Ceres' message
+  Fit estimation_idim, estimation_oe;
+  std::optional<Fit> validation_idim, validation_oe;
+  std::vector<Parameter> parameters;   ///< every key: identified, derived and held
+  std::vector<std::string> unidentifiable;  ///< keys held because the log does not excite them
+  Series series, validation_series;
+};
+
+/// Fits one joint of `log` (and checks it on `validation`, the same joint's columns). InputError for a
+/// log too short for the unknowns. Pure: reads nothing, writes nothing.
+JointIdentification identify_joint(const JointLog& joint, const std::vector<double>& time, const JointPrior& prior,
+                                   const JointLog* validation, const std::vector<double>* validation_time,
+                                   const IdentifyOptions& options);
+
+/// The least-squares core: Y = W theta + e with the columns of `W` named; a column not separable
+/// from the earlier ones (rank_tolerance) is held at `prior` and named. Used for the mechanical and
+/// electrical regressions.
+Estimate least_squares(const Eigen::MatrixXd& W, const Eigen::VectorXd& Y, const std::vector<std::string>& names,
+                       const Eigen::VectorXd& prior, double rank_tolerance);
+
+/// 100 (1 - ||y - yhat|| / ||y - mean y||).
+double fit_percent(const std::vector<double>& y, const std::vector<double>& yhat);
+
+/// Open-loop simulation of the reduced model (RK4, the drive held over each sample) from q0, w0.
+std::vector<double> simulate_position(const std::vector<double>& time, const std::vector<double>& drive_torque_u,
+                                      double g, const Eigen::VectorXd& mechanical, bool per_direction, double q0,
+                                      double w0, double coulomb_smoothing);
+
+/// Measured against fitted (position above, drive below), SVG and PNG.
+RenderedPlot identify_plot(const JointIdentification& r, bool validation);
+
+}  // namespace fivebar::identify

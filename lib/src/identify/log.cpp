@@ -1,0 +1,269 @@
+// Identification logs (fivebar/identify/log.hpp).
+
+#include "fivebar/identify/log.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <system_error>
+
+#include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
+
+namespace fivebar::identify {
+
+namespace {
+
+struct ColumnKind {
+  const char* suffix;
+  enum Role { drive, reading, current } role;
+  DriveKind drive_kind;
+  ReadingKind reading_kind;
+  int linear;  ///< 1 linear, 0 rotary, -1 either
+};
+
+constexpr ColumnKind kColumns[] = {
+    {"duty", ColumnKind::drive, DriveKind::duty, ReadingKind::angle, -1},
+    {"voltage_V", ColumnKind::drive, DriveKind::voltage, ReadingKind::angle, -1},
+    {"torque_Nm", ColumnKind::drive, DriveKind::torque, ReadingKind::angle, 0},
+    {"force_N", ColumnKind::drive, DriveKind::torque, ReadingKind::angle, 1},
+    {"current_A", ColumnKind::current, DriveKind::current, ReadingKind::angle, -1},
+    {"volts", ColumnKind::reading, DriveKind::torque, ReadingKind::volts, -1},
+    {"counts", ColumnKind::reading, DriveKind::torque, ReadingKind::counts, -1},
+    {"theta_rad", ColumnKind::reading, DriveKind::torque, ReadingKind::angle, 0},
+    {"position_m", ColumnKind::reading, DriveKind::torque, ReadingKind::angle, 1},
+};
+
+std::string where(const std::string& path, std::size_t line) { return path + ":" + std::to_string(line) + ": "; }
+
+std::string trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
+  return std::string(s);
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = line.find(',', start);
+    out.push_back(trim(std::string_view(line).substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+/// Joint part of a column name: "" or "<station>_<mechanism>_theta<1|2>_"; false when malformed.
+bool parse_prefix(const std::string& prefix, JointLog& j) {
+  if (prefix.empty()) return true;
+  const std::size_t theta = prefix.rfind("_theta");
+  if (theta == std::string::npos || prefix.size() != theta + 8 || prefix.back() != '_') return false;
+  const char digit = prefix[theta + 6];
+  if (digit != '1' && digit != '2') return false;
+  const std::string sm = prefix.substr(0, theta);
+  const std::size_t cut = sm.rfind('_');
+  if (cut == std::string::npos || cut == 0 || cut + 1 == sm.size()) return false;
+  j.station = sm.substr(0, cut);
+  j.mechanism = sm.substr(cut + 1);
+  j.joint = digit - '0';
+  return true;
+}
+
+}  // namespace
+
+double IdentifyLog::sample_time() const {
+  if (time.size() < 2) return 0.0;
+  std::vector<double> dt(time.size() - 1);
+  for (std::size_t i = 0; i + 1 < time.size(); ++i) dt[i] = time[i + 1] - time[i];
+  std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
+  return dt[dt.size() / 2];
+}
+
+IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
+  IdentifyLog log;
+  log.path = path;
+  std::string line;
+  std::size_t line_no = 0;
+  auto next_line = [&]() -> bool {
+    if (!std::getline(in, line)) return false;
+    ++line_no;
+    if (line.size() > kMaxLogLine) {
+      throw InputError(where(path, line_no) + "line longer than " + std::to_string(kMaxLogLine) + " characters");
+    }
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return true;
+  };
+  // Header (comment lines starting with '#' are skipped anywhere).
+  bool have_header = false;
+  while (next_line()) {
+    if (trim(line).empty() || trim(line).front() == '#') continue;
+    have_header = true;
+    break;
+  }
+  if (!have_header) throw InputError(path + ": empty log (expected a header line: time_s, drive and reading columns)");
+  const std::vector<std::string> header = split(line);
+  const std::size_t header_line = line_no;
+  int time_col = -1;
+  std::map<std::string, std::size_t> joint_index;  // prefix -> joints[]
+  struct Binding {
+    std::size_t joint;
+    const ColumnKind* kind;
+  };
+  std::vector<std::optional<Binding>> bind(header.size());
+  std::map<std::string, std::size_t> seen;
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    const std::string& name = header[c];
+    const std::string at = where(path, header_line) + "column " + std::to_string(c + 1) + " '" + name + "': ";
+    if (name.empty()) throw InputError(at + "empty column name");
+    if (seen.count(name)) throw InputError(at + "duplicate of column " + std::to_string(seen[name] + 1));
+    seen[name] = c;
+    if (name == "time_s") {
+      time_col = static_cast<int>(c);
+      continue;
+    }
+    const ColumnKind* kind = nullptr;
+    std::string prefix;
+    for (const ColumnKind& k : kColumns) {
+      const std::string suffix = k.suffix;
+      if (name == suffix || (name.size() > suffix.size() + 1 && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+                             name[name.size() - suffix.size() - 1] == '_')) {
+        kind = &k;
+        prefix = name.substr(0, name.size() - suffix.size());
+        break;
+      }
+    }
+    JointLog probe;
+    if (kind == nullptr || !parse_prefix(prefix, probe)) {
+      throw InputError(at +
+                       "unknown column (expected time_s and, per joint, [<station>_<mechanism>_theta<1|2>_] followed by "
+                       "duty, voltage_V, current_A, torque_Nm or force_N, and volts, counts, theta_rad or position_m)");
+    }
+    auto [it, added] = joint_index.emplace(prefix, log.joints.size());
+    if (added) {
+      probe.prefix = prefix.empty() ? "" : prefix.substr(0, prefix.size() - 1);
+      log.joints.push_back(probe);
+    }
+    bind[c] = Binding{it->second, kind};
+  }
+  if (time_col < 0) throw InputError(where(path, header_line) + "missing column 'time_s'");
+  if (log.joints.empty()) throw InputError(where(path, header_line) + "no joint columns (a drive and a reading per joint)");
+  // Roles per joint.
+  struct Roles {
+    int drive = -1, reading = -1, current = -1;
+  };
+  std::vector<Roles> roles(log.joints.size());
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    if (!bind[c]) continue;
+    Roles& r = roles[bind[c]->joint];
+    const ColumnKind& k = *bind[c]->kind;
+    const std::string at = where(path, header_line) + "column '" + header[c] + "': ";
+    int& slot = k.role == ColumnKind::drive ? r.drive : k.role == ColumnKind::reading ? r.reading : r.current;
+    if (slot >= 0) {
+      throw InputError(at + "a second " + (k.role == ColumnKind::reading ? "reading" : "drive") + " column for the joint (already '" +
+                       header[static_cast<std::size_t>(slot)] + "')");
+    }
+    slot = static_cast<int>(c);
+  }
+  for (std::size_t j = 0; j < log.joints.size(); ++j) {
+    JointLog& jl = log.joints[j];
+    Roles& r = roles[j];
+    const std::string who = jl.prefix.empty() ? std::string("the joint") : "joint '" + jl.prefix + "'";
+    if (r.drive < 0 && r.current >= 0) {  // a current-controlled driver: the current is the drive
+      r.drive = r.current;
+      r.current = -1;
+    }
+    if (r.drive < 0) {
+      throw InputError(where(path, header_line) + "missing drive column for " + who +
+                       " (one of duty, voltage_V, current_A, torque_Nm, force_N)");
+    }
+    if (r.reading < 0) {
+      throw InputError(where(path, header_line) + "missing reading column for " + who +
+                       " (one of volts, counts, theta_rad, position_m)");
+    }
+    const ColumnKind& dk = *bind[static_cast<std::size_t>(r.drive)]->kind;
+    const ColumnKind& rk = *bind[static_cast<std::size_t>(r.reading)]->kind;
+    if (dk.linear >= 0 && rk.linear >= 0 && dk.linear != rk.linear) {
+      throw InputError(where(path, header_line) + "columns '" + header[static_cast<std::size_t>(r.drive)] + "' and '" +
+                       header[static_cast<std::size_t>(r.reading)] +
+                       "': units do not match (a linear axis is force_N with position_m, a rotary one torque_Nm with theta_rad)");
+    }
+    jl.linear = dk.linear == 1 || rk.linear == 1;
+    if (jl.linear && (dk.linear != 1 || rk.linear != 1)) {
+      throw InputError(where(path, header_line) + "a linear axis takes force_N and position_m together (found '" +
+                       header[static_cast<std::size_t>(r.drive)] + "' and '" + header[static_cast<std::size_t>(r.reading)] + "')");
+    }
+    jl.drive = dk.drive_kind;
+    jl.drive_column = header[static_cast<std::size_t>(r.drive)];
+    jl.reading = rk.reading_kind;
+    jl.reading_column = header[static_cast<std::size_t>(r.reading)];
+  }
+  // Rows.
+  std::size_t rows = 0;
+  std::vector<std::size_t> row_lines;
+  while (next_line()) {
+    const std::string t = trim(line);
+    if (t.empty() || t.front() == '#') continue;
+    if (++rows > kMaxLogRows) throw InputError(where(path, line_no) + "more than " + std::to_string(kMaxLogRows) + " rows");
+    const std::vector<std::string> cells = split(line);
+    if (cells.size() != header.size()) {
+      throw InputError(where(path, line_no) + std::to_string(cells.size()) + " cells, the header has " + std::to_string(header.size()));
+    }
+    std::vector<double> v(cells.size());
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const std::string& s = cells[c];
+      const char* b = s.data();
+      const char* e = s.data() + s.size();
+      if (!s.empty() && *b == '+') ++b;
+      const auto [p, ec] = std::from_chars(b, e, v[c]);
+      if (s.empty() || ec != std::errc() || p != e || !std::isfinite(v[c])) {
+        throw InputError(where(path, line_no) + "column '" + header[c] + "': '" + s + "' is not a finite number");
+      }
+      if (std::abs(v[c]) > kMaxLogValue) {
+        throw InputError(where(path, line_no) + "column '" + header[c] + "': " + s + " is outside +-" +
+                         format::shortest(kMaxLogValue) + " (no bench quantity is that large in SI units)");
+      }
+    }
+    const double time = v[static_cast<std::size_t>(time_col)];
+    if (!log.time.empty() && !(time > log.time.back())) {
+      throw InputError(where(path, line_no) + "column 'time_s': " + format::shortest(time) + " does not increase (previous row " +
+                       format::shortest(log.time.back()) + ")");
+    }
+    log.time.push_back(time);
+    row_lines.push_back(line_no);
+    for (std::size_t j = 0; j < log.joints.size(); ++j) {
+      log.joints[j].drive_values.push_back(v[static_cast<std::size_t>(roles[j].drive)]);
+      log.joints[j].reading_values.push_back(v[static_cast<std::size_t>(roles[j].reading)]);
+      if (roles[j].current >= 0) log.joints[j].current.push_back(v[static_cast<std::size_t>(roles[j].current)]);
+    }
+  }
+  if (in.bad()) throw InputError(path + ": read error");
+  if (log.time.size() < 16) {
+    throw InputError(path + ": " + std::to_string(log.time.size()) + " data rows; an identification log needs at least 16");
+  }
+  // Even sampling (central differences and the filters assume it).
+  const double dt = log.sample_time();
+  for (std::size_t i = 0; i + 1 < log.time.size(); ++i) {
+    const double step = log.time[i + 1] - log.time[i];
+    if (std::abs(step - dt) > 0.05 * dt) {
+      throw InputError(where(path, row_lines[i + 1]) + "column 'time_s': step " + format::shortest(step) +
+                       " s differs from the log's sample time " + format::shortest(dt) + " s by more than 5 % (resample the log evenly)");
+    }
+  }
+  return log;
+}
+
+IdentifyLog read_identify_log(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(path, ec);
+  if (ec) throw InputError(path.string() + ": cannot read the log (" + ec.message() + ")");
+  if (size > kMaxLogBytes) throw InputError(path.string() + ": log larger than " + std::to_string(kMaxLogBytes >> 20) + " MiB");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open the log");
+  return read_identify_log(in, path.string());
+}
+
+}  // namespace fivebar::identify

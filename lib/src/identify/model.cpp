@@ -1,0 +1,48 @@
+// The motor-rig model (fivebar/identify/model.hpp).
+
+#include "fivebar/identify/model.hpp"
+
+#include <cmath>
+
+namespace fivebar::identify {
+
+ReducedDrive reduced_drive(DriveKind kind, const MotorParams& m) {
+  const double K = m.gearbox_efficiency * m.gear_ratio * m.torque_constant();  // N m per A at the output
+  const double emf = m.back_emf_constant() * m.gear_ratio;                      // V per rad/s at the output
+  switch (kind) {
+    case DriveKind::torque: return {1.0, 0.0};
+    case DriveKind::current: return {K, 0.0};
+    case DriveKind::voltage: return {K / m.resistance(), K * emf / m.resistance()};
+    case DriveKind::duty: return {K * m.supply_voltage_V / m.resistance(), K * emf / m.resistance()};
+  }
+  return {1.0, 0.0};
+}
+
+std::vector<double> joint_angle(const JointLog& joint, const JointPrior& prior) {
+  std::vector<double> q(joint.reading_values.size());
+  const double volts_per_count = (prior.adc_hi_v - prior.adc_lo_v) / std::ldexp(1.0, prior.adc_bits);
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    const double r = joint.reading_values[i];
+    switch (joint.reading) {
+      case ReadingKind::angle: q[i] = r; break;
+      case ReadingKind::volts: q[i] = prior.rad_per_volt * (r - prior.volts_at_zero); break;
+      case ReadingKind::counts:
+        q[i] = prior.rad_per_volt * (prior.adc_lo_v + r * volts_per_count - prior.volts_at_zero);
+        break;
+    }
+  }
+  return q;
+}
+
+std::vector<std::string> mechanical_names(bool per_direction, bool linear) {
+  if (linear) {
+    if (per_direction) return {"mass_kg", "viscous_pos_N_s_per_m", "viscous_neg_N_s_per_m", "coulomb_N", "offset_N"};
+    return {"mass_kg", "viscous_N_s_per_m", "coulomb_N", "offset_N"};
+  }
+  if (per_direction) {
+    return {"inertia_kg_m2", "viscous_pos_Nm_s_per_rad", "viscous_neg_Nm_s_per_rad", "coulomb_Nm", "offset_Nm"};
+  }
+  return {"inertia_kg_m2", "viscous_Nm_s_per_rad", "coulomb_Nm", "offset_Nm"};
+}
+
+}  // namespace fivebar::identify

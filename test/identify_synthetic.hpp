@@ -1,0 +1,110 @@
+#pragma once
+// Synthetic bench logs for the identify tests and benchmarks: a motor with known parameters driven
+// by a logged current, simulated at ten times the log rate with effects the identified model does
+// not have: a small compliance between the motor and the load (a second inertia on a spring, the
+// reading taken on the load side), backlash in the reading (a play operator), ADC quantisation of
+// the reading, and white noise on the logged current.
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fivebar::testing {
+
+struct SyntheticTruth {
+  double K = 0.7;             ///< N m per A at the output (eta N k_t of the design's defaults)
+  double J = 2e-3;            ///< total inertia at the output, kg m^2 (motor side + load side)
+  double load_share = 0.3;    ///< of J on the load side of the compliance
+  double resonance_hz = 300;  ///< of the compliance (0: rigid)
+  double b = 1e-3;            ///< N m s / rad
+  double c = 5e-3;            ///< N m
+  double offset = 1e-3;       ///< N m
+  double current_noise = 2e-3;   ///< A, logged current
+  double quantum = 2.0 * std::numbers::pi / 65536.0;  ///< reading quantum, rad (16-bit over a turn)
+  double backlash = 2e-5;     ///< rad, play in the reading
+  double amplitude = 0.06;    ///< A, multisine current
+  double bias_current = 0.0;  ///< A added to the command (a constant drive keeps one direction)
+  double duration = 10.0;     ///< s
+  double rate = 1000.0;       ///< Hz
+};
+
+struct SyntheticLog {
+  std::vector<double> time, current, theta;
+  std::string csv() const {
+    std::ostringstream o;
+    o.precision(17);
+    o << "time_s,current_A,theta_rad\n";
+    for (std::size_t i = 0; i < time.size(); ++i) o << time[i] << "," << current[i] << "," << theta[i] << "\n";
+    return o.str();
+  }
+};
+
+inline SyntheticLog synthetic_log(const SyntheticTruth& t, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * std::numbers::pi);
+  // A random-phase multisine current, 0.3 ... 6 Hz.
+  const int harmonics = 20;
+  std::vector<double> ph(harmonics);
+  for (double& p : ph) p = phase(rng);
+  auto command = [&](double time) {
+    double s = 0.0;
+    for (int k = 1; k <= harmonics; ++k) s += std::sin(2.0 * std::numbers::pi * 0.3 * k * time + ph[static_cast<std::size_t>(k - 1)]);
+    return t.bias_current + t.amplitude * s / std::sqrt(0.5 * harmonics);
+  };
+  const double Jl = t.J * t.load_share, Jm = t.J - Jl;
+  const bool rigid = t.resonance_hz <= 0.0;
+  const double w_res = 2.0 * std::numbers::pi * t.resonance_hz;
+  const double k = rigid ? 0.0 : w_res * w_res * (Jm * Jl / t.J);
+  const double d = rigid ? 0.0 : 2.0 * 0.05 * std::sqrt(k * Jm * Jl / t.J);
+  const int sub = 10;
+  const double h = 1.0 / (t.rate * sub);
+  const std::size_t n = static_cast<std::size_t>(t.duration * t.rate);
+  SyntheticLog log;
+  // State: motor angle, motor speed, load angle, load speed.
+  double y[4] = {0.0, 0.0, 0.0, 0.0};
+  double play = 0.0;  // reading behind the backlash
+  auto f = [&](const double* s, double i, double* ds) {
+    const double friction = t.b * s[1] + t.c * std::tanh(s[1] / 1e-3) + t.offset;
+    if (rigid) {
+      ds[0] = s[1];
+      ds[1] = (t.K * i - friction) / t.J;
+      ds[2] = s[1];
+      ds[3] = ds[1];
+      return;
+    }
+    const double spring = k * (s[0] - s[2]) + d * (s[1] - s[3]);
+    ds[0] = s[1];
+    ds[1] = (t.K * i - friction - spring) / Jm;
+    ds[2] = s[3];
+    ds[3] = spring / Jl;
+  };
+  for (std::size_t j = 0; j < n; ++j) {
+    const double time = static_cast<double>(j) / t.rate;
+    const double i = command(time);
+    // The reading: backlash (play operator) then quantisation.
+    const double load = y[2];
+    if (load > play + 0.5 * t.backlash) play = load - 0.5 * t.backlash;
+    if (load < play - 0.5 * t.backlash) play = load + 0.5 * t.backlash;
+    log.time.push_back(time);
+    log.current.push_back(i + t.current_noise * noise(rng));
+    log.theta.push_back(t.quantum > 0.0 ? t.quantum * std::round(play / t.quantum) : play);
+    for (int s = 0; s < sub; ++s) {  // RK4, the current held over the sample
+      double k1[4], k2[4], k3[4], k4[4], tmp[4];
+      f(y, i, k1);
+      for (int q = 0; q < 4; ++q) tmp[q] = y[q] + 0.5 * h * k1[q];
+      f(tmp, i, k2);
+      for (int q = 0; q < 4; ++q) tmp[q] = y[q] + 0.5 * h * k2[q];
+      f(tmp, i, k3);
+      for (int q = 0; q < 4; ++q) tmp[q] = y[q] + h * k3[q];
+      f(tmp, i, k4);
+      for (int q = 0; q < 4; ++q) y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q]);
+    }
+  }
+  return log;
+}
+
+}  // namespace fivebar::testing

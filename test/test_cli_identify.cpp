@@ -1,0 +1,125 @@
+// End-to-end tests of `fivebar identify`: real processes, exit codes, the JSON document, the files.
+// The expected values are the synthetic truth the logs were generated from (identify_synthetic.hpp)
+// and the EMPS benchmark's published parameters (Janot, Gautier, Brunot 2019).
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cli_test.hpp"
+#include "identify_synthetic.hpp"
+
+namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using ft::Outcome;
+using nlohmann::json;
+using ::testing::HasSubstr;
+using ::testing::IsEmpty;
+
+namespace {
+
+class CliIdentify : public ft::CliTest {
+ protected:
+  CliIdentify() : CliTest("fivebar_test_cli_identify") {}
+
+  static const json& parameter(const json& joint, const std::string& key) {
+    for (const json& p : joint["parameters"]) {
+      if (p["parameter"] == key) return p;
+    }
+    static const json none;
+    ADD_FAILURE() << "no parameter " << key;
+    return none;
+  }
+};
+
+TEST_F(CliIdentify, SyntheticMotorLogGivesTheTruthWithinThreeSigmaAndWritesItsFiles) {
+  ft::SyntheticTruth truth;
+  const fs::path log = write("bench.csv", ft::synthetic_log(truth, 11).csv());
+  const fs::path val = write("val.csv", ft::synthetic_log(truth, 12).csv());
+  const Outcome r = run({"identify", kDesign, log.string(), "--validation", val.string(), "--rig", "motor", "--json", "--out", "out"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["command"], "identify");
+  ASSERT_EQ(j["joints"].size(), 1u);
+  const json& joint = j["joints"][0];
+  const std::vector<std::pair<std::string, double>> want = {
+      {"inertia_kg_m2", truth.J}, {"viscous_Nm_s_per_rad", truth.b}, {"coulomb_Nm", truth.c}, {"offset_Nm", truth.offset}};
+  for (const auto& [key, value] : want) {
+    const json& p = parameter(joint, key);
+    EXPECT_TRUE(p["identified"].get<bool>()) << key;
+    EXPECT_LE(std::abs(p["value"].get<double>() - value), 3.0 * p["sigma"].get<double>()) << key;
+  }
+  // The design keys in the design's units: the Coulomb friction in mNm.
+  EXPECT_NEAR(parameter(joint, "motor.coulomb_friction_mNm")["value"].get<double>(),
+              1e3 * parameter(joint, "coulomb_Nm")["value"].get<double>(), 1e-9);
+  EXPECT_FALSE(parameter(joint, "motor.terminal_resistance_ohm")["identified"].get<bool>());
+  EXPECT_GT(joint["fit"]["validation"]["idim_ls"]["drive_fit_percent"].get<double>(), 80.0);
+  EXPECT_EQ(tree(dir_ / "out"), (std::vector<std::string>{"identify.json", "motor-estimation.png", "motor-estimation.svg",
+                                                         "motor-validation.png", "motor-validation.svg"}));
+}
+
+TEST_F(CliIdentify, AParameterTheLogCannotSeparateIsNamedAndRefusedWhenAskedFor) {
+  ft::SyntheticTruth truth;
+  truth.bias_current = 0.2;
+  truth.amplitude = 0.02;
+  const auto full = ft::synthetic_log(truth, 3);
+  ft::SyntheticLog cut;
+  for (std::size_t i = 2000; i < full.time.size(); ++i) {
+    cut.time.push_back(full.time[i]);
+    cut.current.push_back(full.current[i]);
+    cut.theta.push_back(full.theta[i]);
+  }
+  const fs::path log = write("forward.csv", cut.csv());
+  Outcome r = run({"identify", kDesign, log.string(), "--no-files", "--no-output-error"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("not identifiable from this log (held at the prior): offset_Nm"));
+  r = run({"identify", kDesign, log.string(), "--no-files", "--no-output-error", "--fit", "offset_Nm", "--out", "o"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("NOT IDENTIFIABLE (asked by --fit): offset_Nm"));
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+TEST_F(CliIdentify, BadLogsExitTwoNamingTheLineAndColumnAndWriteNothing) {
+  const fs::path bad = write("bad.csv", "time_s,current_A,theta_rad\n0,1,0\n0.001,1,0\n0.001,1,0\n");
+  Outcome r = run({"identify", kDesign, bad.string(), "--out", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("bad.csv:4: column 'time_s'"));
+  const fs::path unknown = write("unknown.csv", "time_s,current_A,theta_rad,rpm\n");
+  r = run({"identify", kDesign, unknown.string(), "--out", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("unknown.csv:1: column 4 'rpm': unknown column"));
+  r = run({"identify", kDesign, bad.string(), "--rig", "mechanism", "--out", "o"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+TEST_F(CliIdentify, PlanWritesAnExcitationWithinTheLimits) {
+  const Outcome r = run({"identify", kDesign, "--plan", "--range-deg", "-60,60", "--json", "--out", "plan"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  EXPECT_EQ(j["plan"]["expected"].size(), 4u);
+  EXPECT_TRUE(fs::exists(dir_ / "plan" / "identify-plan.csv"));
+}
+
+TEST_F(CliIdentify, EmpsBenchmarkThroughTheCommandLine) {
+  const fs::path dir = fs::path(fivebar_test_paths::shared_data_dir()) / "sysid" / "emps";
+  if (!fs::exists(dir / "est.csv")) GTEST_SKIP() << "EMPS data not found under " << dir;
+  const Outcome r = run({"identify", kDesign, (dir / "est.csv").string(), "--validation", (dir / "val.csv").string(),
+                         "--instant-drive", "--json", "--no-files"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  const json& joint = j["joints"][0];
+  // Published IDIM-LS (Janot, Gautier, Brunot 2019), tolerance 3 published sigmas (test_identify.cpp).
+  EXPECT_NEAR(parameter(joint, "inertia_kg_m2")["value"].get<double>(), 95.1089, 3 * 0.1085);
+  EXPECT_NEAR(parameter(joint, "viscous_Nm_s_per_rad")["value"].get<double>(), 203.5034, 3 * 1.1460);
+  EXPECT_NEAR(parameter(joint, "coulomb_Nm")["value"].get<double>(), 20.3935, 3 * 0.1012);
+  EXPECT_NEAR(parameter(joint, "offset_Nm")["value"].get<double>(), -3.1648, 3 * 0.0444);
+}
+
+}  // namespace
