@@ -54,7 +54,8 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   EXPECT_THAT(r.out, Not(HasSubstr("FAILED")));
   EXPECT_EQ(listing(dir_ / "ctl"), (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
                                                              "iros2022_controller.yaml", "iros2022_index.urdf",
-                                                             "iros2022_thumb.urdf"}));
+                                                             "iros2022_index.xml", "iros2022_thumb.urdf",
+                                                             "iros2022_thumb.xml"}));
   // The ROS file with yaml-cpp: the paper's numbers in SI units, doubles as doubles.
   const YAML::Node p = YAML::LoadFile((dir_ / "ctl" / "iros2022_controller.yaml").string())["fivebar_controller"]["ros__parameters"];
   EXPECT_EQ(p["loop_rate_hz"].Scalar(), "100.0");
@@ -195,11 +196,16 @@ TEST_F(CliExport, RunBuildsTheExportProduct) {
   EXPECT_EQ(doc["results"]["export"]["exported"], true);
   EXPECT_EQ(doc["results"]["export"]["files"],
             json({"export/iros2022_controller.yaml", "export/iros2022_controller.json", "export/iros2022_controller.hpp",
-                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf"}));
-  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 5u);
+                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf", "export/iros2022_index.xml",
+                  "export/iros2022_thumb.xml"}));
+  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 7u);
   EXPECT_EQ(run({"export", "--check", (dir_ / "scene" / "iros2022" / "export" / "iros2022_controller.json").string(), kDesign}).code, 0);
   EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"), AllOf(HasSubstr("## Controller export (`export`)"),
                                                                        HasSubstr("Files:")));
+  // The report links the MJCF beside the URDF (summary.md, and the HTML page rendered from it).
+  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"),
+              HasSubstr("[`export/iros2022_index.xml`](export/iros2022_index.xml)"));
+  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "index.html"), HasSubstr("href=\"export/iros2022_index.xml\""));
 
   // A refused export fails the scene and writes no export/ folder.
   const fs::path bad = design_with("bad.yaml", "  min_lci: 0.05", "  min_lci: 0.5");

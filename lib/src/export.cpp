@@ -590,6 +590,12 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
       documents.emplace_back(dir / urdf_file_name(d, s), render_urdf(d, s, options.urdf_options));
     }
   }
+  if (options.mjcf && d.has<Geometry>()) {  // fivebar/mjcf.hpp
+    for (const std::string& name : result.gate.stations) {
+      const Station& s = *d.station(name);
+      documents.emplace_back(dir / mjcf_file_name(d, s), render_mjcf(d, s, options.urdf_options));
+    }
+  }
   // A target that cannot be replaced (a directory of that name) fails before anything is written.
   for (const auto& [path, text] : documents) {
     std::error_code ec;

@@ -76,11 +76,25 @@ void require_ros_list(const Json& list, const std::string& path) {
   }
 }
 
+/// A map key as YAML: double-quoted when a YAML 1.1 reader (ROS 2's libyaml-based parser, PyYAML)
+/// would resolve the plain scalar to a boolean or null (y, n, yes, no, on, off, true, false, null,
+/// ~, empty, in any case), so that a station named `on` stays the string "on". Keys are the
+/// export's identifiers otherwise (the gate's names check), which no reader takes for anything else.
+std::string yaml_key(const std::string& key) {
+  std::string lower = key;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  static const char* const kSpecial[] = {"y", "n", "yes", "no", "on", "off", "true", "false", "null", "~", ""};
+  for (const char* s : kSpecial) {
+    if (lower == s) return yaml_scalar(Json(key), key);
+  }
+  return key;
+}
+
 void yaml_map(std::string& out, const Json& map, int indent, const std::string& path) {
   for (const auto& [key, value] : map.items()) {
     const std::string at = path.empty() ? key : path + "." + key;
     out.append(std::size_t(indent), ' ');
-    out += key + ":";
+    out += yaml_key(key) + ":";
     if (value.is_object()) {
       out += "\n";
       yaml_map(out, value, indent + 2, at);

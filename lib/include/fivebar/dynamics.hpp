@@ -49,7 +49,8 @@
 ///
 /// Controller as on the device (fivebar/sections/controller.hpp, the exported PID): every
 /// T = 1 / loop_rate_hz the potentiometer voltage v = volts_at_zero + theta / rad_per_volt is read
-/// through the ADC (round to the nearest of 2^bits levels over range_v, clamped), converted back
+/// through the ADC (2^bits codes over range_v, one count = (range_v[1] - range_v[0]) / 2^bits, the
+/// exported adc.volts_per_count; round to the nearest code, clamped to 0 ... 2^bits - 1), converted back
 /// to an angle, and DiscretePid gives a duty; that duty is applied one period later (the
 /// computation delay of a ROS loop) and held constant until the next (zero-order hold). The
 /// reference is the IK of the pattern's commanded points (fivebar/pattern.hpp check_pattern, with
@@ -218,7 +219,8 @@ class DiscretePid {
 };
 
 /// The angle the controller reads for a true angle `theta` (rad): the potentiometer voltage,
-/// quantised by an ADC of `bits` over `range_v` (nearest level, clamped to the range), converted back.
+/// quantised by an ADC of `bits` over `range_v` (2^bits codes, code k reading range_v[0] + k (range_v[1] -
+/// range_v[0]) / 2^bits, the exported volts_per_count; the nearest code, clamped), converted back.
 double adc_reading(double theta, const Potentiometer& pot, int bits, const std::array<double, 2>& range_v);
 
 // --- Simulation -----------------------------------------------------------------------------------

@@ -293,9 +293,11 @@ double DiscretePid::update(double e) {
 
 double adc_reading(double theta, const Potentiometer& pot, int bits, const std::array<double, 2>& range_v) {
   const double v = pot.volts_at_zero + theta / pot.rad_per_volt;
-  const double levels = std::ldexp(1.0, bits) - 1.0;  // codes 0 ... 2^bits - 1
-  const double q = (range_v[1] - range_v[0]) / levels;
-  const double code = std::clamp(std::round((v - range_v[0]) / q), 0.0, levels);
+  // 2^bits codes over the input range, one count = range / 2^bits (the exported volts_per_count):
+  // code k reads range_v[0] + k q, k = 0 ... 2^bits - 1.
+  const double q = (range_v[1] - range_v[0]) / std::ldexp(1.0, bits);
+  const double top = std::ldexp(1.0, bits) - 1.0;
+  const double code = std::clamp(std::round((v - range_v[0]) / q), 0.0, top);
   return pot.rad_per_volt * (range_v[0] + code * q - pot.volts_at_zero);
 }
 
