@@ -308,8 +308,8 @@ TEST(Formats, KeysYaml11ReadsAsBooleansOrNullAreQuoted) {
   tree.begin().value()["ros__parameters"]["scratch"] = scratch;
   const std::string text = render_ros2_yaml(tree);
   EXPECT_THAT(text, HasSubstr("\n      \"on\":\n"));      // stations."on"
-  EXPECT_THAT(text, HasSubstr("\n    \"~\": 1.5\n"));
-  EXPECT_THAT(text, HasSubstr("\n    online: 2.5\n"));
+  EXPECT_THAT(text, HasSubstr("\n      \"~\": 1.5\n"));
+  EXPECT_THAT(text, HasSubstr("\n      online: 2.5\n"));
   for (const std::string& k : special) EXPECT_THAT(text, HasSubstr("\"" + k + "\": 1.5")) << k;
   EXPECT_EQ(parse_export(ExportFormat::ros2, text, "<yaml>"), tree);
   // PyYAML, a YAML 1.1 reader, keeps every key a string (python3-yaml, .ci/setup.sh).
