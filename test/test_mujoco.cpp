@@ -294,15 +294,30 @@ struct Trace {
   double max_loop_gap_m = 0.0;                             ///< the connect constraints' largest violation
 };
 
+/// Departures from the exported model, to measure what limits the agreement.
+struct Variant {
+  bool quantise = true;        ///< the ADC in both
+  double timestep_s = 0.0;     ///< MuJoCo's timestep; 0: the file's
+  bool coulomb = true;         ///< Coulomb friction in both (false: none in either)
+  double inductance_mH = 0.0;  ///< > 0: simulate's winding inductance instead of the motor's
+  int integrator = -1;         ///< MuJoCo's integrator (mjINT_*); -1: the file's
+};
+
 /// `input` (its references, initial pose) under the exported PID in MuJoCo on the MJCF `file`:
 /// at each sample t_k the potentiometers are read through the ADC (the exported calibration), the
 /// PID's duty is computed and applied from t_k+1 (one period of delay), held over the period.
-Trace run_mujoco(const fs::path& file, const SimulationInput& input, const Json& parameters, std::size_t samples) {
+Trace run_mujoco(const fs::path& file, const SimulationInput& input, const Json& parameters, std::size_t samples,
+                 const Variant& v) {
   Loaded l(file);
   EXPECT_NE(l.model, nullptr) << l.error;
   Trace tr;
   if (l.model == nullptr) return tr;
   mjModel* m = l.model;
+  if (v.timestep_s > 0.0) m->opt.timestep = v.timestep_s;
+  if (v.integrator >= 0) m->opt.integrator = v.integrator;
+  if (!v.coulomb) {
+    for (int i = 0; i < m->nv; ++i) m->dof_frictionloss[i] = 0.0;
+  }
   mjData* d = mj_makeData(m);
   const Json& p = parameters.begin().value().at("ros__parameters");
   const double T = 1.0 / p.at("loop_rate_hz").get<double>();
@@ -358,7 +373,7 @@ Trace run_mujoco(const fs::path& file, const SimulationInput& input, const Json&
       for (std::size_t j = 0; j < 2; ++j) {
         Joint& jt = joints[k][j];
         th[k][j] = d->sensordata[jt.sensor];
-        const double measured = adc_reading(th[k][j], jt.pot, bits, range);
+        const double measured = v.quantise ? adc_reading(th[k][j], jt.pot, bits, range) : th[k][j];
         const double fresh = jt.pid->update(ref[j] - measured);
         d->ctrl[jt.actuator] = pending[k][j];
         pending[k][j] = fresh;
@@ -412,12 +427,19 @@ Agreement compare(const SimulationResult& sim, const Trace& mj) {
 
 /// simulate() and MuJoCo on the same input; the figures printed.
 Agreement run_both(const Design& d, const fs::path& mjcf, const Json& parameters, SimulationInput input,
-                   const std::string& label, double* loop_gap_m = nullptr) {
+                   const std::string& label, double* loop_gap_m = nullptr, const Variant& v = {}) {
   SimulationOptions o;
   o.contact = false;  // the MJCF leaves the skin out (fivebar/mjcf.hpp)
+  o.quantise = v.quantise;
+  for (SimulatedMechanism& m : input.mechanisms) {
+    for (MotorParams& p : m.model.motors) {
+      if (!v.coulomb) p.coulomb_friction_mNm = 0.0;
+      if (v.inductance_mH > 0.0) p.inductance_mH = v.inductance_mH;
+    }
+  }
   const SimulationResult sim = simulate(input, o);
   EXPECT_TRUE(sim.ok()) << sim.reason;
-  const Trace mj = run_mujoco(mjcf, input, parameters, sim.samples.size());
+  const Trace mj = run_mujoco(mjcf, input, parameters, sim.samples.size(), v);
   EXPECT_EQ(mj.theta.size(), sim.samples.size());
   const Agreement a = compare(sim, mj);
   std::printf("[ MuJoCo ] %s: %zu samples, MuJoCo vs fivebar simulate: max %.3g rad, %.3g mm (simulate's tracking error "
@@ -438,10 +460,12 @@ std::map<std::string, MechanismInertia> closed_form(const Design& d, const std::
   return inertia;
 }
 
-// The agreement bound asserted below: 2 um at the tactor, 50x under the showcase's 0.11 mm
-// tracking error (the measured figures are printed; docs/mjcf.md quotes them).
-constexpr double kAgreementMm = 2e-3;
-constexpr double kAgreementRad = 2e-4;
+// The agreement bound asserted below: 10 um at the tactor, 11x under the showcase's 0.11 mm
+// tracking error, and 1e-3 rad (measured 5.9e-4 rad and 5.9 um on the step, 4.3e-4 rad and
+// 5.2 um on the stretch; printed, and quoted in docs/mjcf.md). The inductance the MJCF leaves out
+// and MuJoCo's Euler step at 0.1 ms set it (WhatLimitsTheAgreement below).
+constexpr double kAgreementMm = 1e-2;
+constexpr double kAgreementRad = 1e-3;
 
 TEST_F(MujocoTest, AOneMillimetreStepFollowsFivebarSimulate) {
   const Design& d = *design_;
@@ -477,6 +501,39 @@ TEST_F(MujocoTest, TheStretchPatternFollowsFivebarSimulate) {
   EXPECT_GT(a.tracking_mm, 0.0);
   EXPECT_LT(a.rad, kAgreementRad);
   EXPECT_LT(a.mm, kAgreementMm);
+}
+
+TEST_F(MujocoTest, WhatLimitsTheAgreement) {
+  const Design& d = *design_;
+  SimulationRequest request;
+  request.station = "index";
+  request.step = true;
+  if (kSanitized) request.step_hold_s = 0.15;
+  const SimulationInput in = simulation_inputs(d, request, closed_form(d, "index")).front();
+  const fs::path f = *dir_ / "export/iros2022_index.xml";
+  const Json& p = result_->parameters;
+  struct Row {
+    const char* label;
+    Variant v;
+  };
+  // Measured, not asserted: each departure alone (printed; docs/mjcf.md quotes them).
+  const std::vector<Row> rows{
+      {"step_no_adc", {.quantise = false}},
+      {"step_no_adc_no_coulomb", {.quantise = false, .coulomb = false}},
+      {"step_no_adc_dt1e-5", {.quantise = false, .timestep_s = 1e-5}},
+  };
+  for (const Row& r : rows) run_both(d, f, p, in, r.label, nullptr, r.v);
+  // The models agree once what the MJCF leaves out is left out of simulate too (an inductance of
+  // 1e-4 mH: L/R = 20 ns) and MuJoCo steps finely: then the difference is MuJoCo's semi-implicit
+  // Euler, first order in the timestep (a tenth of the step, a tenth of the difference).
+  const Variant ideal{.quantise = false, .coulomb = false, .inductance_mH = 1e-4};
+  Variant fine = ideal;
+  fine.timestep_s = 1e-5;
+  const Agreement coarse_a = run_both(d, f, p, in, "step_ideal_dt1e-4", nullptr, ideal);
+  const Agreement fine_a = run_both(d, f, p, in, "step_ideal_dt1e-5", nullptr, fine);
+  EXPECT_LT(fine_a.rad, 6e-5);
+  EXPECT_GT(coarse_a.rad / fine_a.rad, 5.0);
+  EXPECT_LT(coarse_a.rad / fine_a.rad, 20.0);
 }
 
 }  // namespace
