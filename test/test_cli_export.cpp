@@ -135,7 +135,7 @@ TEST_F(CliExport, ARefusedExportWritesNothingAndListsEveryReason) {
   const std::string before = slurp(dir_ / "kept" / "iros2022_controller.yaml");
   EXPECT_EQ(run({"export", bad.string(), "--out", "kept"}).code, 1);
   EXPECT_EQ(slurp(dir_ / "kept" / "iros2022_controller.yaml"), before);
-  EXPECT_EQ(listing(dir_ / "kept").size(), 5u);  // three formats and two URDFs
+  EXPECT_EQ(listing(dir_ / "kept").size(), 7u);  // three formats, two URDFs and two MJCFs
 }
 
 TEST_F(CliExport, BadInputIsExitTwo) {

@@ -4,6 +4,7 @@
 
 #include "fivebar/format.hpp"
 #include "fivebar/export.hpp"
+#include "fivebar/mjcf.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 

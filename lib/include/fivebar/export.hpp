@@ -58,7 +58,6 @@
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
 #include "fivebar/json.hpp"
-#include "fivebar/mjcf.hpp"
 #include "fivebar/urdf.hpp"
 
 namespace fivebar {

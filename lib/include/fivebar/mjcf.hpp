@@ -16,10 +16,11 @@
 ///
 /// Loop closure: `<equality><connect body1=carrier body2=other anchor=P in the carrier's frame>`.
 /// MuJoCo 2.2.2 computes the anchor on body2 from qpos0; with qpos0 closed (above) it is P in the
-/// other distal link's frame. (With every ref at 0, the open tree's qpos0 puts it elsewhere: on the
-/// showcase 0.0275 m along L4 instead of 0.015 m.) Made stiff by solref (time constant
-/// kMjcfSolrefTimeconst_s, critically damped) and solimp (impedance 0.9999): the loop opens by
-/// micrometres at most under the PID's accelerations (test/test_mujoco.cpp).
+/// other distal link's frame. (With the bodies unrotated and no ref, qpos0 is the open tree's
+/// straight pose and the anchor lands elsewhere: on the showcase's index station 0.0025 m along L4
+/// instead of its 0.015 m length; a tree built another way lands elsewhere again.) Made stiff by
+/// solref (time constant kMjcfSolrefTimeconst_s, critically damped) and solimp (impedance 0.9999):
+/// the loop opens by nanometres under the PID's accelerations (test/test_mujoco.cpp).
 ///
 /// Motors (with `motor:`): joint `armature` = N^2 J_r (the reflected rotor inertia), `damping` = b
 /// and `frictionloss` = tau_c at the output shaft; one `general` actuator per motor joint,
