@@ -56,7 +56,7 @@ std::map<std::string, std::string> stl_by_use(const Json& parts, const Station& 
 
 StationBodies station_bodies(const Design& design, const Station& station, const UrdfOptions& options) {
   const Geometry* gp = design.get<Geometry>();
-  if (gp == nullptr) throw InputError("the URDF needs the design's `geometry:` section (the links' outlines and masses)");
+  if (gp == nullptr) throw InputError("the URDF and the MJCF need the design's `geometry:` section (the links' outlines and masses)");
   const Geometry& g = *gp;
   const PrintSettings print = design.get<PrintSettings>() ? *design.get<PrintSettings>() : PrintSettings{};
   const PartsHardware hw;
