@@ -138,6 +138,15 @@ TEST_F(CliExport, ARefusedExportWritesNothingAndListsEveryReason) {
   EXPECT_EQ(listing(dir_ / "kept").size(), 7u);  // three formats, two URDFs and two MJCFs
 }
 
+TEST_F(CliExport, FormatMjcfWritesOnlyTheMjcf) {
+  const Outcome r = run({"export", kDesign, "--station", "index", "--format", "mjcf", "--out", "m"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(listing(dir_ / "m"), (std::vector<std::string>{"iros2022_index.xml"}));
+  EXPECT_THAT(slurp(dir_ / "m" / "iros2022_index.xml"),
+              AllOf(HasSubstr("<mujoco model=\"iros2022_index\">"), HasSubstr("<connect name=\"index_lower_loop\""),
+                    HasSubstr("armature=\"0.002\""), HasSubstr("<general name=\"index_upper_theta2\"")));
+}
+
 TEST_F(CliExport, BadInputIsExitTwo) {
   const fs::path no_controller = (kSource / "designs" / "iros2022-index.yaml");
   const Outcome a = run({"export", no_controller.string(), "--out", "x"});
