@@ -22,6 +22,11 @@ FIVEBAR_PACKAGES=(
   # Tests of what users open: urdfdom's check_urdf reads the exported URDF, python3-jsonschema
   # validates every command's --json against docs/schemas/, headless Chromium loads the HTML report.
   liburdfdom-tools python3-jsonschema chromium
+  # MuJoCo's library and headers: test_mujoco loads the exported URDF and MJCF and runs them against
+  # fivebar simulate.
+  libmujoco-dev
+  # PyYAML, a YAML 1.1 reader as ROS 2's parameter parser is: test_export reads the parameters file with it.
+  python3-yaml
   openscad
   # The Python module fivebar (python/): pybind11 bindings for the system python3 with NumPy, and
   # its tests (pytest, run by ctest).

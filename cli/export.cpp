@@ -25,9 +25,9 @@ struct ExportCliOptions {
 
 std::vector<ExportFormat> formats_of(const std::string& text) {
   if (text == "all") return all_export_formats();
-  if (text == "urdf") return {};
+  if (text == "urdf" || text == "mjcf") return {};
   if (const auto f = parse_export_format(text)) return {*f};
-  throw InputError("--format '" + text + "': expected ros2, json, header, urdf or all");
+  throw InputError("--format '" + text + "': expected ros2, json, header, urdf, mjcf or all");
 }
 
 void print_gate(const ExportGate& gate) {
@@ -99,6 +99,7 @@ int run_export(const ExportCliOptions& opt) {
   const Design design = load(opt.design);
   ExportOptions options;
   options.urdf = opt.format == "all" || opt.format == "urdf";  // fivebar/export/urdf.hpp: closed-form masses here
+  options.mjcf = opt.format == "all" || opt.format == "mjcf";  // fivebar/export/mjcf.hpp
   if (!opt.station.empty()) options.stations = {opt.station};
   options.progress = terminal_progress("export");
   // The directory is created only once the gate has passed.
@@ -146,7 +147,8 @@ void setup_export(CLI::App& app) {
   add_design_argument(*sub, opt->design);
   sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
   sub->add_option("--format", opt->format,
-                  "ros2, json, header, urdf or all (default: all; urdf: one URDF with ros2_control per station)")->type_name("FORMAT");
+                  "ros2, json, header, urdf, mjcf or all (default: all; urdf: one URDF with ros2_control per station; "
+                  "mjcf: one MuJoCo MJCF per station, loops closed, motors as actuators)")->type_name("FORMAT");
   sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/export)")
       ->type_name("DIR");
   sub->add_option("--check", opt->check,
@@ -154,7 +156,8 @@ void setup_export(CLI::App& app) {
       ->type_name("FILE");
   sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
   sub->footer(
-      "Files: <design>_controller[_<station>].yaml|.json|.hpp and <design>_<station>.urdf (with geometry:), SI\n"
+      "Files: <design>_controller[_<station>].yaml|.json|.hpp, <design>_<station>.urdf and <design>_<station>.xml\n"
+      "(MJCF; both with geometry:), SI "
       "units; joints <station>_<mechanism>_theta<1|2>, their limits the usable range of each joint (potentiometer\n"
       "travel, hard stops, joint_limits).\n"
       "Exit status: 0 exported (or --check: the file matches), 1 export refused by the gate (nothing written) or\n"

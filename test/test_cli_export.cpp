@@ -54,7 +54,8 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   EXPECT_THAT(r.out, Not(HasSubstr("FAILED")));
   EXPECT_EQ(listing(dir_ / "ctl"), (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
                                                              "iros2022_controller.yaml", "iros2022_index.urdf",
-                                                             "iros2022_thumb.urdf"}));
+                                                             "iros2022_index.xml", "iros2022_thumb.urdf",
+                                                             "iros2022_thumb.xml"}));
   // The ROS file with yaml-cpp: the paper's numbers in SI units, doubles as doubles.
   const YAML::Node p = YAML::LoadFile((dir_ / "ctl" / "iros2022_controller.yaml").string())["fivebar_controller"]["ros__parameters"];
   EXPECT_EQ(p["loop_rate_hz"].Scalar(), "100.0");
@@ -134,7 +135,16 @@ TEST_F(CliExport, ARefusedExportWritesNothingAndListsEveryReason) {
   const std::string before = slurp(dir_ / "kept" / "iros2022_controller.yaml");
   EXPECT_EQ(run({"export", bad.string(), "--out", "kept"}).code, 1);
   EXPECT_EQ(slurp(dir_ / "kept" / "iros2022_controller.yaml"), before);
-  EXPECT_EQ(listing(dir_ / "kept").size(), 5u);  // three formats and two URDFs
+  EXPECT_EQ(listing(dir_ / "kept").size(), 7u);  // three formats, two URDFs and two MJCFs
+}
+
+TEST_F(CliExport, FormatMjcfWritesOnlyTheMjcf) {
+  const Outcome r = run({"export", kDesign, "--station", "index", "--format", "mjcf", "--out", "m"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(listing(dir_ / "m"), (std::vector<std::string>{"iros2022_index.xml"}));
+  EXPECT_THAT(slurp(dir_ / "m" / "iros2022_index.xml"),
+              AllOf(HasSubstr("<mujoco model=\"iros2022_index\">"), HasSubstr("<connect name=\"index_lower_loop\""),
+                    HasSubstr("armature=\"0.002\""), HasSubstr("<general name=\"index_upper_theta2\"")));
 }
 
 TEST_F(CliExport, BadInputIsExitTwo) {
@@ -195,11 +205,16 @@ TEST_F(CliExport, RunBuildsTheExportProduct) {
   EXPECT_EQ(doc["results"]["export"]["exported"], true);
   EXPECT_EQ(doc["results"]["export"]["files"],
             json({"export/iros2022_controller.yaml", "export/iros2022_controller.json", "export/iros2022_controller.hpp",
-                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf"}));
-  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 5u);
+                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf", "export/iros2022_index.xml",
+                  "export/iros2022_thumb.xml"}));
+  EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 7u);
   EXPECT_EQ(run({"export", "--check", (dir_ / "scene" / "iros2022" / "export" / "iros2022_controller.json").string(), kDesign}).code, 0);
   EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"), AllOf(HasSubstr("## Controller export (`export`)"),
                                                                        HasSubstr("Files:")));
+  // The report links the MJCF beside the URDF (summary.md, and the HTML page rendered from it).
+  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"),
+              HasSubstr("[`export/iros2022_index.xml`](export/iros2022_index.xml)"));
+  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "index.html"), HasSubstr("href=\"export/iros2022_index.xml\""));
 
   // A refused export fails the scene and writes no export/ folder.
   const fs::path bad = design_with("bad.yaml", "  min_lci: 0.05", "  min_lci: 0.5");

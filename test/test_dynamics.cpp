@@ -541,13 +541,23 @@ TEST(Dynamics, AdcQuantisesToTheNearestLevelAndClamps) {
   // apart from the range's low end, the top code one step below its high end.
   Potentiometer pot;  // 2.5 V at 0, pi/3 rad per V
   const std::array<double, 2> range{-10.0, 10.0};
-  const double q = 20.0 / 65536.0;  // V per code
+  // One count is range / 2^bits, the exported adc.volts_per_count (a 16-bit converter over 20 V:
+  // 20/65536 V; codes 0 ... 65535 read -10 V ... 10 V - one count).
+  const double q = 20.0 / 65536.0;  // V per count
   for (double theta : {0.0, 0.1234567, -1.0, 2.0}) {
     const double read = adc_reading(theta, pot, 16, range);
     EXPECT_LE(std::abs(read - theta), 0.5 * q * pot.rad_per_volt * (1 + 1e-9)) << theta;
+    // The reading is a whole number of counts above the range's bottom.
+    const double counts = (read / pot.rad_per_volt + pot.volts_at_zero - range[0]) / q;
+    EXPECT_NEAR(counts, std::round(counts), 1e-6) << theta;
   }
-  // 8 bits: codes 20/256 V apart; 40 rad is 40.7 V, beyond the range: reads the top code, 255.
-  EXPECT_NEAR(adc_reading(40.0, pot, 8, range), pot.rad_per_volt * (-10.0 + 255 * (20.0 / 256) - 2.5), 1e-12);
+  // Two angles one count apart (in volts) read one count apart.
+  const double a = adc_reading(0.3, pot, 16, range);
+  const double b = adc_reading(0.3 + q * pot.rad_per_volt, pot, 16, range);
+  EXPECT_NEAR((b - a) / pot.rad_per_volt, q, 1e-12);
+  // 8 bits: counts 20/256 V apart; 40 rad is 40.7 V, beyond the range: reads the top code 255,
+  // 10 V - 20/256 V (was 10 V when the step was range / (2^bits - 1)).
+  EXPECT_NEAR(adc_reading(40.0, pot, 8, range), pot.rad_per_volt * (10.0 - 20.0 / 256 - 2.5), 1e-12);
   EXPECT_NEAR(adc_reading(-40.0, pot, 8, range), pot.rad_per_volt * (-10.0 - 2.5), 1e-12);
   EXPECT_NEAR(adc_reading(0.0, pot, 8, range), pot.rad_per_volt * (-10.0 + std::round(12.5 / (20.0 / 256)) * (20.0 / 256) - 2.5),
               1e-12);

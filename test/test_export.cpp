@@ -319,6 +319,53 @@ TEST(Formats, RosYamlKeysAreStringsInYaml11) {
   EXPECT_TRUE(stations.contains("Yes"));
 }
 
+TEST(Formats, KeysYaml11ReadsAsBooleansOrNullAreQuoted) {
+  // A station named `on` (an identifier, so the gate allows it): YAML 1.1 readers (ROS 2's
+  // libyaml-based parser, PyYAML) take a plain `on:` key for the boolean true.
+  Design d = paper();
+  d.stations[0].name = "on";
+  for (auto& o : d.get<ControllerSettings>()->overrides) {
+    if (o.station == "index") o.station = "on";
+  }
+  for (auto& e : d.get<PatternSettings>()->per_station) {
+    if (e.first == "index") e.first = "on";
+  }
+  Json tree = controller_parameters(d, {});
+  // And every other spelling of a YAML 1.1 boolean or null as a key, in a scratch map.
+  const std::vector<std::string> special{"on", "On", "ON", "off", "Off", "yes", "Yes", "no", "NO", "y", "Y", "n", "N",
+                                         "true", "False", "null", "Null", "NULL", "~"};
+  Json scratch = Json::object();
+  for (const std::string& k : special) scratch[k] = 1.5;
+  scratch["online"] = 2.5;  // not special: stays plain
+  tree.begin().value()["ros__parameters"]["scratch"] = scratch;
+  const std::string text = render_ros2_yaml(tree);
+  EXPECT_THAT(text, HasSubstr("\n      \"on\":\n"));      // stations."on"
+  EXPECT_THAT(text, HasSubstr("\n      \"~\": 1.5\n"));
+  EXPECT_THAT(text, HasSubstr("\n      online: 2.5\n"));
+  for (const std::string& k : special) EXPECT_THAT(text, HasSubstr("\"" + k + "\": 1.5")) << k;
+  EXPECT_EQ(parse_export(ExportFormat::ros2, text, "<yaml>"), tree);
+  // PyYAML, a YAML 1.1 reader, keeps every key a string (python3-yaml, .ci/setup.sh).
+  const fs::path file = fs::temp_directory_path() / ("fivebar_yaml11_" + std::to_string(::getpid()) + ".yaml");
+  {
+    std::ofstream out(file);
+    out << text;
+  }
+  const std::string script =
+      "import sys, yaml\n"
+      "p = yaml.safe_load(open(sys.argv[1]))['fivebar_controller']['ros__parameters']\n"
+      "bad = [k for k in list(p['stations']) + list(p['scratch']) if not isinstance(k, str)]\n"
+      "sys.exit(1 if bad or 'on' not in p['stations'] or 'on_lower_theta1' not in p['gains'] else 0)\n";
+  const fs::path py = file.string() + ".py";
+  {
+    std::ofstream out(py);
+    out << script;
+  }
+  const int rc = std::system(("/usr/bin/python3 " + py.string() + " " + file.string()).c_str());
+  fs::remove(file);
+  fs::remove(py);
+  EXPECT_EQ(rc, 0) << "PyYAML read a key as a non-string";
+}
+
 TEST(Formats, EveryDoubleLineOfTheYamlHasAPointOrExponent) {
   // Line by line, independent of any YAML reader: a numeric scalar is an integer only for the
   // integer parameters (format_version, adc.bits, layers).

@@ -245,7 +245,7 @@ TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
   EXPECT_EQ(robot->at("name"), "iros2022_index");
 
   // A tree: every link but the root is the child of exactly one joint; 4 motor joints, 4 elbows,
-  // 2 tactor joints (the cut), 2 fixed tips.
+  // 2 fixed tips and 2 fixed cut frames P (no massless link on a moving joint: MuJoCo refuses one).
   std::map<std::string, int> parents;
   for (const Element* l : robot->all("link")) parents[l->at("name")] = 0;
   EXPECT_EQ(parents.size(), 1u + 2 * 6);  // base + per mechanism L1..L4, tip, P
@@ -258,8 +258,19 @@ TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
   }
   for (const auto& [link, n] : parents) EXPECT_EQ(n, link == "index_base" ? 0 : 1) << link;
   EXPECT_EQ(types["revolute"], 4);
-  EXPECT_EQ(types["continuous"], 6);
-  EXPECT_EQ(types["fixed"], 2);
+  EXPECT_EQ(types["continuous"], 4);
+  EXPECT_EQ(types["fixed"], 4);
+  for (const Element* j : robot->all("joint")) {
+    if (j->at("type") == "fixed") continue;
+    const Element* child = find_named(*robot, "link", j->child("child")->at("link"));
+    ASSERT_NE(child->child("inertial"), nullptr) << j->at("name") << " moves a link without mass";
+    EXPECT_GT(number(child->child("inertial")->child("mass")->at("value")), 0.0);
+  }
+  // The cut: P on L4 (L3 carries the post), at L4's length, one plane up (L3's plane).
+  const Element* cut = find_named(*robot, "joint", "index_lower_P_mount");
+  ASSERT_NE(cut, nullptr);
+  EXPECT_EQ(cut->child("parent")->at("link"), "index_lower_L4");
+  EXPECT_DOUBLE_EQ(triple(cut->child("origin")->at("xyz"))[0], 0.015);
 
   // Motor joints: limits = the usable ranges, by hand: the boss of the other motor 19.38 deg
   // (cos = 212.25 / 225) and the potentiometer's end 285 deg (0.25 V offset, 60 deg/V, 300 deg).
@@ -270,7 +281,10 @@ TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
   const Element* lim = t1->child("limit");
   EXPECT_NEAR(number(lim->at("lower")), stop, 1e-15);
   EXPECT_NEAR(number(lim->at("upper")), deg(285), 1e-15);
-  EXPECT_DOUBLE_EQ(number(lim->at("velocity")), 2 * kPi);  // controller.max_velocity_deg_s 360
+  // The motor's no-load speed at the output, V / (k_e N) = 6 V / (5 mV s/rad x 200) = 6 rad/s
+  // (344 deg/s), below controller.max_velocity_deg_s 360 (was 2 pi: the controller's alone).
+  // (k_e = 0.5235987755982988 mV/rpm is 5.0000117 mV s/rad: 5.99999 rad/s.)
+  EXPECT_NEAR(number(lim->at("velocity")), 6.0, 1e-4);
   // Stall torque at the output: eta N k_t min(V / R, I_max) = 0.7 x 200 x 5 mN m/A x min(6/5, 1) A.
   EXPECT_NEAR(number(lim->at("effort")), 0.7 * 200 * 0.005 * 1.0, 1e-15);
   EXPECT_EQ(triple(t1->child("origin")->at("xyz"))[0], 0.0);
@@ -292,7 +306,19 @@ TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
   const auto e = triple(elbow->child("origin")->at("xyz"));
   EXPECT_DOUBLE_EQ(e[0], 0.009);
   EXPECT_NEAR(e[2], 0.0029, 1e-15);
-  EXPECT_THAT(text, HasSubstr("fills the passive joints from forward kinematics"));
+  EXPECT_THAT(text, HasSubstr("fills the passive elbows from forward kinematics"));
+  // The gearing and the rotor inertia: a transmission per motor joint, N = 200, J_r = 0.5 g cm^2.
+  const auto transmissions = robot->all("transmission");
+  ASSERT_EQ(transmissions.size(), 4u);
+  for (const Element* tr : transmissions) {
+    EXPECT_EQ(tr->child("type")->text, "transmission_interface/SimpleTransmission");
+    const Element* act = tr->child("actuator");
+    ASSERT_NE(act, nullptr);
+    EXPECT_EQ(act->at("name"), tr->child("joint")->at("name") + "_motor");
+    EXPECT_EQ(number(act->child("mechanicalReduction")->text), 200.0);
+    EXPECT_DOUBLE_EQ(number(act->child("drake:rotor_inertia")->at("value")), 0.5e-7);
+  }
+  EXPECT_THAT(text, HasSubstr("reflected rotor inertia N^2 J_r = 0.002 kg m^2"));
 
   // Masses: the distal link without the post (L4) is a 15 x 4 x 2.5 mm slab with a half disc of
   // 2.5 mm at each end, less two pin holes of 2 + 2 x 0.15 mm, at 1.15 g/cm^3.

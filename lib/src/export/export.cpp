@@ -5,6 +5,7 @@
 #include "fivebar/format.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/provenance.hpp"
+#include "fivebar/export/mjcf.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
 
@@ -603,6 +604,12 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
     for (const std::string& name : result.gate.stations) {
       const Station& s = *d.station(name);
       documents.emplace_back(dir / urdf_file_name(d, s), render_urdf(d, s, options.urdf_options));
+    }
+  }
+  if (options.mjcf && d.has<Geometry>()) {  // fivebar/export/mjcf.hpp
+    for (const std::string& name : result.gate.stations) {
+      const Station& s = *d.station(name);
+      documents.emplace_back(dir / mjcf_file_name(d, s), render_mjcf(d, s, options.urdf_options));
     }
   }
   // A target that cannot be replaced (a directory of that name) fails before anything is written.

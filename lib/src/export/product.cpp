@@ -26,8 +26,10 @@ constexpr const char* kPreamble =
     "sampled PID loop is stable at every pose of each target and every pattern, simulated, keeps its tracking "
     "error and saturation within `controller.max_tracking_error_mm` and `controller.max_saturation_fraction`. The "
     "three files hold the same values (SI units); `fivebar export --check FILE DESIGN` confirms a file still "
-    "matches the design. Each station also gets a URDF with a `<ros2_control>` block (masses and meshes from the "
-    "parts' STL renders when the scene built them).\n\n";
+    "matches the design. Each station also gets a URDF with a `<ros2_control>` block and the transmissions "
+    "(gearing, rotor inertia) and an MJCF for MuJoCo with the loops closed, the motors as actuators and the "
+    "reflected rotor inertia as armature (docs/urdf.md, docs/mjcf.md; masses and meshes from the parts' STL "
+    "renders when the scene built them).\n\n";
 
 }  // namespace
 
@@ -44,6 +46,7 @@ Product export_product() {
     ExportOptions options;
     options.progress = ctx.progress;
     options.urdf = true;
+    options.mjcf = true;
     // The URDF's masses and meshes from the parts' STL renders when the scene built them (the
     // parts product comes first in products.def); the closed form otherwise (fivebar/export/urdf.hpp).
     if (const Json* parts = ctx.result_of("parts")) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "fivebar/dynamics.hpp"
@@ -21,6 +22,7 @@
 #include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/print.hpp"
 #include "fivebar/version.hpp"
+#include "export/robot_bodies.hpp"
 
 namespace fivebar {
 
@@ -40,52 +42,7 @@ std::string comment_text(std::string text) {
   return text;
 }
 
-/// Full mass properties of one body in its link frame (mm, kg, kg mm^2).
-struct Body {
-  double mass_kg = 0.0;
-  Eigen::Vector3d com_mm = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d inertia_kg_mm2 = Eigen::Matrix3d::Zero();  ///< about the centre of mass
-  std::string mesh;  ///< relative to the URDF, empty without a render
-};
-
-/// The plate approximation of the out-of-plane components (header).
-Body plate(const LinkInertia& l, double width, double thickness) {
-  Body b;
-  b.mass_kg = l.mass_kg;
-  b.com_mm = Eigen::Vector3d(l.com_mm.x(), l.com_mm.y(), 0.5 * thickness);
-  const double ixx = l.mass_kg * (width * width + thickness * thickness) / 12.0;
-  const double iyy = l.izz_kg_mm2 - l.mass_kg * width * width / 12.0 + l.mass_kg * thickness * thickness / 12.0;
-  b.inertia_kg_mm2.diagonal() << ixx, iyy, l.izz_kg_mm2;
-  return b;
-}
-
-Body from_mesh(const std::filesystem::path& file, double density) {
-  const MassProperties p = mass_properties(read_stl(file), density);
-  Body b;
-  b.mass_kg = p.mass_kg;
-  b.com_mm = p.com_mm;
-  b.inertia_kg_mm2 = p.inertia_kg_mm2;
-  return b;
-}
-
-/// The STL of every piece of `mechanism` ("L1" ... "tactor") and of "base", from a parts report.
-std::map<std::string, std::string> stl_by_use(const Json& parts, const Station& station, const std::string& mechanism) {
-  std::map<std::string, std::string> out;
-  const Json& list = parts.contains("parts") ? parts["parts"] : parts;
-  for (const Json& p : list) {
-    if (!p.is_object() || p.value("station", "") != station.name || !p.contains("uses") || !p.contains("stl") ||
-        !p["stl"].is_string()) {
-      continue;
-    }
-    for (const Json& use : p["uses"]) {
-      const std::string u = use.get<std::string>();
-      const std::string prefix = mechanism + "/";
-      if (u.rfind(prefix, 0) == 0) out[u.substr(prefix.size())] = p["stl"].get<std::string>();
-      if (u == "base") out["base"] = p["stl"].get<std::string>();
-    }
-  }
-  return out;
-}
+using detail::Body;
 
 class Writer {
  public:
@@ -128,28 +85,24 @@ std::string xyz(double x_mm, double y_mm, double z_mm) { return "xyz=\"" + m(x_m
 
 std::string urdf_file_name(const Design& design, const Station& station) { return design.name + "_" + station.name + ".urdf"; }
 
-std::string render_urdf(const Design& design, const Station& station, const UrdfOptions& options) {
-  const Geometry* gp = design.get<Geometry>();
-  if (gp == nullptr) throw InputError("the URDF needs the design's `geometry:` section (the links' outlines and masses)");
-  const Geometry& g = *gp;
-  const PrintSettings print = design.get<PrintSettings>() ? *design.get<PrintSettings>() : PrintSettings{};
-  const PartsHardware hw;
+double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint) {
   const ControllerSettings* controller = design.get<ControllerSettings>();
   const MotorSettings* motors = design.get<MotorSettings>();
-  // The renders when the report has every piece of the station; the closed form otherwise (say why).
-  const Json* parts = options.parts;
-  std::string parts_problem;
-  std::map<std::string, MechanismInertia> inertia;
-  try {
-    inertia = station_inertia(design, station, parts, options.parts_dir);
-  } catch (const InputError& e) {
-    if (parts == nullptr) throw;
-    parts_problem = e.what();
-    parts = nullptr;
-    inertia = station_inertia(design, station, nullptr, options.parts_dir);
+  double v = controller != nullptr ? controller->max_velocity : 0.0;
+  if (motors != nullptr) {
+    const MotorParams p = motors->joint(station.name, mechanism.name, joint);
+    const double no_load = p.supply_voltage_V / (p.back_emf_constant() * p.gear_ratio);
+    v = controller != nullptr ? std::min(v, no_load) : no_load;
   }
+  return v;
+}
+
+std::string render_urdf(const Design& design, const Station& station, const UrdfOptions& options) {
+  const detail::StationBodies bodies = detail::station_bodies(design, station, options);
+  const Geometry& g = *design.get<Geometry>();
+  const MotorSettings* motors = design.get<MotorSettings>();
   const double t = g.link_thickness;
-  const auto plane_z = [&](int layer) { return hw.hub_height + layer * (t + g.layer_gap); };
+  const auto plane_z = [&](int layer) { return bodies.plane_z(layer); };
   const std::string robot = design.name + "_" + station.name;
   const std::string base = station.name + "_base";
 
@@ -158,30 +111,28 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
   w.comment(0, "Generated by fivebar " + std::string(version()) + " from design " + design.name + ", station " + station.name +
                    " (design hash " + design_hash(design, {station.name}) + "). SI units (REP 103). Do not edit: "
                    "change the design and run fivebar export again.");
-  w.line(0, "<robot name=\"" + format::xml_escape(robot) + "\">");
+  w.line(0, "<robot name=\"" + format::xml_escape(robot) + "\" xmlns:drake=\"http://drake.mit.edu\">");
   w.comment(1, "The five-bar linkages are closed loops, which URDF cannot express: each loop is cut at its tactor "
-               "joint P. Only the four motor joints (theta1, theta2 of each mechanism, the angles of the station "
-               "frame) are measured and commanded. The controller fills the passive joints from forward kinematics "
-               "of the measured motor angles (the design's assembly mode): elbow1 = phi3 - theta1, elbow2 = phi4 - "
-               "theta2 and tactor = phi_carrier - phi_other, where phi3 and phi4 are the directions of A1->P and "
-               "A2->P; the frame <mechanism>_P then coincides with the carrier link's frame moved to P, which closes "
-               "the loop. See docs/urdf.md.");
+               "P. Only the four motor joints (theta1, theta2 of each mechanism, the angles of the station "
+               "frame) are measured and commanded. The controller fills the passive elbows from forward kinematics "
+               "of the measured motor angles (the design's assembly mode): elbow1 = phi3 - theta1 and elbow2 = phi4 - "
+               "theta2, where phi3 and phi4 are the directions of A1->P and A2->P; the closing constraint is that the "
+               "frame <mechanism>_P (fixed on the distal link without the tactor, at P) and <mechanism>_tip_mount's "
+               "origin (on the carrier) coincide in x and y. The sibling MJCF (<design>_<station>.xml) states it as "
+               "an equality. See docs/urdf.md.");
+  w.comment(1, "MuJoCo reads the compiler settings below: keep the meshes' paths relative to this file (MuJoCo strips "
+               "them by default). It reads neither the transmissions nor the rotor inertia: simulate the MJCF, whose "
+               "joints carry the reflected rotor inertia as armature.");
+  w.line(1, "<mujoco>");
+  w.line(2, "<compiler strippath=\"false\" discardvisual=\"false\" fusestatic=\"false\" angle=\"radian\"/>");
+  w.line(1, "</mujoco>");
 
   // Base: the root, no inertia (it is fixed to the gripper).
-  std::string base_mesh;
-  for (const Mechanism* mech : station.mechanisms()) {
-    if (parts != nullptr) {
-      const auto stl = stl_by_use(*parts, station, mech->name);
-      if (auto it = stl.find("base"); it != stl.end()) base_mesh = options.mesh_prefix + "/" + it->second;
-    }
-  }
-  if (!base_mesh.empty()) {
-    Body b;
-    b.mesh = base_mesh;
+  if (!bodies.base_mesh.empty()) {
     w.line(1, "<link name=\"" + format::xml_escape(base) + "\">");
     w.line(2, "<visual>");
     w.line(3, "<origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>");
-    w.line(3, "<geometry><mesh filename=\"" + format::xml_escape(base_mesh) + "\" scale=\"0.001 0.001 0.001\"/></geometry>");
+    w.line(3, "<geometry><mesh filename=\"" + format::xml_escape(bodies.base_mesh) + "\" scale=\"0.001 0.001 0.001\"/></geometry>");
     w.line(2, "</visual>");
     w.line(1, "</link>");
   } else {
@@ -191,61 +142,36 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
   struct MotorJoint {
     std::string name;
     UsableRange range;
+    std::optional<MotorParams> motor;
   };
   std::vector<MotorJoint> motor_joints;
-  for (const Mechanism* mech : station.mechanisms()) {
+  for (const detail::MechanismBodies& mb : bodies.mechanisms) {
+    const Mechanism* mech = mb.mechanism;
     const std::string prefix = station.name + "_" + mech->name;
-    const MechanismInertia& in = inertia.at(mech->name);
+    const MechanismInertia& in = mb.inertia;
     const std::array<UsableRange, 2> ranges = usable_ranges(design, station, *mech);
     for (const UsableRange& r : ranges) {
       if (!r.usable) throw InputError("joint " + r.joint + " has no usable range: " + r.problem);
     }
-    std::map<std::string, std::string> stl;
-    if (parts != nullptr) stl = stl_by_use(*parts, station, mech->name);
-    const bool from_stl = in.source == MassSource::stl;
     w.comment(1, mech->name + " mechanism. Mass properties: " +
-                     (from_stl ? std::string("volume integrals over the printed parts' STL renders (every component of "
-                                             "the inertia tensor), ") + in.note
-                               : "fivebar/dynamics.hpp closed_form_inertia(), " + in.note +
-                                     "; the components out of the link plane are those of a plate of the link's "
-                                     "width and thickness. " +
-                                     (parts_problem.empty() ? std::string("Build the parts product (fivebar run) for "
-                                                                          "the STL values and meshes.")
-                                                            : "The parts report could not be used: " + parts_problem)));
+                     (mb.from_stl ? std::string("volume integrals over the printed parts' STL renders (every component of "
+                                                "the inertia tensor), ") + in.note
+                                  : "fivebar/dynamics.hpp closed_form_inertia(), " + in.note +
+                                        "; the components out of the link plane are those of a plate of the link's "
+                                        "width and thickness. " +
+                                        (bodies.parts_problem.empty()
+                                             ? std::string("Build the parts product (fivebar run) for the STL values and meshes.")
+                                             : "The parts report could not be used: " + bodies.parts_problem)) +
+                     " The motors' rotor inertia is not in the links: see the transmissions.");
     const int carrier = in.carrier;   // 2: L3, 3: L4
     const int other = 5 - carrier;
-    std::array<Body, 4> bodies;
-    for (std::size_t i = 0; i < 4; ++i) {
-      const std::string use = "L" + std::to_string(i + 1);
-      if (from_stl && stl.count(use) != 0) {
-        bodies[i] = from_mesh(options.parts_dir / stl.at(use), print.density_g_cm3);
-        bodies[i].mesh = options.mesh_prefix + "/" + stl.at(use);
-      } else {
-        bodies[i] = plate(in.links[i], g.link_width[i], t);
-      }
-    }
-    Body tip;
-    const double tip_height = hw.tip_flange_height + hw.tip_dome_height;
-    const double post_height = std::max(0.0, g.tactor_height - tip_height);
-    if (from_stl && stl.count("tactor") != 0) {
-      tip = from_mesh(options.parts_dir / stl.at("tactor"), print.density_g_cm3);
-      tip.mesh = options.mesh_prefix + "/" + stl.at("tactor");
-    } else {
-      // A disc of the tactor's diameter (closed_form_inertia(): flange, half the dome, the peg).
-      const double r = 0.5 * g.tactor_diameter;
-      const double h = hw.tip_flange_height + hw.tip_dome_height;
-      tip.mass_kg = in.tip_mass_kg;
-      tip.com_mm = Eigen::Vector3d(0.0, 0.0, 0.25 * h);
-      const double side = in.tip_mass_kg * (3.0 * r * r + h * h) / 12.0;
-      tip.inertia_kg_mm2.diagonal() << side, side, in.tip_izz_kg_mm2;
-    }
     const auto box = [&](std::size_t i) {
       const double L = mech->L[i];
       return "<origin xyz=\"" + m(0.5 * L) + " 0 " + m(0.5 * t) + "\" rpy=\"0 0 0\"/><geometry><box size=\"" + m(L) +
              " " + m(g.link_width[i]) + " " + m(t) + "\"/></geometry>";
     };
-    for (std::size_t i = 0; i < 4; ++i) w.link_element(prefix + "_L" + std::to_string(i + 1), &bodies[i], box(i));
-    w.link_element(prefix + "_tip", &tip, "");
+    for (std::size_t i = 0; i < 4; ++i) w.link_element(prefix + "_L" + std::to_string(i + 1), &mb.links[i], box(i));
+    w.link_element(prefix + "_tip", &mb.tip, "");
     w.link_element(prefix + "_P", nullptr, "");
 
     // Motor joints.
@@ -257,19 +183,22 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
       if (r.limited) limit += " lower=\"" + num(r.lo) + "\" upper=\"" + num(r.hi) + "\"";
       double effort = 0.0;
       std::string dynamics;
+      std::optional<MotorParams> motor;
       if (motors != nullptr) {
         const MotorParams p = motors->joint(station.name, mech->name, j);
+        motor = p;
         effort = p.gearbox_efficiency * p.gear_ratio * p.torque_constant() *
                  std::min(p.supply_voltage_V / p.resistance(), p.current_limit_A);
         dynamics = "<dynamics damping=\"" + num(p.viscous_friction()) + "\" friction=\"" + num(p.coulomb_friction()) + "\"/>";
       }
-      const double velocity = controller != nullptr ? controller->max_velocity : 0.0;
+      const double velocity = motor_velocity_limit(design, station, *mech, j);
       limit += " effort=\"" + num(effort) + "\" velocity=\"" + num(velocity) + "\"/>";
       w.comment(1, r.joint + ": motor joint. Position limits: " + describe(r) +
                        (motors != nullptr ? "; effort: the stall torque at the output, eta N k_t min(V_supply / R, I_limit) "
                                             "(motor: section); damping and friction at the output shaft"
                                           : "; effort 0: the design has no motor: section") +
-                       "; velocity: controller.max_velocity_deg_s.");
+                       "; velocity: the smaller of controller.max_velocity_deg_s and the motor's no-load speed at the "
+                       "output, V_supply / (k_e N).");
       w.line(1, "<joint name=\"" + format::xml_escape(r.joint) + "\" type=\"" + (r.limited ? "revolute" : "continuous") + "\">");
       w.line(2, "<parent link=\"" + format::xml_escape(base) + "\"/>");
       w.line(2, "<child link=\"" + format::xml_escape(prefix + "_L" + std::to_string(j)) + "\"/>");
@@ -278,7 +207,7 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
       w.line(2, limit);
       if (!dynamics.empty()) w.line(2, dynamics);
       w.line(1, "</joint>");
-      motor_joints.push_back({r.joint, r});
+      motor_joints.push_back({r.joint, r, motor});
     }
     // Passive elbows.
     for (int j = 1; j <= 2; ++j) {
@@ -292,23 +221,47 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
       w.line(2, "<axis xyz=\"0 0 1\"/>");
       w.line(1, "</joint>");
     }
-    // The tip on the carrier's post, and the cut tactor joint on the other distal link.
+    // The tip on the carrier's post, and the cut: the frame P fixed on the other distal link.
     const std::size_t c = static_cast<std::size_t>(carrier), o = static_cast<std::size_t>(other);
     w.line(1, "<joint name=\"" + format::xml_escape(prefix + "_tip_mount") + "\" type=\"fixed\">");
     w.comment(2, "the tactor tip on the post of L" + std::to_string(carrier + 1) + ", the link carrying it");
     w.line(2, "<parent link=\"" + format::xml_escape(prefix + "_L" + std::to_string(carrier + 1)) + "\"/>");
     w.line(2, "<child link=\"" + format::xml_escape(prefix + "_tip") + "\"/>");
-    w.line(2, "<origin " + xyz(mech->L[c], 0.0, t + post_height) + " rpy=\"0 0 0\"/>");
+    w.line(2, "<origin " + xyz(mech->L[c], 0.0, t + mb.post_height_mm) + " rpy=\"0 0 0\"/>");
     w.line(1, "</joint>");
-    w.line(1, "<joint name=\"" + format::xml_escape(prefix + "_tactor") + "\" type=\"continuous\">");
-    w.comment(2, "passive tactor joint P where the loop is cut: phi" + std::to_string(carrier + 1) + " - phi" +
-                     std::to_string(other + 1) + " from FK; its child frame is L" + std::to_string(carrier + 1) +
-                     "'s frame moved to P");
+    w.line(1, "<joint name=\"" + format::xml_escape(prefix + "_P_mount") + "\" type=\"fixed\">");
+    w.comment(2, "the loop's cut: P on L" + std::to_string(other + 1) + " (at the height of L" + std::to_string(carrier + 1) +
+                     "'s plane). Closing constraint: this frame's origin and the tip mount's have the same x and y; "
+                     "a fixed frame, so no massless link moves");
     w.line(2, "<parent link=\"" + format::xml_escape(prefix + "_L" + std::to_string(other + 1)) + "\"/>");
     w.line(2, "<child link=\"" + format::xml_escape(prefix + "_P") + "\"/>");
     w.line(2, "<origin " + xyz(mech->L[o], 0.0, plane_z(g.layers[c]) - plane_z(g.layers[o])) + " rpy=\"0 0 0\"/>");
-    w.line(2, "<axis xyz=\"0 0 1\"/>");
     w.line(1, "</joint>");
+  }
+
+  // Transmissions: the gearing and the rotor inertia, as ROS 1 / Gazebo (mechanicalReduction) and
+  // Drake (drake:gear_ratio, drake:rotor_inertia) read them.
+  if (motors != nullptr) {
+    w.comment(1, "Transmissions: each motor drives its joint through a gearbox of ratio N (motor turns per joint "
+                 "turn). The rotor inertia J_r (at the motor shaft) reaches the joint as N^2 J_r, which dominates the "
+                 "links' inertia: a simulator that reads neither the transmission nor drake:rotor_inertia must add N^2 "
+                 "J_r to the joint (MuJoCo: the joint's armature; the MJCF has it). See docs/urdf.md.");
+    for (const MotorJoint& mj : motor_joints) {
+      const MotorParams& p = *mj.motor;
+      w.line(1, "<transmission name=\"" + format::xml_escape(mj.name + "_transmission") + "\">");
+      w.comment(2, "reflected rotor inertia N^2 J_r = " + num(p.gear_ratio * p.gear_ratio * p.rotor_inertia()) + " kg m^2");
+      w.line(2, "<type>transmission_interface/SimpleTransmission</type>");
+      w.line(2, "<joint name=\"" + format::xml_escape(mj.name) + "\">");
+      w.line(3, "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>");
+      w.line(2, "</joint>");
+      w.line(2, "<actuator name=\"" + format::xml_escape(mj.name + "_motor") + "\">");
+      w.line(3, "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>");
+      w.line(3, "<mechanicalReduction>" + num(p.gear_ratio) + "</mechanicalReduction>");
+      w.line(3, "<drake:gear_ratio value=\"" + num(p.gear_ratio) + "\"/>");
+      w.line(3, "<drake:rotor_inertia value=\"" + num(p.rotor_inertia()) + "\"/>");
+      w.line(2, "</actuator>");
+      w.line(1, "</transmission>");
+    }
   }
 
   // ros2_control: the motor joints.
@@ -333,6 +286,18 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
     w.line(3, "</state_interface>");
     w.line(3, "<state_interface name=\"velocity\"/>");
     w.line(2, "</joint>");
+  }
+  for (const MotorJoint& mj : motor_joints) {
+    if (!mj.motor) continue;
+    const MotorParams& p = *mj.motor;
+    w.line(2, "<transmission name=\"" + format::xml_escape(mj.name + "_transmission") + "\">");
+    w.line(3, "<plugin>transmission_interface/SimpleTransmission</plugin>");
+    w.line(3, "<joint name=\"" + format::xml_escape(mj.name) + "\" role=\"joint1\">");
+    w.line(4, "<mechanical_reduction>" + num(p.gear_ratio) + "</mechanical_reduction>");
+    w.line(3, "</joint>");
+    w.line(3, "<actuator name=\"" + format::xml_escape(mj.name + "_motor") + "\" role=\"actuator1\"/>");
+    w.line(3, "<param name=\"rotor_inertia\">" + num(p.rotor_inertia()) + "</param>");
+    w.line(2, "</transmission>");
   }
   w.line(1, "</ros2_control>");
   w.line(0, "</robot>");

@@ -85,6 +85,9 @@ struct ExportOptions {
   /// has `geometry:` (the links' outlines and masses), with these
   /// options (the parts' renders for masses and meshes, when there are).
   bool urdf = false;
+  /// Also write `<design>_<station>.xml` per exported station, the MJCF (fivebar/export/mjcf.hpp), with
+  /// `geometry:`; the same urdf_options (parts and meshes).
+  bool mjcf = false;
   UrdfOptions urdf_options;
 };
 
@@ -164,7 +167,8 @@ Json controller_parameters(const Design& design, const std::vector<std::string>&
 /// "-2.5e+20", "0.1"); "inf", "-inf", "nan" for non-finite values.
 std::string format_double(double value);
 
-/// The tree as a ROS 2 parameters file (block maps, flow lists, quoted strings, doubles by
+/// The tree as a ROS 2 parameters file (block maps, flow lists, quoted strings, keys quoted where YAML 1.1
+/// would read a boolean or null (`on`, `off`, `yes`, `no`, `y`, `n`, `true`, `false`, `null`, `~`, any case), doubles by
 /// format_double). std::logic_error for a value ROS cannot hold (non-finite double, nested or
 /// empty or mixed list).
 std::string render_ros2_yaml(const Json& parameters);
@@ -192,8 +196,8 @@ struct ExportResult {
 /// `<design>_controller` + `_<station>` for a one-station export of a several-station design.
 std::string export_stem(const Design& design, const std::vector<std::string>& stations);
 
-/// Runs the gate; only when it passes, renders every requested format (and, with options.urdf,
-/// the URDF of every exported station) in memory, creates `dir`
+/// Runs the gate; only when it passes, renders every requested format (and, with options.urdf
+/// and options.mjcf, the URDF and the MJCF of every exported station) in memory, creates `dir`
 /// and writes each file atomically (all temporaries written before the first rename; a target
 /// that is not a regular file is refused before anything is written). A failed gate creates and
 /// writes nothing. IoError when the files cannot be written.

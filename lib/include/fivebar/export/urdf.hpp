@@ -10,7 +10,7 @@
 ///    │            └─ (fixed) <..>_tip_mount at P ─ <..>_tip     when L3 carries the tactor post
 ///    └─ <station>_<mech>_theta2 (revolute, motor)  at O2 ─ <..>_L2
 ///          └─ <..>_elbow2 (continuous, passive) at A2 ─ <..>_L4
-///                 └─ <..>_tactor (continuous, passive) at P ─ <..>_P   the loop's cut
+///                 └─ <..>_P_mount (fixed) at P ─ <..>_P     the loop's cut (a frame, no mass)
 ///
 /// (the roles of L3 and L4 swap when L4 carries the post: geometry.layers[3] > layers[2], as in
 /// fivebar/dynamics.hpp). Each link's frame is its part's frame (fivebar/parts.hpp): z along its
@@ -18,9 +18,11 @@
 /// to theta in the parent's frame. So the motor joints' positions are the station-frame angles
 /// theta1, theta2 of docs/conventions.md, and a controller fills the passive joints from FK of the
 /// measured theta (fivebar/kinematics.hpp fk(), the design's assembly mode):
-///   elbow1 = phi3 - theta1,  elbow2 = phi4 - theta2,  tactor = phi_carrier - phi_other,
-/// phi3, phi4 the directions of A1->P and A2->P; then the frame <..>_P coincides with the tip's
-/// mount on the other chain, which is the loop closure URDF cannot state.
+///   elbow1 = phi3 - theta1,  elbow2 = phi4 - theta2,
+/// phi3, phi4 the directions of A1->P and A2->P; then the origin of the frame <..>_P (fixed on the
+/// distal link without the post) has the x and y of the tip's mount on the carrier: the loop
+/// closure URDF cannot state. (An earlier layout hung <..>_P on a `continuous` tactor joint; a
+/// massless link on a moving joint is refused by MuJoCo's compiler, so the cut is a fixed frame.)
 ///
 /// Heights: the proximal links' hubs (PartsHardware::hub_height) stand on the base plate; link
 /// plane k's plate starts at hub_height + k (link_thickness + layer_gap); the tip sits on the post,
@@ -34,8 +36,17 @@
 /// mid-plate). The URDF says which in a comment. The base is the root and carries no inertia.
 ///
 /// Limits: motor joints carry the usable range of fivebar/export/joint_limits.hpp (continuous when the
-/// joint has none), velocity controller.max_velocity, effort the stall torque at the output of the
-/// motor section, eta N k_t min(supply / R, current limit) (0 without `motor:`: unknown).
+/// joint has none), velocity motor_velocity_limit() (controller.max_velocity, at most the motor's
+/// no-load speed), effort the stall torque at the output of the motor section,
+/// eta N k_t min(supply / R, current limit) (0 without `motor:`: unknown).
+///
+/// Gearing and rotor inertia (with `motor:`): per motor joint a top-level `<transmission>`
+/// (transmission_interface/SimpleTransmission; the actuator `<joint>_motor` with
+/// `mechanicalReduction` N, and Drake's `drake:gear_ratio` and `drake:rotor_inertia` J_r at the motor
+/// shaft), and the same transmission inside `<ros2_control>` in its layout (`mechanical_reduction`,
+/// a `rotor_inertia` param). The links' inertials stay the printed parts': the reflected inertia
+/// N^2 J_r is the transmission's. A `<mujoco><compiler strippath="false"/></mujoco>` element keeps
+/// the mesh paths relative to the file for MuJoCo's URDF import.
 ///
 /// ros2_control: one `<ros2_control type="system">` naming the four motor joints, each with a
 /// position command interface (min/max = the usable range) and position and velocity state
@@ -59,6 +70,12 @@ struct UrdfOptions {
   /// The same folder as the URDF should name it (relative to the URDF file, e.g. "../parts").
   std::string mesh_prefix = "../parts";
 };
+
+/// The velocity limit of motor joint `joint` (1 or 2) of `mechanism`, rad/s: the smaller of
+/// controller.max_velocity and the motor's no-load speed at the output, V_supply / (k_e N) (344 deg/s
+/// with the assumed motor of `motor:`); either alone when the design has only that section, 0 with
+/// neither.
+double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint);
 
 /// `<design>_<station>.urdf`.
 std::string urdf_file_name(const Design& design, const Station& station);
