@@ -39,14 +39,14 @@ void print_mechanism(const ToleranceMap& r) {
     std::cout << to_string(r.centre.status) << " (no first-order estimate)\n";
   } else {
     std::cout << "3-sigma " << fixed(r.centre.ellipse_semi_axes.x(), 4) << " mm (Monte Carlo "
-              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst +-3-sigma corner " << fixed(r.centre.worst_case_mm, 4)
+              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst case (+-3-sigma corner) " << fixed(r.centre.worst_case_mm, 4)
               << " mm (separate effects added: " << fixed(r.centre.sum_of_effects_mm, 4) << " mm), resolution "
               << fixed(r.centre.resolution_um, 3) << " um per count, play " << fixed(r.centre_play.extent_mm, 4) << " mm"
               << (r.centre.near_singular ? " [near singular: first order not trusted]" : "") << "\n";
   }
   std::cout << "    over the target (" << r.target_points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)
             << " mm at " << point(r.worst_3sigma_at) << (r.worst_3sigma_flagged ? " [near singular]" : "")
-            << ", worst corner up to " << fixed(r.worst_case_mm, 4) << " mm at "
+            << ", worst case up to " << fixed(r.worst_case_mm, 4) << " mm at "
             << point(r.worst_case_at) << (r.worst_case_flagged ? " [near singular]" : "") << ", resolution up to "
             << fixed(r.worst_resolution_um, 3)
             << " um per count, play up to " << fixed(r.worst_play_mm, 4) << " mm at " << point(r.worst_play_at);

@@ -74,6 +74,7 @@ Product coverage_product() {
   p.name = "coverage";
   p.title = "Target coverage";
   p.unavailable = without_mechanisms;
+  p.after = {"workspace"};  // links to the workspace pictures, when built
   p.build = [](Context& ctx) {
     Built b;
     Json stations = Json::array();
