@@ -2,6 +2,7 @@
 // (ZOH plant, PID with one period of delay; fivebar/control.hpp): spectral radius map, worst pose,
 // verdict, gain margins and the damping of the dominant pole; picture, VTK field, CSV, JSON.
 
+#include <cmath>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -56,6 +57,16 @@ void print_tuning(const TuneResult& r) {
               << "            " << fixed(100 * t.saturation_before, 1) << " % / " << fixed(100 * t.saturation_after, 1)
               << " %        " << t.evaluations << "     " << t.stop << (t.feasible ? "" : ", NOT FEASIBLE") << "\n";
     if (per_joint) std::cout << std::string(15 + 35, ' ') << "theta2 " << gains_text(t.after[1]) << "\n";
+    const auto onset = [](double hz) { return std::isfinite(hz) ? fixed(hz, 1) + " Hz" : std::string("never"); };
+    std::cout << "    least zeta " << fixed(t.damping_before, 3) << " -> " << fixed(t.damping_after, 3) << " (floor "
+              << fixed(r.min_damping, 2) << "), kp margin x" << fixed(t.kp_margin_before, 2) << " -> x"
+              << fixed(t.kp_margin_after, 2) << ", kd margin x" << fixed(t.kd_margin_before, 2) << " -> x"
+              << fixed(t.kd_margin_after, 2) << " (floor x" << fixed(r.min_gain_margin, 2) << "), 1 mm step overshoot "
+              << fixed(t.overshoot_before_mm, 3) << " -> " << fixed(t.overshoot_after_mm, 3) << " mm; chirp -3 dB "
+              << fixed(t.chirp_bandwidth_before_hz, 1) << " -> " << fixed(t.chirp_bandwidth_after_hz, 1)
+              << " Hz, motors saturate at " << onset(t.chirp_saturation_before_hz) << " -> "
+              << onset(t.chirp_saturation_after_hz) << ": bandwidth " << fixed(t.bandwidth_before_hz, 1) << " -> "
+              << fixed(t.bandwidth_after_hz, 1) << " Hz\n";
   }
 }
 

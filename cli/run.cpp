@@ -19,6 +19,7 @@ struct RunOptions {
   std::vector<std::string> products;
   bool json = false;
   bool quiet = false;
+  unsigned jobs = 0;
 };
 
 void print_report(const SceneReport& report) {
@@ -57,6 +58,8 @@ int run_run(const RunOptions& opt) {
   options.out_root = opt.out;
   if (!opt.products.empty()) options.products = opt.products;
   if (!opt.quiet) options.progress = terminal_progress("run");  // only for a person watching
+  if (opt.jobs > 64) throw InputError("--jobs must be within [0, 64] (0: one per core)");
+  options.jobs = opt.jobs;
   const SceneReport report = run_scene(design, options);
   if (opt.json) {
     Json doc = {{"command", "run"}};
@@ -91,6 +94,10 @@ void setup_run(CLI::App& app) {
       ->type_name("LIST");
   sub->add_flag("--json", opt->json, "Print the summary as one JSON document on stdout and nothing else");
   sub->add_flag("-q,--quiet", opt->quiet, "No progress lines on stderr");
+  sub->add_option("-j,--jobs", opt->jobs,
+                  "Products built at once, each after its prerequisites (0: one per core); the outputs do not depend on it")
+      ->capture_default_str()
+      ->type_name("N");
   sub->footer(
       "Exit status: 0 every built product passed, 1 a check failed or a requested product could not be built, "
       "2 bad input, 3 internal error or output not writable.");

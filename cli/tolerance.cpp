@@ -41,27 +41,50 @@ void print_mechanism(const ToleranceMap& r) {
     std::cout << to_string(r.centre.status) << " (no first-order estimate)\n";
   } else {
     std::cout << "3-sigma " << fixed(r.centre.ellipse_semi_axes.x(), 4) << " mm (Monte Carlo "
-              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst case " << fixed(r.centre.worst_case_mm, 4)
-              << " mm, resolution " << fixed(r.centre.resolution_um, 3) << " um per count, play "
-              << fixed(r.centre_play.extent_mm, 4) << " mm\n";
+              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst case (+-3-sigma corner) " << fixed(r.centre.worst_case_mm, 4)
+              << " mm (separate effects added: " << fixed(r.centre.sum_of_effects_mm, 4) << " mm), resolution "
+              << fixed(r.centre.resolution_um, 3) << " um per count, play " << fixed(r.centre_play.extent_mm, 4) << " mm"
+              << (r.centre.near_singular ? " [near singular: first order not trusted]" : "") << "\n";
   }
   if (r.target_not_ok >= r.target_points) {  // nothing to report: no 0 mm at (0, 0) (issue 31)
     std::cout << "    over the target (" << r.target_points << " points): no point is reachable and regular (no estimate)";
   } else {
   std::cout << "    over the target (" << r.target_points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)
-            << " mm at " << point(r.worst_3sigma_at) << ", worst case up to " << fixed(r.worst_case_mm, 4) << " mm at "
-            << point(r.worst_case_at) << ", resolution up to " << fixed(r.worst_resolution_um, 3)
+            << " mm at " << point(r.worst_3sigma_at) << (r.worst_3sigma_flagged ? " [near singular]" : "")
+            << ", worst case up to " << fixed(r.worst_case_mm, 4) << " mm at "
+            << point(r.worst_case_at) << (r.worst_case_flagged ? " [near singular]" : "") << ", resolution up to "
+            << fixed(r.worst_resolution_um, 3)
             << " um per count, play up to " << fixed(r.worst_play_mm, 4) << " mm at " << point(r.worst_play_at);
   if (r.target_not_ok > 0) std::cout << "; " << r.target_not_ok << " points unreachable or singular (no estimate)";
   }
   std::cout << "\n";
+  if (!r.near_singular.empty()) {
+    std::cout << "    first order not trusted at " << r.near_singular.size()
+              << " target points (near a type II singularity); there the Monte Carlo and the nonlinear corners:\n";
+    for (const auto& f : r.near_singular) {
+      std::cout << "      " << point(f.at) << ": 3-sigma " << fixed(f.first_order.ellipse_semi_axes.x(), 4)
+                << " mm first order, " << fixed(f.monte_carlo_3sigma_mm, 4) << " mm Monte Carlo ("
+                << f.monte_carlo.failed << " of " << (f.monte_carlo.used + f.monte_carlo.failed)
+                << " devices fail); worst corner " << fixed(f.first_order.worst_case_mm, 4) << " mm first order, "
+                << fixed(f.corners.worst_mm, 4) << " mm nonlinear (" << f.corners.failed << " of " << f.corners.corners
+                << " corners fail)\n";
+    }
+  }
   const RobustCoverage& c = r.robust;
   std::cout << "    robust coverage: margin " << fixed(c.margin_mm, 4) << " mm, sigma " << fixed(c.sigma_mm, 4)
             << " mm per printed device: " << fixed(100.0 * c.fraction, 1) << " % of devices keep "
-            << fixed(c.robust_margin_mm, 4) << " mm -> " << (c.covered ? "covered" : "NOT covered")
+            << fixed(c.robust_margin_mm, 4) << " mm (first order, "
+            << (c.robust_certified ? "certified >= " + fixed(c.robust_margin_lower_mm, 4) + " mm" : std::string("sampled, not certified"))
+            << ") -> " << (c.covered ? "covered" : "NOT covered")
             << " at " << point(c.robust_point) << " (first order: at most " << fixed(100.0 * c.fraction_first_order, 2)
             << " % cover; Monte Carlo "
             << fixed(100.0 * c.fraction_monte_carlo, 2) << " % of " << c.samples << ")\n";
+  if (c.samples > 0) {
+    std::cout << "    Monte Carlo: the " << fixed(100.0 * (1.0 - c.fraction), 1) << " % quantile of the devices' margins "
+              << fixed(c.quantile_margin_mm, 4) << " mm, >= "
+              << (std::isfinite(c.quantile_lower_mm) ? fixed(c.quantile_lower_mm, 4) + " mm" : std::string("? (too few samples)"))
+              << " with " << fixed(100.0 * c.quantile_confidence, 0) << " % confidence (order statistic, binomial)\n";
+  }
 }
 
 int run_tolerance(const ToleranceCliOptions& opt) {
@@ -179,7 +202,7 @@ void setup_tolerance(CLI::App& app) {
   sub->footer(
       "Tolerances come from the design's tolerance: section (docs/design-file.md), else from its defaults, which are "
       "assumptions.\nFiles: <station>-<mechanism>-tolerance.vti (ParaView: three_sigma_mm, worst_case_mm, resolution_um, "
-      "play_mm, status) and <station>-tolerance.svg|.png.\nExit status: 0 every mechanism covers its target for "
+      "play_mm, near_singular, status) and <station>-tolerance.svg|.png.\nExit status: 0 every mechanism covers its target for "
       "tolerance.robust_fraction of printed devices, 1 one does not, 2 bad input, 3 internal error.");
   sub->callback([opt]() { finish(run_tolerance(*opt)); });
 }

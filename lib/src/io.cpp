@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <cctype>
+#include <mutex>
 #include <set>
 #include <random>
 #include <streambuf>
@@ -195,8 +196,12 @@ long temporary_pid(const std::string& name) {
 /// whose process no longer exists (a live process's, or one we may not signal, are kept).
 void remove_stale_temporaries(const fs::path& dir) {
   static std::set<fs::path> swept;
+  static std::mutex swept_lock;  // products of a scene write from several threads
   const fs::path key = absolute_normal(dir.empty() ? fs::path(".") : dir);
-  if (!swept.insert(key).second) return;
+  {
+    const std::lock_guard<std::mutex> lock(swept_lock);
+    if (!swept.insert(key).second) return;
+  }
   std::error_code ec;
   for (fs::directory_iterator it(key, ec), end; !ec && it != end; it.increment(ec)) {
     const long pid = temporary_pid(it->path().filename().string());

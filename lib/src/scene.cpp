@@ -2,7 +2,13 @@
 #include "fivebar/scene.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <exception>
 #include <fstream>
+#include <functional>
+#include <mutex>
+#include <thread>
 #include <sstream>
 #include <map>
 #include <set>
@@ -52,6 +58,7 @@ json SceneReport::to_json() const {
                        {"prerequisite", p.prerequisite},
                        {"passed", p.passed},
                        {"check", p.check},
+                       {"wall_s", p.wall_s},
                        {"files", files}});
       results[p.name] = p.result;
     } else {
@@ -91,15 +98,16 @@ std::string SceneReport::to_markdown() const {
   out += ok() ? "**Result: every built product passed its check.**\n\n"
               : "**Result: attention needed** — see the products marked ✗ below.\n\n";
 
-  md::Table table({"product", "state", "check", "files"}, "llll");
+  md::Table table({"product", "state", "check", "time (s)", "files"}, "lllrl");
   for (const auto& p : products) {
     if (p.state == ProductOutcome::State::built) {
       std::string files;
       for (const auto& f : p.files) files += (files.empty() ? "" : ", ") + md::code(f.generic_string());
       std::string state = p.prerequisite && !p.requested ? "built (prerequisite)" : "built";
-      table.row({md::code(p.name), state, (p.passed ? "✓ " : "✗ ") + p.check, files.empty() ? "—" : files});
+      table.row({md::code(p.name), state, (p.passed ? "✓ " : "✗ ") + p.check, md::fixed(p.wall_s, 2),
+                 files.empty() ? "—" : files});
     } else {
-      table.row({md::code(p.name), p.requested ? "**not built** (requested)" : "left out", p.reason, "—"});
+      table.row({md::code(p.name), p.requested ? "**not built** (requested)" : "left out", p.reason, "—", "—"});
     }
   }
   out += "## Products\n\n";
@@ -183,45 +191,121 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
   report.out_dir = resolve_output_dir(options.out_root, design.name);
   make_directories(report.out_dir);
 
-  std::map<std::string, json> results;
-  std::set<std::string> built;
-  for (const auto& name : known) {
-    ProductOutcome outcome;
+  // What each product needs first: its prerequisites and the products it reads when they are built
+  // (Product::after) that this scene builds. Left-out products are decided up front, in order.
+  const std::size_t n = known.size();
+  report.products.resize(n);
+  std::vector<const Product*> product(n);
+  std::vector<std::vector<std::size_t>> deps(n);
+  std::vector<char> pending(n, 0);
+  std::map<std::string, std::size_t> index;
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string& name = known[k];
+    ProductOutcome& outcome = report.products[k];
     outcome.name = name;
     outcome.requested = listed && requested.count(name) > 0;
     outcome.prerequisite = needed.count(name) > 0 && !wanted(name);
-    const Product* product = find(name);
+    product[k] = find(name);
+    index[name] = k;
     if (needed.count(name) == 0) {
       outcome.reason = "not listed in the scene's products";
-    } else if (auto why = product->unavailable ? product->unavailable(design) : std::nullopt) {
+      continue;
+    }
+    if (auto why = product[k]->unavailable ? product[k]->unavailable(design) : std::nullopt) {
       outcome.reason = *why;
-    } else {
-      std::vector<std::string> missing_pre;
-      for (const auto& pre : product->prerequisites) {
-        if (built.count(pre) == 0) missing_pre.push_back(pre);
-      }
-      if (!missing_pre.empty()) {
-        outcome.reason = "needs " + join(missing_pre, ", ") + ", which could not be built";
+      continue;
+    }
+    std::vector<std::string> missing_pre;
+    for (const auto& pre : product[k]->prerequisites) {
+      const auto it = index.find(pre);  // prerequisites come earlier in the list
+      if (it == index.end() || !pending[it->second]) {
+        missing_pre.push_back(pre);
       } else {
-        if (options.progress) options.progress("building " + name);
-        Context ctx{design, report.out_dir, results, options.progress, {}, {}};
+        deps[k].push_back(it->second);
+      }
+    }
+    if (!missing_pre.empty()) {
+      outcome.reason = "needs " + join(missing_pre, ", ") + ", which could not be built";
+      continue;
+    }
+    for (const auto& after : product[k]->after) {
+      const auto it = index.find(after);
+      if (it != index.end() && pending[it->second]) deps[k].push_back(it->second);
+    }
+    pending[k] = 1;
+  }
+
+  // Build: a worker takes the first product (in list order) whose dependencies are built; each sees
+  // the results of its dependencies only, so that nothing depends on the timing.
+  std::map<std::string, json> results;
+  std::mutex lock;
+  std::condition_variable changed;
+  std::vector<char> started(n, 0), done(n, 0);
+  std::exception_ptr failure;
+  std::mutex say_lock;
+  const std::function<void(std::string_view)> progress =
+      options.progress ? std::function<void(std::string_view)>([&](std::string_view line) {
+        const std::lock_guard<std::mutex> guard(say_lock);
+        options.progress(line);
+      })
+                       : std::function<void(std::string_view)>();
+  const auto worker = [&] {
+    std::unique_lock<std::mutex> guard(lock);
+    for (;;) {
+      std::size_t pick = n;
+      bool left = false;
+      for (std::size_t k = 0; k < n && !failure; ++k) {
+        if (!pending[k] || started[k]) continue;
+        left = true;
+        if (std::all_of(deps[k].begin(), deps[k].end(), [&](std::size_t d) { return done[d] != 0; })) {
+          pick = k;
+          break;
+        }
+      }
+      if (failure || !left) return;
+      if (pick == n) {
+        changed.wait(guard);
+        continue;
+      }
+      started[pick] = 1;
+      std::map<std::string, json> inputs;
+      for (const std::size_t d : deps[pick]) inputs[known[d]] = results.at(known[d]);
+      guard.unlock();
+      ProductOutcome& outcome = report.products[pick];
+      try {
+        if (progress) progress("building " + known[pick]);
+        const auto t0 = std::chrono::steady_clock::now();
+        Context ctx{design, report.out_dir, inputs, progress, {}, {}};
         ctx.check_design = [&registry](const Design& d, const std::filesystem::path& root) {
           return check_design_with(d, root, registry);
         };
-        Built result = product->build(ctx);
+        Built result = product[pick]->build(ctx);
+        outcome.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         outcome.state = ProductOutcome::State::built;
         outcome.passed = result.passed;
         outcome.check = result.check;
         outcome.result = result.result;
         outcome.files = ctx.files;
-        results[name] = std::move(result.result);
-        built.insert(name);
-        outcome.title = product->title;
+        outcome.title = product[pick]->title;
         outcome.markdown = std::move(result.markdown);
+        guard.lock();
+        results[known[pick]] = std::move(result.result);
+      } catch (...) {
+        guard.lock();
+        if (!failure) failure = std::current_exception();
       }
+      done[pick] = 1;
+      changed.notify_all();
     }
-    report.products.push_back(std::move(outcome));
+  };
+  const unsigned jobs = std::max(1u, options.jobs ? options.jobs : std::thread::hardware_concurrency());
+  {
+    std::vector<std::thread> pool;
+    for (unsigned k = 1; k < jobs; ++k) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
   }
+  if (failure) std::rethrow_exception(failure);
 
   report.summary_md = report.out_dir / "summary.md";
   report.summary_json = report.out_dir / "summary.json";

@@ -341,9 +341,16 @@ std::vector<std::string> summary_lines(const StationControl& study);
 // Gains per mechanism (the same kp, ki, kd on both joints; or per joint with `per_joint`; i_clamp
 // kept) that minimise the worst tracking error over the station's patterns, simulated with this
 // mechanism alone under the new gains (fivebar/dynamics.hpp, CVODE at TuneOptions::rtol), subject
-// to max rho <= rho_limit over the target (the constraint, on the export gate's 21 x 21 grid) and
-// to the saturation limit (a penalty of 10 mm per unit of saturated-time fraction beyond
-// controller.max_saturation_fraction).
+// to the constraints an engineer sets, all over the export gate's 21 x 21 grid of the target:
+// max rho <= rho_limit; the least damping ratio of any oscillatory pole >= min_damping (0.3); max
+// rho < 1 with kp, and with kd, multiplied by min_gain_margin (2: the margins then reach it, since
+// gain_margin() brackets from factor 1 up); and, for what the linear model does not see, the
+// simulated 1 mm step of the tactor (with the duty saturation and the integral clamp) overshooting
+// by at most the second-order bound at min_damping, exp(-pi zeta / sqrt(1 - zeta^2)) of the step.
+// The saturation limit is a penalty of 10 mm per unit of saturated-time fraction beyond
+// controller.max_saturation_fraction. Before and after, each mechanism also runs the chirp of
+// SimulationRequest: the -3 dB bandwidth, and the frequency at which the motors first saturate,
+// the smaller being the bandwidth to report. The mechanisms are tuned in parallel (std::thread).
 //
 // Start: pole placement on the linearised model at the target's centre. Each joint j of the plant
 // above, with the current taken as settled (L/R = 0.1 ms with the motor defaults, far below
@@ -396,6 +403,13 @@ struct TuneOptions {
   int max_evaluations = 60;     ///< objective evaluations per mechanism
   double max_seconds = 30.0;    ///< wall time for the whole tuning, shared among the mechanisms
   double rtol = 1e-3;           ///< CVODE tolerance of the tracking runs
+  double min_damping = 0.3;     ///< controller.tune.min_damping: least oscillatory zeta over the target
+  double min_gain_margin = 2.0; ///< controller.tune.min_gain_margin: kp and kd factors keeping rho < 1
+  bool chirp = true;            ///< run the before/after chirps (bandwidth, saturation onset)
+  /// Mechanisms tuned at once (std::thread; 0: std::thread::hardware_concurrency()). The result
+  /// does not depend on it (each mechanism's search is deterministic and independent) unless the
+  /// wall-time bound stops a search.
+  unsigned threads = 0;
   std::function<void(std::string_view)> progress;  ///< one line per evaluation; may be empty
 };
 
@@ -415,8 +429,25 @@ struct TunedMechanism {
   double rho_before = 0.0, rho_after = 0.0;        ///< max over the constraint's grid
   double error_before_mm = 0.0, error_after_mm = 0.0;  ///< worst tracking error over the patterns
   double saturation_before = 0.0, saturation_after = 0.0;  ///< worst saturated-time fraction
+  /// Least damping ratio of an oscillatory pole over the constraint's grid (LoopPoles).
+  double damping_before = 1.0, damping_after = 1.0;
+  double damping_hz_before = 0.0, damping_hz_after = 0.0;  ///< that pole's frequency
+  /// Gain margins over the constraint's grid (StabilityMap::kp_margin, kd_margin; capped at 1e3).
+  double kp_margin_before = 0.0, kp_margin_after = 0.0, kd_margin_before = 0.0, kd_margin_after = 0.0;
+  /// Largest overshoot of the 1 mm step along x (the simulation, with the duty saturation and the
+  /// integral clamp), mm; the constraint allows step * exp(-pi zeta / sqrt(1 - zeta^2)).
+  double overshoot_before_mm = 0.0, overshoot_after_mm = 0.0;
+  /// The chirp (SimulationRequest's defaults: 0.2 mm, 0.5 Hz to a quarter of the loop rate):
+  /// its -3 dB bandwidth (the chirp's top frequency when it never falls 3 dB), the instantaneous
+  /// frequency at which a motor's duty first saturates (inf: never), and the bandwidth to report,
+  /// the smaller of the two: above it the motors saturate or the gain has fallen.
+  double chirp_bandwidth_before_hz = 0.0, chirp_bandwidth_after_hz = 0.0;
+  double chirp_saturation_before_hz = 0.0, chirp_saturation_after_hz = 0.0;
+  double bandwidth_before_hz = 0.0, bandwidth_after_hz = 0.0;
   int evaluations = 0;
-  bool feasible = false;   ///< rho_after <= rho_limit and the saturation within its limit
+  /// rho_after <= rho_limit, the saturation within its limit, the damping and gain margin floors
+  /// met and the step's overshoot within its bound.
+  bool feasible = false;
   std::string stop;        ///< why the optimiser stopped
   /// The design already runs with the tuned gains (to 6 significant digits on every joint).
   bool applied() const;
@@ -425,6 +456,8 @@ struct TunedMechanism {
 struct TuneResult {
   std::vector<TunedMechanism> mechanisms;
   double rho_limit = 0.9;
+  double min_damping = 0.3, min_gain_margin = 2.0;
+  double max_overshoot_fraction = 0.0;  ///< of the step: exp(-pi zeta / sqrt(1 - zeta^2)) at min_damping
   double wall_s = 0.0;
 };
 
@@ -440,7 +473,9 @@ std::string tuned_patch_yaml(const TuneResult& result);
 Json to_json(const TuneResult& result);
 /// One row per mechanism: station,mechanism,kp_before,ki_before,kd_before,kp_after,ki_after,
 /// kd_after,max_rho_before,max_rho_after,max_tracking_error_before_mm,max_tracking_error_after_mm,
-/// saturation_before,saturation_after,evaluations,feasible,applied,stop.
+/// saturation_before,saturation_after,evaluations,feasible,applied,stop, then before and after each:
+/// min_damping, kp_margin, kd_margin, step_overshoot_mm, chirp_bandwidth_hz, chirp_saturation_hz
+/// (empty: never saturates), bandwidth_hz.
 std::string tuning_csv(const TuneResult& result);
 
 /// The picture of a station's maps (one panel per mechanism, `fields[k]` for `maps[k]`): rho over

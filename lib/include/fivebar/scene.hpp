@@ -27,6 +27,9 @@ struct SceneOptions {
   std::optional<std::vector<std::string>> products;
   /// Progress lines ("building kinematics"), e.g. to stderr; may be empty.
   std::function<void(std::string_view)> progress;
+  /// Products built at once (their prerequisites first; docs/architecture.md "Products"); 0: one
+  /// per core (std::thread::hardware_concurrency()). The outputs do not depend on it.
+  unsigned jobs = 0;
 };
 
 /// What happened to one known product.
@@ -43,6 +46,7 @@ struct ProductOutcome {
   std::string title;         ///< heading of its section in summary.md
   std::string markdown;      ///< body of its section in summary.md
   std::vector<std::filesystem::path> files;  ///< files it wrote, relative to the scene directory
+  double wall_s = 0.0;       ///< wall time of its build (0 when left out)
 };
 
 struct SceneReport {

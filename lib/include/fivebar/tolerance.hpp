@@ -21,9 +21,15 @@
 /// finite differences of fk() in test/test_tolerance.cpp.
 ///
 /// With independent parameter errors of standard deviations sigma_j, the tactor covariance is
-/// C = S diag(sigma^2) S^T; the 3-sigma ellipse has semi-axes 3 sqrt(eig(C)); the worst case puts
-/// every parameter at the edge of its +-3 sigma band with the worst sign,
-/// sum_j |S_j| 3 sigma_j, which bounds the 3-sigma ellipse's major semi-axis (triangle inequality).
+/// C = S diag(sigma^2) S^T; the 3-sigma ellipse has semi-axes 3 sqrt(eig(C)). The worst case puts
+/// every parameter at the edge of its +-3 sigma band with the worst sign: to first order the tactor
+/// displacements of the box |dq_j| <= 3 sigma_j form the zonotope Z = { sum_j s_j g_j : |s_j| <= 1 }
+/// with generators g_j = 3 sigma_j S_j, and the worst case is its farthest point from P, a vertex:
+/// with the generators turned into the upper half plane and sorted by angle, the 2n vertices are
+/// -sum g + 2 (g_(1) + ... + g_(k)) and their negatives (zonotope_farthest(), exact, O(n log n);
+/// checked against all 2^n corners in test/test_tolerance.cpp). It is at least the 3-sigma
+/// ellipse's major semi-axis (l1 >= l2 norm of the projections u . g_j) and at most the sum of the
+/// separate effects sum_j |g_j| (triangle inequality), which is also reported, under that name.
 /// The resolution is the tactor step of one ADC count on one joint: max_i |J_i| dtheta_count.
 ///
 /// Clearance as a set (tolerance_play()). A pin of diameter d in a hole of d + 2c lets the joint
@@ -43,19 +49,18 @@
 ///
 /// Robust coverage (robust_coverage()). A printed device's own reachable region is the design's
 /// with its perturbed lengths and base positions; it covers the target when its certified margin
-/// (fivebar/coverage/coverage.hpp containment()) is >= 0. At each of 72 points b of the ellipse's boundary
-/// the signed distance to the region's boundary is, to first order, d(b) + g(b) . dq with
-/// g = dd/dq (central differences, step 1 % of each sigma), so its standard deviation is
-/// sigma(b) = sqrt(sum_j g_j(b)^2 sigma_j^2) and the robust margin is the signed margin minus the
-/// error at each boundary point: min_b d(b) - z_p sigma(b), z_p = Phi^{-1}(p), capped by the
-/// certified margin. The signed distance moves at most 1 mm per mm of any length or base
-/// coordinate, so sigma(b) <= S = sqrt(sum sigma_j^2) and the gradients are taken only at the
-/// points (by increasing d(b)) where d(b) - z S could still set the robust margin: the same answer
-/// at a fraction of the cost. A device covers only if every point does, so min_b Phi(d(b) /
-/// sigma(b)) over those points is an upper bound of the fraction of devices that cover (the points' errors are correlated, and
+/// (fivebar/coverage/coverage.hpp containment()) is >= 0. At each point b of the ellipse's boundary the
+/// distance to each boundary arc k of the region is, to first order, d_k(b) + g_k(b) . dq (closed
+/// form: robust_margin_at()), with standard deviation sigma_k(b) = sqrt(sum_j g_kj(b)^2 sigma_j^2);
+/// the robust margin is min over b and k of d_k(b) - z_p sigma_k(b), z_p = Phi^{-1}(p), minimised
+/// over the whole boundary by branch and bound with a certified lower bound (robust_margin_min(),
+/// as containment() certifies the margin itself), capped by the certified margin. A device
+/// covers only if every point does, so min Phi(d_k(b) / sigma_k(b)) over the points evaluated is
+/// an upper bound of the fraction of devices that cover (the points' errors are correlated, and
 /// where two boundary points are nearly as close the true fraction is lower). The Monte Carlo
 /// reference evaluates containment() on each sampled device: the fraction that covers, and the
-/// (1 - p) quantile of their margins to set beside the robust margin. Joint angle offsets and
+/// (1 - p) quantile of their margins with a one-sided 95 % lower confidence bound (an order
+/// statistic; quantile_lower_bound_rank()) to set beside the robust margin. Joint angle offsets and
 /// play do not move the reachable region (play only widens it), so they do not enter.
 
 #include <Eigen/Core>
@@ -99,14 +104,28 @@ struct ToleranceEstimate {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  ///< mm^2
   Vec2 ellipse_semi_axes{0.0, 0.0};  ///< 3-sigma semi-axes, major first, mm
   double ellipse_angle = 0.0;        ///< direction of the major axis, rad, in (-pi/2, pi/2]
-  double worst_case_mm = 0.0;        ///< sum_j |S_j| * 3 sigma_j, mm
+  double worst_case_mm = 0.0;        ///< farthest point of the +-3 sigma zonotope (exact, first order), mm
+  double sum_of_effects_mm = 0.0;    ///< sum_j |S_j| 3 sigma_j: the separate effects added, an upper bound, mm
+  /// The sign of each parameter's 3 sigma at the worst corner (+1 or -1; ToleranceParameter order).
+  std::array<std::int8_t, kToleranceParameters> worst_corner{};
   double resolution_um = 0.0;        ///< tactor step of one count on the worse joint, micrometres
-  /// The linearisation is not to be trusted here: the worst-case displacement reaches a quarter of
+  /// The linearisation is not to be trusted here: the sum of separate effects (a bound of every
+  /// first-order displacement in the +-3 sigma box) reaches a quarter of
   /// the way to the type II singularity (min(L3, L4) |sin| of the tactor angle, the distance a
   /// distal link's end must move to align the links), where the error is no longer linear in the
   /// tolerances (the Monte Carlo then disagrees, and some printed devices cannot assemble).
   bool near_singular = false;
 };
+
+/// Farthest point from the origin of the 2-D zonotope { sum_j s_j g_j : -1 <= s_j <= 1 } (derivation
+/// above): its norm, the point and the signs s_j in {-1, +1} of a vertex that attains it. Exact in
+/// O(n log n); an empty or all-zero set of generators gives 0 with every sign +1.
+struct ZonotopeExtreme {
+  double norm = 0.0;
+  Vec2 point{0.0, 0.0};
+  std::vector<std::int8_t> signs;
+};
+ZonotopeExtreme zonotope_farthest(const std::vector<Vec2>& generators);
 
 /// Closed-form sensitivity of the tactor to the ten parameters at P (derivation above).
 /// Status is ik()'s: not ok (unreachable or within tol::kSingularSin of a singularity) gives zeros.
@@ -150,6 +169,22 @@ std::vector<MonteCarloTolerance> tolerance_monte_carlo(const Mechanism& m, const
                                                        const ParameterSigmas& sigma, std::size_t samples,
                                                        std::uint64_t seed);
 
+/// The nonlinear counterpart of the worst case: the printed device at every corner of the box
+/// |dq_j| <= k_sigma sigma_j (2^10 devices; parameters with sigma_j = 0 stay nominal), each
+/// tactor its FK at the nominal IK angles on the nominal assembly branch. The largest |P_printed -
+/// P| over the corners is where the first-order worst case should land when the first order holds
+/// (the nonlinear maximum over the box need not be at a corner; this is the reference where the
+/// first order is flagged).
+struct CornerEnumeration {
+  Status status = Status::unreachable;  ///< nominal ik()'s status; zeros unless ok
+  double worst_mm = 0.0;                ///< max over the corners that assemble, mm
+  std::size_t corners = 0;              ///< corners enumerated (2^(parameters with sigma > 0))
+  std::size_t failed = 0;               ///< corners whose device cannot reach (or is singular)
+  std::array<std::int8_t, kToleranceParameters> worst_corner{};  ///< signs at the worst corner
+};
+CornerEnumeration tolerance_corners(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+                                    double k_sigma = 3.0);
+
 // --- Sources from a design ----------------------------------------------------------------------
 
 /// What the analyses of one mechanism take from the design (`tolerance:`, `print:`, `controller:`).
@@ -190,13 +225,57 @@ bool in_play_set(const Mechanism& m, const Vec2& P, const std::array<double, 2>&
 
 // --- Robust coverage -------------------------------------------------------------------------------
 
+/// The first-order robust margin at one point b inside the region (derivation in
+/// lib/src/tolerance/tolerance_robust.cpp): each leg's set is bounded by circular arcs (centre c(q), radius
+/// R(q)); the distance from b to an arc whose radial projection of b lies on it is |R - |b - c||,
+/// with gradient g = sign (dR/dq - u . dc/dq), u = (b - c)/|b - c|; the margin at b is the smallest
+/// of these over both legs, and the robust value is the smallest of d_k - z sigma_k, sigma_k^2 =
+/// sum_j g_j^2 sigma_j^2 (a device fails at b when any arc passes it).
+struct RobustPoint {
+  bool inside = false;  ///< b lies in both legs' sets (otherwise the other fields are zero)
+  double distance_mm = 0.0;   ///< signed distance to the region's boundary (min over the arcs)
+  double robust_mm = 0.0;     ///< min over the arcs of d_k - z sigma_k
+  double sigma_mm = 0.0;      ///< sigma_k of the arc that sets robust_mm
+  std::array<double, kToleranceParameters> gradient{};  ///< g of that arc
+};
+RobustPoint robust_margin_at(const Mechanism& m, const ParameterSigmas& sigma, double z, const Vec2& b);
+
+/// The minimum of robust_margin_at() over the boundary of `target`, certified by branch and bound
+/// on the ellipse parameter with a Lipschitz bound per arc (speed of the boundary times 1 + z
+/// |dsigma_k/du| / |b - c|), to `tol_mm`: the true minimum lies in [lower_mm, value_mm].
+/// Precondition: the target is inside the region (its margin > 0); otherwise certified is false.
+struct RobustMarginBound {
+  bool certified = false;
+  double value_mm = 0.0;   ///< attained at `point` (an upper bound of the minimum)
+  double lower_mm = 0.0;   ///< certified lower bound of the minimum
+  Vec2 point{0.0, 0.0};
+  RobustPoint at;          ///< robust_margin_at(point)
+  std::size_t evaluations = 0;
+  bool capped = false;     ///< the evaluation budget ran out before tol_mm was met
+  double fraction_first_order = 1.0;  ///< min Phi(d_k / sigma_k) over the points evaluated
+};
+RobustMarginBound robust_margin_min(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double z,
+                                    double tol_mm);
+
+/// One-sided lower confidence bound of the p-quantile from n independent samples of a continuous
+/// distribution: the (1-based) rank r of the largest order statistic X_(r) with
+/// P(X_(r) <= q_p) = P(Binomial(n, p) >= r) >= confidence, and that probability (its exact
+/// coverage). r = 0 when even X_(1) does not reach the confidence (too few samples).
+struct QuantileBound {
+  std::size_t rank = 0;
+  double coverage = 0.0;
+};
+QuantileBound quantile_lower_bound_rank(std::size_t n, double p, double confidence);
+
 struct RobustCoverage {
   double fraction = 0.997;         ///< of printed devices that must cover
   double margin_mm = 0.0;          ///< the design's certified margin (containment())
   bool decided = true;             ///< containment() decided the nominal verdict
   double sigma_mm = 0.0;           ///< sigma(b) at the boundary point that sets the robust margin
   double z = 0.0;                  ///< Phi^{-1}(fraction)
-  double robust_margin_mm = 0.0;   ///< margin - z sigma: what `fraction` of printed devices keep
+  double robust_margin_mm = 0.0;   ///< margin - z sigma: what `fraction` of printed devices keep (first order)
+  double robust_margin_lower_mm = 0.0;  ///< certified lower bound of robust_margin_mm (robust_margin_min())
+  bool robust_certified = false;   ///< the bound holds (the nominal margin is > 0 and the search converged)
   double fraction_first_order = 0.0;  ///< min_b Phi(d(b) / sigma(b)): an upper bound of the covering fraction
   bool covered = false;            ///< robust_margin_mm >= 0
   std::array<double, kToleranceParameters> gradient{};  ///< g(b) there (mm per mm, mm per rad)
@@ -207,6 +286,11 @@ struct RobustCoverage {
   std::size_t samples_covering = 0;
   double fraction_monte_carlo = 0.0;
   double quantile_margin_mm = 0.0;  ///< the (1 - fraction) quantile of the sampled margins
+  /// One-sided lower bound of that quantile at quantile_confidence (order statistic, binomial;
+  /// quantile_lower_bound_rank()); -inf stands for "too few samples" (then quantile_lower_rank = 0).
+  double quantile_lower_mm = 0.0;
+  double quantile_confidence = 0.95;
+  std::size_t quantile_lower_rank = 0;
   double monte_carlo_stderr = 0.0;  ///< binomial standard error of fraction_monte_carlo
 };
 /// Robust coverage of `target` by `m` under `sigma` for a `fraction` of printed devices, with a
@@ -248,6 +332,7 @@ struct ToleranceMap {
   std::vector<double> field_worst_case_mm;
   std::vector<double> field_resolution_um;     ///< tactor step of one count on the worse joint
   std::vector<double> field_play_mm;           ///< play set extent
+  std::vector<std::uint8_t> field_near_singular;  ///< 1 where the first order is flagged (near_singular)
   // Over the filled target (a 21 x 21 grid of its bounding box, points inside):
   ToleranceEstimate centre;
   MonteCarloTolerance centre_monte_carlo;
@@ -258,6 +343,17 @@ struct ToleranceMap {
   Vec2 worst_3sigma_at{0.0, 0.0}, worst_case_at{0.0, 0.0}, worst_resolution_at{0.0, 0.0}, worst_play_at{0.0, 0.0};
   std::vector<Vec2> target_points_mm;                  ///< the target grid's points
   std::vector<ToleranceEstimate> target_estimates;     ///< first order at each of them
+  /// The target points where the first order is flagged (near_singular), with the Monte Carlo
+  /// (the design's samples and seed) and the nonlinear corners there: the figures to believe.
+  struct Flagged {
+    Vec2 at{0.0, 0.0};
+    ToleranceEstimate first_order;
+    MonteCarloTolerance monte_carlo;
+    double monte_carlo_3sigma_mm = 0.0;
+    CornerEnumeration corners;
+  };
+  std::vector<Flagged> near_singular;
+  bool worst_3sigma_flagged = false, worst_case_flagged = false;  ///< the reported worst point is flagged
   RobustCoverage robust;
 };
 /// The map of one mechanism with `spacing_mm` (> 0; the grid is capped at 1000 x 1000 points).
@@ -278,7 +374,7 @@ Json to_json(const ToleranceMap& map);
 RenderedPlot plot_tolerance(const Station& station, const std::vector<ToleranceMap>& maps);
 
 /// The files of a station's maps, name and bytes: `<station>-<mechanism>-tolerance.vti` per map
-/// (ParaView: three_sigma_mm, worst_case_mm, resolution_um, play_mm, status) and
+/// (ParaView: three_sigma_mm, worst_case_mm, resolution_um, play_mm, near_singular, status) and
 /// `<station>-tolerance.svg`, `.png`.
 std::vector<std::pair<std::string, std::string>> tolerance_files(const Station& station,
                                                                  const std::vector<ToleranceMap>& maps);

@@ -45,6 +45,7 @@ Product animate_product() {
   p.name = "animate";
   p.title = "Animated patterns";
   p.prerequisites = {"pattern"};
+  p.after = {"simulate"};  // its simulated tracks, when the scene simulates
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<PatternSettings>()) return "the design has no `patterns:` section";
     return without_pairs(d, "the patterns are checked with the link outlines");

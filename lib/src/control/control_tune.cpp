@@ -4,10 +4,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
+#include <optional>
 #include <cmath>
 #include <cstdio>
+#include <atomic>
 #include <limits>
+#include <mutex>
 #include <numbers>
+#include <thread>
 
 #include <Eigen/Dense>
 
@@ -64,6 +69,84 @@ Tracking track(const std::vector<SimulationInput>& runs, const std::array<PidGai
   return t;
 }
 
+/// The figures of the linear loop over the constraint's grid that the constraints read.
+struct Linear {
+  double rho = 0.0;           ///< max spectral radius
+  double damping = 1.0;       ///< least oscillatory damping ratio
+  double damping_hz = 0.0;
+  double rho_kp = 0.0, rho_kd = 0.0;  ///< max rho with kp (kd) times the margin floor
+};
+
+Linear linear_figures(const std::vector<PoseLoop>& poses, const std::array<PidGains, 2>& gains, bool delay,
+                      double margin) {
+  Linear l;
+  for (const PoseLoop& p : poses) {
+    if (p.status != Status::ok) continue;
+    const LoopPoles poles = loop_poles(closed_loop(p.plant, gains, delay), p.plant.period_s);
+    l.rho = std::max(l.rho, poles.rho);
+    if (poles.oscillatory_damping < l.damping) {
+      l.damping = poles.oscillatory_damping;
+      l.damping_hz = poles.oscillatory_frequency_hz;
+    }
+  }
+  std::array<PidGains, 2> g = gains;
+  for (PidGains& x : g) x.kp *= margin;
+  l.rho_kp = max_spectral_radius(poses, g, delay, 1.0);
+  g = gains;
+  for (PidGains& x : g) x.kd *= margin;
+  l.rho_kd = max_spectral_radius(poses, g, delay, 1.0);
+  return l;
+}
+
+/// Largest overshoot (mm) of the tactor past the step's final reference, along the step (+x).
+double step_overshoot(SimulationInput step, const std::array<PidGains, 2>& gains, double rtol) {
+  step.mechanisms[0].control[0].pid = gains[0];
+  step.mechanisms[0].control[1].pid = gains[1];
+  SimulationOptions o;
+  o.rtol = rtol;
+  o.max_wall_s = 10.0;
+  const SimulationResult r = simulate(step, o);
+  if (!r.ok() || r.samples.empty()) return std::numeric_limits<double>::infinity();
+  const double end = r.samples.back().mechanisms[0].P_ref_mm.x();
+  double over = 0.0;
+  for (const TimeSample& t : r.samples) over = std::max(over, t.mechanisms[0].P_mm.x() - end);
+  return over;
+}
+
+/// The chirp with these gains: -3 dB bandwidth, saturation onset (instantaneous frequency of the
+/// first sample with a duty at its limit; inf when none), and the smaller, as TunedMechanism says.
+struct ChirpFigures {
+  double bandwidth_hz = 0.0, saturation_hz = std::numeric_limits<double>::infinity(), reported_hz = 0.0;
+};
+ChirpFigures chirp_figures(SimulationInput chirp, const SimulationRequest& request, const std::array<PidGains, 2>& gains,
+                           double rtol) {
+  ChirpFigures c;
+  chirp.mechanisms[0].control[0].pid = gains[0];
+  chirp.mechanisms[0].control[1].pid = gains[1];
+  SimulationOptions o;
+  o.rtol = rtol;
+  o.max_wall_s = 20.0;
+  const SimulationResult r = simulate(chirp, o);
+  const double rate = chirp.controller.loop_rate_hz;
+  const double f0 = request.chirp_f0_hz, f1 = request.chirp_f1_hz > 0.0 ? request.chirp_f1_hz : 0.25 * rate;
+  const double D = request.chirp_duration_s;
+  if (!r.ok() || r.samples.empty()) {
+    c.saturation_hz = 0.0;
+    return c;
+  }
+  const BodeResult bode = chirp_bode(chirp, r, request);
+  c.bandwidth_hz = !bode.bandwidth_hz.empty() && bode.bandwidth_hz[0] ? *bode.bandwidth_hz[0] : f1;
+  for (const TimeSample& t : r.samples) {
+    const auto& d = t.mechanisms[0].duty;
+    if (std::max(std::abs(d[0]), std::abs(d[1])) >= 1.0 - 1e-12) {
+      c.saturation_hz = f0 * std::pow(f1 / f0, std::min(t.t, D) / D);
+      break;
+    }
+  }
+  c.reported_hz = std::min(c.bandwidth_hz, c.saturation_hz);
+  return c;
+}
+
 /// Gains from the unknowns: (ln kp, ln ki, ln kd) for both joints, or per joint (six).
 std::array<PidGains, 2> with(const std::array<PidGains, 2>& base, const std::vector<double>& x) {
   std::array<PidGains, 2> g = base;
@@ -82,20 +165,35 @@ constexpr double kFailedRunMm = 1e3;   // a run that did not finish
 constexpr double kRange = 5.0;         // ln of the factor each gain may move by: e^5 ~ 148
 constexpr double kRhoSafety = 0.003;   // COBYLA ends within its tolerance of the constraint: aim inside
 
+constexpr double kDampingSafety = 0.005;  // as kRhoSafety, for the damping floor
+
 struct Problem {
   const std::vector<SimulationInput>* runs;
   const std::vector<PoseLoop>* poses;
+  const SimulationInput* step;  ///< the 1 mm step of this mechanism (nullptr: none)
   std::array<PidGains, 2> base;
   double rho_limit, saturation_limit, rtol;
   bool delay;
+  double min_damping, margin, max_overshoot_mm;
   int evaluations = 0;
-  const TuneOptions* options;
+  std::function<void(std::string_view)> progress;
   std::string label;
   // The best evaluated point that meets the constraints, and its tracking.
   std::vector<double> best_x;
   double best_value = std::numeric_limits<double>::infinity();
-  Tracking best_tracking;
-  Clock::time_point deadline;
+  // The linear figures of the last point asked (NLopt asks the objective and each constraint at
+  // the same point in turn).
+  std::vector<double> last_x;
+  Linear last;
+  const Linear& at(const double* x, unsigned n) {
+    if (last_x.size() != n || !std::equal(last_x.begin(), last_x.end(), x)) {
+      last_x.assign(x, x + n);
+      last = linear_figures(*poses, with(base, last_x), delay, margin);
+    }
+    return last;
+  }
+  Clock::time_point deadline;  ///< the tuning's wall-time bound, checked inside every evaluation
+  Tracking best_tracking;      ///< the tracking of best_x, reused rather than simulated again
 };
 
 double objective(unsigned n, const double* x, double*, void* data) {
@@ -104,30 +202,51 @@ double objective(unsigned n, const double* x, double*, void* data) {
   const std::array<PidGains, 2> g = with(p.base, std::vector<double>(x, x + n));
   ++p.evaluations;
   // An unstable loop is not simulated: its error is that of a failed run.
-  const double rho = max_spectral_radius(*p.poses, g, p.delay, 1.0);
+  const Linear& l = p.at(x, n);
   double value = kFailedRunMm;
-  if (rho < 1.0) {
+  double overshoot = 0.0;
+  if (l.rho < 1.0) {
     const Tracking t = track(*p.runs, g, p.rtol, p.deadline);
     if (t.out_of_time) throw nlopt::forced_stop();  // abandoned: not a measurement
     if (t.ok) value = t.error_mm + kSaturationPenaltyMm * std::max(0.0, t.saturation - p.saturation_limit);
-    if (t.ok && rho <= p.rho_limit && t.saturation <= p.saturation_limit && value < p.best_value) {
-      p.best_value = value;
-      p.best_x.assign(x, x + n);
-      p.best_tracking = t;
+    const bool linear_ok = l.rho <= p.rho_limit && l.damping >= p.min_damping && l.rho_kp < 1.0 && l.rho_kd < 1.0;
+    // The large step (duty saturation, integral clamp) where the linear constraints hold: its
+    // overshoot beyond the bound is penalised like saturation (wind-up steers the search away).
+    if (t.ok && linear_ok) {
+      overshoot = p.step ? step_overshoot(*p.step, g, p.rtol) : 0.0;
+      value += kSaturationPenaltyMm * std::max(0.0, overshoot - p.max_overshoot_mm);
+      if (t.saturation <= p.saturation_limit && overshoot <= p.max_overshoot_mm && value < p.best_value) {
+        p.best_value = value;
+        p.best_x.assign(x, x + n);
+        p.best_tracking = t;
+      }
     }
   }
-  if (p.options->progress) {
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "%s: evaluation %d, kp %.4g ki %.4g kd %.4g: max rho %.4f, objective %.4f mm",
-                  p.label.c_str(), p.evaluations, g[0].kp, g[0].ki, g[0].kd, rho, value);
-    p.options->progress(buf);
+  if (p.progress) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "%s: evaluation %d, kp %.4g ki %.4g kd %.4g: max rho %.4f, least zeta %.3f, objective %.4f mm",
+                  p.label.c_str(), p.evaluations, g[0].kp, g[0].ki, g[0].kd, l.rho, l.damping, value);
+    p.progress(buf);
   }
   return value;
 }
 
-double constraint(unsigned n, const double* x, double*, void* data) {
+double rho_constraint(unsigned n, const double* x, double*, void* data) {
   auto& p = *static_cast<Problem*>(data);
-  return max_spectral_radius(*p.poses, with(p.base, std::vector<double>(x, x + n)), p.delay) - (p.rho_limit - kRhoSafety);
+  return p.at(x, n).rho - (p.rho_limit - kRhoSafety);
+}
+double damping_constraint(unsigned n, const double* x, double*, void* data) {
+  auto& p = *static_cast<Problem*>(data);
+  return (p.min_damping + kDampingSafety) - p.at(x, n).damping;
+}
+double kp_margin_constraint(unsigned n, const double* x, double*, void* data) {
+  auto& p = *static_cast<Problem*>(data);
+  return p.at(x, n).rho_kp - (1.0 - kRhoSafety);
+}
+double kd_margin_constraint(unsigned n, const double* x, double*, void* data) {
+  auto& p = *static_cast<Problem*>(data);
+  return p.at(x, n).rho_kd - (1.0 - kRhoSafety);
 }
 
 std::string stop_text(nlopt::result r) {
@@ -229,6 +348,25 @@ PolePlacement pole_placement(const LoopModel& loop, const Vec2& centre_mm, const
   return out;
 }
 
+namespace {
+
+/// pole_placement_gains() of the plant at the target's centre for a given omega (as pole_placement()).
+std::optional<std::array<PidGains, 2>> pole_placement_at(const LoopModel& loop, const Vec2& centre_mm, double omega,
+                                                         bool per_joint, const std::array<PidGains, 2>& base) {
+  const AnglesResult a = ik_angles(loop.model.mechanism, centre_mm);
+  if (a.status != Status::ok) return std::nullopt;
+  MechanismModel model = loop.model;
+  if (model.branch == AssemblyMode::Any) {
+    const Pose p = fk(model.mechanism, a.theta1, a.theta2);
+    if (p.assembly != 0) model.branch = p.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  }
+  const LinearPlant plant = linear_plant(model, Eigen::Vector2d(a.theta1, a.theta2), loop.contact ? &loop.skin : nullptr);
+  if (plant.status != Status::ok) return std::nullopt;
+  return pole_placement_gains(plant, model.motors, omega, per_joint, base);
+}
+
+}  // namespace
+
 TuneOptions tune_options(const ControllerSettings& c) {
   TuneOptions o;
   const TuneSettings t = c.tune.value_or(TuneSettings{});
@@ -237,6 +375,8 @@ TuneOptions tune_options(const ControllerSettings& c) {
   o.max_seconds = t.max_seconds;
   o.per_joint = t.per_joint;
   o.start = t.start == "hand_set" ? TuneStart::hand_set : TuneStart::pole_placement;
+  o.min_damping = t.min_damping;
+  o.min_gain_margin = t.min_gain_margin;
   return o;
 }
 
@@ -261,13 +401,21 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
   const double saturation_limit = ctl.max_saturation_fraction;
   TuneResult result;
   result.rho_limit = options.rho_limit;
+  result.min_damping = options.min_damping;
+  result.min_gain_margin = options.min_gain_margin;
+  const double zeta = options.min_damping;
+  result.max_overshoot_fraction = zeta > 0.0 ? std::exp(-std::numbers::pi * zeta / std::sqrt(1.0 - zeta * zeta)) : 1.0;
   // Every mechanism's pattern runs and constraint poses first (InputError before any work).
   struct Job {
     const Station* station;
     LoopModel loop;
     std::vector<SimulationInput> runs;
     std::vector<PoseLoop> poses;
+    std::optional<SimulationInput> step, chirp;
   };
+  SimulationRequest step_request, chirp_request;
+  step_request.step = true;
+  chirp_request.chirp = true;
   std::vector<Job> jobs;
   for (const Station* s : stations) {
     const auto it = inertia.find(s->name);
@@ -275,21 +423,65 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     SimulationRequest request;
     request.station = s->name;
     const std::vector<SimulationInput> all = simulation_inputs(d, request, it->second);
+    step_request.station = chirp_request.station = s->name;
+    const std::vector<SimulationInput> steps = simulation_inputs(d, step_request, it->second);
+    std::vector<SimulationInput> chirps;
+    if (options.chirp) {
+      try {
+        chirps = simulation_inputs(d, chirp_request, it->second);
+      } catch (const InputError&) {
+        // A chirp that leaves the workspace: no chirp figures (reported as such), the tuning stands.
+      }
+    }
     std::size_t k = 0;
     for (const LoopModel& loop : loop_models(d, *s, it->second)) {
-      Job job{s, loop, {}, {}};
+      Job job{s, loop, {}, {}, {}, {}};
       for (const SimulationInput& in : all) {
         if (!in.unusable.empty()) throw InputError("tune: station " + s->name + " " + in.reference_name + ": " + in.unusable);
         SimulationInput one = in;
         one.mechanisms = {in.mechanisms[k]};
         job.runs.push_back(std::move(one));
       }
+      for (const std::vector<SimulationInput>* source : {&steps, static_cast<const std::vector<SimulationInput>*>(&chirps)}) {
+        if (source->empty() || !source->front().unusable.empty()) continue;
+        SimulationInput one = source->front();
+        one.mechanisms = {one.mechanisms[k]};
+        (source == &steps ? job.step : job.chirp) = std::move(one);
+      }
       for (const Vec2& P : ellipse_lattice(s->target, options.grid)) job.poses.push_back(pose_loop(loop, P));
       jobs.push_back(std::move(job));
       ++k;
     }
   }
-  for (std::size_t j = 0; j < jobs.size(); ++j) {
+  std::mutex say;
+  const auto progress = [&](std::string_view line) {
+    if (!options.progress) return;
+    const std::lock_guard<std::mutex> lock(say);
+    options.progress(line);
+  };
+  const auto figures_of = [&](const Job& job, const std::array<PidGains, 2>& g, TunedMechanism& t, bool after) {
+    StabilityOptions so;
+    LoopModel loop = job.loop;
+    loop.gains = g;
+    // The margins over the constraint's grid, bisected as the stability map does.
+    std::vector<Vec2> points;
+    for (const PoseLoop& p : job.poses) points.push_back(p.P_mm);
+    const StabilityMap map = stability_map(loop, points, so);
+    const Linear l = linear_figures(job.poses, g, job.loop.delay, options.min_gain_margin);
+    const double over = job.step ? step_overshoot(*job.step, g, options.rtol) : 0.0;
+    ChirpFigures c{0.0, 0.0, 0.0};
+    if (job.chirp) c = chirp_figures(*job.chirp, chirp_request, g, options.rtol);
+    (after ? t.damping_after : t.damping_before) = l.damping;
+    (after ? t.damping_hz_after : t.damping_hz_before) = l.damping_hz;
+    (after ? t.kp_margin_after : t.kp_margin_before) = map.kp_margin;
+    (after ? t.kd_margin_after : t.kd_margin_before) = map.kd_margin;
+    (after ? t.overshoot_after_mm : t.overshoot_before_mm) = over;
+    (after ? t.chirp_bandwidth_after_hz : t.chirp_bandwidth_before_hz) = c.bandwidth_hz;
+    (after ? t.chirp_saturation_after_hz : t.chirp_saturation_before_hz) = c.saturation_hz;
+    (after ? t.bandwidth_after_hz : t.bandwidth_before_hz) = c.reported_hz;
+  };
+  std::vector<TunedMechanism> tuned(jobs.size());
+  const auto tune_one = [&](std::size_t j) {
     Job& job = jobs[j];
     TunedMechanism t;
     t.station = job.station->name;
@@ -301,8 +493,10 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     t.error_before_mm = tb.ok ? tb.error_mm : std::numeric_limits<double>::infinity();
     t.saturation_before = tb.saturation;
 
-    Problem p{&job.runs, &job.poses, t.before, options.rho_limit, saturation_limit, options.rtol, job.loop.delay, 0,
-              &options, t.station + "/" + t.mechanism, {}, std::numeric_limits<double>::infinity(), {}, deadline};
+    Problem p{&job.runs, &job.poses, job.step ? &*job.step : nullptr, t.before, options.rho_limit, saturation_limit,
+              options.rtol, job.loop.delay, options.min_damping, options.min_gain_margin,
+              result.max_overshoot_fraction * step_request.step_mm, 0, progress, t.station + "/" + t.mechanism, {},
+              std::numeric_limits<double>::infinity(), {}, {}, deadline};
     t.start = t.before;
     if (options.start == TuneStart::pole_placement) {
       const PolePlacement pp = pole_placement(job.loop, job.station->target.center, job.poses, options.per_joint, t.before);
@@ -311,11 +505,34 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
         t.start_omega_rad_s = pp.omega_rad_s;
       }
     }
-    t.rho_start = max_spectral_radius(job.poses, t.start, job.loop.delay);
-    if (options.progress) {
-      options.progress(p.label + ": start kp " + format::shortest(t.start[0].kp) + " ki " + format::shortest(t.start[0].ki) +
-                       " kd " + format::shortest(t.start[0].kd) + ", max rho " + format::shortest(t.rho_start));
+    if (options.start == TuneStart::pole_placement && t.start_omega_rad_s > 0.0) {
+      // The least-rho omega may break the damping or margin floors (a fast placement meets the
+      // period of delay): among placements from omega* / 0.85^4 down to omega* 0.85^8, the first
+      // that meets the linear floors, else the one that misses them least.
+      const auto violation = [&](const std::array<PidGains, 2>& g) {
+        const Linear l = linear_figures(job.poses, g, job.loop.delay, options.min_gain_margin);
+        return std::max(0.0, l.rho - options.rho_limit) + std::max(0.0, options.min_damping + kDampingSafety - l.damping) +
+               std::max(0.0, l.rho_kp - (1.0 - kRhoSafety)) + std::max(0.0, l.rho_kd - (1.0 - kRhoSafety));
+      };
+      const double omega0 = t.start_omega_rad_s;
+      double best_violation = violation(t.start);
+      for (int k = -4; k <= 8 && best_violation > 0.0; ++k) {
+        if (k == 0) continue;
+        const double omega = omega0 * std::pow(0.85, k);
+        const std::optional<std::array<PidGains, 2>> g =
+            pole_placement_at(job.loop, job.station->target.center, omega, options.per_joint, t.before);
+        if (!g) continue;
+        const double v = violation(*g);
+        if (v < best_violation) {
+          best_violation = v;
+          t.start = *g;
+          t.start_omega_rad_s = omega;
+        }
+      }
     }
+    t.rho_start = max_spectral_radius(job.poses, t.start, job.loop.delay);
+    progress(p.label + ": start kp " + format::shortest(t.start[0].kp) + " ki " + format::shortest(t.start[0].ki) + " kd " +
+             format::shortest(t.start[0].kd) + ", max rho " + format::shortest(t.rho_start));
     const std::size_t unknowns = options.per_joint ? 6 : 3;
     std::vector<double> x(unknowns);
     for (std::size_t i = 0; i < unknowns; ++i) {
@@ -331,16 +548,18 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     opt.set_lower_bounds(lo);
     opt.set_upper_bounds(hi);
     opt.set_min_objective(objective, &p);
-    opt.add_inequality_constraint(constraint, &p, 1e-4);
+    opt.add_inequality_constraint(rho_constraint, &p, 1e-4);
+    opt.add_inequality_constraint(damping_constraint, &p, 1e-4);
+    opt.add_inequality_constraint(kp_margin_constraint, &p, 1e-4);
+    opt.add_inequality_constraint(kd_margin_constraint, &p, 1e-4);
     opt.set_initial_step(std::log(2.0));
     opt.set_xtol_rel(1e-3);
     opt.set_maxeval(options.max_evaluations);
     const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
-    // What is left of the bound, less a second for each mechanism still to come: a loaded machine
-    // slows one mechanism without cutting the next ones' evaluations short. The bound itself is
-    // checked inside the evaluations (Problem::deadline): no floor here.
-    const double share = left - 1.0 * double(jobs.size() - j - 1);
-    opt.set_maxtime(std::max(std::min(left, 0.5), share));
+    // The mechanisms run side by side: each may take what is left of the bound, less a second for
+    // its before/after figures. The bound itself is checked inside the evaluations
+    // (Problem::deadline).
+    opt.set_maxtime(std::max(std::min(left, 0.5), left - 1.0));
     double best = 0.0;
     nlopt::result r = nlopt::MAXTIME_REACHED;
     if (left > 0.0 && !tb.out_of_time) {
@@ -362,9 +581,36 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     const Tracking ta = found ? p.best_tracking : track(job.runs, t.after, options.rtol, deadline);
     t.error_after_mm = ta.ok ? ta.error_mm : std::numeric_limits<double>::infinity();
     t.saturation_after = ta.saturation;
-    t.feasible = ta.ok && t.rho_after <= options.rho_limit && t.saturation_after <= saturation_limit;
-    result.mechanisms.push_back(t);
-  }
+    figures_of(job, t.before, t, false);
+    figures_of(job, t.after, t, true);
+    t.feasible = ta.ok && t.rho_after <= options.rho_limit && t.saturation_after <= saturation_limit &&
+                 t.damping_after >= options.min_damping && t.kp_margin_after >= options.min_gain_margin &&
+                 t.kd_margin_after >= options.min_gain_margin &&
+                 t.overshoot_after_mm <= result.max_overshoot_fraction * step_request.step_mm;
+    tuned[j] = std::move(t);
+  };
+  // One worker per core (or options.threads), each taking the next mechanism.
+  const unsigned threads = std::max(1u, std::min<unsigned>(options.threads ? options.threads : std::thread::hardware_concurrency(),
+                                                          static_cast<unsigned>(jobs.size())));
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_lock;
+  const auto worker = [&] {
+    for (std::size_t j = next++; j < jobs.size(); j = next++) {
+      try {
+        tune_one(j);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_lock);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned k = 1; k < threads; ++k) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+  result.mechanisms = std::move(tuned);
   result.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
   return result;
 }
@@ -373,8 +619,9 @@ std::string tuned_patch_yaml(const TuneResult& result) {
   std::string out =
       "# Tuned by fivebar (control --tune, or the control product of run): per mechanism the PID minimising\n"
       "# the worst simulated tracking error over the station's patterns with the loop's spectral radius <= " +
-      format::shortest(result.rho_limit) +
-      "\n# over the target. Merge into the design's controller: section.\n"
+      format::shortest(result.rho_limit) + "\n# over the target, every oscillatory pole damped at zeta >= " +
+      format::shortest(result.min_damping) + ", kp and kd margins >= x" + format::shortest(result.min_gain_margin) +
+      " and the 1 mm step's\n# overshoot within its bound. Merge into the design's controller: section.\n"
       "controller:\n  stations:\n";
   std::string station;
   for (const TunedMechanism& t : result.mechanisms) {
@@ -394,6 +641,11 @@ std::string tuned_patch_yaml(const TuneResult& result) {
   return out;
 }
 
+namespace {
+/// inf (no saturation in the chirp, a step that did not finish) is written as null.
+Json finite_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+}  // namespace
+
 Json to_json(const TuneResult& result) {
   Json mechs = Json::array();
   for (const TunedMechanism& t : result.mechanisms) {
@@ -403,15 +655,32 @@ Json to_json(const TuneResult& result) {
                      {"start", {{"gains", gains(t.start[0])}, {"gains_theta2", gains(t.start[1])},
                                 {"omega_rad_s", t.start_omega_rad_s}, {"max_rho", t.rho_start}}},
                      {"before", {{"gains", gains(t.before[0])}, {"gains_theta2", gains(t.before[1])}, {"max_rho", t.rho_before},
-                                 {"max_tracking_error_mm", t.error_before_mm}, {"saturation_fraction", t.saturation_before}}},
+                                 {"max_tracking_error_mm", t.error_before_mm}, {"saturation_fraction", t.saturation_before},
+                                 {"min_damping", t.damping_before}, {"min_damping_hz", t.damping_hz_before},
+                                 {"kp_margin", t.kp_margin_before}, {"kd_margin", t.kd_margin_before},
+                                 {"step_overshoot_mm", finite_or_null(t.overshoot_before_mm)},
+                                 {"chirp_bandwidth_hz", t.chirp_bandwidth_before_hz},
+                                 {"chirp_saturation_hz", finite_or_null(t.chirp_saturation_before_hz)},
+                                 {"bandwidth_hz", t.bandwidth_before_hz}}},
                      {"after", {{"gains", gains(t.after[0])}, {"gains_theta2", gains(t.after[1])}, {"max_rho", t.rho_after},
-                                {"max_tracking_error_mm", t.error_after_mm}, {"saturation_fraction", t.saturation_after}}},
+                                {"max_tracking_error_mm", t.error_after_mm}, {"saturation_fraction", t.saturation_after},
+                                {"min_damping", t.damping_after}, {"min_damping_hz", t.damping_hz_after},
+                                {"kp_margin", t.kp_margin_after}, {"kd_margin", t.kd_margin_after},
+                                {"step_overshoot_mm", finite_or_null(t.overshoot_after_mm)},
+                                {"chirp_bandwidth_hz", t.chirp_bandwidth_after_hz},
+                                {"chirp_saturation_hz", finite_or_null(t.chirp_saturation_after_hz)},
+                                {"bandwidth_hz", t.bandwidth_after_hz}}},
                      {"design", {{"gains", gains(t.design[0])}, {"gains_theta2", gains(t.design[1])}, {"applied", t.applied()}}},
                      {"evaluations", t.evaluations},
                      {"feasible", t.feasible},
                      {"stop", t.stop}});
   }
-  return {{"rho_limit", result.rho_limit}, {"wall_s", result.wall_s}, {"mechanisms", mechs}};
+  return {{"rho_limit", result.rho_limit},
+          {"min_damping", result.min_damping},
+          {"min_gain_margin", result.min_gain_margin},
+          {"max_step_overshoot_fraction", result.max_overshoot_fraction},
+          {"wall_s", result.wall_s},
+          {"mechanisms", mechs}};
 }
 
 std::string tuning_csv(const TuneResult& result) {
@@ -419,13 +688,21 @@ std::string tuning_csv(const TuneResult& result) {
   std::string csv =
       "station,mechanism,kp_before,ki_before,kd_before,kp_after,ki_after,kd_after,max_rho_before,max_rho_after,"
       "max_tracking_error_before_mm,max_tracking_error_after_mm,saturation_before,saturation_after,evaluations,"
-      "feasible,applied,stop\n";
+      "feasible,applied,stop,min_damping_before,min_damping_after,kp_margin_before,kp_margin_after,kd_margin_before,"
+      "kd_margin_after,step_overshoot_before_mm,step_overshoot_after_mm,chirp_bandwidth_before_hz,"
+      "chirp_bandwidth_after_hz,chirp_saturation_before_hz,chirp_saturation_after_hz,bandwidth_before_hz,"
+      "bandwidth_after_hz\n";
   for (const TunedMechanism& t : result.mechanisms) {
     csv += t.station + "," + t.mechanism + "," + num(t.before[0].kp) + "," + num(t.before[0].ki) + "," +
            num(t.before[0].kd) + "," + num(t.after[0].kp) + "," + num(t.after[0].ki) + "," + num(t.after[0].kd) + "," +
            num(t.rho_before) + "," + num(t.rho_after) + "," + num(t.error_before_mm) + "," + num(t.error_after_mm) +
            "," + num(t.saturation_before) + "," + num(t.saturation_after) + "," + std::to_string(t.evaluations) + "," +
-           (t.feasible ? "true" : "false") + "," + (t.applied() ? "true" : "false") + "," + t.stop + "\n";
+           (t.feasible ? "true" : "false") + "," + (t.applied() ? "true" : "false") + "," + t.stop + "," +
+           num(t.damping_before) + "," + num(t.damping_after) + "," + num(t.kp_margin_before) + "," +
+           num(t.kp_margin_after) + "," + num(t.kd_margin_before) + "," + num(t.kd_margin_after) + "," +
+           num(t.overshoot_before_mm) + "," + num(t.overshoot_after_mm) + "," + num(t.chirp_bandwidth_before_hz) + "," +
+           num(t.chirp_bandwidth_after_hz) + "," + num(t.chirp_saturation_before_hz) + "," +
+           num(t.chirp_saturation_after_hz) + "," + num(t.bandwidth_before_hz) + "," + num(t.bandwidth_after_hz) + "\n";
   }
   return csv;
 }

@@ -43,9 +43,14 @@ constexpr const char* kTuning =
     "`controller.tune` asks for the gains to be tuned, per mechanism (lib/include/fivebar/control.hpp "
     "\"Tuning\"): a pole placement on the loop linearised at the target's centre (the three roots of each "
     "joint's PID loop at −ω, ω chosen for the least spectral radius over the target) is refined by NLopt's "
-    "COBYLA to the least worst simulated tracking error over the station's patterns, with the spectral radius "
-    "at most the limit over the target (the export gate's grid) and no sustained saturation; masses from the "
-    "closed form, as the export gate. \"Before\" is the hand-set PID (the file's gains without the "
+    "COBYLA to the least worst simulated tracking error over the station's patterns, with the constraints an "
+    "engineer sets over the target (the export gate's grid): spectral radius at most the limit, every oscillatory "
+    "pole damped at least `controller.tune.min_damping` (ζ), kp and kd each multipliable by "
+    "`controller.tune.min_gain_margin` without losing stability, the simulated 1 mm step (duty saturation and "
+    "integral clamp included) overshooting no more than a second-order loop at that ζ, and no sustained "
+    "saturation; masses from the closed form, as the export gate. The chirp (0.2 mm, 0.5 Hz to a quarter of the "
+    "loop rate) gives the −3 dB bandwidth and the frequency at which a motor's duty first saturates; the "
+    "bandwidth reported is the smaller. \"Before\" is the hand-set PID (the file's gains without the "
     "per-station-mechanism scopes a tuning patch writes); `control/tuned-controller.yaml` is the patch of "
     "`controller:` that applies the tuned gains, `control/tuning.csv` the table.\n\n";
 
@@ -175,9 +180,31 @@ Product control_product() {
                    (m.feasible ? "" : ", **not feasible**"),
                m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design) + ")"});
       }
+      md::Table f({"station", "mechanism", "least ζ (Hz) before → after", "kp margin before → after",
+                   "kd margin before → after", "1 mm step overshoot (mm) before → after",
+                   "chirp −3 dB / saturates at (Hz) before → after", "bandwidth (Hz) before → after",
+                   "tracking error (mm) before → after"},
+                  "llrrrrrrr");
+      const auto onset = [](double hz) { return std::isfinite(hz) ? md::fixed(hz, 1) : std::string("never"); };
+      const auto chirp = [&](double bw, double sat) { return md::fixed(bw, 1) + " / " + onset(sat); };
+      for (const TunedMechanism& m : tuned.mechanisms) {
+        f.row({m.station, m.mechanism,
+               md::fixed(m.damping_before, 3) + " (" + md::fixed(m.damping_hz_before, 1) + ") → " +
+                   md::fixed(m.damping_after, 3) + " (" + md::fixed(m.damping_hz_after, 1) + ")",
+               "×" + md::fixed(m.kp_margin_before, 2) + " → ×" + md::fixed(m.kp_margin_after, 2),
+               "×" + md::fixed(m.kd_margin_before, 2) + " → ×" + md::fixed(m.kd_margin_after, 2),
+               md::fixed(m.overshoot_before_mm, 3) + " → " + md::fixed(m.overshoot_after_mm, 3),
+               chirp(m.chirp_bandwidth_before_hz, m.chirp_saturation_before_hz) + " → " +
+                   chirp(m.chirp_bandwidth_after_hz, m.chirp_saturation_after_hz),
+               md::fixed(m.bandwidth_before_hz, 1) + " → " + md::fixed(m.bandwidth_after_hz, 1),
+               md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3)});
+      }
       b.result["tuning"] = to_json(tuned);
-      b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nTuned in " + md::fixed(tuned.wall_s, 1) +
-                    " s, max ρ ≤ " + md::fixed(tuned.rho_limit, 2) + " over the target." +
+      b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nThe engineer's figures, hand-set → tuned " +
+                    "(floors: ζ ≥ " + md::fixed(tuned.min_damping, 2) + ", margins ≥ ×" +
+                    md::fixed(tuned.min_gain_margin, 2) + ", step overshoot ≤ " +
+                    md::fixed(tuned.max_overshoot_fraction, 3) + " mm):\n\n" + f.str() + "\nTuned in " +
+                    md::fixed(tuned.wall_s, 1) + " s, max ρ ≤ " + md::fixed(tuned.rho_limit, 2) + " over the target." +
                     (applied ? " The design runs the tuned gains.\n"
                              : " The design does not run the tuned gains everywhere: merge "
                                "`control/tuned-controller.yaml` into its `controller:` section.\n");

@@ -75,6 +75,7 @@ Product coverage_product() {
   p.checks_designs = true;  // re-run on a proposed design (check_design())
   p.title = "Target coverage";
   p.unavailable = without_mechanisms;
+  p.after = {"workspace"};  // links to the workspace pictures, when built
   p.build = [](Context& ctx) {
     Built b;
     Json stations = Json::array();

@@ -41,6 +41,7 @@ Product export_product() {
     if (!d.get<ControllerSettings>()) return "the design has no `controller:` section";
     return std::nullopt;
   };
+  p.after = {"parts"};  // the URDF's masses and meshes from the parts' renders, when built
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
     ExportOptions options;

@@ -55,6 +55,10 @@ struct Product {
   std::string name;                   ///< as in known_products()
   std::string title;                  ///< section heading in summary.md
   std::vector<std::string> prerequisites;  ///< products that must be built first
+  /// Products whose results (or files) this one uses when the scene builds them too, without
+  /// needing them: it then waits for them (the scene runs independent products in parallel, and
+  /// what a product reads must not depend on the timing).
+  std::vector<std::string> after;
   /// Why this design cannot have the product (missing section, no mechanism, tool not
   /// installed), or std::nullopt when it can.
   std::function<std::optional<std::string>(const Design&)> unavailable;

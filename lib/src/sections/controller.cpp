@@ -125,6 +125,12 @@ void TuneSettings::validate() const {
   if (!(max_seconds > 0.0) || !(max_seconds <= 3600.0)) {
     throw ValidationError("max_seconds", "= " + plain_number(max_seconds) + " s: must be > 0 and <= 3600 s");
   }
+  if (!(min_damping >= 0.0) || !(min_damping < 1.0)) {
+    throw ValidationError("min_damping", "= " + plain_number(min_damping) + ": must be in [0, 1) (a damping ratio)");
+  }
+  if (!(min_gain_margin >= 1.0) || !(min_gain_margin <= 100.0)) {
+    throw ValidationError("min_gain_margin", "= " + plain_number(min_gain_margin) + ": must be in [1, 100] (a factor on the gains)");
+  }
   if (start != "pole_placement" && start != "hand_set") {
     throw ValidationError("start", "= " + detail::quoted(start) + ": must be pole_placement or hand_set");
   }
@@ -296,8 +302,11 @@ void load(const Value& v, Design& design) {
   if (const Value* t = find(all, "tune")) {
     TuneSettings& tune = c.tune.emplace();
     if (!t->is_null()) {  // `tune:` alone: every default
-      const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds", "per_joint", "start"},
-                                   "(rho_limit, evaluations, max_seconds, per_joint, start)");
+      const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds", "per_joint", "start", "min_damping",
+                                    "min_gain_margin"},
+                                   "(rho_limit, evaluations, max_seconds, per_joint, start, min_damping, min_gain_margin)");
+      tune.min_damping = number_or(keys, "min_damping", tune.min_damping, "");
+      tune.min_gain_margin = number_or(keys, "min_gain_margin", tune.min_gain_margin, "");
       tune.rho_limit = number_or(keys, "rho_limit", tune.rho_limit, "");
       if (const Value* n = find(keys, "evaluations")) tune.evaluations = int(n->whole(1, 10000));
       tune.max_seconds = number_or(keys, "max_seconds", tune.max_seconds, "s");
@@ -436,6 +445,8 @@ void write(const Design& d, Out& top) {
     t.add("max_seconds", Out::number(c.tune->max_seconds));
     t.add("per_joint", Out::plain(c.tune->per_joint ? "true" : "false"));
     t.add("start", Out::plain(c.tune->start));
+    t.add("min_damping", Out::number(c.tune->min_damping));
+    t.add("min_gain_margin", Out::number(c.tune->min_gain_margin));
   }
 
   // Overrides in canonical form: every station's mechanisms, then by station (design order), then

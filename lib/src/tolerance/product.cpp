@@ -2,6 +2,8 @@
 // controller believes it is, and whether the target stays covered by the printed devices
 // (fivebar/tolerance.hpp); maps under tolerance/ (VTK image data and a picture per station).
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -21,10 +23,13 @@ constexpr const char* kPreamble =
     "playing in their clearances and the gears in their backlash (every default an assumption to replace with "
     "measurements; lib/include/fivebar/tolerance.hpp). *3σ* is the major semi-axis of the first-order error "
     "ellipse of the tactor (Monte Carlo at the centre beside it), *worst case* every parameter at 3σ with the "
-    "worst sign, *play* the largest displacement the clearances allow (the exact set, not a linearisation), "
+    "worst sign (the farthest corner of the first-order zonotope, exact; ⚠ where the first order is flagged near a "
+    "type II singularity, with the Monte Carlo and the nonlinear corners there below the table), *play* the largest displacement the clearances allow (the exact set, not a linearisation), "
     "*resolution* the tactor step of one ADC count. *Robust margin*: the coverage margin minus the error of "
-    "each boundary point of the target at the design's `robust_fraction` of printed devices; the Monte Carlo "
-    "column counts the sampled devices whose own region covers the target.\n\n";
+    "each boundary point of the target at the design's `robust_fraction` of printed devices, minimised over the "
+    "whole boundary with a certified bound; the Monte Carlo columns count the sampled devices whose own region "
+    "covers the target and give their margins' quantile at 1 − `robust_fraction` with a one-sided 95 % lower "
+    "confidence bound (order statistic).\n\n";
 
 }  // namespace
 
@@ -44,8 +49,9 @@ Product tolerance_product() {
     const Design& d = ctx.design;
     md::Table table({"station", "mechanism", "3σ at centre (mm)", "Monte Carlo (mm)", "worst 3σ (mm)",
                      "worst case (mm)", "play (mm)", "resolution (µm/count)", "margin (mm)", "robust margin (mm)",
-                     "devices covering (MC)"},
-                    "llrrrrrrrrr");
+                     "devices covering (MC)", "MC margin quantile (mm)"},
+                    "llrrrrrrrrrr");
+    std::string flagged_md;
     Json stations = Json::array();
     std::vector<std::string> failed, pictures;
     std::size_t total = 0;
@@ -66,11 +72,29 @@ Product tolerance_product() {
         if (!map.robust.covered) failed.push_back(s.name + "/" + map.mechanism);
         table.row({s.name, map.mechanism, md::fixed(map.centre.ellipse_semi_axes.x(), 3),
                    md::fixed(map.centre_monte_carlo_3sigma_mm, 3), md::fixed(map.worst_3sigma_mm, 3),
-                   md::fixed(map.worst_case_mm, 3), md::fixed(map.worst_play_mm, 3),
+                   (map.worst_case_flagged ? "⚠ " : "") + md::fixed(map.worst_case_mm, 3), md::fixed(map.worst_play_mm, 3),
                    md::fixed(map.worst_resolution_um, 2), md::fixed(map.robust.margin_mm, 3),
                    (map.robust.covered ? "" : "✗ ") + md::fixed(map.robust.robust_margin_mm, 3),
                    md::fixed(100.0 * map.robust.fraction_monte_carlo, 2) + " % of " +
-                       std::to_string(map.robust.samples)});
+                       std::to_string(map.robust.samples),
+                   map.robust.samples == 0 ? std::string("—")
+                                           : md::fixed(map.robust.quantile_margin_mm, 3) + " (≥ " +
+                                                 (std::isfinite(map.robust.quantile_lower_mm)
+                                                      ? md::fixed(map.robust.quantile_lower_mm, 3)
+                                                      : std::string("?")) +
+                                                 " at 95 %)"});
+        if (!map.near_singular.empty()) {
+          double mc = 0.0, corners = 0.0, first = 0.0;
+          for (const auto& f : map.near_singular) {
+            mc = std::max(mc, f.monte_carlo_3sigma_mm);
+            corners = std::max(corners, f.corners.worst_mm);
+            first = std::max(first, f.first_order.worst_case_mm);
+          }
+          flagged_md += "- " + s.name + "/" + map.mechanism + ": first order flagged near a type II singularity at " +
+                        std::to_string(map.near_singular.size()) + " of " + std::to_string(map.target_points) +
+                        " target points; there 3σ up to " + md::fixed(mc, 3) + " mm by Monte Carlo, worst corner " +
+                        md::fixed(corners, 3) + " mm nonlinear against " + md::fixed(first, 3) + " mm first order.\n";
+        }
       }
       js["files"] = Json::array();
       for (const auto& [name, bytes] : tolerance_files(s, maps)) {
@@ -84,9 +108,10 @@ Product tolerance_product() {
     Built b;
     b.result = {{"stations", stations}};
     std::string markdown = kPreamble + table.str() + "\n";
+    if (!flagged_md.empty()) markdown += flagged_md + "\n";
     for (const std::string& f : pictures) markdown += "Picture: [" + f + "](" + f + ").\n\n";
     markdown += "Maps for ParaView: `tolerance/<station>-<mechanism>-tolerance.vti` (3σ, worst case, resolution, "
-                "play and status over the reachable region).\n";
+                "play, near_singular and status over the reachable region).\n";
     b.markdown = markdown;
     b.passed = failed.empty();
     const std::string percent = md::fixed(100.0 * fraction, 1) + " %";

@@ -25,6 +25,42 @@ const std::array<const char*, kToleranceParameters>& tolerance_parameter_names()
   return names;
 }
 
+ZonotopeExtreme zonotope_farthest(const std::vector<Vec2>& generators) {
+  const std::size_t n = generators.size();
+  ZonotopeExtreme out;
+  out.signs.assign(n, 1);
+  // Every generator into the upper half plane (angle in [0, pi)), remembering the flip.
+  std::vector<Vec2> g(generators);
+  std::vector<std::int8_t> flip(n, 1);
+  for (std::size_t j = 0; j < n; ++j) {
+    if (g[j].y() < 0.0 || (g[j].y() == 0.0 && g[j].x() < 0.0)) {
+      g[j] = -g[j];
+      flip[j] = -1;
+    }
+  }
+  std::vector<std::size_t> order;  // zero generators stay out: they would break the ordering
+  for (std::size_t j = 0; j < n; ++j)
+    if (g[j].x() != 0.0 || g[j].y() != 0.0) order.push_back(j);
+  // Sorting by angle in [0, pi) without atan2: a before b when cross(a, b) > 0.
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cross(g[a], g[b]) > 0.0; });
+  // Walk the lower chain from -sum g to +sum g: vertex k has the first k sorted generators at +1.
+  Vec2 v{0.0, 0.0};
+  for (const Vec2& x : g) v -= x;
+  std::size_t best_k = 0;
+  out.norm = v.norm();
+  out.point = v;
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    v += 2.0 * g[order[k]];
+    if (v.norm() > out.norm) {
+      out.norm = v.norm();
+      out.point = v;
+      best_k = k + 1;
+    }
+  }
+  for (std::size_t k = 0; k < order.size(); ++k) out.signs[order[k]] = static_cast<std::int8_t>(flip[order[k]] * (k < best_k ? 1 : -1));
+  return out;
+}
+
 Sensitivity tolerance_sensitivity(const Mechanism& m, const Vec2& P) {
   Sensitivity out;
   const Pose pose = ik(m, P);
@@ -97,10 +133,15 @@ ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const
   out.ellipse_semi_axes = {3.0 * std::sqrt(std::max(0.0, mid + rad)), 3.0 * std::sqrt(std::max(0.0, mid - rad))};
   out.ellipse_angle = (rad > 0.0) ? 0.5 * std::atan2(2.0 * b, a - c) : 0.0;
   double worst = 0.0;
+  std::vector<Vec2> generators(kToleranceParameters);
   for (std::size_t j = 0; j < kToleranceParameters; ++j) {
-    worst += s.S.col(static_cast<Eigen::Index>(j)).norm() * 3.0 * sigma[j];
+    generators[j] = s.S.col(static_cast<Eigen::Index>(j)) * (3.0 * sigma[j]);
+    worst += generators[j].norm();
   }
-  out.worst_case_mm = worst;
+  const ZonotopeExtreme z = zonotope_farthest(generators);
+  out.worst_case_mm = z.norm;
+  std::copy(z.signs.begin(), z.signs.end(), out.worst_corner.begin());
+  out.sum_of_effects_mm = worst;
   out.near_singular = worst > 0.25 * std::min(m.L[2], m.L[3]) * s.pose.type2_sin;
   const double step = std::max(s.pose.J.col(0).norm(), s.pose.J.col(1).norm()) * rad_per_count;
   out.resolution_um = 1000.0 * step;

@@ -21,7 +21,7 @@ constexpr double kPanel = 400.0;  // panel width and height, pixels
 constexpr double kLeft = 56.0;
 constexpr double kTop = 70.0;
 constexpr double kGap = 80.0;
-constexpr double kRow = kPanel + 110.0;
+constexpr double kRow = kPanel + 126.0;
 
 std::string fmt(const char* format, double v) {
   char buf[64];
@@ -140,12 +140,31 @@ RenderedPlot plot_tolerance(const Station& s, const std::vector<ToleranceMap>& m
       cairo_arc(cr, w[0], w[1], 4.0, 0.0, 2.0 * std::numbers::pi);
       set_colour(cr, kLowerColour);
       cairo_fill(cr);
+      // Where the first order is not to be trusted (near_singular): black crosses.
+      for (const auto& f : map.near_singular) {
+        const auto c = panel.px(f.at);
+        cairo_move_to(cr, c[0] - 4.0, c[1] - 4.0);
+        cairo_line_to(cr, c[0] + 4.0, c[1] + 4.0);
+        cairo_move_to(cr, c[0] - 4.0, c[1] + 4.0);
+        cairo_line_to(cr, c[0] + 4.0, c[1] - 4.0);
+        set_colour(cr, kInk);
+        cairo_set_line_width(cr, 1.6);
+        cairo_stroke(cr);
+      }
       axes(cr, panel, b, 2.0);
       colour_bar(cr, x0, y0 + kPanel + 28.0, top, "mm");
       text(cr, x0 + 40.0, y0 + kPanel + 56.0,
            "worst over the target " + fmt("%.3f", map.worst_3sigma_mm) + " mm (red dot); worst case " +
                fmt("%.3f", map.worst_case_mm) + " mm",
            10.5, kInk);
+      if (!map.near_singular.empty()) {
+        double mc = 0.0;
+        for (const auto& f : map.near_singular) mc = std::max(mc, f.monte_carlo_3sigma_mm);
+        text(cr, x0 + 40.0, y0 + kPanel + 88.0,
+             std::to_string(map.near_singular.size()) + " points near singular (x): first order not trusted; Monte Carlo "
+                 "3-sigma there up to " + fmt("%.3f", mc) + " mm",
+             10.5, kInk);
+      }
       text(cr, x0 + 40.0, y0 + kPanel + 72.0,
            "robust margin " + fmt("%.3f", map.robust.robust_margin_mm) + " mm at " +
                fmt("%.1f", 100.0 * map.robust.fraction) +

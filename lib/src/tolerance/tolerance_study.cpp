@@ -29,6 +29,8 @@ constexpr int kTargetGrid = 21;
 constexpr int kMaxGrid = 1000;
 /// Points of the ellipse's boundary at which robust coverage linearises the signed distance.
 constexpr std::size_t kRobustBoundaryPoints = 72;
+/// Tolerance of the certified robust margin, relative to the mechanism's longest link.
+constexpr double kRobustTolRel = 1e-6;
 
 double cross(const Vec2& a, const Vec2& b) { return a.x() * b.y() - a.y() * b.x(); }
 
@@ -62,6 +64,9 @@ Mechanism perturbed(const Mechanism& m, const std::array<double, kToleranceParam
 bool lengths_positive(const Mechanism& m) {
   return std::all_of(m.L.begin(), m.L.end(), [](double l) { return l > 0.0; });
 }
+
+void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double fraction,
+                         std::size_t samples, std::uint64_t seed, RobustCoverage& out);
 
 }  // namespace
 
@@ -207,6 +212,24 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
     }
     return d;
   };
+  // Inside: the certified minimum over the whole boundary (lib/src/tolerance/tolerance_robust.cpp). Outside
+  // (or undecided) the first-order distances do not hold across the boundary: the sampled estimate
+  // below, reported as not certified.
+  if (nominal.decided && nominal.margin_mm > 0.0) {
+    const RobustMarginBound b = robust_margin_min(m, target, sigma, out.z, kRobustTolRel * scale);
+    out.robust_margin_mm = b.value_mm;
+    out.robust_margin_lower_mm = b.lower_mm;
+    out.robust_certified = b.certified;
+    out.sigma_mm = b.at.sigma_mm;
+    out.gradient = b.at.gradient;
+    out.robust_point = b.point;
+    out.fraction_first_order = b.fraction_first_order;
+    out.robust_margin_mm = std::min(out.robust_margin_mm, out.margin_mm);
+    out.robust_margin_lower_mm = std::min(out.robust_margin_lower_mm, out.robust_margin_mm);
+    out.covered = out.robust_margin_mm >= 0.0;
+    monte_carlo_margins(m, target, sigma, fraction, samples, seed, out);
+    return out;
+  }
   const std::vector<double> d0 = distances(m);
   // The signed distance of a point to a leg's set moves at most 1 mm per mm of any length or base
   // coordinate (its boundary arcs' radii and centres do), so sigma(b) <= S = sqrt(sum_j sigma_j^2)
@@ -260,8 +283,17 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   }
   // The nominal margin also sees what the boundary points cannot (a hole inside the ellipse).
   out.robust_margin_mm = std::min(out.robust_margin_mm, out.margin_mm);
+  out.robust_margin_lower_mm = out.robust_margin_mm;
   out.covered = out.robust_margin_mm >= 0.0;
-  if (samples == 0) return out;
+  monte_carlo_margins(m, target, sigma, fraction, samples, seed, out);
+  return out;
+}
+
+namespace {
+
+void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double fraction,
+                         std::size_t samples, std::uint64_t seed, RobustCoverage& out) {
+  if (samples == 0) return;
 
   // Draws first, in order, so that the answer does not depend on the threads.
   std::vector<std::array<double, kToleranceParameters>> draws(samples);
@@ -286,8 +318,18 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   std::nth_element(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(q), margins.end());
   const double quantile = margins[q];
   out.quantile_margin_mm = std::isfinite(quantile) ? quantile : -std::numeric_limits<double>::max();
-  return out;
+  const QuantileBound bound = quantile_lower_bound_rank(samples, 1.0 - fraction, out.quantile_confidence);
+  out.quantile_lower_rank = bound.rank;
+  if (bound.rank == 0) {
+    out.quantile_lower_mm = -std::numeric_limits<double>::infinity();
+  } else {
+    std::nth_element(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(bound.rank - 1), margins.end());
+    const double lower = margins[bound.rank - 1];
+    out.quantile_lower_mm = std::isfinite(lower) ? lower : -std::numeric_limits<double>::max();
+  }
 }
+
+}  // namespace
 
 std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
                                             std::size_t samples, std::uint64_t seed) {
@@ -357,6 +399,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
   map.field_worst_case_mm.assign(n, 0.0);
   map.field_resolution_um.assign(n, 0.0);
   map.field_play_mm.assign(n, 0.0);
+  map.field_near_singular.assign(n, 0);
   const auto count = static_cast<std::ptrdiff_t>(n);
 #pragma omp parallel for schedule(static)
   for (std::ptrdiff_t k = 0; k < count; ++k) {
@@ -367,6 +410,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
     if (e.status != Status::ok) continue;
     map.field_3sigma_mm[idx] = e.ellipse_semi_axes.x();
     map.field_worst_case_mm[idx] = e.worst_case_mm;
+    map.field_near_singular[idx] = e.near_singular ? 1 : 0;
     map.field_resolution_um[idx] = e.resolution_um;
     map.field_play_mm[idx] = tolerance_play(m, p, src.leg_play_mm).extent_mm;
   }
@@ -385,13 +429,22 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
       ++map.target_not_ok;
       continue;
     }
+    if (e.near_singular) {
+      ToleranceMap::Flagged f;
+      f.at = p;
+      f.first_order = e;
+      f.corners = tolerance_corners(m, p, src.sigma);
+      map.near_singular.push_back(f);
+    }
     if (e.ellipse_semi_axes.x() > map.worst_3sigma_mm) {
       map.worst_3sigma_mm = e.ellipse_semi_axes.x();
       map.worst_3sigma_at = p;
+      map.worst_3sigma_flagged = e.near_singular;
     }
     if (e.worst_case_mm > map.worst_case_mm) {
       map.worst_case_mm = e.worst_case_mm;
       map.worst_case_at = p;
+      map.worst_case_flagged = e.near_singular;
     }
     if (e.resolution_um > map.worst_resolution_um) {
       map.worst_resolution_um = e.resolution_um;
@@ -400,6 +453,15 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
     if (play.extent_mm > map.worst_play_mm) {
       map.worst_play_mm = play.extent_mm;
       map.worst_play_at = p;
+    }
+  }
+  if (!map.near_singular.empty()) {  // the Monte Carlo where the first order is not to be trusted
+    std::vector<Vec2> at;
+    for (const auto& f : map.near_singular) at.push_back(f.at);
+    const auto mc = tolerance_monte_carlo(m, at, src.sigma, src.samples, src.seed);
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      map.near_singular[k].monte_carlo = mc[k];
+      map.near_singular[k].monte_carlo_3sigma_mm = major_3sigma_mm(mc[k].covariance);
     }
   }
   map.robust = robust_coverage(m, target, src.sigma, src.robust_fraction, src.samples, src.seed);
@@ -417,6 +479,8 @@ Json to_json(const RobustCoverage& r) {
   robust["margin_sigma_mm"] = r.sigma_mm;
   robust["z"] = r.z;
   robust["robust_margin_mm"] = r.robust_margin_mm;
+  robust["robust_margin_lower_mm"] = r.robust_margin_lower_mm;
+  robust["robust_margin_certified"] = r.robust_certified;
   robust["covered"] = r.covered;
   robust["fraction_first_order_at_most"] = r.fraction_first_order;
   robust["robust_point_mm"] = xy(r.robust_point);
@@ -426,6 +490,10 @@ Json to_json(const RobustCoverage& r) {
   robust["fraction_monte_carlo"] = r.fraction_monte_carlo;
   robust["fraction_monte_carlo_stderr"] = r.monte_carlo_stderr;
   robust["monte_carlo_quantile_margin_mm"] = r.quantile_margin_mm;
+  // -inf (too few samples for the confidence) is written as null.
+  robust["monte_carlo_quantile_lower_mm"] =
+      std::isfinite(r.quantile_lower_mm) ? Json(r.quantile_lower_mm) : Json(nullptr);
+  robust["monte_carlo_quantile_confidence"] = r.quantile_confidence;
   return robust;
 }
 
@@ -438,6 +506,8 @@ Json to_json(const ToleranceMap& map) {
   j["centre_3sigma_minor_mm"] = map.centre.ellipse_semi_axes.y();
   j["centre_3sigma_angle_deg"] = angle_deg(map.centre.ellipse_angle);
   j["centre_worst_case_mm"] = map.centre.worst_case_mm;
+  j["centre_sum_of_effects_mm"] = map.centre.sum_of_effects_mm;
+  j["centre_near_singular"] = map.centre.near_singular;
   j["centre_resolution_um"] = map.centre.resolution_um;
   j["centre_monte_carlo_3sigma_mm"] = map.centre_monte_carlo_3sigma_mm;
   j["monte_carlo_samples_used"] = map.centre_monte_carlo.used;
@@ -451,6 +521,21 @@ Json to_json(const ToleranceMap& map) {
   j["target_worst_3sigma_at_mm"] = xy(map.worst_3sigma_at);
   j["target_worst_case_mm"] = map.worst_case_mm;
   j["target_worst_case_at_mm"] = xy(map.worst_case_at);
+  j["target_worst_3sigma_near_singular"] = map.worst_3sigma_flagged;
+  j["target_worst_case_near_singular"] = map.worst_case_flagged;
+  Json flagged = Json::array();
+  for (const auto& f : map.near_singular) {
+    flagged.push_back({{"at_mm", xy(f.at)},
+                       {"first_order_3sigma_mm", f.first_order.ellipse_semi_axes.x()},
+                       {"first_order_worst_case_mm", f.first_order.worst_case_mm},
+                       {"monte_carlo_3sigma_mm", f.monte_carlo_3sigma_mm},
+                       {"monte_carlo_samples_used", f.monte_carlo.used},
+                       {"monte_carlo_samples_failed", f.monte_carlo.failed},
+                       {"corners_worst_case_mm", f.corners.worst_mm},
+                       {"corners_failed", f.corners.failed}});
+  }
+  j["target_points_near_singular"] = map.near_singular.size();
+  j["near_singular"] = std::move(flagged);
   j["target_worst_resolution_um"] = map.worst_resolution_um;
   j["target_worst_resolution_at_mm"] = xy(map.worst_resolution_at);
   j["target_worst_play_mm"] = map.worst_play_mm;
@@ -491,6 +576,8 @@ std::vector<std::pair<std::string, std::string>> tolerance_files(const Station& 
     f.arrays.emplace_back("worst_case_mm", map.field_worst_case_mm);
     f.arrays.emplace_back("resolution_um", map.field_resolution_um);
     f.arrays.emplace_back("play_mm", map.field_play_mm);
+    f.arrays.emplace_back("near_singular",
+                          std::vector<double>(map.field_near_singular.begin(), map.field_near_singular.end()));
     f.arrays.emplace_back("status", std::vector<double>(map.field_status.begin(), map.field_status.end()));
     out.emplace_back(station.name + "-" + map.mechanism + "-tolerance.vti", image_vti(f));
   }

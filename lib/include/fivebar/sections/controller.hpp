@@ -79,6 +79,14 @@ struct TuneSettings {
   /// Where the optimiser starts: "pole_placement" (on the linearised model at the target's
   /// centre) or "hand_set" (the file's gains).
   std::string start = "pole_placement";
+  /// Least damping ratio of any oscillatory closed-loop pole allowed anywhere on the target grid.
+  /// 0.3 is a stated engineering floor, not a datasheet value: a second-order loop at zeta = 0.3
+  /// overshoots a step by exp(-pi zeta / sqrt(1 - zeta^2)) = 37 %; the tuned large step (with the
+  /// duty saturation and the integral clamp) must not overshoot more than that either.
+  double min_damping = 0.3;
+  /// Least factor on kp and on kd (each alone, the others fixed) that must keep max rho < 1 over
+  /// the target: a classical gain margin floor of 2 (6 dB), an engineering convention.
+  double min_gain_margin = 2.0;
   void validate() const;
 };
 
