@@ -767,7 +767,7 @@ TEST(ControlTune, TunedShowcaseMeetsTheFloorsOverTheTargetAndItsChirpDoesNotSatu
     ASSERT_TRUE(t.feasible);
     LoopModel loop = paper_loop("index", t.mechanism);
     loop.gains = t.after;
-    const StabilityMap map = stability_map(loop, ellipse_grid(index.target, o.grid));
+    const StabilityMap map = stability_map(loop, ellipse_lattice(index.target, o.grid));
     ASSERT_TRUE(map.stable);
     EXPECT_LE(map.max_rho, o.rho_limit);
     EXPECT_GE(map.oscillatory_damping, o.min_damping);

@@ -208,6 +208,14 @@ std::optional<YAML::Node> resolve_design_key(const YAML::Node& root, std::string
   return node;
 }
 
+std::optional<YAML::Node> follow_design_key(const YAML::Node& root, std::string_view key, std::string& canonical) {
+  std::vector<Component> parts;
+  std::string why;
+  return follow(root, key, canonical, parts, why);
+}
+
+bool yaml_number(const YAML::Node& node, double& value) { return scalar_number(node, value); }
+
 }  // namespace detail
 
 namespace {

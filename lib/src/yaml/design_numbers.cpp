@@ -46,7 +46,7 @@ void number_leaves(const YAML::Node& node, const std::string& path, std::vector<
     for (const auto& e : node) number_leaves(e.second, path + (path.empty() ? "" : ".") + e.first.as<std::string>(), out);
   } else if (node.IsSequence()) {
     for (std::size_t i = 0; i < node.size(); ++i) number_leaves(node[i], path + "[" + std::to_string(i) + "]", out);
-  } else if (scalar_number(node, v)) {
+  } else if (detail::yaml_number(node, v)) {
     out.push_back(path);
   }
 }
@@ -54,10 +54,11 @@ void number_leaves(const YAML::Node& node, const std::string& path, std::vector<
 
 std::vector<std::string> design_number_keys(const Design& design, std::string_view prefix) {
   YAML::Node root = YAML::Load(to_yaml(design));
-  std::string why;
-  std::optional<YAML::Node> node = follow(root, prefix, why);
+  std::string canonical;
+  std::optional<YAML::Node> node = prefix.empty() ? std::optional<YAML::Node>(root)
+                                                  : detail::follow_design_key(root, prefix, canonical);
   std::vector<std::string> out;
-  if (node) number_leaves(*node, std::string(prefix), out);
+  if (node) number_leaves(*node, prefix.empty() ? std::string() : canonical, out);
   return out;
 }
 
