@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Quick start 1/2: install what is missing, build (Release) and run the paper's scene,
 #   fivebar run designs/iros2022.yaml [ARGS...]   -> outputs/iros2022/summary.md
+# It also builds the Python module (build/python/fivebar; README "Python").
 # Extra arguments go to `fivebar run` (e.g. ./run.sh --out /tmp/x --products kinematics).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 source .ci/setup.sh
-fivebar_setup fivebar_cli
+fivebar_setup fivebar_cli fivebar_python
 exec build/fivebar run designs/iros2022.yaml "$@"

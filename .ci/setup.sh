@@ -94,7 +94,14 @@ fivebar_build_in() {
   cmake -S "$FIVEBAR_ROOT" -B "$dir" "${cmake_args[@]}" "${generator[@]}"
   local targets=()
   local t
-  for t in "$@"; do targets+=(--target "$t"); done
+  for t in "$@"; do
+    # The Python module is a target only where pybind11 and NumPy were found (FIVEBAR_PYTHON).
+    if [[ "$t" == "fivebar_python" ]] && ! grep -q '^FIVEBAR_PYTHON:BOOL=ON' "$dir/CMakeCache.txt"; then
+      fivebar_log "the Python module is not configured (FIVEBAR_PYTHON off): skipped"
+      continue
+    fi
+    targets+=(--target "$t")
+  done
   fivebar_log "building with $(nproc) jobs"
   cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
 }
