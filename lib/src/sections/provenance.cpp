@@ -24,7 +24,11 @@ void ProvenanceEntry::validate() const {
 }
 
 void ProvenanceSettings::validate() const {
-  for (const auto& [key, entry] : entries) rules::validate_nested(key, [&] { entry.validate(); });
+  // Not a structured binding: clang before 16 cannot capture one in a lambda (the fuzz build).
+  for (const auto& item : entries) {
+    const ProvenanceEntry& entry = item.second;
+    rules::validate_nested(item.first, [&entry] { entry.validate(); });
+  }
 }
 
 namespace sections {
