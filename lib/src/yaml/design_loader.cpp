@@ -468,7 +468,7 @@ class Loader {
   /// When set, every key a visited map allows is added here, as its shape ("stations.<name>.target").
   std::set<std::string>* catalogue = nullptr;
   /// The caller's rule from a layer above the design (DesignRule), or none.
-  const DesignRule* rule = nullptr;
+  const DesignRule* scene_rule = nullptr;
 };
 
 Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, int line,
@@ -813,7 +813,7 @@ Design Loader::load(const std::string& raw) {
 
   try {
     design.validate();
-    if (rule != nullptr && *rule) (*rule)(design);
+    if (scene_rule != nullptr && *scene_rule) (*scene_rule)(design);
   } catch (const ValidationError& e) {
     fail(line_for(e.key()), e.key(), e.rule());
   }
@@ -918,7 +918,7 @@ sections::Value Loader::value(const Entry& entry) {
 
 Design load_design_from_string(const std::string& text, const std::string& origin, const DesignRule& rule) {
   Loader loader(origin);
-  loader.rule = &rule;
+  loader.scene_rule = &rule;
   return loader.load(text);
 }
 
