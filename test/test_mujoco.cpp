@@ -503,6 +503,7 @@ TEST_F(MujocoTest, TheStretchPatternFollowsFivebarSimulate) {
     for (SimulatedMechanism& m : in.mechanisms) {
       m.reference.resize(30);
       m.reference_point_mm.resize(30);
+      if (!m.target_mm.empty()) m.target_mm.resize(30);  // what the runtime is fed (fivebar/dynamics.hpp)
     }
   }
   const Agreement a = run_both(d, *dir_ / "export/iros2022_index.xml", result_->parameters, in, "stretch");
