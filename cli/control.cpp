@@ -89,7 +89,7 @@ int run_control(const ControlCliOptions& opt) {
     for (const Mechanism* m : s->mechanisms()) none[m->name] = MechanismInertia{};
     (void)loop_models(design, *s, none);
   }
-  // --tune needs a station with both mechanisms: refused before anything is written (issue 31).
+  // --tune needs a station with both mechanisms: refused before anything is written (docs/reliability.md).
   std::vector<const Station*> pairs;
   for (const Station* s : stations)
     if (s->lower && s->upper) pairs.push_back(s);

@@ -48,7 +48,7 @@ std::vector<std::string> join_dash_values(int argc, char** argv) {
   return out;
 }
 
-/// Issue 31 family 3: every numeric flag of every command refuses, as bad input (exit 2), what
+/// docs/reliability.md: every numeric flag of every command refuses, as bad input (exit 2), what
 /// is not a finite number of its type: `nan`, `inf`, an overflow (`1e999`), a negative or
 /// fractional value for a count or a seed (CLI11 would wrap `--seed -1` to 2^64 - 1). Numeric
 /// options are known by their value name: CLI11's FLOAT, INT and UINT, and the unit names the

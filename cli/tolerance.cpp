@@ -46,7 +46,7 @@ void print_mechanism(const ToleranceMap& r) {
               << fixed(r.centre.resolution_um, 3) << " um per count, play " << fixed(r.centre_play.extent_mm, 4) << " mm"
               << (r.centre.near_singular ? " [near singular: first order not trusted]" : "") << "\n";
   }
-  if (r.target_not_ok >= r.target_points) {  // nothing to report: no 0 mm at (0, 0) (issue 31)
+  if (r.target_not_ok >= r.target_points) {  // nothing to report: no 0 mm at (0, 0) (docs/reliability.md)
     std::cout << "    over the target (" << r.target_points << " points): no point is reachable and regular (no estimate)";
   } else {
   std::cout << "    over the target (" << r.target_points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)

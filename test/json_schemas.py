@@ -182,7 +182,7 @@ def main():
         run("calibrate", "calibrate", ["calibrate", DESIGN, str(WORK / "meas.csv"), "--frame", "fit", "--holdout", "2",
                                        "--out", out + "/cal"])
     run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/twist.svg"])
-    # Issue 31 family 5: the hostile and partial shapes validate too, and keep the conventions.
+    # docs/reliability.md: the hostile and partial shapes validate too, and keep the conventions.
     if keyed_by_name({"a": {"lower": 1.0, "upper": None}}) != ["$.a"] or keyed_by_name({"lower": 1, "x": 2}):
         failures.append("self-test: the name-key walk is wrong")
     showcase = pathlib.Path(DESIGN).read_text()

@@ -146,7 +146,7 @@ TEST_F(CliSimulate, ChirpGivesTheBodeMagnitudeAndBandwidth) {
   const json& run0 = doc["runs"][0];
   EXPECT_EQ(run0["reference"], "chirp");
   ASSERT_EQ(run0["status"], "ok");
-  // One record per mechanism (issue 31 family 5: never an object keyed by the mechanisms' names).
+  // One record per mechanism (docs/reliability.md: never an object keyed by the mechanisms' names).
   ASSERT_TRUE(run0["bandwidth"].is_array());
   ASSERT_EQ(run0["bandwidth"].size(), 2u);
   EXPECT_FALSE(run0.contains("bandwidth_hz"));

@@ -312,7 +312,7 @@ TEST(Control, TheKdMarginBoundsTheDerivativeGainBothWays) {
 }
 
 TEST(ControlTune, TheTimeBoundIsCheckedInsideTheEvaluations) {
-  // Issue 31 family 2: --tune-seconds 0.5 took 3.8-8 s: each mechanism got at least 0.5 s of
+  // docs/reliability.md: --tune-seconds 0.5 took 3.8-8 s: each mechanism got at least 0.5 s of
   // COBYLA, and the tracking before and after ran outside the bound. Now the bound is checked
   // before every evaluation and between the pattern runs of one: a bound already spent allows no
   // evaluation, whatever the evaluation count allows, and the result says the time limit stopped it.

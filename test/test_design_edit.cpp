@@ -1,4 +1,4 @@
-// One way to edit a design (fivebar/design/edit.hpp, issue 27 item 3 and issue 31 family 1): key
+// One way to edit a design (fivebar/design/edit.hpp, docs/reliability.md): key
 // paths canonicalised once (two spellings are one key), the optimize section's "each number in
 // one variable only" rule on canonical keys, set_design_number() against the design file's own
 // round trip, the minimum-length rule stated once and met identically by the sweep, the optimiser
@@ -88,7 +88,7 @@ std::string with_optimize(const std::string& variables) {
 }
 
 TEST(DesignKeys, TwoVariablesCannotSetOneNumberBySpellingItTwice) {
-  // Issue 31 family 1: links[2] and links[02] were two keys to the optimize section, so two
+  // docs/reliability.md: links[2] and links[02] were two keys to the optimize section, so two
   // variables set one number and the reports showed a value that never reached chosen.yaml.
   for (const std::string& second : {std::string("\"stations.index.mechanisms.lower.links[02]\""),
                                     std::string("'stations[\"index\"].mechanisms.lower.links[2]'"),
@@ -206,7 +206,7 @@ std::string many_keys(int stations) {
 }
 
 TEST(DesignKeys, LoadingIsLinearInTheKeys) {
-  // Issue 31 family 1: each key was resolved by writing and re-reading the whole design, so a
+  // docs/reliability.md: each key was resolved by writing and re-reading the whole design, so a
   // design of 1,200 keys took 29 s to load (every command, even fk). The child's time bound is
   // the hostile corpus's (10 s, FIVEBAR_TEST_CHILD_TIMEOUT_S under the sanitizers); the figure
   // is BM_LoadDesignWithManyOptimizeKeys in test/bench/bench_optimize.cpp.

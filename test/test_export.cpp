@@ -289,7 +289,7 @@ TEST(Formats, RosYamlReadByYamlCppEqualsTheDesign) {
 }
 
 TEST(Formats, RosYamlKeysAreStringsInYaml11) {
-  // Issue 31 family 6: a station named `on`, `yes` or `off` became a YAML 1.1 boolean key of the
+  // docs/reliability.md: a station named `on`, `yes` or `off` became a YAML 1.1 boolean key of the
   // ROS 2 parameters file (ROS 2's parser is YAML 1.1). Reference: the YAML 1.1 type regexps
   // (yaml.org/type/bool.html, null.html, int.html, float.html): no unquoted key may match them.
   Design d = paper();

@@ -380,7 +380,7 @@ std::vector<Case> cases() {
   c.push_back({"OptimizeShardAndMerge", sub({"optimize"}, {"--shard", "0/2", "--merge", "2"}), {both}, {"no optimize: section"}});
   c.push_back({"SweepRandomWithoutCount", sub({"sweep"}, {"-s", "index", "--vary", "L1=8:10:3", "--sample", "random"}), {both},
                {"sweep.count", "required for random sampling"}});
-  // --- Issue 31: budgets, key paths, validation before writing, identity, schemas --------------
+  // --- docs/reliability.md: budgets, key paths, validation before writing, identity, schemas --------------
   // The showcase design (every section), changed by one edit.
   const std::string show = ft::slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/iros2022.yaml");
   const auto show_with = [&](const std::string& from, const std::string& to) {

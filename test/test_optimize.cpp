@@ -475,7 +475,7 @@ TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   EXPECT_GT(hv_opt, hv_sobol);
 }
 
-/// Issue 31 family 4: shard, checkpoint and merge files state what they are and every reader
+/// docs/reliability.md: shard, checkpoint and merge files state what they are and every reader
 /// checks it before use (InputError naming the file and the mismatch; the CLI's exit 2).
 std::string what_of(const std::function<void()>& f) {
   try {

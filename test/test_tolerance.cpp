@@ -545,7 +545,7 @@ TEST(ToleranceMaps, TheFieldIsTheFirstOrderAtEachPointAndZeroWithoutTolerances) 
   EXPECT_EQ(zero.robust.robust_margin_mm, zero.robust.margin_mm);
 }
 
-// --- Exact worst case, certified robust margin, quantile confidence (issue 32) -------------------
+// --- Exact worst case, certified robust margin, quantile confidence ---------------------------------------
 
 /// max |sum_j s_j g_j| over every sign vector: the reference for zonotope_farthest().
 double brute_force_farthest(const std::vector<Vec2>& g) {

@@ -1,4 +1,4 @@
-// Kinematic calibration (fivebar/calibrate.hpp): issue 28's goals, calibrating 200 poses < 50 ms
+// Kinematic calibration (fivebar/calibrate.hpp): goals, calibrating 200 poses < 50 ms
 // and planning 30 poses < 1 s.
 #include <benchmark/benchmark.h>
 

@@ -147,7 +147,7 @@ BENCHMARK(BM_optimize_eight_variables_vs_sobol)
     ->UseRealTime()
     ->Iterations(1);
 
-/// Issue 31 family 1: loading a design whose optimize: section ties 13 numbers of each of
+/// docs/reliability.md: loading a design whose optimize: section ties 13 numbers of each of
 /// Arg stations in one variable (1,300 keys for 100). Every key is resolved in one reading of
 /// the design (fivebar/design/edit.hpp), so the time grows linearly with the keys (it was
 /// quadratic: 29 s for 1,200 keys). Goal: well under a second for 1,300 keys.

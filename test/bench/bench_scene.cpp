@@ -1,6 +1,6 @@
 // Wall time of the showcase scene, `fivebar run designs/iros2022.yaml`, as the library runs it
 // (run_scene(): every product of the showcase, independent products side by side on the cores;
-// issue 32). Goal: under 10 s of wall time on a 2-core machine. Arg: the workers (0: one per core,
+// docs/architecture.md). Goal: under 10 s of wall time on a 2-core machine. Arg: the workers (0: one per core,
 // 1: one after another). Each product's own time is in the scene's summary.json (built[].wall_s),
 // reported here as counters.
 //   ./build/fivebar_bench --benchmark_filter=scene

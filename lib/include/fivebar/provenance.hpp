@@ -1,5 +1,5 @@
 #pragma once
-/// Measured or assumed (issue 28 section 3; docs/calibrate.md): which values of a design rest on
+/// Measured or assumed (docs/calibrate.md): which values of a design rest on
 /// a measurement (a `provenance:` entry, fivebar/sections/provenance.hpp) and which are
 /// assumptions, by group:
 ///   kinematics     every mechanism's links and bases (`stations.<s>.mechanisms.<m>.links`, `bases`)

@@ -224,7 +224,7 @@ std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_
     if (!line.empty() && line.back() == ',') out.emplace_back();
     return out;
   };
-  // A reader of a user-named file is bounded (issue 31 family 2): lines of at most
+  // A reader of a user-named file is bounded (docs/reliability.md): lines of at most
   // kMaxSimulatedLineBytes (a `fivebar simulate` row is about 250) and at most
   // kMaxSimulatedBytes in all, so /dev/zero or a wrong file is refused after one bounded read.
   constexpr std::size_t kMaxSimulatedLineBytes = 4096;

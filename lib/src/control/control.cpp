@@ -357,7 +357,7 @@ Json to_json(const StabilityMap& map) {
   j["kd_margin"] = map.kd_margin;
   if (map.not_ok >= map.poses.size()) {
     // No pose of the target is reachable and regular: no verdict, and null for every figure
-    // that does not exist (docs/conventions.md; issue 31 family 5), never a 0 that reads as a value.
+    // that does not exist (docs/conventions.md; docs/reliability.md), never a 0 that reads as a value.
     for (const char* key : {"max_rho", "worst_pose_mm", "dominant_damping", "dominant_frequency_hz", "oscillatory_damping",
                             "oscillatory_frequency_hz", "oscillatory_pose_mm", "kp_margin", "kd_margin"}) {
       j[key] = nullptr;

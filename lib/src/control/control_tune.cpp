@@ -34,7 +34,7 @@ struct Tracking {
 
 using Clock = std::chrono::steady_clock;
 
-/// The tuning's time bound (TuneOptions::max_seconds) is checked inside the loops (issue 31
+/// The tuning's time bound (TuneOptions::max_seconds) is checked inside the loops (docs/reliability.md
 /// family 2): before every evaluation and between the pattern runs of one, and each run is itself
 /// cut at the bound, so the tuning ends at most one simulation step past it.
 Tracking track(const std::vector<SimulationInput>& runs, const std::array<PidGains, 2>& gains, double rtol,

@@ -77,7 +77,7 @@ void require_ros_list(const Json& list, const std::string& path) {
   }
 }
 
-/// A map key as YAML 1.1 reads it back as the same string (issue 31 family 6): a station named
+/// A map key as YAML 1.1 reads it back as the same string (docs/reliability.md): a station named
 /// `on`, `yes` or `off` must not become a boolean key, nor `null`/`~` a null or `1e3` a number.
 /// Names are is_safe_name() ([A-Za-z0-9_.-]); those YAML would read as anything but a string are
 /// written as quoted strings.

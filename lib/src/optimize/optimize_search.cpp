@@ -603,7 +603,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     if (j.value("design_hash", "") != design_hash(p)) {
       throw InputError(checkpoint.string() + ": the checkpoint is of another design or other optimize: settings");
     }
-    // Identity and sizes before use (issue 31 family 4): the shard, every island's number and
+    // Identity and sizes before use (docs/reliability.md): the shard, every island's number and
     // population size, and every individual's dimension and fitness length.
     auto damaged = [&](const std::string& what) { return InputError(checkpoint.string() + ": " + what); };
     try {
@@ -686,7 +686,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       return finish(p, design, std::move(all), options, r, options.shards == 1, 0.0);
     }
   }
-  // Every input checked (the checkpoint too): only now is anything created (issue 31 family 3).
+  // Every input checked (the checkpoint too): only now is anything created (docs/reliability.md).
   make_directories(options.out_dir);
   // pagmo's populations hold their own copies of the problem: point them at this run's logs.
   // (A population built above already does; after a resume the same.)
@@ -761,7 +761,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       }
     }
     // The checkpoint holds every candidate so far, so writing it after every round made a long run
-    // quadratic (issue 31 family 2). It is written when at least kCheckpointSeconds and ten times
+    // quadratic (docs/reliability.md). It is written when at least kCheckpointSeconds and ten times
     // its own last writing time have passed since the last one: checkpoints take at most about a
     // tenth of the run (linear in it); an interrupted or finished run always writes its last round.
     if (elapsed() - checkpoint_at >= std::max(kCheckpointSeconds, 10.0 * checkpoint_cost)) write_checkpoint();
@@ -793,7 +793,7 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
     if (j.value("format", "") != kShardFormat || j.value("design_hash", "") != design_hash(p)) {
       throw InputError(path.string() + ": a shard of another design or other optimize: settings");
     }
-    // Identity and sizes before use (issue 31 family 4): the file must say it is shard k of
+    // Identity and sizes before use (docs/reliability.md): the file must say it is shard k of
     // `shards`, finished, with as many candidates as it holds.
     try {
       const std::uint64_t says = j.at("shard").get<std::uint64_t>(), of = j.at("shards").get<std::uint64_t>();

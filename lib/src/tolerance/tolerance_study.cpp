@@ -542,7 +542,7 @@ Json to_json(const ToleranceMap& map) {
   j["target_worst_play_at_mm"] = xy(map.worst_play_at);
   j["robust_coverage"] = to_json(map.robust);
   j["grid"] = {{"origin_mm", xy(Vec2(map.x0, map.y0))}, {"spacing_mm", map.spacing_mm}, {"nx", map.nx}, {"ny", map.ny}};
-  // Quantities that do not exist are null, never 0 mm at (0, 0) (docs/conventions.md; issue 31
+  // Quantities that do not exist are null, never 0 mm at (0, 0) (docs/conventions.md; docs/reliability.md
   // family 5): no first-order estimate at the centre, no regular point of the target.
   if (map.centre.status != Status::ok) {
     for (const char* key : {"centre_3sigma_mm", "centre_3sigma_minor_mm", "centre_3sigma_angle_deg", "centre_worst_case_mm",

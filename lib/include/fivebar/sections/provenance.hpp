@@ -1,5 +1,5 @@
 #pragma once
-/// The `provenance:` section of a design file (issue 28 section 3; docs/calibrate.md
+/// The `provenance:` section of a design file (docs/calibrate.md
 /// "Measured or assumed"): where a value came from. A map from a key path of the design
 /// (`stations.index.mechanisms.lower.links[2]`, `controller.stations.index.lower.theta1.potentiometer.volts_at_zero`,
 /// as design_number() takes them; a path that leads to a map or list covers every number below it)
