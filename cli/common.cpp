@@ -202,6 +202,18 @@ Ellipse parse_ellipse(std::string_view text, std::string_view option) {
 
 // --- Output -----------------------------------------------------------------------------------
 
+std::string remedy_hint(Remedy remedy) {
+  switch (remedy) {
+    case Remedy::none: return "";
+    case Remedy::confirm: return "--yes confirms it";
+    case Remedy::start_afresh: return "rerun without --resume to start afresh";
+    case Remedy::without_rendering: return "--no-render writes the .scad sources only";
+    case Remedy::resume_shard: return "fivebar optimize --shard K/N --resume finishes the shard";
+    case Remedy::longer_budget: return "--seconds (or optimize.seconds) gives it more time";
+  }
+  return "";
+}
+
 void print_json(const Json& doc) { std::cout << doc.dump(2) << "\n"; }
 
 std::string fixed(double value, int digits) {

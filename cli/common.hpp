@@ -97,6 +97,10 @@ std::optional<double> parse_number(std::string_view text);
 
 // --- Output -----------------------------------------------------------------------------------
 
+/// The command line's words for a library remedy (fivebar/error.hpp): "--yes confirms it", ...;
+/// empty for Remedy::none.
+std::string remedy_hint(Remedy remedy);
+
 /// The one JSON document of a --json run, on stdout.
 void print_json(const Json& doc);
 /// Fixed-point text ("-0.0000" shows as "0.0000").

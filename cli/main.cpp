@@ -191,6 +191,9 @@ int run(int argc, char** argv) {
     return kBadInput;
   } catch (const fivebar::InputError& e) {
     std::cerr << "fivebar: error: " << e.what() << "\n";
+    if (const std::string hint = fivebar::cli::remedy_hint(e.remedy()); !hint.empty()) {
+      std::cerr << "fivebar: hint: " << hint << "\n";
+    }
     return kBadInput;
   } catch (const fivebar::IoError& e) {
     std::cerr << "fivebar: error: " << e.what() << "\n";

@@ -68,6 +68,7 @@ int run_parts(const PartsCliOptions& opt) {
     report = build_parts(design, options);
   } catch (const ToolError& e) {
     std::cerr << "fivebar parts: " << e.what() << "\n";
+    if (const std::string hint = remedy_hint(e.remedy()); !hint.empty()) std::cerr << "fivebar: hint: " << hint << "\n";
     return kCheckFailed;
   }
   if (opt.json) {

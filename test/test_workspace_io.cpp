@@ -557,14 +557,26 @@ TEST(Picture, PngDecodesWithTheRequestedSizeAndShowsBothMechanismColours) {
   EXPECT_THROW((void)station_png(ws, plot), InputError);
 }
 
-TEST(Picture, ViridisEndsAndClamps) {
-  // Matplotlib's viridis: 0 = (0.267004, 0.004874, 0.329415), 0.5 = (0.163625, 0.471133, 0.558148),
-  // 1 = (0.993248, 0.906157, 0.143936); 0.5625 is halfway to the next stop at 0.625.
-  const Rgb lo = viridis(0.0), hi = viridis(1.0), mid = viridis(0.5), between = viridis(0.5625);
+TEST(Picture, ViridisIsMatplotlibsMap) {
+  // matplotlib.cm.viridis (matplotlib 3.6, Debian 12), independent of the table in the code:
+  // 0 = (0.267004, 0.004874, 0.329415), 0.5 = (0.127568, 0.566949, 0.550556),
+  // 1 = (0.993248, 0.906157, 0.143936); between the table's stops (every 0.1) the map is linear, so
+  // 0.25 and 0.75 are matplotlib's (0.229739, 0.322361, 0.545706) and (0.369214, 0.788888, 0.382914)
+  // to within the interpolation error (< 0.02).
+  const Rgb lo = viridis(0.0), hi = viridis(1.0), mid = viridis(0.5);
   EXPECT_NEAR(lo.r, 0.267004, 1e-6);
+  EXPECT_NEAR(lo.b, 0.329415, 1e-6);
+  EXPECT_NEAR(mid.r, 0.127568, 1e-6);
+  EXPECT_NEAR(mid.g, 0.566949, 1e-6);
+  EXPECT_NEAR(mid.b, 0.550556, 1e-6);
   EXPECT_NEAR(hi.g, 0.906157, 1e-6);
-  EXPECT_NEAR(mid.g, 0.471133, 1e-6);
-  EXPECT_NEAR(between.g, 0.5 * (0.471133 + 0.566949), 1e-6);
+  const Rgb q1 = viridis(0.25), q3 = viridis(0.75);
+  EXPECT_NEAR(q1.r, 0.229739, 0.02);
+  EXPECT_NEAR(q1.g, 0.322361, 0.02);
+  EXPECT_NEAR(q1.b, 0.545706, 0.02);
+  EXPECT_NEAR(q3.r, 0.369214, 0.02);
+  EXPECT_NEAR(q3.g, 0.788888, 0.02);
+  EXPECT_NEAR(q3.b, 0.382914, 0.02);
   EXPECT_EQ(viridis(-3).r, lo.r);
   EXPECT_EQ(viridis(7).b, hi.b);
   EXPECT_EQ(viridis(std::nan("")).r, lo.r);

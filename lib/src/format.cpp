@@ -28,6 +28,25 @@ std::string fixed(double value, int digits) {
   return s;
 }
 
+namespace {
+/// printf of one double; a result that reads as zero (every digit 0) never carries a sign.
+std::string unsigned_zero(const char* spec, int digits, double value) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, spec, digits, value);
+  std::string s = buffer;
+  if (s.front() == '-') {
+    const std::size_t e = s.find_first_of("eE");
+    const std::string mantissa = s.substr(0, e);
+    if (mantissa.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
+  }
+  return s;
+}
+}  // namespace
+
+std::string general(double value, int significant) { return unsigned_zero("%.*g", significant, value); }
+
+std::string sci(double value, int digits) { return unsigned_zero("%.*e", digits, value); }
+
 std::string join(const std::vector<std::string>& items, std::string_view separator) {
   std::string out;
   for (std::size_t i = 0; i < items.size(); ++i) {

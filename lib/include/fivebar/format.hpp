@@ -24,6 +24,11 @@ std::string shortest(double value);
 /// Fixed point with `digits` decimals; a result that reads as zero never carries a sign
 /// ("-0.000" is written "0.000").
 std::string fixed(double value, int digits);
+/// `significant` significant digits, the shorter of fixed and scientific (printf's %g): "12.5",
+/// "1e-05"; never "-0".
+std::string general(double value, int significant = 6);
+/// Scientific with `digits` decimals (printf's %e): "1.2e-15"; never "-0.0e+00".
+std::string sci(double value, int digits = 1);
 /// The items separated by `separator`.
 std::string join(const std::vector<std::string>& items, std::string_view separator = ", ");
 

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/error.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/print.hpp"
 #include "fivebar/json.hpp"
@@ -35,7 +36,13 @@ namespace fivebar {
 /// not an internal error: the CLI reports it and exits 1.
 class ToolError : public std::runtime_error {
  public:
-  explicit ToolError(const std::string& message) : std::runtime_error(message) {}
+  explicit ToolError(const std::string& message, Remedy remedy = Remedy::none)
+      : std::runtime_error(message), remedy_(remedy) {}
+  /// What the caller can do about it (fivebar/error.hpp).
+  Remedy remedy() const noexcept { return remedy_; }
+
+ private:
+  Remedy remedy_;
 };
 
 // --- Meshes -------------------------------------------------------------------------------------

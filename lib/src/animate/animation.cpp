@@ -17,16 +17,18 @@
 #include "fivebar/kinematics.hpp"
 #include "fivebar/workspace/polyline.hpp"
 #include "fivebar/workspace/region.hpp"
+#include "plot/style.hpp"
 
 namespace fivebar {
 
 namespace {
 
-constexpr const char* kUpperColour = "#2961c7";  // as the pattern pictures (lib/src/plot/tactor_canvas.hpp)
-constexpr const char* kLowerColour = "#d12e29";
-constexpr const char* kInk = "#1f1f1f";
-constexpr const char* kGrey = "#8c8c8c";
-constexpr const char* kSimColour = "#1a8a3a";
+// The house colours (plot/style.hpp), as every other picture of a run.
+const std::string kUpper = style::hex(style::kUpper);
+const std::string kLower = style::hex(style::kLower);
+const std::string kInk = style::hex(style::kInk);
+const std::string kGrey = style::hex(style::kGrey);
+const std::string kSimColour = style::hex(style::kSimulated);
 constexpr double kSide = 16.0;     // px left and right of the panel
 constexpr double kHeader = 58.0;   // title lines
 constexpr double kFooter = 92.0;   // controls and legend
@@ -330,7 +332,7 @@ std::vector<AnimationFrame> animation_frames(const Station& station, const Patte
 std::string animate_pattern_svg(const Station& station, const PatternResult& result, const AnimationOptions& options) {
   const std::vector<AnimationFrame> frames = animation_frames(station, result, options.max_frames);
   const std::array<const Mechanism*, 2> mechs{&*station.upper, &*station.lower};
-  const std::array<const char*, 2> colours{kUpperColour, kLowerColour};
+  const std::array<std::string, 2> colours{kUpper, kLower};
   const std::string pattern(to_string(result.spec.kind));
 
   // Simulated points per frame and mechanism: the last simulated sample at or before the frame.
@@ -604,15 +606,15 @@ std::string animate_pattern_svg(const Station& station, const PatternResult& res
   // Legend.
   const double ly = cy + 38.0;
   double lx = kSide;
-  const auto swatch = [&](const char* colour, const char* dash, const std::string& label) {
+  const auto swatch = [&](const std::string& colour, const char* dash, const std::string& label) {
     o << "<line x1=\"" << num(lx) << "\" y1=\"" << num(ly - 4.0) << "\" x2=\"" << num(lx + 24.0) << "\" y2=\"" << num(ly - 4.0)
       << "\" stroke=\"" << colour << "\" stroke-width=\"3\"" << (dash[0] ? std::string(" stroke-dasharray=\"") + dash + "\"" : "")
       << "/><text x=\"" << num(lx + 30.0) << "\" y=\"" << num(ly) << "\" font-size=\"11\" fill=\"" << kInk << "\">"
       << format::xml_escape(label) << "</text>\n";
     lx += 30.0 + 6.2 * static_cast<double>(label.size()) + 18.0;
   };
-  swatch(kUpperColour, "", "upper linkage and tactor path");
-  swatch(kLowerColour, "", "lower linkage and tactor path");
+  swatch(kUpper, "", "upper linkage and tactor path");
+  swatch(kLower, "", "lower linkage and tactor path");
   if (has_sim[0] || has_sim[1]) swatch(kSimColour, "4 2", "simulated tactor (dynamics)");
   o << "<text x=\"" << kSide << "\" y=\"" << num(ly + 17.0) << "\" font-size=\"11\" fill=\"" << kGrey
     << "\">shaded: reachable regions; dashed ellipse: fingertip target; dots: pattern targets; squares: motors</text>\n";

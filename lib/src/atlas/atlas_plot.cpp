@@ -9,6 +9,7 @@
 #include <numbers>
 #include <string>
 
+#include "fivebar/format.hpp"
 #include "fivebar/atlas.hpp"
 #include "plot/tactor_canvas.hpp"
 
@@ -27,11 +28,8 @@ constexpr double kGap = 50.0;
 constexpr Rgb kNoWorkspace{0.86, 0.86, 0.86};
 constexpr Rgb kStation{0.95, 0.20, 0.55};
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+using format::fixed;
+using format::general;
 
 struct Figure {
   std::string title, unit;
@@ -53,9 +51,9 @@ void triangle_path(cairo_t* cr, const Panel& panel) {
 RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
   const std::vector<Figure> figures = {
       {"(a) inscribed target s* (semi-major, units of D)", "D", [](const InscribedTarget& f) { return f.scale; }},
-      {"(b) min LCI over " + fmt("%.2f", atlas.options.fraction) + " s*", "",
+      {"(b) min LCI over " + fixed(atlas.options.fraction, 2) + " s*", "",
        [](const InscribedTarget& f) { return f.min_lci; }},
-      {"(c) min |sin| tactor angle over " + fmt("%.2f", atlas.options.fraction) + " s*", "",
+      {"(c) min |sin| tactor angle over " + fixed(atlas.options.fraction, 2) + " s*", "",
        [](const InscribedTarget& f) { return f.min_transmission_sin; }},
   };
   const double n = double(figures.size());
@@ -70,8 +68,8 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
        "shape and different sizes are one point.",
        11.5, kInk);
   text(cr, kLeft, 64.0,
-       "Target: aspect " + fmt("%.3f", o.shape.aspect) + ", major axis at " +
-           fmt("%.1f", o.shape.angle * 180.0 / std::numbers::pi) +
+       "Target: aspect " + fixed(o.shape.aspect, 3) + ", major axis at " +
+           fixed(o.shape.angle * 180.0 / std::numbers::pi, 1) +
            " deg to the base line, centred on the symmetry axis at its best height; working mode " +
            to_string(o.working_mode) + ", assembly " + to_string(o.assembly_mode) + ", no joint limits.",
        11.5, kInk);
@@ -92,7 +90,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       const double v = fig.value(c.figures);
       if (std::isfinite(v) && (!top || v > hi)) hi = v, top = &c;
     }
-    const auto colour = [&](double v) { return ramp_colour(hi > 0.0 ? v / hi : 0.0); };
+    const auto colour = [&](double v) { return viridis(hi > 0.0 ? v / hi : 0.0); };
     // Designs whose inscribed target is smaller than the station's own target are veiled.
     const double veil = atlas.station ? atlas.station->target_scale : 0.0;
     // The cells as one raster (one pixel per cell, drawn nearest), clipped to the triangle.
@@ -192,7 +190,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       cairo_line_to(cr, p[0] + 7, p[1] - 7);
       cairo_stroke(cr);
       const bool ok = s.figures.status == AtlasStatus::ok;
-      const std::string label = s.station + (ok ? ": " + fmt("%.3f", fig.value(s.figures)) : ": none");
+      const std::string label = s.station + (ok ? ": " + fixed(fig.value(s.figures), 3) : ": none");
       const double tw = text_width(cr, label, 11.0, true);
       cairo_rectangle(cr, p[0] + 9.0, p[1] - 20.0, tw + 6.0, 16.0);
       set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
@@ -214,7 +212,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
       cairo_set_line_width(cr, 1.6);
       cairo_stroke(cr);
       const bool ok = m.figures.status == AtlasStatus::ok;
-      const std::string label = m.label + (ok ? ": " + fmt("%.3f", fig.value(m.figures)) : ": none");
+      const std::string label = m.label + (ok ? ": " + fixed(fig.value(m.figures), 3) : ": none");
       const double tw = text_width(cr, label, 10.5, false);
       cairo_rectangle(cr, p[0] + 9.0, p[1] + 2.0, tw + 6.0, 15.0);
       set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
@@ -232,39 +230,39 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
     set_colour(cr, kNoWorkspace);
     cairo_fill(cr);
     text(cr, x0 + 36.0, by + 10.0, "0", 10.0, kInk, 1.0);
-    text(cr, x0 + 300.0, by + 24.0, fmt("%.4f", hi), 10.0, kInk, 1.0);
+    text(cr, x0 + 300.0, by + 24.0, fixed(hi, 4), 10.0, kInk, 1.0);
     text(cr, x0 + 330.0, by + 10.0, "no workspace", 10.0, kInk, 0.0);
     if (top) {
       text(cr, x0, by + 42.0,
-           "best " + fmt("%.4f", hi) + " (circle) at (r1, r2, r3) = (" + fmt("%.3f", top->point.r1) + ", " +
-               fmt("%.3f", top->point.r2) + ", " + fmt("%.3f", top->point.r3) + ")",
+           "best " + fixed(hi, 4) + " (circle) at (r1, r2, r3) = (" + fixed(top->point.r1, 3) + ", " +
+               fixed(top->point.r2, 3) + ", " + fixed(top->point.r3, 3) + ")",
            11.0, kInk);
     }
     if (atlas.station) {
       const AtlasStation& s = *atlas.station;
       const bool ok = s.figures.status == AtlasStatus::ok;
       text(cr, x0, by + 60.0,
-           "station " + s.station + " (cross): " + (ok ? fmt("%.4f", fig.value(s.figures)) : std::string("no workspace")),
+           "station " + s.station + " (cross): " + (ok ? fixed(fig.value(s.figures), 4) : std::string("no workspace")),
            11.0, kInk, 0.0, true);
       if (k == 0) {
         text(cr, x0, by + 78.0,
-             "at (r1, r2, r3) = (" + fmt("%.3f", s.point.r1) + ", " + fmt("%.3f", s.point.r2) + ", " +
-                 fmt("%.3f", s.point.r3) + "), D = " + fmt("%.2f", s.point.D_mm) + " mm",
+             "at (r1, r2, r3) = (" + fixed(s.point.r1, 3) + ", " + fixed(s.point.r2, 3) + ", " +
+                 fixed(s.point.r3, 3) + "), D = " + fixed(s.point.D_mm, 2) + " mm",
              10.5, kInk);
         if (ok) {
           text(cr, x0, by + 96.0,
-               "its own target: " + fmt("%.4f", s.target_scale) + " D (" +
-                   fmt("%.1f", 100.0 * s.target_scale / s.figures.scale) + " % of s*); s* = " +
-                   fmt("%.2f", s.figures.scale * s.point.D_mm) + " mm, limited by the " + s.figures.limited_by,
+               "its own target: " + fixed(s.target_scale, 4) + " D (" +
+                   fixed(100.0 * s.target_scale / s.figures.scale, 1) + " % of s*); s* = " +
+                   fixed(s.figures.scale * s.point.D_mm, 2) + " mm, limited by the " + s.figures.limited_by,
                10.5, kInk);
         }
         text(cr, x0, by + 114.0,
-             "veiled: designs whose s* is below the station's target (" + fmt("%.4f", s.target_scale) + " D)", 10.0,
+             "veiled: designs whose s* is below the station's target (" + fixed(s.target_scale, 4) + " D)", 10.0,
              kGrey);
       } else {
         text(cr, x0, by + 78.0,
              std::string("over its own target: ") + (k == 1 ? "min LCI " : "") +
-                 fmt("%.4f", k == 1 ? s.target_min_lci : s.target_min_transmission_sin),
+                 fixed(k == 1 ? s.target_min_lci : s.target_min_transmission_sin, 4),
              10.5, kInk);
         // The best design that holds the station's target.
         const AtlasCell* held = nullptr;
@@ -274,9 +272,9 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
         }
         if (held) {
           text(cr, x0, by + 96.0,
-               "best holding its target: " + fmt("%.4f", fig.value(held->figures)) + " at (" +
-                   fmt("%.3f", held->point.r1) + ", " + fmt("%.3f", held->point.r2) + ", " +
-                   fmt("%.3f", held->point.r3) + ")",
+               "best holding its target: " + fixed(fig.value(held->figures), 4) + " at (" +
+                   fixed(held->point.r1, 3) + ", " + fixed(held->point.r2, 3) + ", " +
+                   fixed(held->point.r3, 3) + ")",
                10.5, kInk);
         }
       }

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "fivebar/collision.hpp"
 #include "plot/tactor_canvas.hpp"
 
@@ -19,11 +20,8 @@ constexpr double kLeft = 50.0;
 constexpr double kTop = 78.0;
 constexpr double kGap = 70.0;
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+using format::fixed;
+using format::general;
 
 std::array<double, 4> ellipse_bounds(const Ellipse& e, double pad) {
   const double r = 0.5 * std::max(e.axes.x(), e.axes.y());
@@ -68,12 +66,12 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
 
   text(cr, kLeft, 28.0, "Collision map — station " + s.name, 19.0, kInk, 0.0, true);
   std::string summary = std::to_string(map.points.size()) + " tactor positions in the target ellipse (grid " +
-                        fmt("%g", map.spacing_mm) + " mm), " + std::to_string(map.pairs) + " usable pairs: " +
-                        fmt("%.1f", 100.0 * map.colliding_fraction) + " % collide (clearance < " +
-                        fmt("%g", g.min_clearance) + " mm).";
+                        general(map.spacing_mm) + " mm), " + std::to_string(map.pairs) + " usable pairs: " +
+                        fixed(100.0 * map.colliding_fraction, 1) + " % collide (clearance < " +
+                        general(g.min_clearance) + " mm).";
   text(cr, kLeft, 50.0, summary, 12.5, kInk);
-  std::string sep = map.any_free ? "Closest collision-free pair: " + fmt("%.2f", map.min_free_separation_mm) + " mm apart" : "No collision-free pair";
-  if (map.any_colliding) sep += ";  every pair farther apart than " + fmt("%.2f", map.max_colliding_separation_mm) + " mm is free.";
+  std::string sep = map.any_free ? "Closest collision-free pair: " + fixed(map.min_free_separation_mm, 2) + " mm apart" : "No collision-free pair";
+  if (map.any_colliding) sep += ";  every pair farther apart than " + fixed(map.max_colliding_separation_mm, 2) + " mm is free.";
   text(cr, kLeft, 67.0, sep, 12.5, kInk);
 
   // (a) Fraction of lower positions colliding, per upper position.
@@ -84,7 +82,7 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
     text(cr, x0, kTop + 14.0, "(a) upper tactor here: share of lower positions that collide", 12.0, kInk, 0.0, true);
     cells(cr, panel, map, [&](std::size_t i) -> std::optional<Rgb> {
       if (!map.upper_ok[i]) return kGrey;
-      return ramp_colour(map.upper_fraction[i]);
+      return viridis(map.upper_fraction[i]);
     });
     ellipse_outline(cr, panel, map.target);
     axes(cr, panel, b, 2.0);
@@ -92,7 +90,7 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
     const double by = kTop + kPanel + 30.0;
     for (int k = 0; k < 100; ++k) {
       cairo_rectangle(cr, x0 + 40.0 + 3.0 * k, by, 3.2, 12.0);
-      set_colour(cr, ramp_colour(k / 99.0));
+      set_colour(cr, viridis(k / 99.0));
       cairo_fill(cr);
     }
     text(cr, x0 + 36.0, by + 10.0, "0 %", 10.0, kInk, 1.0);
@@ -117,11 +115,11 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
     const Pose centre_up = map.centre_rule.upper;
     if (centre_up.status != Status::unreachable) {
       panel.begin();
-      fill_outline(cr, link_outline(*s.upper, centre_up, g), kUpperColour, 0.45);
+      fill_outline(cr, link_outline(*s.upper, centre_up, g), kUpper, 0.45);
       panel.end();
       const auto c = panel.px(centre_up.P);
       cairo_arc(cr, c[0], c[1], 0.5 * g.tactor_diameter * panel.scale(), 0.0, 2.0 * std::numbers::pi);
-      set_colour(cr, kUpperColour, 0.9);
+      set_colour(cr, kUpper, 0.9);
       cairo_set_line_width(cr, 1.5);
       cairo_stroke(cr);
     }
@@ -130,11 +128,11 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
       const auto to = panel.px(map.centre_rule.lower_point);
       cairo_move_to(cr, from[0], from[1]);
       cairo_line_to(cr, to[0], to[1]);
-      set_colour(cr, kLowerColour);
+      set_colour(cr, kLower);
       cairo_set_line_width(cr, 2.0);
       cairo_stroke(cr);
       cairo_arc(cr, to[0], to[1], 0.5 * g.tactor_diameter * panel.scale(), 0.0, 2.0 * std::numbers::pi);
-      set_colour(cr, kLowerColour, 0.9);
+      set_colour(cr, kLower, 0.9);
       cairo_stroke(cr);
       cairo_arc(cr, to[0], to[1], 3.0, 0.0, 2.0 * std::numbers::pi);
       cairo_fill(cr);
@@ -153,7 +151,7 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
     key(x0 + 150.0, Rgb{0.85, 0.85, 0.85}, "not usable (lower)");
     std::string rule = "priority rule, both targets at the centre: " + std::string(to_string(map.centre_rule.status));
     if (map.centre_rule.status == PriorityStatus::moved) {
-      rule += ", lower moved " + fmt("%.2f", map.centre_rule.moved_mm) + " mm (red)";
+      rule += ", lower moved " + fixed(map.centre_rule.moved_mm, 2) + " mm (red)";
     }
     text(cr, x0 + 10.0, by + 30.0, rule, 10.5, kInk);
   }
@@ -174,15 +172,15 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
       if (bin.pairs == 0) continue;
       const double f = double(bin.colliding) / double(bin.pairs);
       cairo_rectangle(cr, X(bin.lo_mm) + 0.5, Y(f), X(bin.hi_mm) - X(bin.lo_mm) - 1.0, Y(0.0) - Y(f));
-      set_colour(cr, ramp_colour(f));
+      set_colour(cr, viridis(f));
       cairo_fill(cr);
     }
     for (int k = 0; k <= 4; ++k) {
       const double f = 0.25 * k;
-      text(cr, x0 - 4.0, Y(f) + 3.5, fmt("%.0f %%", 100.0 * f), 10.0, kGrey, 1.0);
+      text(cr, x0 - 4.0, Y(f) + 3.5, (fixed(100.0 * f, 0) + " %"), 10.0, kGrey, 1.0);
     }
     for (double mm = 0.0; mm <= max_sep + 1e-9; mm += 2.0) {
-      text(cr, X(mm), y0 + h + 13.0, fmt("%g", mm), 10.0, kGrey, 0.5);
+      text(cr, X(mm), y0 + h + 13.0, general(mm), 10.0, kGrey, 0.5);
     }
     text(cr, x0 + 0.5 * w, y0 + h + 28.0, "tactor separation |P_upper - P_lower| (mm)", 11.0, kInk, 0.5);
     const auto vline = [&](double mm, const Rgb& c, const std::string& label, double ty) {
@@ -203,8 +201,8 @@ RenderedPlot plot_collision_map(const Station& s, const Geometry& g, const Colli
       cairo_fill(cr);
       text(cr, tx, ty, label, 10.5, c);
     };
-    if (map.any_free) vline(map.min_free_separation_mm, Rgb{0.10, 0.50, 0.20}, "closest free pair " + fmt("%.2f", map.min_free_separation_mm) + " mm", y0 + h - 30.0);
-    if (map.any_colliding) vline(map.max_colliding_separation_mm, kLowerColour, "farthest colliding pair " + fmt("%.2f", map.max_colliding_separation_mm) + " mm", y0 + 16.0);
+    if (map.any_free) vline(map.min_free_separation_mm, Rgb{0.10, 0.50, 0.20}, "closest free pair " + fixed(map.min_free_separation_mm, 2) + " mm", y0 + h - 30.0);
+    if (map.any_colliding) vline(map.max_colliding_separation_mm, kLower, "farthest colliding pair " + fixed(map.max_colliding_separation_mm, 2) + " mm", y0 + 16.0);
   }
   return canvas.render();
 }

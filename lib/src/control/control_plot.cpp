@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "fivebar/control.hpp"
 #include "fivebar/error.hpp"
 #include "plot/tactor_canvas.hpp"
@@ -23,11 +24,8 @@ constexpr double kGap = 70.0;
 constexpr Rgb kUnstable{0.80, 0.10, 0.10};
 constexpr Rgb kOutside{0.88, 0.88, 0.88};
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+using format::fixed;
+using format::general;
 
 /// The colour scale: [lo, hi] of the finite rho below 1 over every field (one scale for the
 /// picture), red at and above 1.
@@ -35,7 +33,7 @@ struct Scale {
   double lo = 0.0, hi = 1.0;
   Rgb operator()(double rho) const {
     if (rho >= 1.0) return kUnstable;
-    return ramp_colour(hi > lo ? std::clamp((rho - lo) / (hi - lo), 0.0, 1.0) : 1.0);
+    return viridis(hi > lo ? std::clamp((rho - lo) / (hi - lo), 0.0, 1.0) : 1.0);
   }
 };
 
@@ -80,7 +78,7 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
            station.target.center.y() + r};
     }
     const Panel panel(cr, x0, kTop + 22.0, kPanel, kPanel - 22.0, b);
-    const Rgb ink = map.mechanism == "upper" ? kUpperColour : kLowerColour;
+    const Rgb ink = map.mechanism == "upper" ? kUpper : kLower;
     text(cr, x0, kTop + 14.0,
          "(" + std::string(1, char('a' + k)) + ") " + map.mechanism + " mechanism: ρ over its reachable region",
          12.0, kInk, 0.0, true);
@@ -144,7 +142,7 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
       cairo_arc(cr, w[0], w[1], 10.0, 0.0, 2.0 * std::numbers::pi);
       set_colour(cr, ink);
       cairo_stroke(cr);
-      const std::string label = "worst ρ = " + fmt("%.4f", map.max_rho);
+      const std::string label = "worst ρ = " + fixed(map.max_rho, 4);
       const double tw = text_width(cr, label, 11.0, true);
       cairo_rectangle(cr, w[0] + 10.0, w[1] - 21.0, tw + 6.0, 17.0);
       set_colour(cr, Rgb{1.0, 1.0, 1.0}, 0.85);
@@ -163,24 +161,24 @@ RenderedPlot stability_plot(const Station& station, const std::vector<StabilityM
     cairo_rectangle(cr, x0 + 343.0, by, 20.0, 12.0);
     set_colour(cr, kUnstable);
     cairo_fill(cr);
-    text(cr, x0 + 36.0, by + 10.0, fmt("%.4f", colour.lo), 10.0, kInk, 1.0);
-    text(cr, x0 + 340.0, by + 24.0, fmt("%.4f", colour.hi), 10.0, kInk, 1.0);
+    text(cr, x0 + 36.0, by + 10.0, fixed(colour.lo, 4), 10.0, kInk, 1.0);
+    text(cr, x0 + 340.0, by + 24.0, fixed(colour.hi, 4), 10.0, kInk, 1.0);
     text(cr, x0 + 368.0, by + 10.0, "≥ 1 unstable", 10.0, kInk, 0.0);
     (void)kOutside;
     const std::string verdict = map.stable ? "stable over the target" : "UNSTABLE on the target";
     text(cr, x0, by + 34.0,
-         verdict + ": max ρ " + fmt("%.4f", map.max_rho) + " at (" + fmt("%.2f", map.worst_P_mm().x()) + ", " +
-             fmt("%.2f", map.worst_P_mm().y()) + ") mm over " + std::to_string(map.poses.size() - map.not_ok) +
+         verdict + ": max ρ " + fixed(map.max_rho, 4) + " at (" + fixed(map.worst_P_mm().x(), 2) + ", " +
+             fixed(map.worst_P_mm().y(), 2) + ") mm over " + std::to_string(map.poses.size() - map.not_ok) +
              " poses",
          11.0, map.stable ? kInk : kUnstable, 0.0, true);
     text(cr, x0, by + 52.0,
-         "dominant pole: damping " + fmt("%.3f", map.damping) + ", " + fmt("%.2f", map.frequency_hz) +
-             " Hz; least-damped oscillation: " + fmt("%.3f", map.oscillatory_damping) + " at " +
-             fmt("%.2f", map.oscillatory_frequency_hz) + " Hz",
+         "dominant pole: damping " + fixed(map.damping, 3) + ", " + fixed(map.frequency_hz, 2) +
+             " Hz; least-damped oscillation: " + fixed(map.oscillatory_damping, 3) + " at " +
+             fixed(map.oscillatory_frequency_hz, 2) + " Hz",
          11.0, kInk);
     text(cr, x0, by + 70.0,
-         "gain margins (factor keeping max ρ < 1): kp ×" + fmt("%.3g", map.kp_margin) + ", kd ×" +
-             fmt("%.3g", map.kd_margin),
+         "gain margins (factor keeping max ρ < 1): kp ×" + general(map.kp_margin, 3) + ", kd ×" +
+             general(map.kd_margin, 3),
          11.0, kInk);
     text(cr, x0, by + 88.0, "dashed: target ellipse; blank: unreachable, singular or outside the joint limits", 10.0,
          kGrey);

@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "plot/canvas.hpp"
+#include "plot/style.hpp"
 
 namespace fivebar::detail {
 
@@ -16,8 +17,8 @@ namespace {
 constexpr double kWidth = 900, kHeight = 600;
 
 using plot_detail::text;
-using plot_detail::tick_step;
-std::string fmt(double v) { return plot_detail::tick_label(v); }
+using style::tick_step;
+std::string fmt(double v) { return style::tick_label(v); }
 
 }  // namespace
 

@@ -676,8 +676,9 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       // Stopped before every island had its first population: the candidates so far are the
       // result, and there is no state to resume from.
       if (!(options.stop && options.stop->load())) {
-        throw InputError("optimize: the wall-time budget (optimize.seconds or --seconds: " + format::shortest(seconds_budget) +
-                         " s) ran out before the initial populations were evaluated");
+        throw InputError("optimize: the wall-time budget (optimize.seconds: " + format::shortest(seconds_budget) +
+                             " s) ran out before the initial populations were evaluated",
+                         Remedy::longer_budget);
       }
       OptimizeResult r;
       r.algorithm = alg;
@@ -803,8 +804,9 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
       }
       if (j.at("interrupted").get<bool>()) {
         throw InputError(path.string() + ": shard " + std::to_string(k) + " of " + std::to_string(shards) +
-                         " was interrupted: finish it first (fivebar optimize --shard " + std::to_string(k) + "/" +
-                         std::to_string(shards) + " --resume), then merge");
+                         " was interrupted: finish it first (resume shard " + std::to_string(k) + "/" +
+                             std::to_string(shards) + "), then merge",
+                         Remedy::resume_shard);
       }
       const Json& cs = j.at("candidates");
       if (j.contains("candidate_count") && j.at("candidate_count").get<std::uint64_t>() != cs.size()) {

@@ -672,7 +672,8 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
       const bool on_path = name.find('/') == std::string::npos;
       throw ToolError("'" + name + "' not found" + (on_path ? " on PATH" : "") +
                       ": rendering the parts to STL needs OpenSCAD (Debian: apt-get install openscad; "
-                      "or set FIVEBAR_OPENSCAD). --no-render writes the .scad sources only.");
+                      "or set FIVEBAR_OPENSCAD); without rendering, the .scad sources alone can be written",
+                      Remedy::without_rendering);
     }
   }
   const fs::path scad_dir = options.scad_dir.empty() ? default_scad_dir() : options.scad_dir;

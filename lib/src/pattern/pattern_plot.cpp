@@ -22,11 +22,8 @@ constexpr double kHeader = 62.0;
 constexpr double kFooter = 70.0;
 constexpr double kPadMm = 4.0;  // around the target ellipse
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+using format::fixed;
+using format::general;
 
 void marker_x(cairo_t* cr, const std::array<double, 2>& p, double r, const Rgb& c, double width) {
   set_colour(cr, c);
@@ -104,22 +101,22 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
   std::string verdict;
   Rgb verdict_colour{0.10, 0.50, 0.20};
   if (r.passed) {
-    verdict = "renderable: " + std::to_string(r.samples.size()) + " samples at " + fmt("%g", r.spec.rate_hz) +
-              " Hz, min clearance " + fmt("%.2f", r.min_clearance_mm) + " mm";
+    verdict = "renderable: " + std::to_string(r.samples.size()) + " samples at " + general(r.spec.rate_hz) +
+              " Hz, min clearance " + fixed(r.min_clearance_mm, 2) + " mm";
   } else {
     verdict_colour = {0.75, 0.10, 0.10};
     verdict = "NOT renderable: " + std::string(to_string(r.first_failure->status)) + " at t = " +
-              fmt("%.2f", r.first_failure->time_s) + " s (" + r.first_failure->mechanism + ")";
+              fixed(r.first_failure->time_s, 2) + " s (" + r.first_failure->mechanism + ")";
   }
   text(cr, x0 + kMargin, y0 + 42.0, verdict, 12.0, verdict_colour);
   std::string params;
   if (r.spec.kind == PatternKind::pivot) {
-    params = "amplitude " + fmt("%g", r.spec.pivot_amplitude * format::kDegPerRad) + " deg, " +
-             fmt("%g", r.spec.pivot_frequency_hz) + " Hz, ";
+    params = "amplitude " + general(r.spec.pivot_amplitude * format::kDegPerRad) + " deg, " +
+             general(r.spec.pivot_frequency_hz) + " Hz, ";
   } else {
-    params = "amplitude " + fmt("%g", r.spec.amplitude_mm) + " mm, ";
+    params = "amplitude " + general(r.spec.amplitude_mm) + " mm, ";
   }
-  params += "duration " + fmt("%g", r.spec.duration_s) + " s, separation " + fmt("%g", r.spec.separation_mm) + " mm";
+  params += "duration " + general(r.spec.duration_s) + " s, separation " + general(r.spec.separation_mm) + " mm";
   text(cr, x0 + kMargin, y0 + 57.0, params, 11.0, kGrey);
 
   // Everything inside the panel is clipped to it.
@@ -131,17 +128,17 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
   panel.begin();
   region_path(cr, low_region);
   panel.end();
-  set_colour(cr, kLowerColour, 0.07);
+  set_colour(cr, kLower, 0.07);
   cairo_fill_preserve(cr);
-  set_colour(cr, kLowerColour, 0.45);
+  set_colour(cr, kLower, 0.45);
   cairo_set_line_width(cr, 1.0);
   cairo_stroke(cr);
   panel.begin();
   region_path(cr, up_region);
   panel.end();
-  set_colour(cr, kUpperColour, 0.07);
+  set_colour(cr, kUpper, 0.07);
   cairo_fill_preserve(cr);
-  set_colour(cr, kUpperColour, 0.45);
+  set_colour(cr, kUpper, 0.45);
   cairo_set_line_width(cr, 1.0);
   cairo_stroke(cr);
   panel.begin();
@@ -161,10 +158,10 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
     const PatternSample& first = r.samples.front();
     const PatternSample& last = r.samples.back();
     panel.begin();
-    if (first.upper.pose.status != Status::unreachable) fill_outline(cr, link_outline(up, first.upper.pose, g), kUpperColour, 0.22);
-    if (first.lower.pose.status != Status::unreachable) fill_outline(cr, link_outline(low, first.lower.pose, g), kLowerColour, 0.22);
-    if (last.upper.pose.status != Status::unreachable) link_lines(cr, up, last.upper.pose, kUpperColour, 1.4, 0.8, true);
-    if (last.lower.pose.status != Status::unreachable) link_lines(cr, low, last.lower.pose, kLowerColour, 1.4, 0.8, true);
+    if (first.upper.pose.status != Status::unreachable) fill_outline(cr, link_outline(up, first.upper.pose, g), kUpper, 0.22);
+    if (first.lower.pose.status != Status::unreachable) fill_outline(cr, link_outline(low, first.lower.pose, g), kLower, 0.22);
+    if (last.upper.pose.status != Status::unreachable) link_lines(cr, up, last.upper.pose, kUpper, 1.4, 0.8, true);
+    if (last.lower.pose.status != Status::unreachable) link_lines(cr, low, last.lower.pose, kLower, 1.4, 0.8, true);
     panel.end();
   }
 
@@ -173,14 +170,14 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
   const auto up_target = [&](std::size_t k) { return r.samples[k].upper.target; };
   const auto low_target = [&](std::size_t k) { return r.samples[k].lower.target; };
   const auto low_point = [&](std::size_t k) { return r.samples[k].lower.point; };
-  polyline(cr, panel, n, up_target, kUpperColour, 3.2, 1.0);
-  polyline(cr, panel, n, low_target, kLowerColour, 3.2, 1.0);
-  path_arrow(cr, panel, n, up_target, kUpperColour);
-  path_arrow(cr, panel, n, low_target, kLowerColour);
+  polyline(cr, panel, n, up_target, kUpper, 3.2, 1.0);
+  polyline(cr, panel, n, low_target, kLower, 3.2, 1.0);
+  path_arrow(cr, panel, n, up_target, kUpper);
+  path_arrow(cr, panel, n, low_target, kLower);
   if (r.moved_samples > 0) {
-    polyline(cr, panel, n, low_point, kMovedColour, 2.0, 1.0);
+    polyline(cr, panel, n, low_point, kMoved, 2.0, 1.0);
     for (std::size_t k = 0; k < n; ++k) {
-      if (r.samples[k].moved_mm > 0.0) dot(cr, panel.px(r.samples[k].lower.point), 2.2, kMovedColour, kMovedColour);
+      if (r.samples[k].moved_mm > 0.0) dot(cr, panel.px(r.samples[k].lower.point), 2.2, kMoved, kMoved);
     }
   }
   if (n > 0) {
@@ -194,10 +191,10 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
       cairo_set_line_width(cr, 1.2);
       cairo_stroke(cr);
     };
-    draw_tactor(r.samples.front().upper.point, kUpperColour);
-    draw_tactor(r.samples.front().lower.point, kLowerColour);
-    dot(cr, panel.px(r.samples.front().upper.target), 3.5, {1, 1, 1}, kUpperColour);
-    dot(cr, panel.px(r.samples.front().lower.target), 3.5, {1, 1, 1}, kLowerColour);
+    draw_tactor(r.samples.front().upper.point, kUpper);
+    draw_tactor(r.samples.front().lower.point, kLower);
+    dot(cr, panel.px(r.samples.front().upper.target), 3.5, {1, 1, 1}, kUpper);
+    dot(cr, panel.px(r.samples.front().lower.target), 3.5, {1, 1, 1}, kLower);
   }
   for (std::size_t k = 0; k < n; ++k) {
     const PatternSample& sample = r.samples[k];
@@ -216,15 +213,15 @@ void draw_panel(cairo_t* cr, const Station& s, const Geometry& g, const Region& 
 
   // Footer: the worst margins.
   const double fy = panel.y() + panel.h() + 32.0;
-  std::string line1 = "min LCI upper " + fmt("%.3f", r.min_lci[0]) + ", lower " + fmt("%.3f", r.min_lci[1]) +
-                      ";  peak motor speed " + fmt("%.0f", r.peak_joint_speed * format::kDegPerRad) +
-                      " deg/s (limit " + fmt("%.0f", r.max_joint_speed * format::kDegPerRad) + ")";
+  std::string line1 = "min LCI upper " + fixed(r.min_lci[0], 3) + ", lower " + fixed(r.min_lci[1], 3) +
+                      ";  peak motor speed " + fixed(r.peak_joint_speed * format::kDegPerRad, 0) +
+                      " deg/s (limit " + fixed(r.max_joint_speed * format::kDegPerRad, 0) + ")";
   text(cr, x0 + kMargin, fy, line1, 11.0, kInk);
   std::string line2 = r.moved_samples > 0 ? "priority rule moved the lower target in " +
                                                 std::to_string(r.moved_samples) + " samples, by up to " +
-                                                fmt("%.2f", r.max_moved_mm) + " mm (orange)"
+                                                fixed(r.max_moved_mm, 2) + " mm (orange)"
                                           : "no collision: the priority rule never moved the lower target";
-  text(cr, x0 + kMargin, fy + 16.0, line2, 11.0, r.moved_samples > 0 ? kMovedColour : kInk);
+  text(cr, x0 + kMargin, fy + 16.0, line2, 11.0, r.moved_samples > 0 ? kMoved : kInk);
 }
 
 }  // namespace
@@ -270,9 +267,9 @@ RenderedPlot plot_patterns(const Station& s, const Geometry& g, const std::vecto
     text(cr, lx, ly, label, 11.0, kGrey);
     lx += w;
   };
-  swatch(kUpperColour, 3.2, "upper tactor path");
-  swatch(kLowerColour, 3.2, "lower tactor path");
-  swatch(kMovedColour, 2.0, "lower, moved by the priority rule");
+  swatch(kUpper, 3.2, "upper tactor path");
+  swatch(kLower, 3.2, "lower tactor path");
+  swatch(kMoved, 2.0, "lower, moved by the priority rule");
   lx = right;  // the notes start on a new line
   for (const char* item : {"filled: links at the start", "dashed: links at the end", "shaded: reachable regions",
                         "dashed ellipse: fingertip target", "x: failing sample"}) {

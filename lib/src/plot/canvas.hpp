@@ -88,21 +88,4 @@ inline void text(cairo_t* cr, double x, double y, const std::string& s, double s
   cairo_show_text(cr, s.c_str());
 }
 
-/// A "nice" tick step for a range (1, 2 or 5 times a power of ten), about 6 ticks.
-inline double tick_step(double span) {
-  const double raw = span / 6.0;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0}) {
-    if (raw <= m * p) return m * p;
-  }
-  return 10 * p;
-}
-
-/// A tick label: four significant digits, no "-0".
-inline std::string tick_label(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", std::fabs(v) < 1e-12 ? 0.0 : v);
-  return buf;
-}
-
 }  // namespace fivebar::plot_detail

@@ -189,15 +189,4 @@ void axes(cairo_t* cr, const Panel& panel, std::array<double, 4> b, double step)
   cairo_restore(cr);
 }
 
-Rgb ramp_colour(double t) {
-  // Dark blue -> teal -> yellow (perceptually ordered, readable in grey).
-  t = std::clamp(t, 0.0, 1.0);
-  const Rgb stops[3] = {{0.18, 0.10, 0.42}, {0.13, 0.57, 0.55}, {0.99, 0.91, 0.15}};
-  const double s = t * 2.0;
-  const int i = std::min(1, static_cast<int>(s));
-  const double f = s - i;
-  return {stops[i].r + f * (stops[i + 1].r - stops[i].r), stops[i].g + f * (stops[i + 1].g - stops[i].g),
-          stops[i].b + f * (stops[i + 1].b - stops[i].b)};
-}
-
 }  // namespace fivebar::tactor_plot

@@ -1,5 +1,6 @@
 #pragma once
-// A small cairo canvas for the collision-map and pattern pictures (private to lib; cairo stays in
+// A small cairo canvas for the pictures of the studies (collision, pattern, simulate, control,
+// tolerance, identify, atlas) (private to lib; cairo stays in
 // lib/src/plot/). Drawing goes to a recording surface that render() replays into SVG and PNG
 // bytes; panels map millimetres (y up) to pixels with equal aspect.
 
@@ -12,17 +13,12 @@
 
 #include "fivebar/collision.hpp"
 #include "fivebar/workspace/region.hpp"
+#include "plot/style.hpp"
 
 namespace fivebar::tactor_plot {
 
-struct Rgb {
-  double r, g, b;
-};
-inline constexpr Rgb kUpperColour{0.16, 0.38, 0.78};   // blue
-inline constexpr Rgb kLowerColour{0.82, 0.18, 0.16};   // red
-inline constexpr Rgb kMovedColour{0.95, 0.55, 0.05};   // orange
-inline constexpr Rgb kInk{0.12, 0.12, 0.12};
-inline constexpr Rgb kGrey{0.55, 0.55, 0.55};
+// Colours, the colour map and the tick rule are the house style's (plot/style.hpp).
+using namespace fivebar::style;
 
 /// Whole picture: a white page of width x height pixels.
 class Canvas {
@@ -81,7 +77,5 @@ void link_lines(cairo_t* cr, const Mechanism& m, const Pose& pose, const Rgb& c,
                 bool dashed);
 /// Axis ticks and labels (mm) along the panel's bottom and left edges.
 void axes(cairo_t* cr, const Panel& panel, std::array<double, 4> bounds_mm, double step_mm);
-/// A colour from a blue-to-yellow ramp for t in [0, 1].
-Rgb ramp_colour(double t);
 
 }  // namespace fivebar::tactor_plot

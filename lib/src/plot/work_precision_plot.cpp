@@ -1,6 +1,7 @@
 // Work-precision plots with cairo (SVG and PNG surfaces, written to memory).
 #include "plot/work_precision_plot.hpp"
 #include "plot/canvas.hpp"
+#include "plot/style.hpp"
 
 #include <cairo-svg.h>
 #include <cairo.h>
@@ -20,14 +21,8 @@ constexpr double kWidth = 1100, kHeight = 680;
 constexpr double kLeft = 100, kRight = 770, kTop = 60, kBottom = 590;  // plot area
 constexpr double kLegendX = 790;
 
-struct Rgb {
-  double r, g, b;
-};
-// Tableau 10: distinguishable, colour-blind friendlier than the defaults.
-constexpr Rgb kPalette[] = {{0.122, 0.467, 0.706}, {1.000, 0.498, 0.055}, {0.173, 0.627, 0.173},
-                            {0.839, 0.153, 0.157}, {0.580, 0.404, 0.741}, {0.549, 0.337, 0.294},
-                            {0.890, 0.467, 0.761}, {0.498, 0.498, 0.498}, {0.737, 0.741, 0.133},
-                            {0.090, 0.745, 0.812}};
+using style::Rgb;
+constexpr const Rgb (&kPalette)[10] = style::kSeries;  // the house style's series colours
 
 struct Axis {
   double lo, hi;  ///< log10 range, whole decades

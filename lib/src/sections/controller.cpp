@@ -70,19 +70,6 @@ void Potentiometer::validate() const {
   if (travel) require_travel("travel_deg", *travel);
 }
 
-std::string ControlOverride::key() const {
-  std::string k = station.empty() ? std::string("mechanisms") : detail::key_child("stations", station);
-  if (!mechanism.empty()) k = detail::key_join(k, mechanism);
-  if (joint != 0) k = detail::key_join(k, "theta" + std::to_string(joint));
-  return k;
-}
-
-int ControlOverride::level() const {
-  if (station.empty()) return joint == 0 ? 0 : 1;
-  if (mechanism.empty()) return 2;
-  return joint == 0 ? 3 : 4;
-}
-
 JointControl ControllerSettings::joint(std::string_view station, std::string_view mechanism, int j) const {
   JointControl out{pid, potentiometer};
   const auto apply = [&out](const ControlOverride& o) {
@@ -94,16 +81,7 @@ JointControl ControllerSettings::joint(std::string_view station, std::string_vie
     if (o.rad_per_volt) out.potentiometer.rad_per_volt = *o.rad_per_volt;
     if (o.travel) out.potentiometer.travel = *o.travel;
   };
-  // Widest scope first, so that the narrower keys win whatever the order of the list.
-  for (int level = 0; level <= 4; ++level) {
-    for (const ControlOverride& o : overrides) {
-      if (o.level() != level) continue;
-      if (!o.station.empty() && o.station != station) continue;
-      if (!o.mechanism.empty() && o.mechanism != mechanism) continue;
-      if (o.joint != 0 && o.joint != j) continue;
-      apply(o);
-    }
-  }
+  apply_overrides(overrides, station, mechanism, j, apply);
   return out;
 }
 
@@ -206,16 +184,8 @@ void ControllerSettings::validate() const {
   rules::validate_nested("potentiometer", [&] { potentiometer.validate(); });
   if (tune) rules::validate_nested("tune", [&] { tune->validate(); });
   for (const ControlOverride& o : overrides) {
+    o.validate();
     const std::string scope = o.key();
-    if (!o.mechanism.empty() && o.mechanism != "lower" && o.mechanism != "upper") {
-      throw ValidationError(scope, "mechanism " + detail::quoted(o.mechanism) + " must be lower or upper");
-    }
-    if (o.station.empty() && o.mechanism.empty()) {
-      throw ValidationError(scope, "an override names a station, a mechanism (lower, upper) or both");
-    }
-    if (o.joint < 0 || o.joint > 2 || (o.joint != 0 && o.mechanism.empty())) {
-      throw ValidationError(scope, "joint " + std::to_string(o.joint) + " must be 1 or 2 within a mechanism");
-    }
     const auto at = [&](std::string_view what) { return detail::key_join(scope, what); };
     if (o.kp) require_gain(at("pid.kp"), *o.kp, "per rad");
     if (o.ki) require_gain(at("pid.ki"), *o.ki, "per rad s");
@@ -359,18 +329,7 @@ void validate(const Design& design) {
   const ControllerSettings* controller = design.get<ControllerSettings>();
   if (controller == nullptr) return;
   rules::validate_nested("controller", [&] { controller->validate(); });
-  for (const ControlOverride& o : controller->overrides) {
-    if (o.station.empty()) continue;  // every station's lower / upper: none is fine
-    const Station* st = design.station(o.station);
-    const std::string key = detail::key_join("controller", o.key());
-    if (st == nullptr) {
-      throw ValidationError(detail::key_join("controller", detail::key_child("stations", o.station)),
-                            "no such station in this design (stations: " + rules::station_list(design) + ")");
-    }
-    if (!o.mechanism.empty() && st->mechanism(o.mechanism) == nullptr) {
-      throw ValidationError(key, "station " + detail::quoted(o.station) + " has no " + o.mechanism + " mechanism");
-    }
-  }
+  for (const ControlOverride& o : controller->overrides) o.validate_in(design, "controller");
 }
 
 // --- writer ----------------------------------------------------------------------------------

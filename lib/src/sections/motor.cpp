@@ -52,33 +52,13 @@ void MotorParams::validate() const {
   for (const MotorField& f : kFields) check_field(f, std::string(f.key), this->*f.member);
 }
 
-std::string MotorOverride::key() const {
-  std::string k = station.empty() ? std::string("mechanisms") : detail::key_child("stations", station);
-  if (!mechanism.empty()) k = detail::key_join(k, mechanism);
-  if (joint != 0) k = detail::key_join(k, "theta" + std::to_string(joint));
-  return k;
-}
-
-int MotorOverride::level() const {
-  if (station.empty()) return joint == 0 ? 0 : 1;
-  if (mechanism.empty()) return 2;
-  return joint == 0 ? 3 : 4;
-}
-
 MotorParams MotorSettings::joint(std::string_view station, std::string_view mechanism, int j) const {
   MotorParams out = defaults;
-  // Widest scope first, so that narrower keys win whatever the order of the list.
-  for (int level = 0; level <= 4; ++level) {
-    for (const MotorOverride& o : overrides) {
-      if (o.level() != level) continue;
-      if (!o.station.empty() && o.station != station) continue;
-      if (!o.mechanism.empty() && o.mechanism != mechanism) continue;
-      if (o.joint != 0 && o.joint != j) continue;
-      for (std::size_t i = 0; i < kMotorFieldCount; ++i) {
-        if (o.values[i]) out.*kFields[i].member = *o.values[i];
-      }
+  apply_overrides(overrides, station, mechanism, j, [&](const MotorOverride& o) {
+    for (std::size_t i = 0; i < kMotorFieldCount; ++i) {
+      if (o.values[i]) out.*kFields[i].member = *o.values[i];
     }
-  }
+  });
   return out;
 }
 
@@ -86,16 +66,8 @@ void MotorSettings::validate() const {
   if (model.empty() || model.size() > 200) throw ValidationError("model", "must be 1 ... 200 characters");
   defaults.validate();
   for (const MotorOverride& o : overrides) {
+    o.validate();
     const std::string scope = o.key();
-    if (!o.mechanism.empty() && o.mechanism != "lower" && o.mechanism != "upper") {
-      throw ValidationError(scope, "mechanism " + detail::quoted(o.mechanism) + " must be lower or upper");
-    }
-    if (o.station.empty() && o.mechanism.empty()) {
-      throw ValidationError(scope, "an override names a station, a mechanism (lower, upper) or both");
-    }
-    if (o.joint < 0 || o.joint > 2 || (o.joint != 0 && o.mechanism.empty())) {
-      throw ValidationError(scope, "joint " + std::to_string(o.joint) + " must be 1 or 2 within a mechanism");
-    }
     for (std::size_t i = 0; i < kMotorFieldCount; ++i) {
       if (o.values[i]) check_field(kFields[i], detail::key_join(scope, kFields[i].key), *o.values[i]);
     }
@@ -163,18 +135,7 @@ void validate(const Design& design) {
   const MotorSettings* motor = design.get<MotorSettings>();
   if (motor == nullptr) return;
   rules::validate_nested("motor", [&] { motor->validate(); });
-  for (const MotorOverride& o : motor->overrides) {
-    if (o.station.empty()) continue;
-    const Station* st = design.station(o.station);
-    if (st == nullptr) {
-      throw ValidationError(detail::key_join("motor", detail::key_child("stations", o.station)),
-                            "no such station in this design (stations: " + rules::station_list(design) + ")");
-    }
-    if (!o.mechanism.empty() && st->mechanism(o.mechanism) == nullptr) {
-      throw ValidationError(detail::key_join("motor", o.key()),
-                            "station " + detail::quoted(o.station) + " has no " + o.mechanism + " mechanism");
-    }
-  }
+  for (const MotorOverride& o : motor->overrides) o.validate_in(design, "motor");
 }
 
 bool has_values(const MotorOverride& o) {

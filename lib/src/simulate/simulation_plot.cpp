@@ -9,9 +9,11 @@
 #include <numbers>
 #include <string>
 
+#include "fivebar/format.hpp"
 #include "fivebar/dynamics.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/workspace/region.hpp"
+#include "plot/chart.hpp"
 #include "plot/tactor_canvas.hpp"
 
 namespace fivebar {
@@ -19,126 +21,19 @@ namespace fivebar {
 namespace {
 
 using namespace tactor_plot;
+using plot::Line;
+using plot::decimated_line;
 
 constexpr double kWidth = 1320.0, kHeight = 700.0;
 constexpr double kPadMm = 3.0;
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+using format::fixed;
+using format::general;
 
-/// A "nice" tick step for a span: 1, 2 or 5 x 10^k giving 4 to 10 ticks.
-double nice_step(double span) {
-  if (!(span > 0.0) || !std::isfinite(span)) return 1.0;
-  const double raw = span / 6.0;
-  const double p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (const double m : {1.0, 2.0, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10.0 * p;
-}
 
-struct Line {
-  std::vector<std::pair<double, double>> points;
-  Rgb colour;
-  double width;
-  bool dashed;
-  std::string label;
-};
 
-/// A linear chart in the page rectangle (x, y, w, h): frame, ticks, labels, lines, legend.
-void chart(cairo_t* cr, double x, double y, double w, double h, const std::string& title, const std::string& y_label,
-           const std::vector<Line>& lines, double t_end) {
-  double lo = 0.0, hi = 0.0;
-  for (const Line& l : lines)
-    for (const auto& p : l.points) {
-      lo = std::min(lo, p.second);
-      hi = std::max(hi, p.second);
-    }
-  if (hi - lo <= 0.0) hi = lo + 1.0;
-  const double pad = 0.05 * (hi - lo);
-  lo -= pad;
-  hi += pad;
-  const auto px = [&](double t, double v) {
-    return std::array<double, 2>{x + t / std::max(t_end, 1e-12) * w, y + h - (v - lo) / (hi - lo) * h};
-  };
-  text(cr, x, y - 10.0, title, 13.0, kInk, 0.0, true);
-  // Grid and ticks.
-  cairo_set_line_width(cr, 0.6);
-  const double ys = nice_step(hi - lo);
-  for (double v = std::ceil(lo / ys) * ys; v <= hi; v += ys) {
-    const auto p = px(0.0, v);
-    set_colour(cr, kGrey, 0.3);
-    cairo_move_to(cr, x, p[1]);
-    cairo_line_to(cr, x + w, p[1]);
-    cairo_stroke(cr);
-    text(cr, x - 6.0, p[1] + 4.0, fmt("%g", std::abs(v) < 1e-12 * ys ? 0.0 : v), 10.0, kInk, 1.0);
-  }
-  const double ts = nice_step(t_end);
-  for (double t = 0.0; t <= t_end * (1 + 1e-9); t += ts) {
-    const auto p = px(t, lo);
-    set_colour(cr, kGrey, 0.3);
-    cairo_move_to(cr, p[0], y);
-    cairo_line_to(cr, p[0], y + h);
-    cairo_stroke(cr);
-    text(cr, p[0], y + h + 14.0, fmt("%g", t), 10.0, kInk, 0.5);
-  }
-  set_colour(cr, kInk);
-  cairo_set_line_width(cr, 1.0);
-  cairo_rectangle(cr, x, y, w, h);
-  cairo_stroke(cr);
-  text(cr, x + w, y + h + 30.0, "time (s)", 11.0, kInk, 1.0);
-  // y label, rotated.
-  cairo_save(cr);
-  cairo_translate(cr, x - 44.0, y + 0.5 * h);
-  cairo_rotate(cr, -0.5 * std::numbers::pi);
-  text(cr, 0.0, 0.0, y_label, 11.0, kInk, 0.5);
-  cairo_restore(cr);
-  // Lines, clipped to the frame.
-  cairo_save(cr);
-  cairo_rectangle(cr, x, y, w, h);
-  cairo_clip(cr);
-  for (const Line& l : lines) {
-    if (l.points.empty()) continue;
-    set_colour(cr, l.colour, 0.95);
-    cairo_set_line_width(cr, l.width);
-    if (l.dashed) {
-      const double dash[2] = {5.0, 3.0};
-      cairo_set_dash(cr, dash, 2, 0.0);
-    }
-    bool first = true;
-    for (const auto& p : l.points) {
-      const auto q = px(p.first, p.second);
-      if (first) cairo_move_to(cr, q[0], q[1]);
-      else cairo_line_to(cr, q[0], q[1]);
-      first = false;
-    }
-    cairo_stroke(cr);
-    cairo_set_dash(cr, nullptr, 0, 0.0);
-  }
-  cairo_restore(cr);
-  // Legend along the top right, inside the frame.
-  double lx = x + w - 8.0;
-  for (auto it = lines.rbegin(); it != lines.rend(); ++it) {
-    const double tw = text_width(cr, it->label, 10.0);
-    lx -= tw + 34.0;
-    set_colour(cr, it->colour);
-    cairo_set_line_width(cr, it->width);
-    if (it->dashed) {
-      const double dash[2] = {5.0, 3.0};
-      cairo_set_dash(cr, dash, 2, 0.0);
-    }
-    cairo_move_to(cr, lx, y + 14.0);
-    cairo_line_to(cr, lx + 22.0, y + 14.0);
-    cairo_stroke(cr);
-    cairo_set_dash(cr, nullptr, 0, 0.0);
-    text(cr, lx + 26.0, y + 18.0, it->label, 10.0, kInk);
-  }
-}
 
-Rgb colour_of(const std::string& mechanism) { return mechanism == "upper" ? kUpperColour : kLowerColour; }
-Rgb darker(const Rgb& c) { return {0.55 * c.r, 0.55 * c.g, 0.55 * c.b}; }
+Rgb colour_of(const std::string& mechanism) { return style::mechanism_colour(mechanism); }
 
 }  // namespace
 
@@ -149,11 +44,11 @@ RenderedPlot plot_simulation(const Station& station, const SimulationInput& inpu
 
   // Header.
   text(cr, 20.0, 28.0, "simulate — " + station.name + ", " + input.reference_name, 18.0, kInk, 0.0, true);
-  std::string verdict = std::string(to_string(result.status)) + ": " + fmt("%.3f", result.t_end) + " s simulated in " +
+  std::string verdict = std::string(to_string(result.status)) + ": " + fixed(result.t_end, 3) + " s simulated in " +
                         std::to_string(result.steps) + " steps";
   for (const MechanismSummary& s : result.summary) {
-    verdict += ";  " + s.name + " error max " + fmt("%.3f", s.max_error_mm) + " mm, peak " +
-               fmt("%.3f", s.peak_current_A) + " A, shear " + fmt("%.2f", s.peak_shear_N) + " N" +
+    verdict += ";  " + s.name + " error max " + fixed(s.max_error_mm, 3) + " mm, peak " +
+               fixed(s.peak_current_A, 3) + " A, shear " + fixed(s.peak_shear_N, 2) + " N" +
                (s.slipped ? ", slipped" : "");
   }
   text(cr, 20.0, 48.0, verdict, 11.5, result.ok() ? Rgb{0.10, 0.50, 0.20} : Rgb{0.75, 0.10, 0.10});
@@ -229,7 +124,7 @@ RenderedPlot plot_simulation(const Station& station, const SimulationInput& inpu
     }
   }
   cairo_restore(cr);
-  axes(cr, panel, b, nice_step(std::max(b[2] - b[0], b[3] - b[1])));
+  axes(cr, panel, b, tick_step(std::max(b[2] - b[0], b[3] - b[1])));
   double ly = panel.y() + panel.h() + 44.0;
   text(cr, panel.x(), ly, "wide, light: commanded path; thin, dark: simulated tactor; circle: start", 11.0, kInk);
   text(cr, panel.x(), ly + 16.0, "red lower, blue upper; shaded: reachable regions; dashed ellipse: fingertip target",
@@ -254,8 +149,9 @@ RenderedPlot plot_simulation(const Station& station, const SimulationInput& inpu
     currents.push_back(std::move(i2));
     forces.push_back(std::move(f));
   }
-  chart(cr, 700.0, 100.0, 590.0, 220.0, "Motor currents (at the controller's samples)", "current (A)", currents, t_end);
-  chart(cr, 700.0, 400.0, 590.0, 220.0, "Shear force on the skin", "|F| (N)", forces, t_end);
+  plot::time_chart(cr, {700.0, 100.0, 590.0, 220.0, "Motor currents (at the controller's samples)", "current (A)", t_end, true},
+                   currents);
+  plot::time_chart(cr, {700.0, 400.0, 590.0, 220.0, "Shear force on the skin", "|F| (N)", t_end, true}, forces);
   return canvas.render();
 }
 

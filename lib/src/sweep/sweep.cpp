@@ -544,8 +544,8 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
   if (!options.confirmed) {
     const SweepEstimate e = estimate_sweep(design, options);
     if (e.seconds > kSweepConfirmSeconds || e.csv_bytes > kSweepConfirmBytes) {
-      throw InputError("this sweep is large: " + e.text() +
-                       "; confirm with `fivebar sweep --yes`, or sample it (sweep.sample: sobol, sweep.count)");
+      throw InputError("this sweep is large: " + e.text() + "; confirm it, or sample it (sweep.sample: sobol, sweep.count)",
+                       Remedy::confirm);
     }
   }
   const SweepSettings& s = *design.get<SweepSettings>();
@@ -566,7 +566,7 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
   };
 
   // The identity of this sweep (docs/reliability.md "Resume"): the whole design with its sweep
-  // section, the CSV layout and the shard. --resume continues only a CSV written under the same one.
+  // section, the CSV layout and the shard. resuming continues only a CSV written under the same one.
   std::filesystem::path identity_path = result.csv;
   identity_path.replace_extension(".identity.json");
   char hash[32];
@@ -591,7 +591,8 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
                                  ", this one " + hash + ")"
                            : "no " + identity_path.filename().string() +
                                  " beside it, so it cannot be shown to belong to this sweep") +
-                       "; rerun without --resume to start afresh");
+                       "; start afresh instead of resuming",
+                       Remedy::start_afresh);
     }
   }
   write_file_atomic(identity_path, identity.dump(2) + "\n");

@@ -19,6 +19,7 @@
 #include "fivebar/io.hpp"
 #include "fivebar/sweep.hpp"
 #include "plot/canvas.hpp"
+#include "plot/style.hpp"
 
 namespace fivebar {
 
@@ -44,8 +45,8 @@ struct Axis {
 };
 
 using plot_detail::text;
-using plot_detail::tick_step;
-std::string fmt(double v) { return plot_detail::tick_label(v); }
+using style::tick_step;
+std::string fmt(double v) { return style::tick_label(v); }
 
 struct Frame {
   double x0 = 90, y0 = 60, x1 = kWidth - 40, y1 = kHeight - 80;  // plot box in pixels

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "fivebar/format.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/tolerance.hpp"
 #include "plot/tactor_canvas.hpp"
@@ -23,11 +24,8 @@ constexpr double kTop = 70.0;
 constexpr double kGap = 80.0;
 constexpr double kRow = kPanel + 126.0;
 
-std::string fmt(const char* format, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
+using format::fixed;
+using format::general;
 
 std::array<double, 4> ellipse_bounds(const Ellipse& e, double pad) {
   const double r = 0.5 * std::max(e.axes.x(), e.axes.y());
@@ -51,7 +49,7 @@ void cells(cairo_t* cr, const Panel& panel, const ToleranceMap& map, const std::
       if (map.field_status[k] != static_cast<std::uint8_t>(Status::ok)) {
         set_colour(cr, Rgb{0.88, 0.88, 0.88});
       } else {
-        set_colour(cr, ramp_colour(top > 0.0 ? values[k] / top : 0.0));
+        set_colour(cr, viridis(top > 0.0 ? values[k] / top : 0.0));
       }
       cairo_fill(cr);
     }
@@ -73,11 +71,11 @@ void ellipse_outline(cairo_t* cr, const Panel& panel, const Ellipse& e) {
 void colour_bar(cairo_t* cr, double x0, double y, double top, const std::string& unit) {
   for (int k = 0; k < 100; ++k) {
     cairo_rectangle(cr, x0 + 40.0 + 2.6 * k, y, 2.8, 11.0);
-    set_colour(cr, ramp_colour(k / 99.0));
+    set_colour(cr, viridis(k / 99.0));
     cairo_fill(cr);
   }
   text(cr, x0 + 36.0, y + 10.0, "0", 10.0, kInk, 1.0);
-  text(cr, x0 + 306.0, y + 10.0, fmt("%.3g", top) + " " + unit, 10.0, kInk, 0.0);
+  text(cr, x0 + 306.0, y + 10.0, general(top, 3) + " " + unit, 10.0, kInk, 0.0);
 }
 
 }  // namespace
@@ -138,7 +136,7 @@ RenderedPlot plot_tolerance(const Station& s, const std::vector<ToleranceMap>& m
       }
       const auto w = panel.px(map.worst_3sigma_at);
       cairo_arc(cr, w[0], w[1], 4.0, 0.0, 2.0 * std::numbers::pi);
-      set_colour(cr, kLowerColour);
+      set_colour(cr, kLower);
       cairo_fill(cr);
       // Where the first order is not to be trusted (near_singular): black crosses.
       for (const auto& f : map.near_singular) {
@@ -154,20 +152,20 @@ RenderedPlot plot_tolerance(const Station& s, const std::vector<ToleranceMap>& m
       axes(cr, panel, b, 2.0);
       colour_bar(cr, x0, y0 + kPanel + 28.0, top, "mm");
       text(cr, x0 + 40.0, y0 + kPanel + 56.0,
-           "worst over the target " + fmt("%.3f", map.worst_3sigma_mm) + " mm (red dot); worst case " +
-               fmt("%.3f", map.worst_case_mm) + " mm",
+           "worst over the target " + fixed(map.worst_3sigma_mm, 3) + " mm (red dot); worst case " +
+               fixed(map.worst_case_mm, 3) + " mm",
            10.5, kInk);
       if (!map.near_singular.empty()) {
         double mc = 0.0;
         for (const auto& f : map.near_singular) mc = std::max(mc, f.monte_carlo_3sigma_mm);
         text(cr, x0 + 40.0, y0 + kPanel + 88.0,
              std::to_string(map.near_singular.size()) + " points near singular (x): first order not trusted; Monte Carlo "
-                 "3-sigma there up to " + fmt("%.3f", mc) + " mm",
+                 "3-sigma there up to " + fixed(mc, 3) + " mm",
              10.5, kInk);
       }
       text(cr, x0 + 40.0, y0 + kPanel + 72.0,
-           "robust margin " + fmt("%.3f", map.robust.robust_margin_mm) + " mm at " +
-               fmt("%.1f", 100.0 * map.robust.fraction) +
+           "robust margin " + fixed(map.robust.robust_margin_mm, 3) + " mm at " +
+               fixed(100.0 * map.robust.fraction, 1) +
                " % of printed devices",
            10.5, kInk);
     }
@@ -188,13 +186,13 @@ RenderedPlot plot_tolerance(const Station& s, const std::vector<ToleranceMap>& m
       ellipse_outline(cr, panel, map.target);
       const auto w = panel.px(map.worst_play_at);
       cairo_arc(cr, w[0], w[1], 4.0, 0.0, 2.0 * std::numbers::pi);
-      set_colour(cr, kLowerColour);
+      set_colour(cr, kLower);
       cairo_fill(cr);
       axes(cr, panel, b, 2.0);
       colour_bar(cr, x0, y0 + kPanel + 28.0, top, "mm");
       text(cr, x0 + 40.0, y0 + kPanel + 56.0,
-           "largest play over the target " + fmt("%.3f", map.worst_play_mm) + " mm (red dot); at the centre " +
-               fmt("%.3f", map.centre_play.extent_mm) + " mm",
+           "largest play over the target " + fixed(map.worst_play_mm, 3) + " mm (red dot); at the centre " +
+               fixed(map.centre_play.extent_mm, 3) + " mm",
            10.5, kInk);
       text(cr, x0 + 40.0, y0 + kPanel + 72.0, "grey: unreachable or singular (no estimate)", 10.5, kInk);
     }

@@ -24,7 +24,9 @@
 #include "fivebar/error.hpp"
 #include "fivebar/workspace/polyline.hpp"
 #include "fivebar/workspace/plot.hpp"
+#include "fivebar/format.hpp"
 #include "plot/canvas.hpp"
+#include "plot/style.hpp"
 
 namespace fivebar {
 
@@ -33,17 +35,18 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 const char* const kFont = "DejaVu Sans";
 
-// Colours: the paper's Fig. 4 (lower red, upper blue), a green target, a purple shared region.
-constexpr Rgb kLowerFill{0.84, 0.19, 0.17};
-constexpr Rgb kLowerInk{0.60, 0.06, 0.06};
-constexpr Rgb kUpperFill{0.16, 0.38, 0.84};
-constexpr Rgb kUpperInk{0.05, 0.18, 0.58};
-constexpr Rgb kSharedInk{0.33, 0.10, 0.42};
-constexpr Rgb kTargetInk{0.0, 0.48, 0.24};
-constexpr Rgb kText{0.12, 0.12, 0.14};
-constexpr Rgb kAxis{0.25, 0.25, 0.28};
-constexpr Rgb kGridLine{0.88, 0.88, 0.90};
-constexpr Rgb kNoData{0.93, 0.93, 0.94};
+// Colours: the house style (plot/style.hpp): the paper's Fig. 4 (lower red, upper blue), a green
+// target, a purple shared region.
+using style::kGridLine;
+using style::kLowerInk;
+using style::kNoData;
+using style::kUpperInk;
+constexpr Rgb kLowerFill = style::kLower;
+constexpr Rgb kUpperFill = style::kUpper;
+constexpr Rgb kSharedInk = style::kShared;
+constexpr Rgb kTargetInk = style::kTarget;
+constexpr Rgb kText = style::kInk;
+constexpr Rgb kAxis = style::kInk;
 constexpr double kFillAlpha = 0.24;
 
 bool is_upper(const Mechanism& m) { return m.name == "upper"; }
@@ -52,13 +55,7 @@ Rgb ink_of(const Mechanism& m) { return is_upper(m) ? kUpperInk : kLowerInk; }
 
 void set(cairo_t* cr, const Rgb& c, double alpha = 1.0) { cairo_set_source_rgba(cr, c.r, c.g, c.b, alpha); }
 
-std::string format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  std::string s(buf);
-  if (s.size() > 1 && s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
-}
+using format::fixed;
 
 enum class Align { left, center, right };
 
@@ -117,14 +114,6 @@ Frame fit(const std::array<double, 4>& data, double left, double top, double wid
   return f;
 }
 
-/// A 1-2-5 tick step giving about `target` intervals over `span`.
-double nice_step(double span, double target) {
-  const double raw = span / target;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-    if (m * mag >= raw) return m * mag;
-  return 10.0 * mag;
-}
 
 // --- paths ------------------------------------------------------------------------------------
 
@@ -188,8 +177,8 @@ void hatch(cairo_t* cr, double x0, double y0, double x1, double y1, double gap, 
 
 void axes(cairo_t* cr, const Frame& f, const std::string& title) {
   // About one labelled tick per 80 px of the longer side; the same step on both (equal) axes.
-  const double step = nice_step(std::max(f.xmax - f.xmin, f.ymax - f.ymin), std::max(f.width, f.height) / 80.0);
-  const char* fmt = step < 1.0 ? "%.1f" : "%.0f";
+  const double step = style::tick_step(std::max(f.xmax - f.xmin, f.ymax - f.ymin), std::max(f.width, f.height) / 80.0);
+  const int digits = step < 1.0 ? 1 : 0;  // 1-2-5 steps: 0.5, 0.2, 0.1 need one decimal
   cairo_save(cr);
   cairo_set_line_width(cr, 1.0);
   // Grid lines and tick labels.
@@ -203,7 +192,7 @@ void axes(cairo_t* cr, const Frame& f, const std::string& title) {
     cairo_move_to(cr, x, f.top + f.height);
     cairo_line_to(cr, x, f.top + f.height + 6);
     cairo_stroke(cr);
-    text(cr, x, f.top + f.height + 18, format(fmt, v), 14, Align::center, false, kAxis);
+    text(cr, x, f.top + f.height + 18, fixed(v, digits), 14, Align::center, false, kAxis);
   }
   for (double v = std::ceil(f.ymin / step) * step; v <= f.ymax + 1e-9 * step; v += step) {
     const double y = f.y(v);
@@ -215,7 +204,7 @@ void axes(cairo_t* cr, const Frame& f, const std::string& title) {
     cairo_move_to(cr, f.left - 6, y);
     cairo_line_to(cr, f.left, y);
     cairo_stroke(cr);
-    text(cr, f.left - 10, y, format(fmt, v), 14, Align::right, false, kAxis);
+    text(cr, f.left - 10, y, fixed(v, digits), 14, Align::right, false, kAxis);
   }
   cairo_restore(cr);
   text(cr, f.left + f.width / 2, f.top + f.height + 42, "x (mm)", 15, Align::center, false, kAxis);
@@ -427,7 +416,7 @@ void colour_bar(cairo_t* cr, double x, double y, double w, double h) {
     cairo_move_to(cr, x + w, yy);
     cairo_line_to(cr, x + w + 5, yy);
     cairo_stroke(cr);
-    text(cr, x + w + 9, yy, format("%.1f", v), 13, Align::left, false, kAxis);
+    text(cr, x + w + 9, yy, fixed(v, 1), 13, Align::left, false, kAxis);
   }
   text(cr, x + w + 44, y + 2, "isotropic", 13, Align::left, false, kAxis);
   text(cr, x + w + 44, y + h - 2, "singular", 13, Align::left, false, kAxis);
@@ -531,7 +520,7 @@ struct Legend {
   }
 };
 
-std::string area_text(double a) { return format("%.1f", a) + " mm²"; }
+std::string area_text(double a) { return fixed(a, 1) + " mm²"; }
 
 // --- the whole picture -----------------------------------------------------------------------
 
@@ -765,7 +754,7 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
   for (const MechanismWorkspace& w : ws.mechanisms)
     lg.swatch_line(ink_of(w.mechanism), 1.8, true,
                    w.mechanism.name + ": limit of the assembly side" +
-                       (w.mechanism.min_lci > 0.0 ? " (right: of LCI ≥ " + format("%.2f", w.mechanism.min_lci) + ")" : ""));
+                       (w.mechanism.min_lci > 0.0 ? " (right: of LCI ≥ " + fixed(w.mechanism.min_lci, 2) + ")" : ""));
   lg.swatch_ellipse("target fingertip ellipse");
   for (const MechanismWorkspace& w : ws.mechanisms) {
     lg.swatch_linkage(ink_of(w.mechanism), w.centre.status == Status::unreachable
@@ -784,15 +773,15 @@ void draw(cairo_t* cr, const StationWorkspace& ws, const PlotOptions& opt) {
   ar.y += 10;
   ar.heading("Assembly side (sampled)");
   for (const MechanismWorkspace& w : ws.mechanisms) {
-    ar.line(w.mechanism.name + ": " + format("%.1f", w.assembly.area_mm2) + " ± " + format("%.2f", w.assembly.error_mm2) +
+    ar.line(w.mechanism.name + ": " + fixed(w.assembly.area_mm2, 1) + " ± " + fixed(w.assembly.error_mm2, 2) +
                 " mm²",
             ink_of(w.mechanism));
   }
   ar.y += 10;
   ar.heading("Target");
   const Ellipse& e = ws.target;
-  ar.line(format("%.1f", e.axes.x()) + " × " + format("%.1f", e.axes.y()) + " mm at (" + format("%.2f", e.center.x()) +
-              ", " + format("%.2f", e.center.y()) + ")",
+  ar.line(fixed(e.axes.x(), 1) + " × " + fixed(e.axes.y(), 1) + " mm at (" + fixed(e.center.x(), 2) +
+              ", " + fixed(e.center.y(), 2) + ")",
           kTargetInk);
 }
 
@@ -809,26 +798,6 @@ void PlotOptions::validate() const {
   }
 }
 
-Rgb viridis(double v) {
-  // Matplotlib's viridis at 9 equally spaced stops, linearly interpolated.
-  static constexpr std::array<Rgb, 9> stops{{{0.267004, 0.004874, 0.329415},
-                                             {0.282623, 0.140926, 0.457517},
-                                             {0.253935, 0.265254, 0.529983},
-                                             {0.206756, 0.371758, 0.553117},
-                                             {0.163625, 0.471133, 0.558148},
-                                             {0.127568, 0.566949, 0.550556},
-                                             {0.134692, 0.658636, 0.517649},
-                                             {0.266941, 0.748751, 0.440573},
-                                             {0.993248, 0.906157, 0.143936}}};
-  if (!(v > 0.0)) return stops.front();
-  if (v >= 1.0) return stops.back();
-  const double t = v * double(stops.size() - 1);
-  const std::size_t k = std::min(std::size_t(t), stops.size() - 2);
-  const double u = t - double(k);
-  const Rgb& a = stops[k];
-  const Rgb& b = stops[k + 1];
-  return {a.r + u * (b.r - a.r), a.g + u * (b.g - a.g), a.b + u * (b.b - a.b)};
-}
 
 namespace {
 plot_detail::Surface surface_of(const PlotOptions& o) {

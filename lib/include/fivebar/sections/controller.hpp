@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/scope.hpp"
 
 namespace fivebar {
 
@@ -54,18 +55,10 @@ struct JointControl {
 /// (`...<mechanism>.theta1|theta2`), a station (`controller.stations.<station>`), one of its
 /// mechanisms, one of their joints. A scope naming a station is narrower than any that does not.
 /// Unset keys keep the value of the wider scope.
-struct ControlOverride {
-  std::string station;    ///< empty: every station (then `mechanism` is set)
-  std::string mechanism;  ///< "lower", "upper", or empty: every mechanism of the station
-  int joint = 0;          ///< 1 or 2 (theta1, theta2), or 0: both joints
+struct ControlOverride : JointScope {
   std::optional<double> kp, ki, kd, i_clamp;
   std::optional<double> volts_at_zero, rad_per_volt;
   std::optional<double> travel;  ///< rad (potentiometer.travel_deg)
-  /// Key path of this scope relative to `controller` ("stations.index.lower.theta1",
-  /// "mechanisms.upper").
-  std::string key() const;
-  /// 0 ... 4, widest first, in the order above.
-  int level() const;
 };
 
 /// `controller.tune`: what `fivebar run` (the `control` product) and `fivebar control --tune` tune

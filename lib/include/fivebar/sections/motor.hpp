@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/scope.hpp"
 
 namespace fivebar {
 
@@ -69,15 +70,9 @@ const std::array<MotorField, kMotorFieldCount>& motor_fields();
 /// or upper mechanism of every station (`motor.mechanisms.<m>`), one of its joints
 /// (`...<m>.theta1|theta2`), a station (`motor.stations.<s>`), one of its mechanisms, one of their
 /// joints; narrower scopes win. Unset keys keep the wider scope's value.
-struct MotorOverride {
-  std::string station;    ///< empty: every station (then `mechanism` is set)
-  std::string mechanism;  ///< "lower", "upper", or empty: every mechanism of the station
-  int joint = 0;          ///< 1 or 2, or 0: both joints
+/// The motor keys one scope of `motor:` gives (scope rule: fivebar/sections/scope.hpp).
+struct MotorOverride : JointScope {
   std::array<std::optional<double>, kMotorFieldCount> values;  ///< indexed as motor_fields()
-  /// Key path of this scope relative to `motor` ("stations.index.lower.theta1").
-  std::string key() const;
-  /// 0 ... 4, widest first.
-  int level() const;
 };
 
 /// `motor:`: the motor of every joint, unless overridden.

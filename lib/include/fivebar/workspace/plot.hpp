@@ -9,6 +9,7 @@
 
 #include <string>
 
+#include "fivebar/colour.hpp"  // Rgb and viridis(), the heat maps' colour map
 #include "fivebar/workspace/station.hpp"
 
 namespace fivebar {
@@ -26,11 +27,5 @@ struct PlotOptions {
 std::string station_svg(const StationWorkspace& workspace, const PlotOptions& options = {});
 /// The same picture as PNG bytes (width_px x height_px, ARGB).
 std::string station_png(const StationWorkspace& workspace, const PlotOptions& options = {});
-
-/// Colour of `value` in [0, 1] on the viridis map (clamped), as r, g, b in [0, 1].
-struct Rgb {
-  double r = 0.0, g = 0.0, b = 0.0;
-};
-Rgb viridis(double value);
 
 }  // namespace fivebar
