@@ -84,6 +84,9 @@ class OptimizeProblem {
   /// Which stages any objective or constraint needs: [cheap, loop, simulation].
   bool needs(OptimizeStage stage) const;
 
+  /// `x` with every variable snapped (OptimizeVariable::snap()): the canonical design of `x`, the
+  /// key of the evaluation cache (tied keys take one value, and no number is set by two variables).
+  std::vector<double> snap(const std::vector<double>& x) const;
   /// The complete design with `x` applied (snapped); InputError / ValidationError when invalid.
   Design design_at(const std::vector<double>& x) const;
   /// Evaluates the candidate `x` (snapped first) through the stages.
@@ -95,6 +98,10 @@ class OptimizeProblem {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Calls of OptimizeProblem::evaluate() in this process so far (every problem, every thread): the
+/// work done, against which a test checks that the search's cache evaluates no design twice.
+std::uint64_t optimize_evaluate_calls();
 
 /// Settings of `design` asking for every figure the design has the data for (each as a constraint
 /// that always holds), for a complete report of one design.
@@ -143,6 +150,11 @@ struct OptimizeStageCounts {
 struct OptimizeResult {
   std::string algorithm;
   std::uint64_t evaluations = 0;   ///< in the search (the polish's apart)
+  /// Distinct designs (snapped values) among the search's evaluations: the others were answered by
+  /// the evaluation cache, shared by the islands of a process (docs/optimize.md "Evaluation cache").
+  std::uint64_t distinct = 0;
+  /// Cache hits of this process (search and polish): requests answered without evaluating.
+  std::uint64_t cache_hits = 0;
   std::uint64_t rounds = 0;
   double seconds = 0.0;
   bool interrupted = false;        ///< stopped by OptimizeOptions::stop (resumable)

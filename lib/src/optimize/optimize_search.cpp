@@ -17,11 +17,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <limits>
 #include <map>
+#include <mutex>
+#include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include "fivebar/atlas.hpp"
 #include "fivebar/format.hpp"
@@ -65,8 +70,83 @@ struct Deadline {
   bool passed() const { return (stop && stop->load()) || std::chrono::steady_clock::now() >= end; }
 };
 
+/// The evaluation cache of a run (docs/optimize.md "Evaluation cache"), shared by the islands of a
+/// process: keyed by the canonical design (OptimizeProblem::snap(): the variables after their step
+/// rounding; tied keys are one variable and no number is set by two, so equal keys are equal
+/// designs). A design asked for while another thread evaluates it waits for that evaluation, so
+/// every distinct design is evaluated exactly once, whatever the thread count.
+class EvaluationCache {
+ public:
+  explicit EvaluationCache(const OptimizeProblem& p) : p_(p) {}
+  /// The candidate of `x` (snapped), evaluated only when no thread has evaluated it yet.
+  OptimizeCandidate get(const std::vector<double>& x) {
+    std::vector<double> key = p_.snap(x);
+    std::shared_future<OptimizeCandidate> pending;
+    std::promise<OptimizeCandidate> mine;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      const auto it = map_.find(key);
+      if (it != map_.end()) {
+        ++hits_;
+        pending = it->second;
+      } else {
+        map_.emplace(key, mine.get_future().share());
+      }
+    }
+    if (pending.valid()) return pending.get();
+    try {
+      OptimizeCandidate c = p_.evaluate(key);
+      mine.set_value(c);
+      return c;
+    } catch (...) {
+      mine.set_exception(std::current_exception());
+      throw;
+    }
+  }
+  /// Known candidates (a resumed run's): later requests of them are hits.
+  void insert(const OptimizeCandidate& c) {
+    std::promise<OptimizeCandidate> done;
+    OptimizeCandidate k = c;
+    k.island = -1;
+    k.round = 0;
+    k.evaluation = 0;
+    done.set_value(std::move(k));
+    std::lock_guard<std::mutex> lock(mu_);
+    map_.emplace(c.x, done.get_future().share());
+  }
+  std::uint64_t hits() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return hits_;
+  }
+
+ private:
+  struct Hash {
+    std::size_t operator()(const std::vector<double>& x) const {
+      std::uint64_t h = 0x243f6a8885a308d3ull;
+      for (double v : x) {
+        std::uint64_t bits = 0;
+        std::memcpy(&bits, &v, sizeof bits);
+        h = mix(h ^ bits);
+      }
+      return std::size_t(h);
+    }
+  };
+  const OptimizeProblem& p_;
+  mutable std::mutex mu_;
+  std::unordered_map<std::vector<double>, std::shared_future<OptimizeCandidate>, Hash> map_;
+  std::uint64_t hits_ = 0;
+};
+
+/// Distinct designs among candidates (their snapped values).
+std::uint64_t distinct_designs(const std::vector<OptimizeCandidate>& all) {
+  std::set<std::vector<double>> seen;
+  for (const auto& c : all) seen.insert(c.x);
+  return seen.size();
+}
+
 struct Udp {
   const OptimizeProblem* problem = nullptr;
+  EvaluationCache* cache = nullptr;
   std::vector<OptimizeCandidate>* log = nullptr;
   int island = 0;
   std::uint32_t* round = nullptr;
@@ -75,7 +155,7 @@ struct Udp {
 
   pagmo::vector_double fitness(const pagmo::vector_double& x) const {
     if (deadline && deadline->passed()) throw Halt{};
-    OptimizeCandidate c = problem->evaluate(x);
+    OptimizeCandidate c = cache ? cache->get(x) : problem->evaluate(x);
     c.island = island;
     c.round = *round;
     c.evaluation = ++*counter;
@@ -233,7 +313,7 @@ std::size_t choose(const OptimizeProblem& p, const std::vector<OptimizeCandidate
 /// COBYLA from the chosen point: minimise the sum of the normalised objectives subject to
 /// feasibility and to every objective no worse than the chosen point's, so that the result is
 /// feasible and dominates (or equals) the chosen design.
-std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const OptimizeCandidate& start, const std::vector<double>& ideal,
+std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, EvaluationCache& cache, const OptimizeCandidate& start, const std::vector<double>& ideal,
                                         const std::vector<double>& nadir, std::uint64_t budget, double seconds,
                                         const std::atomic<bool>* stop, std::uint64_t& used) {
   const std::size_t n = p.dimension(), m = p.settings().objectives.size();
@@ -243,6 +323,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
   for (std::size_t i = 0; i < m; ++i) scale[i] = nadir[i] > ideal[i] ? nadir[i] - ideal[i] : 1.0;
   struct State {
     const OptimizeProblem* p;
+    EvaluationCache* cache;
     std::vector<double> last_x;
     OptimizeCandidate last;
     std::optional<OptimizeCandidate> best;
@@ -251,7 +332,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
     std::vector<double> f0, scale;
     const OptimizeCandidate& at(const std::vector<double>& x) {
       if (x != last_x || last.x.empty()) {
-        last = p->evaluate(x);
+        last = cache->get(x);
         last_x = x;
         ++evaluations;
         if (last.feasible()) {
@@ -270,7 +351,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
       }
       return last;
     }
-  } st{&p, {}, {}, std::nullopt, std::numeric_limits<double>::infinity(), 0, f0, scale};
+  } st{&p, &cache, {}, {}, std::nullopt, std::numeric_limits<double>::infinity(), 0, f0, scale};
   nlopt::opt o(nlopt::LN_COBYLA, unsigned(n));
   o.set_lower_bounds(p.lower());
   o.set_upper_bounds(p.upper());
@@ -364,13 +445,15 @@ void sort_candidates(std::vector<OptimizeCandidate>& all) {
 }
 
 /// Everything after the search: front, curve, choice, polish, files.
-OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vector<OptimizeCandidate> all,
+OptimizeResult finish(const OptimizeProblem& p, EvaluationCache& cache, const Design& design, std::vector<OptimizeCandidate> all,
                       const OptimizeOptions& options, OptimizeResult r, bool whole_run, double polish_seconds) {
   // polish_seconds: what is left of the wall-time budget, for the polish and the full figures.
   sort_candidates(all);
   r.stages = {};
   for (const auto& c : all) r.stages.add(c);
   r.evaluations = all.size();
+  r.distinct = distinct_designs(all);
+  r.cache_hits = cache.hits();
   r.front = optimize_front(p, all);
   normalisation(p, r.front, r.ideal, r.nadir);
   // A front of one value in an objective (always so for one objective): its nadir is the worst
@@ -382,7 +465,7 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
     }
   }
   r.hypervolume = hypervolume_curve(p, all, r.ideal, r.nadir);
-  r.reference = p.evaluate(p.reference_values());
+  r.reference = cache.get(p.reference_values());
   const std::filesystem::path& dir = options.out_dir;
   make_directories(dir);
   auto record = [&](const std::filesystem::path& f) { r.files.push_back(f); };
@@ -399,9 +482,10 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
   if (!r.front.empty()) {
     r.chosen = r.front[choose(p, r.front, r.ideal, r.nadir)];
     if (p.settings().polish) {
-      r.polished = polish(p, *r.chosen, r.ideal, r.nadir, p.settings().polish_evaluations, polish_seconds, options.stop,
+      r.polished = polish(p, cache, *r.chosen, r.ideal, r.nadir, p.settings().polish_evaluations, polish_seconds, options.stop,
                           r.polish_evaluations);
     }
+    r.cache_hits = cache.hits();
     const OptimizeCandidate& best = r.polished ? *r.polished : *r.chosen;
     Design chosen = p.design_at(best.x);
     std::string name = design.name + "-optimized";
@@ -586,8 +670,9 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
   };
   Deadline deadline{t0 + span(seconds_budget), options.stop};
+  EvaluationCache cache(p);
   auto problem_of = [&](std::size_t k) {
-    return pagmo::problem(Udp{&p, &logs[k], islands[k], &rounds[k], &counters[k], &deadline});
+    return pagmo::problem(Udp{&p, &cache, &logs[k], islands[k], &rounds[k], &counters[k], &deadline});
   };
 
   if (options.resume) {
@@ -658,6 +743,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       throw InputError(checkpoint.string() + ": a damaged checkpoint (" + e.what() + ")");
     }
     for (const auto& c : all) {
+      cache.insert(c);
       for (std::size_t k = 0; k < n; ++k) {
         if (c.island == islands[k]) counters[k] = std::max(counters[k], c.evaluation);
       }
@@ -683,7 +769,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       r.algorithm = alg;
       r.interrupted = true;
       r.seconds = elapsed();
-      return finish(p, design, std::move(all), options, r, options.shards == 1, 0.0);
+      return finish(p, cache, design, std::move(all), options, r, options.shards == 1, 0.0);
     }
   }
   // Every input checked (the checkpoint too): only now is anything created (docs/reliability.md).
@@ -770,7 +856,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   if (round == 0 || r.interrupted || checkpoint_round != round) write_checkpoint();
   r.rounds = round;
   r.seconds = prior_seconds + elapsed();
-  OptimizeResult out = finish(p, design, std::move(all), options, r, options.shards == 1, seconds_budget - r.seconds);
+  OptimizeResult out = finish(p, cache, design, std::move(all), options, r, options.shards == 1, seconds_budget - r.seconds);
   out.files.push_back(checkpoint);
   return out;
 }
@@ -831,7 +917,9 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
   OptimizeOptions whole = options;
   whole.shard = 0;
   whole.shards = 1;
-  return finish(p, design, std::move(all), whole, r, true, options.seconds > 0.0 ? options.seconds : p.settings().seconds);
+  EvaluationCache cache(p);
+  for (const auto& c : all) cache.insert(c);
+  return finish(p, cache, design, std::move(all), whole, r, true, options.seconds > 0.0 ? options.seconds : p.settings().seconds);
 }
 
 Json OptimizeResult::to_json(const OptimizeProblem& p) const {
@@ -842,6 +930,8 @@ Json OptimizeResult::to_json(const OptimizeProblem& p) const {
   j["population"] = s.population;
   j["seed"] = s.seed;
   j["evaluations"] = evaluations;
+  j["distinct_evaluations"] = distinct;
+  j["cache_hits"] = cache_hits;
   j["rounds"] = rounds;
   j["seconds"] = seconds;
   j["interrupted"] = interrupted;
