@@ -9,6 +9,8 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 #include <random>
@@ -131,7 +133,10 @@ TEST(OptimizeSettings, BadInputNamesTheKey) {
   }
   t = s;
   t.population = 18;  // NSGA-II: a multiple of 4
+  t.algorithm = "nsga2";
   EXPECT_EQ(key_of(t), "optimize.population");
+  t.algorithm = "auto";  // the hybrid takes any population size
+  EXPECT_EQ(key_of(t), "accepted");
   t = s;
   t.algorithm = "cmaes";  // one objective only
   EXPECT_EQ(key_of(t), "optimize.algorithm");
@@ -587,6 +592,65 @@ TEST(HybridAlgorithm, DISABLED_Study) {
   ScratchDir dir("fivebar_test_optimize_study");
   const int seeds = std::getenv("SEEDS") ? std::atoi(std::getenv("SEEDS")) : 8;
   for (int v : {2, 3, 8}) fivebar::testing::print_study_row(fivebar::testing::algorithm_study(v, seeds, dir.path()));
+}
+
+}  // namespace
+}  // namespace fivebar
+
+namespace fivebar {
+namespace {
+
+/// docs/optimize.md "Evaluation cache": on a grid of 8 x 7 designs (steps of 1 mm) a budget of
+/// 400 candidates must repeat designs; every distinct design is evaluated once (the process-wide
+/// count of OptimizeProblem::evaluate() calls against the distinct rows of candidates.csv), the
+/// repeats carry the same figures, and the JSON's counts say so. Both for pagmo's NSGA-II (which
+/// repeats designs itself) and the hybrid (which repeats only once the grid is spent).
+TEST(RunOptimize, TheCacheEvaluatesEveryDistinctDesignOnce) {
+  ScratchDir dir("fivebar_test_optimize_cache");
+  for (const char* alg : {"nsga2", "hybrid"}) {
+    OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
+    s.variables[0].step = 1.0;
+    s.variables[1].step = 1.0;
+    s.algorithm = alg;
+    s.evaluations = 400;
+    s.polish = false;
+    const Design d = with(s);
+    OptimizeOptions o;
+    o.plots = false;
+    o.full_figures = false;
+    o.threads = 2;
+    o.out_dir = dir.path() / alg;
+    const std::uint64_t before = optimize_evaluate_calls();
+    const OptimizeResult r = run_optimize(d, o);
+    const std::uint64_t work = optimize_evaluate_calls() - before;
+    std::ifstream csv(o.out_dir / "candidates.csv");
+    std::string line;
+    std::getline(csv, line);
+    std::map<std::pair<double, double>, std::string> rest;  // the figures, verdict and status of each design
+    std::uint64_t rows = 0;
+    while (std::getline(csv, line)) {
+      ++rows;
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+      ASSERT_GE(cells.size(), 6u);
+      const std::pair<double, double> x{std::stod(cells[3]), std::stod(cells[4])};
+      std::string tail;
+      for (std::size_t i = 5; i < cells.size(); ++i) tail += cells[i] + ",";
+      const auto [it, fresh] = rest.emplace(x, tail);
+      if (!fresh) EXPECT_EQ(it->second, tail) << alg << ": a repeated design with other figures";
+    }
+    EXPECT_EQ(rows, r.evaluations) << alg;
+    EXPECT_LE(rest.size(), 56u) << alg;
+    EXPECT_GT(rows, rest.size()) << alg << ": the budget exceeds the grid, repeats are certain";
+    EXPECT_EQ(r.distinct, rest.size()) << alg;
+    // The design as given is evaluated too (the comparison's reference), through the same cache.
+    const OptimizeProblem p(d);
+    const std::vector<double> ref = p.snap(p.reference_values());
+    const std::uint64_t distinct_with_reference = rest.size() + (rest.count({ref[0], ref[1]}) ? 0 : 1);
+    EXPECT_EQ(work, distinct_with_reference) << alg << ": evaluations that did work";
+    EXPECT_EQ(r.cache_hits, r.evaluations + 1 - work) << alg;
+  }
 }
 
 }  // namespace
