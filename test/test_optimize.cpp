@@ -377,67 +377,80 @@ TEST(RunOptimize, ShardsMergeIntoTheFrontOfTheirUnion) {
   }
 }
 
-/// The issue's check on the sweep's own two-variable problem (L34 and L12 of the index station,
-/// margin against footprint), on the showcase sweep's box at twice its resolution (57 x 49 designs,
-/// steps 0.125 mm): with a tenth of the grid's evaluations the front reaches nearly the grid's
-/// hypervolume (both normalised by the grid front's ideal and nadir: measured 0.659 against 0.713)
-/// and about half the grid-optimal points (23 of 47) have a found point within one grid step of
-/// them or one that dominates them. Every point, as the issue words it, needs more evaluations
-/// than a tenth of the grid: docs/optimize.md "Measured".
+/// The sweep's own two-variable problem (L34 and L12 of the index station, margin against
+/// footprint) on the showcase sweep's box at twice its resolution (57 x 49 designs, steps 0.125 mm),
+/// searched with a tenth of the grid's evaluations (256) for seeds 1 ... kSeeds (docs/optimize.md
+/// "Measured"): for every seed the front's hypervolume is at least 97 % of the grid front's (both
+/// normalised by the grid front's ideal and nadir), at least 80 % of the grid-optimal points have a
+/// found point within one grid step of them or one that dominates them, and the best margin is the
+/// grid's to within what one grid step changes it; the means over the seeds are printed (the docs
+/// quote them).
 TEST(RunOptimize, FrontNearlyMatchesTheGridParetoSetWithATenthOfItsEvaluations) {
   OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
   constexpr int kA = 57, kB = 49;
+#if defined(__SANITIZE_ADDRESS__)  // the sanitizer build (FIVEBAR_SANITIZE): fewer seeds
+  constexpr int kSeeds = 2;
+#else
+  constexpr int kSeeds = 8;
+#endif
   const double da = 7.0 / (kA - 1), db = 6.0 / (kB - 1);
   s.population = 16;
   s.islands = 2;
   s.evaluations = kA * kB / 10;
   s.polish = false;
-  const Design d = with(s);
-  const OptimizeProblem p(d);
+  const OptimizeProblem p(with(s));
   std::vector<OptimizeCandidate> grid;
   for (int i = 0; i < kA; ++i) {
     for (int j = 0; j < kB; ++j) grid.push_back(p.evaluate({12.0 + da * i, 6.0 + db * j}));
   }
   const auto grid_front = optimize_front(p, grid);
   ASSERT_GT(grid_front.size(), 20u);
-  ScratchDir dir("fivebar_test_optimize_grid");
-  OptimizeOptions o;
-  o.plots = false;
-  o.out_dir = dir.path();
-  const OptimizeResult r = run_optimize(d, o);
-  EXPECT_LE(r.evaluations, std::uint64_t(kA * kB / 10));
-  std::size_t matched = 0;
-  for (const auto& g : grid_front) {
-    const bool near = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
-      return std::fabs(f.x[0] - g.x[0]) <= da + 1e-9 && std::fabs(f.x[1] - g.x[1]) <= db + 1e-9;
-    });
-    const bool dominates = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
-      const auto a = p.fitness(f), b = p.fitness(g);
-      return a[0] <= b[0] && a[1] <= b[1];
-    });
-    matched += near || dominates;
-  }
   std::vector<double> ideal(2, 1e300), nadir(2, -1e300);
   for (const auto& g : grid_front) {
     const auto f = p.fitness(g);
-    for (int i = 0; i < 2; ++i) {
-      ideal[std::size_t(i)] = std::min(ideal[std::size_t(i)], f[std::size_t(i)]);
-      nadir[std::size_t(i)] = std::max(nadir[std::size_t(i)], f[std::size_t(i)]);
-    }
+    for (std::size_t i = 0; i < 2; ++i) ideal[i] = std::min(ideal[i], f[i]), nadir[i] = std::max(nadir[i], f[i]);
   }
   const std::vector<double> ref{1.1, 1.1};
   const double hv_grid = hypervolume(normalised_objectives(p, grid_front, ideal, nadir), ref);
-  const double hv_found = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
-  std::printf("grid %d x %d: %zu grid-optimal points, %zu matched; hypervolume %.4f found / %.4f grid with %llu evaluations\n",
-              kA, kB, grid_front.size(), matched, hv_found, hv_grid, (unsigned long long)r.evaluations);
-  EXPECT_GE(hv_found, 0.9 * hv_grid);
-  EXPECT_GE(double(matched), 0.45 * double(grid_front.size()));
-  // The grid's best margin is reached to within what one grid step changes it (0.125 mm of L12
-  // moves the margin by about that much).
-  double best_margin = -1e300, grid_margin = -1e300;
-  for (const auto& f : r.front) best_margin = std::max(best_margin, f.figures[0]);
+  double grid_margin = -1e300;
   for (const auto& g : grid_front) grid_margin = std::max(grid_margin, g.figures[0]);
-  EXPECT_GE(best_margin, grid_margin - 0.2);
+  ScratchDir dir("fivebar_test_optimize_grid");
+  double sum_hv = 0.0, sum_matched = 0.0;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    s.seed = std::uint64_t(seed);
+    const Design d = with(s);
+    OptimizeOptions o;
+    o.plots = false;
+    o.full_figures = false;
+    o.out_dir = dir.path() / std::to_string(seed);
+    const OptimizeResult r = run_optimize(d, o);
+    EXPECT_LE(r.evaluations, std::uint64_t(kA * kB / 10));
+    std::size_t matched = 0;
+    for (const auto& g : grid_front) {
+      const bool near = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
+        return std::fabs(f.x[0] - g.x[0]) <= da + 1e-9 && std::fabs(f.x[1] - g.x[1]) <= db + 1e-9;
+      });
+      const bool dominates = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
+        const auto a = p.fitness(f), b = p.fitness(g);
+        return a[0] <= b[0] && a[1] <= b[1];
+      });
+      matched += near || dominates;
+    }
+    const double hv_found = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
+    std::printf("seed %d: %zu of %zu grid-optimal points matched; hypervolume %.4f found / %.4f grid with %llu evaluations\n",
+                seed, matched, grid_front.size(), hv_found, hv_grid, (unsigned long long)r.evaluations);
+    EXPECT_GE(hv_found, 0.97 * hv_grid) << "seed " << seed;
+    EXPECT_GE(double(matched), 0.8 * double(grid_front.size())) << "seed " << seed;
+    // The grid's best margin is reached to within what one grid step changes it (0.125 mm of L12
+    // moves the margin by about that much).
+    double best_margin = -1e300;
+    for (const auto& f : r.front) best_margin = std::max(best_margin, f.figures[0]);
+    EXPECT_GE(best_margin, grid_margin - 0.2) << "seed " << seed;
+    sum_hv += hv_found;
+    sum_matched += double(matched);
+  }
+  std::printf("grid %d x %d, %d seeds: mean hypervolume %.4f found / %.4f grid (%.1f %%), mean %.1f of %zu grid-optimal points matched\n",
+              kA, kB, kSeeds, sum_hv / kSeeds, hv_grid, 100.0 * sum_hv / kSeeds / hv_grid, sum_matched / kSeeds, grid_front.size());
 }
 
 /// The showcase's eight-variable search of the index station (without the robust constraint, to
@@ -586,12 +599,6 @@ TEST(HybridAlgorithm, AheadOfNsga2OnTheTwoVariableProblem) {
   EXPECT_GE(r.ratio(), 1.0);
   // No design evaluated twice by the hybrid (its children avoid the island's designs).
   EXPECT_EQ(r.distinct_hybrid, r.evaluations_hybrid);
-}
-
-TEST(HybridAlgorithm, DISABLED_Study) {
-  ScratchDir dir("fivebar_test_optimize_study");
-  const int seeds = std::getenv("SEEDS") ? std::atoi(std::getenv("SEEDS")) : 8;
-  for (int v : {2, 3, 8}) fivebar::testing::print_study_row(fivebar::testing::algorithm_study(v, seeds, dir.path()));
 }
 
 }  // namespace

@@ -273,9 +273,23 @@ struct Hybrid {
       std::vector<pagmo::vector_double> xs = X, fs = F;
       // The island's front so far: each point's distance to its nearest neighbour in the front's
       // normalised objectives (the extremes of each objective: infinite), for a sparse-first pick.
-      // (A copy: the evaluations of this generation change the island's front.)
-      const std::vector<std::vector<double>> front_x = memory ? memory->front_x : std::vector<std::vector<double>>{};
-      const std::vector<std::vector<double>> front_f = memory ? memory->front_f : std::vector<std::vector<double>>{};
+      // (A copy: the evaluations of this generation change the island's front. At most kFrontSample
+      // of its points, drawn at random, so that a generation costs a bounded time on a long run.)
+      constexpr std::size_t kFrontSample = 400;
+      std::vector<std::vector<double>> front_x, front_f;
+      if (memory) {
+        std::vector<std::size_t> idx(memory->front_x.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+        if (idx.size() > kFrontSample) {
+          std::shuffle(idx.begin(), idx.end(), rng);
+          idx.resize(kFrontSample);
+          std::sort(idx.begin(), idx.end());
+        }
+        for (std::size_t i : idx) {
+          front_x.push_back(memory->front_x[i]);
+          front_f.push_back(memory->front_f[i]);
+        }
+      }
       const std::size_t A = front_x.size();
       std::vector<double> sparse(A, 0.0);
       std::vector<std::size_t> neighbour(A, 0);
@@ -346,8 +360,8 @@ struct Hybrid {
         return y;
       };
       // The surrogate: the objectives of a design predicted from its nearest evaluated neighbours on
-      // the island (inverse-distance weights over the 4 nearest in the box's normalised
-      // coordinates; infeasible when the nearest is). Of kChoices children the one predicted to be
+      // the island (inverse-distance weights over the 4 nearest of its latest 512 designs, in the
+      // box's normalised coordinates; infeasible when the nearest is). Of kChoices children the one predicted to be
       // dominated by the fewest points of the island's front is evaluated (ties: the farthest from
       // every evaluated design).
       constexpr int kChoices = 8;
@@ -355,7 +369,9 @@ struct Hybrid {
         constexpr std::size_t kNear = 4;
         std::vector<std::pair<double, std::size_t>> near;
         const auto& ax = memory->all_x;
-        for (std::size_t i = 0; i < ax.size(); ++i) {
+        // The island's latest kWindow designs only (they surround the population): a bounded cost.
+        constexpr std::size_t kWindow = 512;
+        for (std::size_t i = ax.size() > kWindow ? ax.size() - kWindow : 0; i < ax.size(); ++i) {
           double d2 = 0.0;
           for (std::size_t d = 0; d < n; ++d) {
             const double t = (x[d] - ax[i][d]) / (hi[d] - lo[d]);
