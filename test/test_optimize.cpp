@@ -451,11 +451,15 @@ TEST(RunOptimize, FrontNearlyMatchesTheGridParetoSetWithATenthOfItsEvaluations) 
   }
   std::printf("grid %d x %d, %d seeds: mean hypervolume %.4f found / %.4f grid (%.1f %%), mean %.1f of %zu grid-optimal points matched\n",
               kA, kB, kSeeds, sum_hv / kSeeds, hv_grid, 100.0 * sum_hv / kSeeds / hv_grid, sum_matched / kSeeds, grid_front.size());
+  // The means docs/optimize.md quotes.
+  EXPECT_GE(sum_hv / kSeeds, 0.99 * hv_grid);
+  EXPECT_GE(sum_matched / kSeeds, 45.0);
 }
 
 /// The showcase's eight-variable search of the index station (without the robust constraint, to
-/// keep the test short) against a Sobol sweep of the same number of candidates over the same box:
-/// the search's front has the larger hypervolume (both normalised by their union's ideal and nadir).
+/// keep the test short), seeds 1 to 3, against a Sobol sweep of the same number of candidates over
+/// the same box: for every seed the search's front has at least twice the hypervolume (both normalised by their union's ideal and
+/// nadir; docs/optimize.md "Measured").
 TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   Design d = paper();
   OptimizeSettings s = *d.get<OptimizeSettings>();
@@ -463,35 +467,45 @@ TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   s.constraints = {{"min_lci", true, 0.25}};
   s.evaluations = 1000;
   s.polish = false;
-  d.set(s);
-  d.validate();
-  const OptimizeProblem p(d);
+  s.atlas = false;
+#if defined(__SANITIZE_ADDRESS__)  // the sanitizer build (FIVEBAR_SANITIZE): one seed
+  constexpr int kSeeds = 1;
+#else
+  constexpr int kSeeds = 3;
+#endif
   ScratchDir dir("fivebar_test_optimize_sobol");
-  OptimizeOptions o;
-  o.plots = false;
-  o.out_dir = dir.path();
-  const OptimizeResult r = run_optimize(d, o);
-  SweepSettings sw;
-  sw.sample = "sobol";
-  sw.count = r.evaluations;
-  sw.seed = 1;
-  for (const auto& v : s.variables) sw.vary.push_back({"L1", v.lo, v.hi, 1});
-  std::vector<OptimizeCandidate> sobol;
-  for (std::uint64_t k = 0; k < r.evaluations; ++k) sobol.push_back(p.evaluate(sweep_point(sw, k)));
-  const auto sobol_front = optimize_front(p, sobol);
-  std::vector<OptimizeCandidate> both = r.front;
-  both.insert(both.end(), sobol_front.begin(), sobol_front.end());
-  std::vector<double> ideal(3, 1e300), nadir(3, -1e300);
-  for (const auto& c : both) {
-    const auto f = p.fitness(c);
-    for (std::size_t i = 0; i < 3; ++i) ideal[i] = std::min(ideal[i], f[i]), nadir[i] = std::max(nadir[i], f[i]);
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    s.seed = std::uint64_t(seed);
+    d.set(s);
+    d.validate();
+    const OptimizeProblem p(d);
+    OptimizeOptions o;
+    o.plots = false;
+    o.full_figures = false;
+    o.out_dir = dir.path() / std::to_string(seed);
+    const OptimizeResult r = run_optimize(d, o);
+    SweepSettings sw;
+    sw.sample = "sobol";
+    sw.count = r.evaluations;
+    sw.seed = 1;
+    for (const auto& v : s.variables) sw.vary.push_back({"L1", v.lo, v.hi, 1});
+    std::vector<OptimizeCandidate> sobol;
+    for (std::uint64_t k = 0; k < r.evaluations; ++k) sobol.push_back(p.evaluate(sweep_point(sw, k)));
+    const auto sobol_front = optimize_front(p, sobol);
+    std::vector<OptimizeCandidate> both = r.front;
+    both.insert(both.end(), sobol_front.begin(), sobol_front.end());
+    std::vector<double> ideal(3, 1e300), nadir(3, -1e300);
+    for (const auto& c : both) {
+      const auto f = p.fitness(c);
+      for (std::size_t i = 0; i < 3; ++i) ideal[i] = std::min(ideal[i], f[i]), nadir[i] = std::max(nadir[i], f[i]);
+    }
+    const std::vector<double> ref(3, 1.1);
+    const double hv_opt = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
+    const double hv_sobol = hypervolume(normalised_objectives(p, sobol_front, ideal, nadir), ref);
+    std::printf("eight variables, seed %d, %llu candidates: hypervolume %.4f (search) against %.4f (Sobol)\n", seed,
+                (unsigned long long)r.evaluations, hv_opt, hv_sobol);
+    EXPECT_GE(hv_opt, 2.0 * hv_sobol) << "seed " << seed;  // docs/optimize.md "Measured": at least twice
   }
-  const std::vector<double> ref(3, 1.1);
-  const double hv_opt = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
-  const double hv_sobol = hypervolume(normalised_objectives(p, sobol_front, ideal, nadir), ref);
-  std::printf("eight variables, %llu candidates: hypervolume %.4f (search) against %.4f (Sobol)\n",
-              (unsigned long long)r.evaluations, hv_opt, hv_sobol);
-  EXPECT_GT(hv_opt, hv_sobol);
 }
 
 /// docs/reliability.md: shard, checkpoint and merge files state what they are and every reader

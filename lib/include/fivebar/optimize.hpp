@@ -1,9 +1,11 @@
 #pragma once
 /// Dimensional synthesis of the whole device (issue "optimize"; docs/optimize.md): the design's
 /// `optimize:` section names design numbers by key path (fivebar/sections/optimize.hpp), the
-/// figures to maximise or minimise and the constraints; islands of pagmo2's NSGA-II / MOEA/D
-/// (several objectives) or CMA-ES / SADE (one) search the box of the variables, migrating in a
-/// ring between rounds; NLopt's COBYLA polishes the chosen design under the same constraints.
+/// figures to maximise or minimise and the constraints; islands of the hybrid algorithm (the
+/// default for several objectives: NSGA-II's selection, a surrogate's pre-screening, no repeated
+/// design), pagmo2's NSGA-II / MOEA/D, or CMA-ES / SADE (one objective) search the box of the
+/// variables, migrating in a ring between rounds; one evaluation cache per process evaluates each
+/// distinct design once; NLopt's COBYLA polishes the chosen design under the same constraints.
 ///
 /// Evaluation is staged (docs/optimize.md "Stages"): every candidate goes through the sweep's
 /// cheap per-design path (certified containment, conditioning, footprint, collision fraction,

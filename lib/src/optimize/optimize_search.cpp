@@ -255,6 +255,8 @@ struct Hybrid {
     if (N < 4 || gens == 0) return pop;
     const auto [lo, hi] = prob.get_bounds();
     const std::size_t n = lo.size();
+    std::vector<double> inv_range(n);
+    for (std::size_t d = 0; d < n; ++d) inv_range[d] = 1.0 / (hi[d] - lo[d]);
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> U(0.0, 1.0);
     auto pick = [&](std::size_t k) { return std::size_t(rng() % k); };
@@ -299,14 +301,17 @@ struct Hybrid {
         for (const auto& f : front_f) {
           for (std::size_t i = 0; i < m; ++i) fmin[i] = std::min(fmin[i], f[i]), fmax[i] = std::max(fmax[i], f[i]);
         }
+        std::vector<double> unit(A * m);  // the front's objectives scaled to [0, 1]
+        for (std::size_t k = 0; k < A; ++k) {
+          for (std::size_t i = 0; i < m; ++i) unit[k * m + i] = (front_f[k][i] - fmin[i]) / (fmax[i] > fmin[i] ? fmax[i] - fmin[i] : 1.0);
+        }
         for (std::size_t k = 0; k < A; ++k) {
           double best = std::numeric_limits<double>::infinity();
           for (std::size_t l = 0; l < A; ++l) {
             if (l == k) continue;
             double d2 = 0.0;
             for (std::size_t i = 0; i < m; ++i) {
-              const double r = fmax[i] > fmin[i] ? fmax[i] - fmin[i] : 1.0;
-              const double t = (front_f[k][i] - front_f[l][i]) / r;
+              const double t = unit[k * m + i] - unit[l * m + i];
               d2 += t * t;
             }
             if (d2 < best) best = d2, neighbour[k] = l;
@@ -374,7 +379,7 @@ struct Hybrid {
         for (std::size_t i = ax.size() > kWindow ? ax.size() - kWindow : 0; i < ax.size(); ++i) {
           double d2 = 0.0;
           for (std::size_t d = 0; d < n; ++d) {
-            const double t = (x[d] - ax[i][d]) / (hi[d] - lo[d]);
+            const double t = (x[d] - ax[i][d]) * inv_range[d];
             d2 += t * t;
           }
           if (near.size() < kNear || d2 < near.back().first) {
