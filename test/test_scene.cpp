@@ -134,7 +134,7 @@ TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
   d.get<ControllerSettings>()->tune->min_damping = 0.0;
   d.get<ControllerSettings>()->tune->min_gain_margin = 1.0;
   // The optimize product: the smallest budget it accepts (the initial populations and a round), a
-  // short polish and a coarse atlas (the showcase's full search is 3,000 candidates and 729 cells).
+  // short polish and a coarse atlas (the showcase's own search is 384 candidates, a 15-cell atlas).
   ASSERT_TRUE(d.get<OptimizeSettings>() != nullptr);
   d.get<OptimizeSettings>()->evaluations = 128;
   d.get<OptimizeSettings>()->polish_evaluations = 10;
