@@ -229,7 +229,7 @@ bool on_every_island(std::size_t n, int threads, const std::function<void(std::s
 /// elitist selection (non-dominated sorting and crowding over parents and children), with other
 /// variation, a surrogate's pre-screening and no repeated design. Per child:
 /// - with probability 0.25 (once the island's own front of feasible designs has 3 points), from a
-///   point of that front picked sparse-first (its nearest neighbour in the front's normalised
+///   point of that front (of at most 400 of its points, drawn at random) picked sparse-first (its nearest neighbour in the front's normalised
 ///   objectives far; the extremes of each objective first): a step toward that neighbour in design
 ///   space (filling the front's gaps), or a Gaussian step of 3 % of each range (refining it);
 /// - otherwise a differential step around a tournament winner a of the population, a + F (b - c)
@@ -239,7 +239,7 @@ bool on_every_island(std::size_t n, int threads, const std::function<void(std::s
 /// - a child that snaps to a design this island has already evaluated (or to a member of the
 ///   population) is moved by a Gaussian step of growing width until it is new (at most 16 tries);
 /// - eight such children are drawn and only one is evaluated: the one whose objectives, predicted
-///   from its nearest evaluated neighbours on the island, are dominated by the fewest points of the
+///   from its nearest neighbours among the island's latest 512 designs, are dominated by the fewest points of the
 ///   island's front (ties: the one farthest from every evaluated design). The prediction costs
 ///   microseconds, an evaluation (the certified coverage, the conditioning, the footprint) far more.
 /// Everything is drawn from the round's seed: deterministic for a seed, whatever the thread count.
@@ -403,9 +403,9 @@ struct Hybrid {
         }
         for (auto& v : f) v /= wsum;
         double dominated_by = 0.0;
-        for (const auto& g : front_f) {
+        for (const auto& q : front_f) {
           bool no_worse = true;
-          for (std::size_t k = 0; k < m && no_worse; ++k) no_worse = g[k] <= f[k];
+          for (std::size_t k = 0; k < m && no_worse; ++k) no_worse = q[k] <= f[k];
           dominated_by += no_worse;
         }
         return dominated_by;
