@@ -138,7 +138,10 @@ double number_after(const std::string& text, const std::string& key) {
 }
 
 TEST_F(Browser, TheReportLoadsOfflineWithNoConsoleMessageAndEveryAnimationRuns) {
-  const Outcome run_scene = run({"run", kDesign, "--products", "kinematics,animate", "--out", "out", "-q"});
+  // The cheap products that write pictures beside the animations: collision, pattern, sweep and
+  // tolerance (their pictures named in the products table or in links, shown inline by the page).
+  const Outcome run_scene =
+      run({"run", kDesign, "--products", "kinematics,animate,collision,sweep,tolerance", "--out", "out", "-q"});
   ASSERT_EQ(run_scene.code, 0) << run_scene.err;
   const fs::path page = dir_ / "out" / "iros2022" / "index.html";
   ASSERT_TRUE(fs::exists(page));
@@ -169,6 +172,47 @@ TEST_F(Browser, TheReportLoadsOfflineWithNoConsoleMessageAndEveryAnimationRuns) 
   }
   EXPECT_EQ(ready, 8u);
   EXPECT_THAT(r.out, HasSubstr("<table>"));
+
+  // Every picture the page shows is a picture: a PNG (its signature) or an SVG document.
+  const std::regex img(R"re(<img src="([^"]+)")re");
+  std::size_t images = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), img); it != std::sregex_iterator(); ++it) {
+    const fs::path file = page.parent_path() / (*it)[1].str();
+    const std::string bytes = slurp(file);
+    ++images;
+    const bool png = bytes.rfind("\x89PNG\r\n\x1a\n", 0) == 0;
+    const bool svg = file.extension() == ".svg" && bytes.find("<svg") != std::string::npos;
+    EXPECT_TRUE(png || svg) << file;
+  }
+  EXPECT_GE(images, 8u);  // collision and patterns (2 stations), sweep (2), tolerance (2)
+
+  // Markdown emphasis is rendered: no `*word` left in the text Chromium shows (pictures, scripts
+  // and code aside); the summary's *exact area* and *covers* are <em>.
+  const std::string text = std::regex_replace(
+      std::regex_replace(r.out, std::regex(R"re(<(svg|script|style|code)[\s>][\s\S]*?</\1>)re"), " "),
+      std::regex("<[^>]*>"), " ");
+  EXPECT_FALSE(std::regex_search(text, std::regex(R"re((^|[\s(])\*+[A-Za-z])re")));
+  EXPECT_THAT(r.out, HasSubstr("<em>covers</em>"));
+
+  // Every product that wrote a picture shows one inline (an <img> of its folder, or the inline
+  // SVG of an animation), each linking to its file.
+  const json summary = json::parse(slurp(dir_ / "out" / "iros2022" / "summary.json"));
+  std::size_t with_pictures = 0;
+  for (const json& b : summary.at("built")) {
+    std::vector<std::string> pictures;
+    for (const json& f : b.at("files")) {
+      const std::string name = f.get<std::string>();
+      if (name.size() > 4 && (name.ends_with(".png") || name.ends_with(".svg"))) pictures.push_back(name);
+    }
+    if (pictures.empty()) continue;
+    ++with_pictures;
+    const bool shown = std::any_of(pictures.begin(), pictures.end(), [&](const std::string& f) {
+      return html.find("<a href=\"" + f + "\"><img src=\"" + f + "\"") != std::string::npos ||
+             (f.rfind("animations/", 0) == 0 && html.find("data-fivebar") != std::string::npos);
+    });
+    EXPECT_TRUE(shown) << b.at("name") << " wrote pictures but the page shows none of them inline";
+  }
+  EXPECT_GE(with_pictures, 5u);  // collision, pattern, sweep, tolerance, animate
 }
 
 TEST_F(Browser, TwoInstantsDifferWhereTheLinkagesAreAndMatchElsewhere) {
