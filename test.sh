@@ -36,7 +36,7 @@ fi
 
 # The main job's packages and the test tools; the fuzzing toolchain only for --fuzz (and --all).
 packages=("${FIVEBAR_PACKAGES[@]}" "${FIVEBAR_TEST_PACKAGES[@]}")
-((fuzz)) && packages+=("${FIVEBAR_HARDENING_PACKAGES[@]}")
+if ((fuzz)); then packages+=("${FIVEBAR_HARDENING_PACKAGES[@]}"); fi
 fivebar_install_packages "${packages[@]}"
 
 if ((normal)); then

@@ -2,7 +2,7 @@
 """Runs every `$ ` example of README.md and docs/*.md and compares its output with the text shown.
 
 Usage:
-  check_docs_examples.py FIVEBAR_BINARY SOURCE_DIR WORK_DIR [--update] [--jobs N] [FILE...]
+  check_docs_examples.py FIVEBAR_BINARY SOURCE_DIR WORK_DIR [--update] [--jobs=N] [FILE...]
   check_docs_examples.py --self-test
 
 An example is a fenced code block without an info string (```) whose lines start with `$ `: each
@@ -10,10 +10,11 @@ An example is a fenced code block without an info string (```) whose lines start
 `$ ` line are its output. Each block runs in a scratch directory of its own (WORK_DIR/NNN-file-line)
 holding:
   build/fivebar      the binary under test;
-  designs/           a copy of the repository's designs/ (an example may edit it);
+  designs/           a copy of the repository's designs/ (an example may edit it; the inputs the
+                     examples read are in designs/examples/); the controller tuning's wall-time
+                     bound is lifted in this copy (WALL_TIME_BOUNDS), so that its result does not
+                     depend on the machine's load;
   test/data/         the repository's test/data (read only);
-                     (designs/examples/ holds the inputs the examples read; the
-                     controller tuning's wall-time bound is lifted in this copy, WALL_TIME_BOUNDS);
   outputs/           a copy of one shared `build/fivebar run designs/iros2022.yaml`, for the blocks
                      whose commands read outputs/ (the run happens once, and a block that shows
                      that very command gets its recorded output instead of a second run).
@@ -23,8 +24,9 @@ order.
 Comparison, line by line after masking: a line that is only `...` or `…` stands for any number of
 lines, `...`/`…` inside a line for any text; trailing blanks and trailing empty lines are ignored, a
 run of blanks inside a line counts as one (a column elided with `…` keeps its alignment).
-Masked on both sides: wall times (`1.73 s of wall time`, `"wall_s": 1.2`), dates and times,
-temporary paths (`/tmp/...`). Numbers are compared as printed (to their printed digits).
+Masked on both sides (MASKS): wall times (`1.73 s of wall time`, `in 0.19 s`, `"wall_s": 1.2`) and
+the rates made from them, dates and times, temporary paths (`/tmp/...`), design hashes (the copy's
+lifted bound changes the text they hash). Numbers are compared as printed (to their printed digits).
 Exit codes: a command that exits non-zero must be followed by `$ echo $?` (or a
 `${PIPESTATUS[...]}` check) showing it; an unexplained non-zero exit fails the example.
 
@@ -36,7 +38,6 @@ Exit 0 when every example matches, 1 otherwise, 2 on bad usage.
 """
 import concurrent.futures
 import difflib
-import hashlib
 import os
 import re
 import shutil
@@ -401,18 +402,15 @@ def check(binary, source_dir, work_dir, names=(), update=False, jobs=2, shared=S
             shared_block = Block("(shared run)", 0)
             shared_block.commands.append(Command("(shared run)", 0, shared))
             shared_future = pool.submit(run_one, 999, shared_block, None)
-        # The light examples beside the shared run; the heavy ones after it, so that no two heavy
-        # processes share the machine (results with a wall-time bound would depend on the load).
-        light = [ib for ib in independent if expected_cost(ib[1]) == 0 or not shared_future]
-        heavy = [ib for ib in independent if ib not in light]
-        futures = [pool.submit(run_one, i, b, None) for i, b in light]
+        # Beside the shared run (which leaves a core idle between its products), the slow examples
+        # first; WALL_TIME_BOUNDS keeps their results independent of the load.
+        futures = [pool.submit(run_one, i, b, None) for i, b in independent]
         if shared_future:
             shared_block = shared_future.result()
             command = shared_block.commands[0]
             cache[shared] = ("\n".join(command.actual), command.rc)
             shared_outputs = os.path.join(work_dir, "999-" + re.sub(r"[^A-Za-z0-9]+", "-", shared_block.name()),
                                           "outputs")
-            futures += [pool.submit(run_one, i, b, None) for i, b in heavy]
             futures += [pool.submit(run_one, i, b, shared_outputs) for i, b in dependent]
         for f in futures:
             f.result()
