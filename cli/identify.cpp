@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -19,6 +21,8 @@
 #include "fivebar/format.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/sha256.hpp"
 #include "fivebar/export/joint_limits.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
@@ -28,6 +32,15 @@ namespace fivebar::cli {
 namespace {
 
 namespace id = fivebar::identify;
+
+std::string today_utc() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buffer[16];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%d", &tm);
+  return buffer;
+}
 
 /// `value` to 5 significant digits, in its shortest text.
 std::string sig(double value) {
@@ -320,12 +333,30 @@ int run_identify(const IdentifyCliOptions& opt) {
   doc["joints"] = Json::array();
   for (const auto& r : results) doc["joints"].push_back(id::to_json(r));
   doc["refused"] = refused;
+  // The patched design (docs/identify.md "The patched design"), built before anything is written.
+  std::optional<Design> patched;
+  if (refused.empty() && !id::patched_keys(results).empty()) {
+    MeasurementSource source;
+    source.file = opt.log;
+    source.sha256 = sha256_file(opt.log);
+    source.date = today_utc();
+    source.method = std::string("fivebar identify --rig motor: ") +
+                    (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
+                    ", standard deviation";
+    patched = id::patched_design(design, results, source);
+    doc["patched"] = id::patched_keys(results);
+  }
   std::vector<std::string> files;
   if (!opt.no_files) {
     const std::filesystem::path dir =
         opt.out.empty() ? resolve_output_dir("outputs", design.name) / "identify" : std::filesystem::path(opt.out);
     make_directories(dir);
     WriteFence fence(dir);
+    if (patched) {
+      const std::filesystem::path f = dir / (design.name + "-identified.yaml");
+      write_file_atomic(f, to_yaml(*patched));
+      files.push_back(f.generic_string());
+    }
     for (const auto& r : results) {
       const id::JointIdentification& jr = r;
       for (bool v : {false, true}) {

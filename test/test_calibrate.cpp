@@ -297,6 +297,57 @@ TEST(CalibratePatch, PatchedDesignCarriesTheEstimatesAndTheirProvenance) {
   EXPECT_THAT(assumed, ::testing::Contains(::testing::HasSubstr("upper")));
   EXPECT_THAT(assumed, ::testing::Not(::testing::Contains(::testing::HasSubstr("stations.index.lower"))));
   EXPECT_THAT(assumed_groups(back), ::testing::Contains("kinematics"));
+  // The posterior covariance survives the file: sigmas and correlations read back give it again,
+  // its diagonal is each parameter's reported sigma squared (computed separately in fit.cpp, O2 with
+  // O1's share), and the correlations are real (the links and bases of a mechanism are not
+  // independent after a fit).
+  const ProvenanceCovariance pc = provenance_covariance(back, r.key_covariance_keys);
+  ASSERT_EQ(pc.covariance.rows(), r.key_covariance.rows());
+  ASSERT_EQ(r.key_covariance_keys.size(), 12u);
+  EXPECT_EQ(pc.sources, std::vector<std::string>{"bench/m.csv"});
+  double largest = 0.0;
+  for (Eigen::Index a = 0; a < pc.covariance.rows(); ++a) {
+    const auto p = std::find_if(r.parameters.begin(), r.parameters.end(),
+                                [&](const Parameter& q) { return q.key == r.key_covariance_keys[static_cast<std::size_t>(a)]; });
+    EXPECT_NEAR(r.key_covariance(a, a), p->sigma * p->sigma, 1e-12 * p->sigma * p->sigma) << p->key;
+    for (Eigen::Index b = 0; b < pc.covariance.cols(); ++b) {
+      const double scale = std::sqrt(r.key_covariance(a, a) * r.key_covariance(b, b));
+      EXPECT_NEAR(pc.covariance(a, b), r.key_covariance(a, b), 1e-12 * scale) << a << "," << b;
+      if (a != b) largest = std::max(largest, std::abs(r.key_covariance(a, b)) / scale);
+    }
+  }
+  EXPECT_GT(largest, 0.3);
+  // A later measurement of one key supersedes its entry and drops its correlations.
+  const Design again = with_measured_values(back, {{r.key_covariance_keys[0], 0.5}}, {"other.csv", sha256_hex("y"), "2026-11-27", "by hand"});
+  const ProvenanceCovariance pc2 = provenance_covariance(again, r.key_covariance_keys);
+  EXPECT_DOUBLE_EQ(pc2.covariance(0, 0), 0.25);
+  for (Eigen::Index b = 1; b < pc2.covariance.cols(); ++b) EXPECT_EQ(pc2.covariance(0, b), 0.0);
+  EXPECT_NEAR(pc2.covariance(1, 2), r.key_covariance(1, 2), 1e-12 * std::sqrt(r.key_covariance(1, 1) * r.key_covariance(2, 2)));
+}
+
+TEST(CalibratePatch, CorrelationsThatBreakTheRulesAreRefusedNamingTheKey) {
+  const std::string head = to_yaml(paper());
+  const std::string entry = "{source: m.csv, sha256: " + sha256_hex("x") + ", date: \"2026-11-26\", method: fit, sigma: 0.01";
+  const auto load = [&](const std::string& extra) {
+    return load_design_from_string(head + "provenance:\n  \"stations.index.mechanisms.lower.links[0]\": " + entry + extra +
+                                       "}\n  \"stations.index.mechanisms.lower.links[1]\": " + entry + "}\n",
+                                   "bad.yaml");
+  };
+  EXPECT_NO_THROW(load(", correlation: {\"stations.index.mechanisms.lower.links[1]\": -0.4}"));
+  try {
+    load(", correlation: {\"stations.index.mechanisms.lower.links[1]\": 1.5}");
+    ADD_FAILURE() << "a correlation of 1.5 was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("correlation"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("[-1, 1]"));
+  }
+  try {
+    load(", correlation: {\"stations.index.mechanisms.lower.links[2]\": 0.5}");
+    ADD_FAILURE() << "a correlation with an unmeasured key was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("links[2]"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("without its own provenance entry"));
+  }
 }
 
 TEST(CalibrateHardStops, OffsetsFromTwoStopsRecoverTheTruth) {

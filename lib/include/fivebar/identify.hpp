@@ -7,3 +7,4 @@
 #include "fivebar/identify/filter.hpp"
 #include "fivebar/identify/plan.hpp"
 #include "fivebar/identify/json.hpp"
+#include "fivebar/identify/patch.hpp"

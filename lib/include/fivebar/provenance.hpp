@@ -11,6 +11,8 @@
 ///   tolerance      every number of `tolerance:`
 /// A group the design does not have (no `motor:`) has no values and so no assumptions.
 
+#include <Eigen/Core>
+
 #include <string>
 #include <string_view>
 #include <vector>
@@ -28,5 +30,37 @@ bool is_measured(const Design& design, std::string_view key);
 std::vector<std::string> assumed_values(const Design& design, std::string_view group);
 /// The groups (provenance_groups() order) with at least one assumed value.
 std::vector<std::string> assumed_groups(const Design& design);
+
+/// Where measured values came from: the fields of a provenance entry but the sigma.
+struct MeasurementSource {
+  std::string file;    ///< as given on the command line
+  std::string sha256;  ///< of its bytes (fivebar/sha256.hpp)
+  std::string date;    ///< YYYY-MM-DD, UTC
+  std::string method;  ///< "fivebar calibrate: ...", "fivebar identify: IDIM-LS ...", ...
+};
+/// One measured value: the key path it sets and its standard deviation (the key's file unit).
+struct MeasuredValue {
+  std::string key;
+  double sigma = 0.0;
+};
+/// The one writer of provenance entries (`fivebar calibrate`, `fivebar identify`): `design` (whose
+/// numbers the caller has already set) with an entry per value, and, when `covariance` is given
+/// (values.size() square, file units, the values' order), the correlation of every pair as
+/// `correlation:` under the key that sorts first. A value's earlier entry is replaced, and the
+/// correlations other entries held with it are dropped (a new measurement supersedes the old one).
+/// The result is validated (ValidationError).
+Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,
+                            const Eigen::MatrixXd& covariance = Eigen::MatrixXd());
+
+/// The covariance that the provenance entries give for `keys` (file units, keys' order): sigma^2 on
+/// the diagonal of each key with an entry and a sigma (its own, or that of a key path above it),
+/// sigma_a sigma_b rho_ab off it where an entry names the pair, 0 elsewhere; `measured[i]` says
+/// whether key i has a sigma (the rows of the others are zero).
+struct ProvenanceCovariance {
+  Eigen::MatrixXd covariance;
+  std::vector<bool> measured;
+  std::vector<std::string> sources;  ///< the distinct source files of the measured keys
+};
+ProvenanceCovariance provenance_covariance(const Design& design, const std::vector<std::string>& keys);
 
 }  // namespace fivebar

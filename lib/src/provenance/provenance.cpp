@@ -1,6 +1,10 @@
 // Measured or assumed (fivebar/provenance.hpp).
 #include "fivebar/provenance.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/sections/controller.hpp"
@@ -72,6 +76,81 @@ std::vector<std::string> assumed_groups(const Design& design) {
   std::vector<std::string> out;
   for (const std::string& g : provenance_groups()) {
     if (!assumed_values(design, g).empty()) out.push_back(g);
+  }
+  return out;
+}
+
+Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,
+                            const Eigen::MatrixXd& covariance) {
+  const auto n = static_cast<Eigen::Index>(values.size());
+  if (covariance.size() != 0 && (covariance.rows() != n || covariance.cols() != n)) {
+    throw std::invalid_argument("with_measured_values: the covariance must be values.size() square");
+  }
+  Design d = design;
+  ProvenanceSettings p = d.get<ProvenanceSettings>() ? *d.get<ProvenanceSettings>() : ProvenanceSettings{};
+  for (const MeasuredValue& v : values) {
+    p.entries.erase(v.key);
+    for (auto& item : p.entries) item.second.correlation.erase(v.key);
+  }
+  for (const MeasuredValue& v : values) {
+    ProvenanceEntry e;
+    e.source = source.file;
+    e.sha256 = source.sha256;
+    e.date = source.date;
+    e.method = source.method;
+    e.sigma = v.sigma;
+    p.entries[v.key] = std::move(e);
+  }
+  if (covariance.size() != 0) {
+    for (Eigen::Index a = 0; a < n; ++a) {
+      for (Eigen::Index b = 0; b < n; ++b) {
+        const MeasuredValue& va = values[static_cast<std::size_t>(a)];
+        const MeasuredValue& vb = values[static_cast<std::size_t>(b)];
+        if (!(va.key < vb.key) || !(va.sigma > 0.0) || !(vb.sigma > 0.0)) continue;
+        const double rho = std::clamp(covariance(a, b) / (va.sigma * vb.sigma), -1.0, 1.0);
+        if (rho != 0.0 && std::isfinite(rho)) p.entries[va.key].correlation[vb.key] = rho;
+      }
+    }
+  }
+  d.set(std::move(p));
+  d.validate();
+  return d;
+}
+
+ProvenanceCovariance provenance_covariance(const Design& design, const std::vector<std::string>& keys) {
+  const auto n = static_cast<Eigen::Index>(keys.size());
+  ProvenanceCovariance out;
+  out.covariance = Eigen::MatrixXd::Zero(n, n);
+  out.measured.assign(keys.size(), false);
+  const ProvenanceSettings* p = design.get<ProvenanceSettings>();
+  if (p == nullptr) return out;
+  // The entry that covers each key: its own, else the nearest key path above it.
+  std::vector<const std::string*> entry_key(keys.size(), nullptr);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    const std::string& key = keys[i];
+    for (const auto& [k, e] : p->entries) {
+      const bool covers = key == k || (key.size() > k.size() && key.compare(0, k.size(), k) == 0 && (key[k.size()] == '.' || key[k.size()] == '['));
+      if (covers && e.sigma && (entry_key[i] == nullptr || k.size() > entry_key[i]->size())) entry_key[i] = &k;
+    }
+    if (entry_key[i] == nullptr) continue;
+    const ProvenanceEntry& e = p->entries.find(*entry_key[i])->second;
+    out.measured[i] = true;
+    out.covariance(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(i)) = *e.sigma * *e.sigma;
+    if (std::find(out.sources.begin(), out.sources.end(), e.source) == out.sources.end()) out.sources.push_back(e.source);
+  }
+  for (Eigen::Index a = 0; a < n; ++a) {
+    for (Eigen::Index b = 0; b < n; ++b) {
+      const std::string* ka = entry_key[static_cast<std::size_t>(a)];
+      const std::string* kb = entry_key[static_cast<std::size_t>(b)];
+      if (a == b || ka == nullptr || kb == nullptr || *ka == *kb) continue;
+      const ProvenanceEntry& ea = p->entries.find(*ka)->second;
+      const auto it = ea.correlation.find(*kb);
+      if (it == ea.correlation.end()) continue;
+      const ProvenanceEntry& eb = p->entries.find(*kb)->second;
+      const double c = it->second * *ea.sigma * *eb.sigma;
+      out.covariance(a, b) = c;
+      out.covariance(b, a) = c;
+    }
   }
   return out;
 }
