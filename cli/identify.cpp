@@ -432,7 +432,8 @@ void setup_identify(CLI::App& app) {
       "Parameters are printed with their design key path (motor.terminal_resistance_ohm, in the design's units) or a "
       "rig-only name with its unit (inertia_kg_m2, viscous_Nm_s_per_rad, coulomb_Nm, offset_Nm; a linear axis: mass_kg, "
       "viscous_N_s_per_m, coulomb_N, offset_N). docs/identify.md.\nFiles: <joint>-estimation.svg|.png, "
-      "<joint>-validation.svg|.png, identify.json; with --plan identify-plan.csv.\nExit status: 0 done, 1 a parameter "
+      "<joint>-validation.svg|.png, identify.json, <design>-identified.yaml (the identified motor keys with provenance: "
+      "entries); with --plan identify-plan.csv.\nExit status: 0 done, 1 a parameter "
       "named by --fit is not identifiable from the log, 2 bad input, 3 internal error.");
   sub->callback([opt]() { finish(run_identify(*opt)); });
 }

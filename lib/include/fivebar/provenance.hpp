@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -30,6 +31,11 @@ bool is_measured(const Design& design, std::string_view key);
 std::vector<std::string> assumed_values(const Design& design, std::string_view group);
 /// The groups (provenance_groups() order) with at least one assumed value.
 std::vector<std::string> assumed_groups(const Design& design);
+
+/// The key paths of a mechanism's twelve calibration values, in the order of
+/// fivebar/calibrate/model.hpp (links[0..3], bases[0][0], bases[0][1], bases[1][0], bases[1][1]; each
+/// joint's volts_at_zero and rad_per_volt at the narrowest `controller` scope that sets it).
+std::array<std::string, 12> calibration_keys(const Design& design, std::string_view station, std::string_view mechanism);
 
 /// Where measured values came from: the fields of a provenance entry but the sigma.
 struct MeasurementSource {

@@ -371,7 +371,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
       for (const Mechanism* m : s.mechanisms()) {
         say(options, "export gate: robust coverage of " + name + "/" + m->name);
         const ToleranceSources src = tolerance_sources(d, s, *m);
-        const RobustCoverage r = robust_coverage(*m, s.target, src.sigma, src.robust_fraction, 0, src.seed);
+        const RobustCoverage r = robust_coverage(*m, s.target, src.spread(), src.robust_fraction, 0, src.seed);
         add("robust_coverage", name + "/" + m->name, r.covered,
             fixed(100.0 * r.fraction, 1) + " % of printed devices keep a margin of " + fixed(r.robust_margin_mm, 3) +
                 " mm (design " + fixed(r.margin_mm, 3) + " mm, sigma " + fixed(r.sigma_mm, 3) + " mm at " +

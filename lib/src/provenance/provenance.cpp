@@ -2,6 +2,8 @@
 #include "fivebar/provenance.hpp"
 
 #include <algorithm>
+#include <array>
+#include <utility>
 #include <cmath>
 #include <stdexcept>
 
@@ -12,6 +14,44 @@
 #include "fivebar/sections/provenance.hpp"
 
 namespace fivebar {
+
+namespace {
+
+/// The key paths of joint j's volts_at_zero and rad_per_volt: the narrowest scope that sets each
+/// (ControlOverride levels; file order within one).
+std::pair<std::string, std::string> potentiometer_keys(const ControllerSettings& c, std::string_view station,
+                                                       std::string_view mechanism, int j) {
+  std::string v0 = "controller.potentiometer.volts_at_zero", k = "controller.potentiometer.rad_per_volt";
+  int l0 = -1, lk = -1;
+  for (const ControlOverride& o : c.overrides) {
+    const bool applies = (o.station.empty() || o.station == station) && (o.mechanism.empty() || o.mechanism == mechanism) &&
+                         (o.joint == 0 || o.joint == j);
+    if (!applies) continue;
+    if (o.volts_at_zero && o.level() >= l0) l0 = o.level(), v0 = "controller." + o.key() + ".potentiometer.volts_at_zero";
+    if (o.rad_per_volt && o.level() >= lk) lk = o.level(), k = "controller." + o.key() + ".potentiometer.rad_per_volt";
+  }
+  return {v0, k};
+}
+
+}  // namespace
+
+std::array<std::string, 12> calibration_keys(const Design& design, std::string_view station, std::string_view mechanism) {
+  std::array<std::string, 12> keys;
+  const std::string k = "stations." + std::string(station) + ".mechanisms." + std::string(mechanism) + ".";
+  for (int i = 0; i < 4; ++i) keys[static_cast<std::size_t>(i)] = k + "links[" + std::to_string(i) + "]";
+  keys[4] = k + "bases[0][0]";
+  keys[5] = k + "bases[0][1]";
+  keys[6] = k + "bases[1][0]";
+  keys[7] = k + "bases[1][1]";
+  const ControllerSettings* c = design.get<ControllerSettings>();
+  const ControllerSettings none;
+  for (int j = 1; j <= 2; ++j) {
+    const auto [v0, kk] = potentiometer_keys(c ? *c : none, station, mechanism, j);
+    keys[static_cast<std::size_t>(6 + 2 * j)] = v0;
+    keys[static_cast<std::size_t>(7 + 2 * j)] = kk;
+  }
+  return keys;
+}
 
 const std::vector<std::string>& provenance_groups() {
   static const std::vector<std::string> groups{"kinematics", "potentiometer", "motor", "contact", "density", "tolerance"};
@@ -44,16 +84,7 @@ std::vector<std::string> assumed_values(const Design& design, std::string_view g
       for (const Station& s : design.stations) {
         for (const Mechanism* m : s.mechanisms()) {
           for (int j = 1; j <= 2; ++j) {
-            // The narrowest scope that sets each value (ControlOverride levels; file order within one).
-            std::string v0 = "controller.potentiometer.volts_at_zero", k = "controller.potentiometer.rad_per_volt";
-            int l0 = -1, lk = -1;
-            for (const ControlOverride& o : c->overrides) {
-              const bool applies = (o.station.empty() || o.station == s.name) && (o.mechanism.empty() || o.mechanism == m->name) &&
-                                   (o.joint == 0 || o.joint == j);
-              if (!applies) continue;
-              if (o.volts_at_zero && o.level() >= l0) l0 = o.level(), v0 = "controller." + o.key() + ".potentiometer.volts_at_zero";
-              if (o.rad_per_volt && o.level() >= lk) lk = o.level(), k = "controller." + o.key() + ".potentiometer.rad_per_volt";
-            }
+            const auto [v0, k] = potentiometer_keys(*c, s.name, m->name, j);
             for (const std::string& key : {v0, k}) {
               if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
             }
