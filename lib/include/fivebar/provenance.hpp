@@ -32,6 +32,33 @@ std::vector<std::string> assumed_values(const Design& design, std::string_view g
 /// The groups (provenance_groups() order) with at least one assumed value.
 std::vector<std::string> assumed_groups(const Design& design);
 
+/// What each validated figure rests on: the one table of figure -> groups of values (the groups
+/// above), used by the export's `fivebar.validation` block, the `export` product's summary (and so
+/// summary.md, summary.json and the HTML page of `fivebar run`) and the export gate's checks.
+///   stability (max_rho, kp_margin, kd_margin, oscillatory_*), min_bandwidth_hz: the plant of
+///     fivebar/control.hpp: the closed-chain masses (kinematics, density) and the motors (motor);
+///   max_tracking_error_m: the simulated patterns (fivebar/simulate): the same plant, the contact
+///     with the finger (contact) and the potentiometers the loop reads (potentiometer);
+///   max_saturation_fraction: the same without the potentiometers (the drive, not the reading);
+///   robust_margin_mm: the reachable region of each printed device (kinematics, tolerance).
+struct FigureBasis {
+  std::string key;      ///< the figure's key (`fivebar.validation.<station>.<mechanism>.<key>`)
+  std::string label;    ///< "max tracking error"
+  double scale = 1.0;   ///< to the unit shown
+  std::string unit;     ///< "mm", "Hz", "" ...
+  int digits = 3;       ///< decimals shown
+  std::vector<std::string> groups;  ///< provenance_groups() it rests on, in that order
+};
+const std::vector<FigureBasis>& figure_bases();
+/// The figure of `key`; InputError naming the known keys otherwise.
+const FigureBasis& figure_basis(std::string_view key);
+/// The groups of `key`'s basis that have assumed values in `design` (provenance_groups() order).
+std::vector<std::string> figure_assumed(const Design& design, std::string_view key);
+/// "motor, contact assumed" or "measured (kinematics, density, motor)": what `key` rests on.
+std::string rests_on_text(const Design& design, std::string_view key);
+/// "max tracking error 0.117 mm: motor, contact assumed" for the figure's value in its key's unit.
+std::string rests_on_line(const Design& design, std::string_view key, double value);
+
 /// The key paths of a mechanism's twelve calibration values, in the order of
 /// fivebar/calibrate/model.hpp (links[0..3], bases[0][0], bases[0][1], bases[1][0], bases[1][1]; each
 /// joint's volts_at_zero and rad_per_volt at the narrowest `controller` scope that sets it).

@@ -375,7 +375,9 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
         add("robust_coverage", name + "/" + m->name, r.covered,
             fixed(100.0 * r.fraction, 1) + " % of printed devices keep a margin of " + fixed(r.robust_margin_mm, 3) +
                 " mm (design " + fixed(r.margin_mm, 3) + " mm, sigma " + fixed(r.sigma_mm, 3) + " mm at " +
-                point_text(r.robust_point) + ")" + (r.covered ? "" : ": printed devices lose the target"));
+                point_text(r.robust_point) + ")" + (r.covered ? "" : ": printed devices lose the target") +
+                (r.calibrated ? "; sigmas: the calibration's posterior covariance" : "") + "; rests on: " +
+                rests_on_text(d, "robust_margin_mm"));
       }
     }
   }
@@ -414,6 +416,16 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
   detail::ControlGate loop = detail::control_gate(d, gate.stations, options.progress);
   for (GateCheck& check : loop.checks) gate.checks.push_back(std::move(check));
   gate.validation = std::move(loop.figures);
+  // What each validated figure rests on (fivebar/provenance.hpp figure_bases()), beside the figures.
+  for (auto& [station, mechanisms] : gate.validation.items()) {
+    for (auto& [mechanism, figures] : mechanisms.items()) {
+      Json rests = Json::object();
+      for (const FigureBasis& f : figure_bases()) {
+        if (figures.contains(f.key)) rests[f.key] = rests_on_text(d, f.key);
+      }
+      figures["rests_on"] = rests;
+    }
+  }
 
   // Measured or assumed (fivebar/provenance.hpp): what the validated figures rest on, and the
   // groups controller.require_measured wants measured.

@@ -7,6 +7,7 @@
 
 #include "fivebar/format.hpp"
 #include "fivebar/export/export.hpp"
+#include "fivebar/provenance.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -30,6 +31,46 @@ constexpr const char* kPreamble =
     "(gearing, rotor inertia) and an MJCF for MuJoCo with the loops closed, the motors as actuators and the "
     "reflected rotor inertia as armature (docs/urdf.md, docs/mjcf.md; masses and meshes from the parts' STL "
     "renders when the scene built them).\n\n";
+
+/// The validated figures of the export gate (its `fivebar.validation` block) with what each rests
+/// on (fivebar/provenance.hpp figure_bases(), the one table): a markdown table, figures by row and
+/// mechanisms by column, and the same as JSON records for summary.json.
+void rests_on(const Design& d, const Json& validation, std::string& markdown, Json& records) {
+  std::vector<std::string> subjects;
+  std::vector<const Json*> figures;
+  for (const auto& [station, mechanisms] : validation.items()) {
+    for (const auto& [mechanism, f] : mechanisms.items()) {
+      subjects.push_back(station + "/" + mechanism);
+      figures.push_back(&f);
+    }
+  }
+  records = Json::array();
+  if (subjects.empty()) return;
+  std::vector<std::string> header{"validated figure"};
+  for (const std::string& s : subjects) header.push_back(md::code(s));
+  header.push_back("rests on");
+  md::Table table(header, "l" + std::string(subjects.size(), 'r') + "l");
+  for (const FigureBasis& basis : figure_bases()) {
+    std::vector<std::string> row{basis.label + (basis.unit.empty() || basis.unit == "x" ? "" : " (" + basis.unit + ")")};
+    bool any = false;
+    for (std::size_t k = 0; k < subjects.size(); ++k) {
+      if (!figures[k]->contains(basis.key) || !figures[k]->at(basis.key).is_number()) {
+        row.push_back("-");
+        continue;
+      }
+      any = true;
+      const double v = figures[k]->at(basis.key).get<double>();
+      row.push_back(md::fixed(v * basis.scale, basis.digits));
+      records.push_back({{"subject", subjects[k]}, {"figure", basis.key}, {"value", v}, {"groups", basis.groups},
+                         {"assumed", figure_assumed(d, basis.key)}, {"text", rests_on_line(d, basis.key, v)}});
+    }
+    if (!any) continue;
+    row.push_back(rests_on_text(d, basis.key));
+    table.row(row);
+  }
+  markdown += "What each validated figure rests on (assumed: no `provenance:` entry; docs/calibrate.md \"What each figure "
+              "rests on\"):\n\n" + table.str() + "\n";
+}
 
 }  // namespace
 
@@ -75,6 +116,8 @@ Product export_product() {
     }
     markdown += "Rests on assumed values (no `provenance:` entry, docs/calibrate.md): " +
                 (r.gate.assumed.empty() ? std::string("none") : format::join(r.gate.assumed)) + ".\n\n";
+    Json records;
+    rests_on(d, r.gate.validation, markdown, records);
     Json files = Json::array();
     if (r.gate.passed()) {
       markdown += "Files:";
@@ -88,7 +131,7 @@ Product export_product() {
       markdown += "**Export refused**: no file written.\n";
     }
     b.result = {{"node", d.get<ControllerSettings>()->node}, {"design_hash", r.hash}, {"exported", r.gate.passed()},
-                {"files", files}, {"gate", to_json(r.gate)}};
+                {"files", files}, {"gate", to_json(r.gate)}, {"rests_on", records}};
     b.markdown = markdown;
     b.passed = r.gate.passed();
     const auto reasons = r.gate.reasons();

@@ -111,6 +111,65 @@ std::vector<std::string> assumed_groups(const Design& design) {
   return out;
 }
 
+const std::vector<FigureBasis>& figure_bases() {
+  static const std::vector<FigureBasis> table = [] {
+    const std::vector<std::string> plant{"kinematics", "motor", "density"};
+    std::vector<FigureBasis> t{
+        {"max_rho", "max spectral radius", 1.0, "", 4, plant},
+        {"kp_margin", "kp margin", 1.0, "x", 2, plant},
+        {"kd_margin", "kd margin", 1.0, "x", 2, plant},
+        {"oscillatory_damping", "least damping", 1.0, "", 3, plant},
+        {"oscillatory_frequency_hz", "least-damped frequency", 1.0, "Hz", 2, plant},
+        {"min_bandwidth_hz", "min bandwidth", 1.0, "Hz", 2, plant},
+        {"max_tracking_error_m", "max tracking error", 1e3, "mm", 3, {"kinematics", "potentiometer", "motor", "contact", "density"}},
+        {"max_saturation_fraction", "time saturated", 100.0, "%", 1, {"kinematics", "motor", "contact", "density"}},
+        {"robust_margin_mm", "robust margin", 1.0, "mm", 3, {"kinematics", "tolerance"}},
+    };
+    // Groups in provenance_groups() order.
+    for (FigureBasis& f : t) {
+      std::vector<std::string> ordered;
+      for (const std::string& g : provenance_groups()) {
+        if (std::find(f.groups.begin(), f.groups.end(), g) != f.groups.end()) ordered.push_back(g);
+      }
+      f.groups = ordered;
+    }
+    return t;
+  }();
+  return table;
+}
+
+const FigureBasis& figure_basis(std::string_view key) {
+  for (const FigureBasis& f : figure_bases()) {
+    if (f.key == key) return f;
+  }
+  std::vector<std::string> keys;
+  for (const FigureBasis& f : figure_bases()) keys.push_back(f.key);
+  throw InputError("unknown validated figure '" + std::string(key) + "' (known: " + format::join(keys) + ")");
+}
+
+std::vector<std::string> figure_assumed(const Design& design, std::string_view key) {
+  const FigureBasis& f = figure_basis(key);
+  std::vector<std::string> out;
+  for (const std::string& g : f.groups) {
+    if (!assumed_values(design, g).empty()) out.push_back(g);
+  }
+  return out;
+}
+
+std::string rests_on_text(const Design& design, std::string_view key) {
+  const std::vector<std::string> assumed = figure_assumed(design, key);
+  if (assumed.empty()) return "measured (" + format::join(figure_basis(key).groups) + ")";
+  return format::join(assumed) + " assumed";
+}
+
+std::string rests_on_line(const Design& design, std::string_view key, double value) {
+  const FigureBasis& f = figure_basis(key);
+  std::string v = format::fixed(value * f.scale, f.digits);
+  if (f.unit == "x") v = "x" + v;
+  else if (!f.unit.empty()) v += (f.unit == "%" ? "" : " ") + f.unit;
+  return f.label + " " + v + ": " + rests_on_text(design, key);
+}
+
 Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,
                             const Eigen::MatrixXd& covariance) {
   const auto n = static_cast<Eigen::Index>(values.size());
