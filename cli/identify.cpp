@@ -5,8 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
-#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -32,15 +30,6 @@ namespace fivebar::cli {
 namespace {
 
 namespace id = fivebar::identify;
-
-std::string today_utc() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buffer[16];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%d", &tm);
-  return buffer;
-}
 
 /// `value` to 5 significant digits, in its shortest text.
 std::string sig(double value) {
@@ -74,43 +63,10 @@ struct IdentifyCliOptions {
   double drive_noise_mNm = 1.0;
 };
 
-/// The priors of a joint: its motor (overrides applied), potentiometer and ADC, and the key path.
+/// The priors of a joint (fivebar/identify/model.hpp joint_prior()).
 id::JointPrior prior_of(const Design& design, const std::string& station, const std::string& mechanism, int joint,
                         double load_inertia, bool need_motor) {
-  id::JointPrior p;
-  const MotorSettings* ms = design.get<MotorSettings>();
-  if (ms == nullptr && need_motor) {
-    throw InputError(design.name + ": the design has no `motor:` section (motor.terminal_resistance_ohm, ...): the priors "
-                                   "of a duty, voltage or current drive");
-  }
-  const ControllerSettings* cs = design.get<ControllerSettings>();
-  if (!station.empty()) {
-    const Station& s = design.require_station(station);
-    if (s.mechanism(mechanism) == nullptr) {
-      throw InputError("joint '" + station + "_" + mechanism + "_theta" + std::to_string(joint) + "': station '" + station +
-                       "' has no mechanism '" + mechanism + "'");
-    }
-    if (ms) p.motor = ms->joint(station, mechanism, joint);
-    if (cs) {
-      const JointControl jc = cs->joint(station, mechanism, joint);
-      p.volts_at_zero = jc.potentiometer.volts_at_zero;
-      p.rad_per_volt = jc.potentiometer.rad_per_volt;
-    }
-    p.motor_key = "motor.stations." + station + "." + mechanism + ".theta" + std::to_string(joint);
-  } else {
-    if (ms) p.motor = ms->defaults;
-    if (cs) {
-      p.volts_at_zero = cs->potentiometer.volts_at_zero;
-      p.rad_per_volt = cs->potentiometer.rad_per_volt;
-    }
-  }
-  if (cs) {
-    p.adc_bits = cs->adc_bits;
-    p.adc_lo_v = cs->adc_range_v[0];
-    p.adc_hi_v = cs->adc_range_v[1];
-  }
-  p.load_inertia = load_inertia;
-  return p;
+  return id::joint_prior(design, station, mechanism, joint, load_inertia, need_motor);
 }
 
 void print_estimate_table(const id::JointIdentification& r) {
@@ -335,6 +291,7 @@ int run_identify(const IdentifyCliOptions& opt) {
   doc["refused"] = refused;
   // The patched design (docs/identify.md "The patched design"), built before anything is written.
   std::optional<Design> patched;
+  std::vector<std::string> skipped;
   if (refused.empty() && !id::patched_keys(results).empty()) {
     MeasurementSource source;
     source.file = opt.log;
@@ -343,8 +300,9 @@ int run_identify(const IdentifyCliOptions& opt) {
     source.method = std::string("fivebar identify --rig motor: ") +
                     (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
                     ", standard deviation";
-    patched = id::patched_design(design, results, source);
+    patched = id::patched_design(design, results, source, &skipped);
     doc["patched"] = id::patched_keys(results);
+    doc["not_patched"] = skipped;
   }
   std::vector<std::string> files;
   if (!opt.no_files) {
@@ -379,6 +337,7 @@ int run_identify(const IdentifyCliOptions& opt) {
   } else {
     for (const auto& r : results) print_joint(r);
     for (const std::string& s : refused) std::cout << "NOT IDENTIFIABLE (asked by --fit): " << s << "\n";
+    for (const std::string& s : skipped) std::cout << "not patched: " << s << "\n";
     if (!files.empty()) std::cout << "wrote " << files.size() << " files into " << std::filesystem::path(files.front()).parent_path().generic_string() << "\n";
   }
   return refused.empty() ? kOk : kCheckFailed;

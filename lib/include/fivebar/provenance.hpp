@@ -71,6 +71,8 @@ struct MeasurementSource {
   std::string date;    ///< YYYY-MM-DD, UTC
   std::string method;  ///< "fivebar calibrate: ...", "fivebar identify: IDIM-LS ...", ...
 };
+/// Today's date, YYYY-MM-DD (UTC): the `date` of the entries written now.
+std::string today_utc();
 /// One measured value: the key path it sets and its standard deviation (the key's file unit).
 struct MeasuredValue {
   std::string key;

@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/sections/motor.hpp"
 
 namespace fivebar::identify {
@@ -23,16 +24,21 @@ bool split_motor_key(const std::string& key, std::string& scope, std::string& fi
 
 std::vector<std::string> patched_keys(const std::vector<JointIdentification>& results) {
   std::vector<std::string> keys;
+  const auto& fields = motor_fields();
   for (const JointIdentification& r : results) {
     for (const Parameter& p : r.parameters) {
       std::string scope, field;
-      if (p.identified && split_motor_key(p.key, scope, field)) keys.push_back(p.key);
+      if (!p.identified || !split_motor_key(p.key, scope, field)) continue;
+      const auto f = std::find_if(fields.begin(), fields.end(), [&](const MotorField& x) { return x.key == field; });
+      if (f != fields.end() && !((p.value > f->lo || (f->zero_ok && p.value >= f->lo)) && p.value <= f->hi)) continue;
+      keys.push_back(p.key);
     }
   }
   return keys;
 }
 
-Design patched_design(const Design& design, const std::vector<JointIdentification>& results, const MeasurementSource& source) {
+Design patched_design(const Design& design, const std::vector<JointIdentification>& results, const MeasurementSource& source,
+                      std::vector<std::string>* skipped) {
   Design d = design;
   MotorSettings* ms = d.get<MotorSettings>();
   std::vector<MeasuredValue> values;
@@ -44,6 +50,16 @@ Design patched_design(const Design& design, const std::vector<JointIdentificatio
       const auto& fields = motor_fields();
       const auto f = std::find_if(fields.begin(), fields.end(), [&](const MotorField& x) { return x.key == field; });
       if (f == fields.end()) throw InputError(p.key + ": not a key of the `motor:` section");
+      // A value the `motor:` section's rules refuse (a friction estimated below zero within its
+      // noise) is not written: the key stays an assumption, and the caller says why.
+      const bool in_range = (p.value > f->lo || (f->zero_ok && p.value >= f->lo)) && p.value <= f->hi;
+      if (!in_range) {
+        if (skipped != nullptr) {
+          skipped->push_back(p.key + " = " + format::shortest(p.value) + " " + std::string(f->unit) +
+                             " (sigma " + format::shortest(p.sigma) + "): outside the motor: section's range, not written");
+        }
+        continue;
+      }
       if (scope.empty()) {
         ms->defaults.*(f->member) = p.value;
       } else {

@@ -2,6 +2,8 @@
 #include "fivebar/provenance.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <array>
 #include <utility>
 #include <cmath>
@@ -168,6 +170,15 @@ std::string rests_on_line(const Design& design, std::string_view key, double val
   if (f.unit == "x") v = "x" + v;
   else if (!f.unit.empty()) v += (f.unit == "%" ? "" : " ") + f.unit;
   return f.label + " " + v + ": " + rests_on_text(design, key);
+}
+
+std::string today_utc() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&now, &tm);
+  char buffer[16];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%d", &tm);
+  return buffer;
 }
 
 Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/design.hpp"
 #include "fivebar/identify/log.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -32,6 +33,13 @@ struct JointPrior {
   double load_inertia = 0.0;    ///< kg m^2 at the output, known (--load-inertia); 0: none
   std::string motor_key = "motor";  ///< "motor" or "motor.stations.index.lower.theta1"
 };
+
+/// The priors of a joint: its motor (the joint's overrides applied), potentiometer and ADC from the
+/// design, and the key path its motor values live at; `station` empty: a motor on the bench (the
+/// `motor:` defaults, key `motor`). InputError when `need_motor` and the design has no `motor:`
+/// section, or when the station has no such mechanism.
+JointPrior joint_prior(const Design& design, const std::string& station, const std::string& mechanism, int joint,
+                       double load_inertia, bool need_motor);
 
 /// tau_d = alpha * d - g * w for the drive kind, from the priors (output shaft, SI).
 struct ReducedDrive {

@@ -15,13 +15,16 @@
 
 namespace fivebar::identify {
 
-/// The key paths of `results` that a patch writes, in order (identified, under `motor.`).
+/// The key paths of `results` that a patch writes, in order (identified, under `motor.`, within the
+/// `motor:` section's range).
 std::vector<std::string> patched_keys(const std::vector<JointIdentification>& results);
 
 /// `design` with the identified motor keys of `results` set and a provenance entry per key
-/// (`source.method` as given). InputError when the design has no `motor:` section or a key names a
-/// joint the design does not have; ValidationError when an identified value breaks a rule of the
-/// `motor:` section (a negative rotor inertia after the load is taken off, ...).
-Design patched_design(const Design& design, const std::vector<JointIdentification>& results, const MeasurementSource& source);
+/// (`source.method` as given). An identified value outside the `motor:` section's range (a friction
+/// estimated below zero within its noise, a negative rotor inertia after the load is taken off) is
+/// not written: the key stays an assumption and `skipped` (when given) says why. InputError when
+/// the design has no `motor:` section or a key names a joint the design does not have.
+Design patched_design(const Design& design, const std::vector<JointIdentification>& results, const MeasurementSource& source,
+                      std::vector<std::string>* skipped = nullptr);
 
 }  // namespace fivebar::identify
