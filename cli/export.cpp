@@ -133,9 +133,8 @@ int run_export(const ExportCliOptions& opt) {
         std::vector<std::pair<std::string, std::vector<std::string>>> by_basis;
         for (const FigureBasis& f : figure_bases()) {
           if (!figures.contains(f.key) || !figures.at(f.key).is_number()) continue;
-          const std::string line = rests_on_line(design, f.key, figures.at(f.key).get<double>());
-          const std::string text = rests_on_text(design, f.key);
-          const std::string figure = line.substr(0, line.size() - text.size() - 2);
+          const std::string text = rests_on_text(design, f.key, station, mechanism);
+          const std::string figure = figure_text(f.key, figures.at(f.key).get<double>());
           auto it = std::find_if(by_basis.begin(), by_basis.end(), [&](const auto& x) { return x.first == text; });
           if (it == by_basis.end()) by_basis.push_back({text, {figure}});
           else it->second.push_back(figure);

@@ -22,6 +22,7 @@
 #include "fivebar/provenance.hpp"
 #include "fivebar/sha256.hpp"
 #include "fivebar/export/joint_limits.hpp"
+#include "fivebar/sections/bench.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -301,6 +302,7 @@ int run_identify(const IdentifyCliOptions& opt) {
                     (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
                     ", standard deviation";
     patched = id::patched_design(design, results, source, &skipped);
+    patched->reset<BenchSettings>();  // written elsewhere: its bench: files would not resolve
     doc["patched"] = id::patched_keys(results);
     doc["not_patched"] = skipped;
   }

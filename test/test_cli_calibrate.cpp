@@ -230,7 +230,7 @@ TEST_F(CliCalibrate, RunFitsTheBenchFilesAndEveryProductSaysWhatItRestsOn) {
   const std::string tracking = "kinematics, potentiometer, motor, contact, density assumed";
   const std::string md = ft::slurp(root / "summary.md");
   EXPECT_THAT(md, HasSubstr("## Kinematic calibration from the bench"));
-  EXPECT_THAT(md, HasSubstr("| max tracking error (mm) |"));
+  EXPECT_THAT(md, HasSubstr("| `index/lower` | max tracking error 0.1"));
   EXPECT_THAT(md, HasSubstr(tracking));
   EXPECT_THAT(ft::slurp(root / "index.html"), HasSubstr(tracking));
   const json summary = json::parse(ft::slurp(root / "summary.json"));

@@ -79,6 +79,17 @@ TEST(FigureBases, MeasuringAGroupTakesItOffEveryFigureThatRestsOnIt) {
     EXPECT_TRUE(figure_assumed(all, f.key).empty()) << f.key;
     EXPECT_EQ(rests_on_text(all, f.key).rfind("measured (", 0), 0u) << f.key;
   }
+  // One mechanism measured: its own figures no longer rest on assumed kinematics and
+  // potentiometers, the other mechanism's still do (a figure of index/lower rests on index/lower).
+  std::vector<MeasuredValue> lower;
+  for (const std::string& k : calibration_keys(d, "index", "lower")) lower.push_back({k, 0.01});
+  const Design one = with_measured_values(d, lower, {"m.csv", sha256_hex("m"), "2026-11-26", "test"});
+  EXPECT_EQ(figure_assumed(one, "max_tracking_error_m", "index", "lower"), (std::vector<std::string>{"motor", "contact", "density"}));
+  EXPECT_EQ(figure_assumed(one, "max_tracking_error_m", "index", "upper"),
+            (std::vector<std::string>{"kinematics", "potentiometer", "motor", "contact", "density"}));
+  // A motor override of one joint measured leaves the other joint's motor values assumed.
+  const Design joint = with_measured_values(one, {{"motor.coulomb_friction_mNm", 0.01}}, {"m.csv", sha256_hex("m"), "2026-11-26", "test"});
+  EXPECT_FALSE(assumed_values(joint, "motor", "index", "lower").empty());
   // One mechanism's links measured is not the kinematics group measured.
   std::vector<MeasuredValue> links;
   for (int i = 0; i < 4; ++i) links.push_back({"stations.index.mechanisms.lower.links[" + std::to_string(i) + "]", 0.01});
@@ -104,7 +115,7 @@ TEST(FigureBases, TheExportValidationBlockCarriesWhatEachFigureRestsOn) {
       if (!value.is_number()) continue;  // worst_pose_m is a place, rests_on the lines
       ++figures;
       ASSERT_TRUE(f.at("rests_on").contains(key)) << key;
-      EXPECT_EQ(f.at("rests_on").at(key).get<std::string>(), rests_on_text(d, key)) << key;
+      EXPECT_EQ(f.at("rests_on").at(key).get<std::string>(), rests_on_text(d, key, "index", m)) << key;
       EXPECT_THAT(f.at("rests_on").at(key).get<std::string>(), Not(HasSubstr("motor"))) << key;
     }
     EXPECT_EQ(figures, 8);

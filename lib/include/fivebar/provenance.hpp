@@ -52,12 +52,23 @@ struct FigureBasis {
 const std::vector<FigureBasis>& figure_bases();
 /// The figure of `key`; InputError naming the known keys otherwise.
 const FigureBasis& figure_basis(std::string_view key);
-/// The groups of `key`'s basis that have assumed values in `design` (provenance_groups() order).
-std::vector<std::string> figure_assumed(const Design& design, std::string_view key);
+/// The values of `group` that one mechanism's figures rest on and that are assumptions: its own
+/// links and bases (kinematics), its joints' potentiometers and motors (each value at the narrowest
+/// scope that sets it), and the design-wide contact, density and tolerance values.
+std::vector<std::string> assumed_values(const Design& design, std::string_view group, std::string_view station,
+                                        std::string_view mechanism);
+/// The groups of `key`'s basis that have assumed values (provenance_groups() order): for one
+/// mechanism's figure when `station` and `mechanism` are given, else over the whole design.
+std::vector<std::string> figure_assumed(const Design& design, std::string_view key, std::string_view station = {},
+                                        std::string_view mechanism = {});
 /// "motor, contact assumed" or "measured (kinematics, density, motor)": what `key` rests on.
-std::string rests_on_text(const Design& design, std::string_view key);
+std::string rests_on_text(const Design& design, std::string_view key, std::string_view station = {},
+                          std::string_view mechanism = {});
 /// "max tracking error 0.117 mm: motor, contact assumed" for the figure's value in its key's unit.
-std::string rests_on_line(const Design& design, std::string_view key, double value);
+std::string rests_on_line(const Design& design, std::string_view key, double value, std::string_view station = {},
+                          std::string_view mechanism = {});
+/// The figure and its value alone: "max tracking error 0.117 mm".
+std::string figure_text(std::string_view key, double value);
 
 /// The key paths of a mechanism's twelve calibration values, in the order of
 /// fivebar/calibrate/model.hpp (links[0..3], bases[0][0], bases[0][1], bases[1][0], bases[1][1]; each

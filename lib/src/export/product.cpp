@@ -2,6 +2,7 @@
 // it passes, written as ROS 2 parameters, JSON and a C++17 header under export/ (fivebar/export/export.hpp).
 // A refused export writes nothing and fails the product's check with every reason.
 
+#include <algorithm>
 #include <numbers>
 #include <string>
 
@@ -33,41 +34,30 @@ constexpr const char* kPreamble =
     "renders when the scene built them).\n\n";
 
 /// The validated figures of the export gate (its `fivebar.validation` block) with what each rests
-/// on (fivebar/provenance.hpp figure_bases(), the one table): a markdown table, figures by row and
-/// mechanisms by column, and the same as JSON records for summary.json.
+/// on (fivebar/provenance.hpp figure_bases(), the one table): a markdown table, a row per mechanism
+/// and set of groups, and the same per figure as JSON records for summary.json.
 void rests_on(const Design& d, const Json& validation, std::string& markdown, Json& records) {
-  std::vector<std::string> subjects;
-  std::vector<const Json*> figures;
-  for (const auto& [station, mechanisms] : validation.items()) {
-    for (const auto& [mechanism, f] : mechanisms.items()) {
-      subjects.push_back(station + "/" + mechanism);
-      figures.push_back(&f);
-    }
-  }
   records = Json::array();
-  if (subjects.empty()) return;
-  std::vector<std::string> header{"validated figure"};
-  for (const std::string& s : subjects) header.push_back(md::code(s));
-  header.push_back("rests on");
-  md::Table table(header, "l" + std::string(subjects.size(), 'r') + "l");
-  for (const FigureBasis& basis : figure_bases()) {
-    std::vector<std::string> row{basis.label + (basis.unit.empty() || basis.unit == "x" ? "" : " (" + basis.unit + ")")};
-    bool any = false;
-    for (std::size_t k = 0; k < subjects.size(); ++k) {
-      if (!figures[k]->contains(basis.key) || !figures[k]->at(basis.key).is_number()) {
-        row.push_back("-");
-        continue;
+  md::Table table({"mechanism", "validated figures", "rest on"}, "lll");
+  for (const auto& [station, mechanisms] : validation.items()) {
+    for (const auto& [mechanism, figures] : mechanisms.items()) {
+      const std::string subject = station + "/" + mechanism;
+      std::vector<std::pair<std::string, std::vector<std::string>>> rows;  // rests-on text -> figures
+      for (const FigureBasis& basis : figure_bases()) {
+        if (!figures.contains(basis.key) || !figures.at(basis.key).is_number()) continue;
+        const double v = figures.at(basis.key).get<double>();
+        const std::string text = rests_on_text(d, basis.key, station, mechanism);
+        records.push_back({{"subject", subject}, {"figure", basis.key}, {"value", v}, {"groups", basis.groups},
+                           {"assumed", figure_assumed(d, basis.key, station, mechanism)},
+                           {"text", rests_on_line(d, basis.key, v, station, mechanism)}});
+        auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.first == text; });
+        if (it == rows.end()) rows.push_back({text, {figure_text(basis.key, v)}});
+        else it->second.push_back(figure_text(basis.key, v));
       }
-      any = true;
-      const double v = figures[k]->at(basis.key).get<double>();
-      row.push_back(md::fixed(v * basis.scale, basis.digits));
-      records.push_back({{"subject", subjects[k]}, {"figure", basis.key}, {"value", v}, {"groups", basis.groups},
-                         {"assumed", figure_assumed(d, basis.key)}, {"text", rests_on_line(d, basis.key, v)}});
+      for (const auto& [text, list] : rows) table.row({md::code(subject), format::join(list), text});
     }
-    if (!any) continue;
-    row.push_back(rests_on_text(d, basis.key));
-    table.row(row);
   }
+  if (table.empty()) return;
   markdown += "What each validated figure rests on (assumed: no `provenance:` entry; docs/calibrate.md \"What each figure "
               "rests on\"):\n\n" + table.str() + "\n";
 }

@@ -12,6 +12,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/print.hpp"
 #include "fivebar/sections/provenance.hpp"
 
@@ -149,27 +150,67 @@ const FigureBasis& figure_basis(std::string_view key) {
   throw InputError("unknown validated figure '" + std::string(key) + "' (known: " + format::join(keys) + ")");
 }
 
-std::vector<std::string> figure_assumed(const Design& design, std::string_view key) {
+std::vector<std::string> assumed_values(const Design& design, std::string_view group, std::string_view station,
+                                        std::string_view mechanism) {
+  std::vector<std::string> keys;
+  if (group == "kinematics" || group == "potentiometer") {
+    const std::array<std::string, 12> all = calibration_keys(design, station, mechanism);
+    const bool kin = group == "kinematics";
+    if (!kin && design.get<ControllerSettings>() == nullptr) return keys;
+    keys.assign(all.begin() + (kin ? 0 : 8), all.begin() + (kin ? 8 : 12));
+  } else if (group == "motor") {
+    const MotorSettings* ms = design.get<MotorSettings>();
+    if (ms == nullptr) return keys;
+    for (int j = 1; j <= 2; ++j) {
+      for (std::size_t f = 0; f < motor_fields().size(); ++f) {
+        std::string key = "motor." + std::string(motor_fields()[f].key);
+        int level = -1;
+        for (const MotorOverride& o : ms->overrides) {
+          const bool applies = (o.station.empty() || o.station == station) && (o.mechanism.empty() || o.mechanism == mechanism) &&
+                               (o.joint == 0 || o.joint == j);
+          if (applies && o.values[f] && o.level() >= level) {
+            level = o.level();
+            key = "motor." + o.key() + "." + std::string(motor_fields()[f].key);
+          }
+        }
+        if (std::find(keys.begin(), keys.end(), key) == keys.end()) keys.push_back(key);
+      }
+    }
+  } else {
+    return assumed_values(design, group);
+  }
+  std::erase_if(keys, [&](const std::string& k) { return is_measured(design, k); });
+  return keys;
+}
+
+std::vector<std::string> figure_assumed(const Design& design, std::string_view key, std::string_view station,
+                                        std::string_view mechanism) {
   const FigureBasis& f = figure_basis(key);
   std::vector<std::string> out;
   for (const std::string& g : f.groups) {
-    if (!assumed_values(design, g).empty()) out.push_back(g);
+    const bool assumed = station.empty() ? !assumed_values(design, g).empty() : !assumed_values(design, g, station, mechanism).empty();
+    if (assumed) out.push_back(g);
   }
   return out;
 }
 
-std::string rests_on_text(const Design& design, std::string_view key) {
-  const std::vector<std::string> assumed = figure_assumed(design, key);
+std::string rests_on_text(const Design& design, std::string_view key, std::string_view station, std::string_view mechanism) {
+  const std::vector<std::string> assumed = figure_assumed(design, key, station, mechanism);
   if (assumed.empty()) return "measured (" + format::join(figure_basis(key).groups) + ")";
   return format::join(assumed) + " assumed";
 }
 
-std::string rests_on_line(const Design& design, std::string_view key, double value) {
+std::string figure_text(std::string_view key, double value) {
   const FigureBasis& f = figure_basis(key);
   std::string v = format::fixed(value * f.scale, f.digits);
   if (f.unit == "x") v = "x" + v;
   else if (!f.unit.empty()) v += (f.unit == "%" ? "" : " ") + f.unit;
-  return f.label + " " + v + ": " + rests_on_text(design, key);
+  return f.label + " " + v;
+}
+
+std::string rests_on_line(const Design& design, std::string_view key, double value, std::string_view station,
+                          std::string_view mechanism) {
+  return figure_text(key, value) + ": " + rests_on_text(design, key, station, mechanism);
 }
 
 std::string today_utc() {
