@@ -43,7 +43,7 @@ struct IdentifyCliOptions {
   std::string design;
   std::string log;
   std::string validation;
-  std::string rig = "motor";
+  std::vector<std::string> rig{"motor"};  ///< motor, or mechanism STATION/MECHANISM
   std::string joint;
   std::string out;
   std::vector<std::string> fit;
@@ -226,8 +226,21 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
 
 int run_identify(const IdentifyCliOptions& opt) {
   const Design design = load(opt.design);
-  if (opt.rig != "motor") {
-    throw InputError("--rig " + opt.rig + ": only `--rig motor` is available (the closed-chain rig is not implemented yet)");
+  // --rig motor, or --rig mechanism STATION/MECHANISM (fivebar/identify/mechanism.hpp).
+  std::string rig_station, rig_mechanism;
+  const std::string rig = opt.rig.empty() ? "motor" : opt.rig.front();
+  if (rig == "mechanism") {
+    const std::string sm = opt.rig.size() == 2 ? opt.rig[1] : "";
+    const std::size_t slash = sm.find('/');
+    if (slash == std::string::npos || slash == 0 || slash + 1 == sm.size() || sm.find('/', slash + 1) != std::string::npos) {
+      throw InputError("--rig mechanism: expected STATION/MECHANISM after it (e.g. --rig mechanism index/lower)");
+    }
+    rig_station = sm.substr(0, slash);
+    rig_mechanism = sm.substr(slash + 1);
+    if (opt.plan) throw InputError("--plan: plans one joint (--joint STATION/MECHANISM/thetaJ), not --rig mechanism");
+    if (!opt.validation.empty()) throw InputError("--validation: not with --rig mechanism yet");
+  } else if (rig != "motor" || opt.rig.size() != 1) {
+    throw InputError("--rig: motor, or mechanism STATION/MECHANISM");
   }
   if (opt.plan) return run_plan(opt, design);
   if (opt.log.empty()) throw InputError("LOG: an identification log is required (or --plan)");
@@ -249,7 +262,9 @@ int run_identify(const IdentifyCliOptions& opt) {
 
   // Identify every joint (or the one --joint names) before writing anything.
   std::vector<id::JointIdentification> results;
+  if (!rig_station.empty()) results = id::identify_mechanism(design, est, rig_station, rig_mechanism, o);
   for (const id::JointLog& j : est.joints) {
+    if (!rig_station.empty()) break;
     if (!opt.joint.empty() && j.prefix != opt.joint && !(opt.joint == "motor" && j.prefix.empty())) continue;
     const id::JointLog* vj = nullptr;
     if (val) {
@@ -284,7 +299,7 @@ int run_identify(const IdentifyCliOptions& opt) {
       throw InputError("--fit " + key + ": not a parameter of this rig (parameters: " + format::join(keys) + ")");
     }
   }
-  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", opt.rig}, {"log", opt.log}};
+  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", rig}, {"log", opt.log}};
   if (val) doc["validation"] = opt.validation;
   doc["method"] = opt.method == "oe" ? "output error" : "IDIM-LS";
   doc["joints"] = Json::array();
@@ -359,9 +374,11 @@ void setup_identify(CLI::App& app) {
                                    "torque_Nm or force_N), a reading (volts, counts, theta_rad or position_m) and optionally current_A")
       ->type_name("LOG.csv");
   sub->add_option("--validation", opt->validation, "A second log of the same joints: fit figures only")->type_name("LOG.csv");
-  sub->add_option("--rig", opt->rig, "What the log was taken on: motor (one motor on the bench, optional known load)")
-      ->capture_default_str()
-      ->type_name("motor|mechanism");
+  sub->add_option("--rig", opt->rig,
+                  "What the log was taken on: motor (one motor on the bench, optional known load), or mechanism "
+                  "STATION/MECHANISM (the assembled five-bar: both motors, the closed chain's inertia from the design)")
+      ->expected(1, 2)
+      ->type_name("motor|mechanism S/M");
   sub->add_option("--joint", opt->joint,
                   "Only this joint of the log (its prefix <station>_<mechanism>_theta<j>, or motor); with --plan "
                   "STATION/MECHANISM/thetaJ: its motor and usable range")

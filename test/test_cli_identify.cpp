@@ -150,6 +150,13 @@ TEST_F(CliIdentify, BadLogsExitTwoNamingTheLineAndColumnAndWriteNothing) {
   EXPECT_THAT(r.err, HasSubstr("unknown.csv:1: column 4 'rpm': unknown column"));
   r = run({"identify", kDesign, bad.string(), "--rig", "mechanism", "--out", "o"});
   EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("STATION/MECHANISM"));
+  // The assembled mechanism needs both motors' columns: a bench motor's log names what is missing.
+  ft::SyntheticTruth truth;
+  const fs::path motor = write("motor.csv", ft::synthetic_log(truth, 5).csv());
+  r = run({"identify", kDesign, motor.string(), "--out", "o", "--rig", "mechanism", "index/lower"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("no columns for joint index_lower_theta1"));
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 

@@ -8,3 +8,4 @@
 #include "fivebar/identify/plan.hpp"
 #include "fivebar/identify/json.hpp"
 #include "fivebar/identify/patch.hpp"
+#include "fivebar/identify/mechanism.hpp"
