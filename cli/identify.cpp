@@ -85,11 +85,12 @@ void print_estimate_table(const id::JointIdentification& r) {
   }
 }
 
-std::string fit_text(const id::Fit& f) {
+std::string fit_text(const id::Fit& f, bool chain = false) {
   std::string s = "drive fit " + fixed(f.drive_fit_percent, 1) + " % (relative error " + fixed(f.drive_relative_error_percent, 2) + " %)";
   s += f.simulated ? ", position fit " + fixed(f.position_fit_percent, 1) + " % (relative error " +
                          fixed(f.position_relative_error_percent, 2) + " %)"
-                   : ", open-loop simulation diverged";
+                   : chain ? ", no position fit (a joint of a closed chain is not simulated alone)"
+                           : ", open-loop simulation diverged";
   return s;
 }
 
@@ -117,7 +118,8 @@ void print_joint(const id::JointIdentification& r) {
     }
   }
   std::cout << "\n";
-  std::cout << "  estimation log: IDIM-LS " << fit_text(r.estimation_idim) << "\n";
+  const bool chain = r.output_error_status.find("closed chain") != std::string::npos;
+  std::cout << "  estimation log: IDIM-LS " << fit_text(r.estimation_idim, chain) << "\n";
   if (r.output_error) std::cout << "                  output error " << fit_text(r.estimation_oe) << "\n";
   if (r.validation_idim) {
     std::cout << "  validation log: IDIM-LS " << fit_text(*r.validation_idim) << "\n";
@@ -313,7 +315,7 @@ int run_identify(const IdentifyCliOptions& opt) {
     source.file = opt.log;
     source.sha256 = sha256_file(opt.log);
     source.date = today_utc();
-    source.method = std::string("fivebar identify --rig motor: ") +
+    source.method = std::string(rig_station.empty() ? "fivebar identify --rig motor: " : "fivebar identify --rig mechanism: ") +
                     (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
                     ", standard deviation";
     patched = id::patched_design(design, results, source, &skipped);
