@@ -3,6 +3,9 @@
 
     python3 designs/bench/make_bench.py [--fivebar build/fivebar]
 
+(needs a built fivebar and PyYAML, Debian python3-yaml; no test runs it: the files are in the
+repository, and running it again rewrites them byte for byte)
+
 Nobody measured these: they stand in for a bench until a lab measures its own device, and they
 are made from a stated truth so that what `fivebar calibrate` and `fivebar identify` find can be
 checked against it (docs/calibrate.md, docs/identify.md).
