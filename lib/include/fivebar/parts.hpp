@@ -3,7 +3,8 @@
 /// (proximal links with a motor D-bore, distal links, the tactor post and tip) and its base, as
 /// small OpenSCAD files that `use` the hand-written library scad/fivebar.scad with the design's
 /// numbers; binary STL renders by `openscad --hardwarnings` (two jobs in parallel, skipping parts
-/// whose inputs did not change); mesh checks (closed, no self-intersection, outward oriented,
+/// whose inputs did not change, and rendering once parts whose sources are the same: the others
+/// copy that STL); mesh checks (closed, no self-intersection, outward oriented,
 /// positive volume, one shell) and design-intent checks measured on the mesh (pin-centre distance
 /// equals the link length, hole diameters equal pin + 2 * clearance); a bill of materials.
 ///
