@@ -218,6 +218,9 @@ struct PartResult {
   RenderState render = RenderState::not_requested;
   double render_seconds = 0.0;       ///< openscad's wall time (0 when up to date)
   std::string render_error;          ///< openscad's warnings and errors when it failed
+  /// The part (PartSpec::label()) whose render this one copied, its source being the same; empty
+  /// when openscad rendered this one (or it was up to date).
+  std::string copied_from;
   std::optional<MeshCheck> mesh;     ///< after a render or when up to date
   std::vector<CircleFit> holes;      ///< one per spec.holes
   std::optional<double> centre_distance_mm;  ///< links: measured distance of the two joint axes

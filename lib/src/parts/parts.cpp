@@ -860,6 +860,7 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
           if (bytes.empty()) throw IoError("cannot read " + source.stl_file.generic_string() + ", the STL of the same source");
           write_file_atomic(stl, bytes);
           r.render = RenderState::rendered;
+          r.copied_from = source.spec.label();
           try {
             write_file_atomic(hash_file, hash);
           } catch (const IoError&) {
@@ -946,6 +947,7 @@ Json to_json(const PartsReport& report) {
                                                                                          : Json(nullptr);
     j["render"] = {{"state", std::string(to_string(p.render))},
                    {"seconds", p.render_seconds},
+                   {"copied_from", p.copied_from.empty() ? Json(nullptr) : Json(p.copied_from)},
                    {"error", p.render_error.empty() ? Json(nullptr) : Json(p.render_error)}};
     if (p.mesh) {
       const MeshCheck& m = *p.mesh;

@@ -35,7 +35,9 @@ std::string markdown(const PartsReport& r) {
               "llllrrlrrlll");
   for (const PartResult& p : r.parts) {
     std::string render(to_string(p.render));
-    if (p.render == RenderState::rendered) render += " (" + md::fixed(p.render_seconds, 1) + " s)";
+    if (p.render == RenderState::rendered) {
+      render += p.copied_from.empty() ? " (" + md::fixed(p.render_seconds, 1) + " s)" : " (copy of " + p.copied_from + ")";
+    }
     std::string bbox = "—";
     if (p.mesh) {
       const Eigen::Vector3d e = p.mesh->bbox_max_mm - p.mesh->bbox_min_mm;
