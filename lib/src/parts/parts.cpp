@@ -1,7 +1,7 @@
 // Printable parts: planning (the distinct parts of each station and their .scad text), rendering
 // with openscad as child processes (two at a time, skipping unchanged inputs, once per distinct
-// source), the design-intent checks and the bill of materials. Reading STL and fitting hole walls: parts_mesh.cpp; CGAL's
-// mesh checks: cgal/mesh_checks.cpp.
+// source), the design-intent checks and the bill of materials. Reading STL and fitting hole
+// walls: parts_mesh.cpp; CGAL's mesh checks: cgal/mesh_checks.cpp.
 
 #include "fivebar/format.hpp"
 #include "fivebar/parts.hpp"
