@@ -542,20 +542,43 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
       // The least-rho omega may break the damping or margin floors (a fast placement meets the
       // period of delay): among placements from omega* / 0.85^4 down to omega* 0.85^8, the first
       // that meets the linear floors, else the one that misses them least.
-      const auto violation = [&](const std::array<PidGains, 2>& g) {
-        const Linear l = linear_figures(job.poses, g, job.loop.delay, options.min_gain_margin);
-        return std::max(0.0, l.rho - options.rho_limit) + std::max(0.0, options.min_damping + kDampingSafety - l.damping) +
-               std::max(0.0, l.rho_kp - (1.0 - kRhoSafety)) + std::max(0.0, l.rho_kd - (1.0 - kRhoSafety));
+      // The violation of linear_figures() pose by pose, in its order (rho_kp and rho_kd stop
+      // growing at their first pose >= 1, as max_spectral_radius() stops there): every term only
+      // grows, so once the sum reaches `stop` the candidate cannot beat it and is left there; below,
+      // the value is that of linear_figures() exactly.
+      const auto violation = [&](const std::array<PidGains, 2>& g, double stop) {
+        std::array<PidGains, 2> g_kp = g, g_kd = g;
+        for (PidGains& x : g_kp) x.kp *= options.min_gain_margin;
+        for (PidGains& x : g_kd) x.kd *= options.min_gain_margin;
+        Linear l;
+        const auto value = [&] {
+          return std::max(0.0, l.rho - options.rho_limit) + std::max(0.0, options.min_damping + kDampingSafety - l.damping) +
+                 std::max(0.0, l.rho_kp - (1.0 - kRhoSafety)) + std::max(0.0, l.rho_kd - (1.0 - kRhoSafety));
+        };
+        for (const PoseLoop& pose : job.poses) {
+          if (pose.status != Status::ok) continue;
+          const LoopPoles poles = loop_poles(closed_loop(pose.plant, g, job.loop.delay), pose.plant.period_s);
+          l.rho = std::max(l.rho, poles.rho);
+          if (poles.oscillatory_damping < l.damping) l.damping = poles.oscillatory_damping;
+          if (l.rho_kp < 1.0) {
+            l.rho_kp = std::max(l.rho_kp, loop_poles(closed_loop(pose.plant, g_kp, job.loop.delay), pose.plant.period_s).rho);
+          }
+          if (l.rho_kd < 1.0) {
+            l.rho_kd = std::max(l.rho_kd, loop_poles(closed_loop(pose.plant, g_kd, job.loop.delay), pose.plant.period_s).rho);
+          }
+          if (value() >= stop) break;
+        }
+        return value();
       };
       const double omega0 = t.start_omega_rad_s;
-      double best_violation = violation(t.start);
+      double best_violation = violation(t.start, std::numeric_limits<double>::infinity());
       for (int k = -4; k <= 8 && best_violation > 0.0; ++k) {
         if (k == 0) continue;
         const double omega = omega0 * std::pow(0.85, k);
         const std::optional<std::array<PidGains, 2>> g =
             pole_placement_at(job.loop, job.station->target.center, omega, options.per_joint, t.before);
         if (!g) continue;
-        const double v = violation(*g);
+        const double v = violation(*g, best_violation);
         if (v < best_violation) {
           best_violation = v;
           t.start = *g;
