@@ -284,12 +284,10 @@ Probe probe(Plan& plan, const MechPlan& low, const Part* upper, V2 q) {
 /// union of those capsules is a closed form (ray_exit), and no point of the ray before it is
 /// free. Candidate directions: kPriorityRays fixed rays and, per forbidden capsule, the direction
 /// of the origin's projection onto it (where the closest point of a single capsule's boundary
-/// lies). Their exits are probed (IK, outline, clearance) in increasing distance; the first free
-/// one ends the search exactly for its ray. The outline's links can still block an exit (and the
-/// lower mechanism's reach, singularities and limits): such rays march outwards in steps of
-/// kPriorityStepRel length scales, ring by ring over the blocked rays whose next point is still
-/// closer than the best found, and the first free step is bisected kPriorityBisections times. At
-/// most kPriorityMaxProbes pose evaluations; true with the point.
+/// lies). Their exits are probed (IK, outline, clearance) best first; a free exit settles its ray
+/// exactly. The outline's links can still block an exit: such a ray advances conservatively (see
+/// below); one that leaves what the lower mechanism can hold (reach, singularities, limits) ends.
+/// At most kPriorityMaxProbes pose evaluations; true with the point.
 bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin, V2& found) {
   const std::size_t np = n_parts(plan);
   const double scale = low.mech.scale;
@@ -338,10 +336,9 @@ bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin,
   // (first its exit); the ray with the smallest is probed next, until it is no smaller than the
   // best free point found. A blocked point advances its ray conservatively by the clearance
   // missing over the fastest speed of the outline (no free point is skipped while that speed
-  // holds), at least kPriorityMinStepRel length scales; an unusable point by kPriorityStepRel. The
-  // first free point of a ray is bisected kPriorityBisections times against the blocked one before
-  // it (none when it is the exit: exact).
-  const double h = kPriorityStepRel * scale, h_min = kPriorityMinStepRel * scale;
+  // holds), at least kPriorityMinStepRel length scales. The first free point of a ray is bisected
+  // kPriorityBisections times against the blocked one before it (none when it is the exit: exact).
+  const double h_min = kPriorityMinStepRel * scale;
   const double inf = std::numeric_limits<double>::infinity();
   for (std::size_t j = 0; j < nd; ++j) {
     plan.at[j] = plan.exits[j];

@@ -53,11 +53,10 @@ enum class Reading : std::uint8_t {
 /// Priority-rule bounds (docs/runtime.md "Priority rule"): the exits of kPriorityRays fixed
 /// directions and of the projections onto the forbidden capsules of the tactor point are closed
 /// forms; a ray whose exit the links block advances conservatively (at least kPriorityMinStepRel
-/// length scales, kPriorityStepRel where the pose is unusable), at most kPriorityAdvances times,
-/// and its first free point is bisected kPriorityBisections times. At most kPriorityMaxProbes pose
-/// evaluations (IK, outline, clearance) per station and cycle.
+/// length scales), at most kPriorityAdvances times, and its first free point is bisected
+/// kPriorityBisections times. At most kPriorityMaxProbes pose evaluations (IK, outline,
+/// clearance) per station and cycle.
 inline constexpr int kPriorityRays = 32;
-inline constexpr double kPriorityStepRel = 0.0125;
 inline constexpr double kPriorityMinStepRel = 0.0005;
 inline constexpr int kPriorityAdvances = 24;
 inline constexpr int kPriorityBisections = 10;
