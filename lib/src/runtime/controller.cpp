@@ -303,16 +303,6 @@ bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin,
       plan.forbid[nf++] = c;
     }
   }
-  // Only the capsules holding the origin, and those overlapping them transitively, can hold a
-  // ray's exit (a point on the boundary of their union strictly inside another capsule would make
-  // that one overlap them): moved to the front, nf of them. None: every exit is the origin.
-  std::size_t nc = 0;
-  for (std::size_t k = 0; k < nf; ++k)
-    if (detail::inside(origin, plan.forbid[k])) std::swap(plan.forbid[k], plan.forbid[nc++]);
-  for (std::size_t i = 0; i < nc; ++i)  // each capsule joins once: at most nf^2 tests
-    for (std::size_t k = nc; k < nf; ++k)
-      if (detail::capsule_gap(plan.forbid[i], plan.forbid[k]) < 0.0) std::swap(plan.forbid[k], plan.forbid[nc++]);
-  nf = nc;
   // Candidate directions: the fixed rays, then the projections.
   std::size_t nd = 0;
   for (const V2 u : plan.rays) plan.dirs[nd++] = u;

@@ -246,10 +246,6 @@ double min_clearance(const Part* a, std::size_t na, const Part* b, std::size_t n
   return best;
 }
 
-double capsule_gap(const Capsule& a, const Capsule& b) { return segment_distance(a.a, a.b, b.a, b.b) - a.r - b.r; }
-
-bool inside(V2 p, const Capsule& c) { return norm(p - closest_on_segment(p, c.a, c.b)) < c.r; }
-
 double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::size_t nb, double cap) {
   double best = cap;
   for (std::size_t i = 0; i < na; ++i) {

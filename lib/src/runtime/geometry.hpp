@@ -100,11 +100,6 @@ bool collide(const Part* a, std::size_t na, const Part* b, std::size_t nb, doubl
 /// are `cap` or more apart are skipped).
 double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::size_t nb, double cap);
 
-/// Distance between the capsules' segments less both radii (negative: they overlap).
-double capsule_gap(const Capsule& a, const Capsule& b);
-/// Is p inside the capsule (distance to its segment < r)?
-bool inside(V2 p, const Capsule& c);
-
 /// A capsule seen from a fixed origin o, for rays o + t u (u a unit vector): the points inside it
 /// (distance to [a, b] < r) form one open interval of t (the capsule is convex), in closed form from
 /// the slab of the segment (two pairs of parallel lines) and the two end disks.
