@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
 # Quick start 2/2: install what is missing, build (Release) and run the whole test suite.
+# Packages (.ci/setup.sh): ./run.sh's FIVEBAR_PACKAGES plus the test tools FIVEBAR_TEST_PACKAGES
+# (GoogleTest, Google Benchmark, Chromium, jsonschema, urdfdom tools, MuJoCo, PrusaSlicer, pytest);
+# --fuzz and --all add FIVEBAR_HARDENING_PACKAGES (clang, its sanitizer runtimes and libFuzzer).
 #
 #   ./test.sh              the test suite through ctest (build/, Release)
 #   ./test.sh --sanitize   the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer
@@ -31,10 +34,13 @@ if ((normal + core + sanitize + fuzz == 0)); then
   if [[ "${CI:-}" == "true" ]]; then core=1 sanitize=1 fuzz=1; fi
 fi
 
-fivebar_install_packages
+# The main job's packages and the test tools; the fuzzing toolchain only for --fuzz (and --all).
+packages=("${FIVEBAR_PACKAGES[@]}" "${FIVEBAR_TEST_PACKAGES[@]}")
+if ((fuzz)); then packages+=("${FIVEBAR_HARDENING_PACKAGES[@]}"); fi
+fivebar_install_packages "${packages[@]}"
 
 if ((normal)); then
-  fivebar_build_in build "Release" --
+  fivebar_build_in build "Release" -DFIVEBAR_BUILD_TESTS=ON --
   fivebar_log "test suite (build/)"
   ctest --test-dir build --output-on-failure -j2 "${ctest_args[@]}"
 fi

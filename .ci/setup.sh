@@ -5,13 +5,17 @@
 
 FIVEBAR_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
-# Every package a capability of fivebar needs, so one set-up serves all of them.
+# What each quick-start command installs (README "Quick start"), in three lists:
+#   FIVEBAR_PACKAGES           ./run.sh: the build, the libraries and the programs `fivebar run` calls
+#   FIVEBAR_TEST_PACKAGES      ./test.sh adds the test tools (what the suites read results with)
+#   FIVEBAR_HARDENING_PACKAGES ./test.sh --fuzz / --all add the fuzzing toolchain (clang, libFuzzer)
+# (--sanitize builds with gcc, whose ASan and UBSan runtimes come with build-essential.)
 FIVEBAR_PACKAGES=(
-  build-essential cmake git pkg-config ccache
+  build-essential cmake git pkg-config ccache ninja-build
   libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libvtk9-dev libcairo2-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # The MPI sweep and optimiser (FIVEBAR_WITH_MPI, on by default).
   libopenmpi-dev openmpi-bin
   libsundials-dev
   # Optimisation: pagmo2 (multi-objective evolutionary search) and NLopt (derivative-free polish, tuning).
@@ -19,6 +23,16 @@ FIVEBAR_PACKAGES=(
   # Kinematic calibration (fivebar calibrate) and identification (fivebar identify): Ceres Solver's
   # nonlinear least squares.
   libceres-dev
+  # index.html: GitHub's CommonMark parser with its tables (lib/src/products/html.cpp).
+  libcmark-gfm-dev libcmark-gfm-extensions-dev
+  # The parts product renders its OpenSCAD sources to STL (fivebar parts, fivebar run).
+  openscad
+  # The Python module fivebar (python/), built by ./run.sh: pybind11 bindings for the system python3
+  # with NumPy.
+  pybind11-dev python3-dev python3-numpy
+)
+FIVEBAR_TEST_PACKAGES=(
+  libgtest-dev libgmock-dev libbenchmark-dev
   # Tests of what users open: urdfdom's check_urdf reads the exported URDF, python3-jsonschema
   # validates every command's --json against docs/schemas/, headless Chromium loads the HTML report.
   liburdfdom-tools python3-jsonschema chromium
@@ -27,32 +41,35 @@ FIVEBAR_PACKAGES=(
   libmujoco-dev
   # PyYAML, a YAML 1.1 reader as ROS 2's parameter parser is: test_export reads the parameters file with it.
   python3-yaml
-  openscad
-  # The Python module fivebar (python/): pybind11 bindings for the system python3 with NumPy, and
-  # its tests (pytest, run by ctest).
-  pybind11-dev python3-dev python3-numpy python3-pytest
+  # The Python module's tests (pytest, run by ctest).
+  python3-pytest
   # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
   prusa-slicer unzip
+)
+FIVEBAR_HARDENING_PACKAGES=(
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
   clang libclang-rt-14-dev libomp-dev
 )
 
 fivebar_log() { printf '[fivebar] %s\n' "$*" >&2; }
 
-# Installs the packages of FIVEBAR_PACKAGES that dpkg does not report as installed.
+# fivebar_install_packages [PACKAGE...]: installs those of the packages (default: FIVEBAR_PACKAGES)
+# that dpkg does not report as installed.
 fivebar_install_packages() {
   if ! command -v dpkg-query >/dev/null 2>&1; then
     fivebar_log "dpkg-query not found: not a Debian system, skipping package installation"
     return 0
   fi
+  local wanted=("$@")
+  ((${#wanted[@]} > 0)) || wanted=("${FIVEBAR_PACKAGES[@]}")
   local missing=() pkg
-  for pkg in "${FIVEBAR_PACKAGES[@]}"; do
+  for pkg in "${wanted[@]}"; do
     if [[ "$(dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null || true)" != "install ok installed" ]]; then
       missing+=("$pkg")
     fi
   done
   if ((${#missing[@]} == 0)); then
-    fivebar_log "all ${#FIVEBAR_PACKAGES[@]} Debian packages present"
+    fivebar_log "all ${#wanted[@]} Debian packages present"
     return 0
   fi
   local as_root=()
@@ -69,9 +86,12 @@ fivebar_install_packages() {
   "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}"
 }
 
-# Configures build/ (Release) once and builds the given targets (default: everything).
+# Configures build/ (Release) once and builds the given targets (default: everything). A new build/
+# is configured without the test suites (./run.sh installs no GoogleTest); ./test.sh turns them on.
 fivebar_build() {
-  fivebar_build_in build "Release" -- "$@"
+  local tests=()
+  [[ -f "$FIVEBAR_ROOT/build/CMakeCache.txt" ]] || tests=(-DFIVEBAR_BUILD_TESTS=OFF)
+  fivebar_build_in build "Release" "${tests[@]}" -- "$@"
 }
 
 # fivebar_build_in DIR DESCRIPTION [CMAKE_ARG...] -- [TARGET...]: configures $FIVEBAR_ROOT/DIR with

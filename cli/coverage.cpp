@@ -90,7 +90,7 @@ int run_coverage(const CoverageCliOptions& opt) {
       for (Json& jm : js["mechanisms"]) {
         const Mechanism* m = s.mechanism(jm["mechanism"].get<std::string>());
         const ToleranceSources src = tolerance_sources(design, s, *m);
-        const RobustCoverage r = robust_coverage(*m, target, src.sigma, src.robust_fraction, src.samples, src.seed);
+        const RobustCoverage r = robust_coverage(*m, target, src.spread(), src.robust_fraction, src.samples, src.seed);
         all = all && r.covered;
         jm["robust"] = to_json(r);
         if (!opt.json) {
@@ -99,7 +99,8 @@ int run_coverage(const CoverageCliOptions& opt) {
                     << (r.covered ? "covered" : "NOT COVERED") << " (Monte Carlo: "
                     << fixed(100.0 * r.fraction_monte_carlo, 2) << " % of " << r.samples << " devices cover; "
                     << fixed(100.0 - 100.0 * r.fraction, 1) << " % quantile of their margins "
-                    << fixed(r.quantile_margin_mm, 4) << " mm)\n";
+                    << fixed(r.quantile_margin_mm, 4) << " mm)" << (r.calibrated ? " [sigmas: the calibration's posterior covariance]" : "")
+                    << "\n";
         }
       }
       if (!opt.json) std::cout << "\n";

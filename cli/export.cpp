@@ -2,12 +2,15 @@
 // header), written only when the design passes the export gate; --check re-reads an exported file
 // and compares it with the design.
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
+#include "fivebar/format.hpp"
+#include "fivebar/provenance.hpp"
 #include "fivebar/io.hpp"
 
 namespace fivebar::cli {
@@ -123,6 +126,24 @@ int run_export(const ExportCliOptions& opt) {
     for (std::size_t i = 0; i < r.gate.stations.size(); ++i) std::cout << (i ? ", " : "") << r.gate.stations[i];
     std::cout << "\n";
     print_gate(r.gate);
+    // What each validated figure rests on (fivebar/provenance.hpp figure_bases()).
+    for (const auto& [station, mechanisms] : r.gate.validation.items()) {
+      for (const auto& [mechanism, figures] : mechanisms.items()) {
+        // Figures that rest on the same groups share a line.
+        std::vector<std::pair<std::string, std::vector<std::string>>> by_basis;
+        for (const FigureBasis& f : figure_bases()) {
+          if (!figures.contains(f.key) || !figures.at(f.key).is_number()) continue;
+          const std::string text = rests_on_text(design, f.key, station, mechanism);
+          const std::string figure = figure_text(f.key, figures.at(f.key).get<double>());
+          auto it = std::find_if(by_basis.begin(), by_basis.end(), [&](const auto& x) { return x.first == text; });
+          if (it == by_basis.end()) by_basis.push_back({text, {figure}});
+          else it->second.push_back(figure);
+        }
+        for (const auto& [text, list] : by_basis) {
+          std::cout << "  validated " << station << "/" << mechanism << ": " << format::join(list) << ": " << text << "\n";
+        }
+      }
+    }
     if (r.gate.passed()) {
       std::cout << "design hash " << r.hash << "\n";
       for (const auto& f : r.files) std::cout << "  wrote " << f.generic_string() << "\n";

@@ -19,7 +19,10 @@
 #include "fivebar/format.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/sha256.hpp"
 #include "fivebar/export/joint_limits.hpp"
+#include "fivebar/sections/bench.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -40,7 +43,7 @@ struct IdentifyCliOptions {
   std::string design;
   std::string log;
   std::string validation;
-  std::string rig = "motor";
+  std::vector<std::string> rig{"motor"};  ///< motor, or mechanism STATION/MECHANISM
   std::string joint;
   std::string out;
   std::vector<std::string> fit;
@@ -61,43 +64,10 @@ struct IdentifyCliOptions {
   double drive_noise_mNm = 1.0;
 };
 
-/// The priors of a joint: its motor (overrides applied), potentiometer and ADC, and the key path.
+/// The priors of a joint (fivebar/identify/model.hpp joint_prior()).
 id::JointPrior prior_of(const Design& design, const std::string& station, const std::string& mechanism, int joint,
                         double load_inertia, bool need_motor) {
-  id::JointPrior p;
-  const MotorSettings* ms = design.get<MotorSettings>();
-  if (ms == nullptr && need_motor) {
-    throw InputError(design.name + ": the design has no `motor:` section (motor.terminal_resistance_ohm, ...): the priors "
-                                   "of a duty, voltage or current drive");
-  }
-  const ControllerSettings* cs = design.get<ControllerSettings>();
-  if (!station.empty()) {
-    const Station& s = design.require_station(station);
-    if (s.mechanism(mechanism) == nullptr) {
-      throw InputError("joint '" + station + "_" + mechanism + "_theta" + std::to_string(joint) + "': station '" + station +
-                       "' has no mechanism '" + mechanism + "'");
-    }
-    if (ms) p.motor = ms->joint(station, mechanism, joint);
-    if (cs) {
-      const JointControl jc = cs->joint(station, mechanism, joint);
-      p.volts_at_zero = jc.potentiometer.volts_at_zero;
-      p.rad_per_volt = jc.potentiometer.rad_per_volt;
-    }
-    p.motor_key = "motor.stations." + station + "." + mechanism + ".theta" + std::to_string(joint);
-  } else {
-    if (ms) p.motor = ms->defaults;
-    if (cs) {
-      p.volts_at_zero = cs->potentiometer.volts_at_zero;
-      p.rad_per_volt = cs->potentiometer.rad_per_volt;
-    }
-  }
-  if (cs) {
-    p.adc_bits = cs->adc_bits;
-    p.adc_lo_v = cs->adc_range_v[0];
-    p.adc_hi_v = cs->adc_range_v[1];
-  }
-  p.load_inertia = load_inertia;
-  return p;
+  return id::joint_prior(design, station, mechanism, joint, load_inertia, need_motor);
 }
 
 void print_estimate_table(const id::JointIdentification& r) {
@@ -115,11 +85,12 @@ void print_estimate_table(const id::JointIdentification& r) {
   }
 }
 
-std::string fit_text(const id::Fit& f) {
+std::string fit_text(const id::Fit& f, bool chain = false) {
   std::string s = "drive fit " + fixed(f.drive_fit_percent, 1) + " % (relative error " + fixed(f.drive_relative_error_percent, 2) + " %)";
   s += f.simulated ? ", position fit " + fixed(f.position_fit_percent, 1) + " % (relative error " +
                          fixed(f.position_relative_error_percent, 2) + " %)"
-                   : ", open-loop simulation diverged";
+                   : chain ? ", no position fit (a joint of a closed chain is not simulated alone)"
+                           : ", open-loop simulation diverged";
   return s;
 }
 
@@ -147,7 +118,8 @@ void print_joint(const id::JointIdentification& r) {
     }
   }
   std::cout << "\n";
-  std::cout << "  estimation log: IDIM-LS " << fit_text(r.estimation_idim) << "\n";
+  const bool chain = r.output_error_status.find("closed chain") != std::string::npos;
+  std::cout << "  estimation log: IDIM-LS " << fit_text(r.estimation_idim, chain) << "\n";
   if (r.output_error) std::cout << "                  output error " << fit_text(r.estimation_oe) << "\n";
   if (r.validation_idim) {
     std::cout << "  validation log: IDIM-LS " << fit_text(*r.validation_idim) << "\n";
@@ -256,8 +228,21 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
 
 int run_identify(const IdentifyCliOptions& opt) {
   const Design design = load(opt.design);
-  if (opt.rig != "motor") {
-    throw InputError("--rig " + opt.rig + ": only `--rig motor` is available (the closed-chain rig is not implemented yet)");
+  // --rig motor, or --rig mechanism STATION/MECHANISM (fivebar/identify/mechanism.hpp).
+  std::string rig_station, rig_mechanism;
+  const std::string rig = opt.rig.empty() ? "motor" : opt.rig.front();
+  if (rig == "mechanism") {
+    const std::string sm = opt.rig.size() == 2 ? opt.rig[1] : "";
+    const std::size_t slash = sm.find('/');
+    if (slash == std::string::npos || slash == 0 || slash + 1 == sm.size() || sm.find('/', slash + 1) != std::string::npos) {
+      throw InputError("--rig mechanism: expected STATION/MECHANISM after it (e.g. --rig mechanism index/lower)");
+    }
+    rig_station = sm.substr(0, slash);
+    rig_mechanism = sm.substr(slash + 1);
+    if (opt.plan) throw InputError("--plan: plans one joint (--joint STATION/MECHANISM/thetaJ), not --rig mechanism");
+    if (!opt.validation.empty()) throw InputError("--validation: not with --rig mechanism yet");
+  } else if (rig != "motor" || opt.rig.size() != 1) {
+    throw InputError("--rig: motor, or mechanism STATION/MECHANISM");
   }
   if (opt.plan) return run_plan(opt, design);
   if (opt.log.empty()) throw InputError("LOG: an identification log is required (or --plan)");
@@ -279,7 +264,9 @@ int run_identify(const IdentifyCliOptions& opt) {
 
   // Identify every joint (or the one --joint names) before writing anything.
   std::vector<id::JointIdentification> results;
+  if (!rig_station.empty()) results = id::identify_mechanism(design, est, rig_station, rig_mechanism, o);
   for (const id::JointLog& j : est.joints) {
+    if (!rig_station.empty()) break;
     if (!opt.joint.empty() && j.prefix != opt.joint && !(opt.joint == "motor" && j.prefix.empty())) continue;
     const id::JointLog* vj = nullptr;
     if (val) {
@@ -314,18 +301,39 @@ int run_identify(const IdentifyCliOptions& opt) {
       throw InputError("--fit " + key + ": not a parameter of this rig (parameters: " + format::join(keys) + ")");
     }
   }
-  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", opt.rig}, {"log", opt.log}};
+  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", rig}, {"log", opt.log}};
   if (val) doc["validation"] = opt.validation;
   doc["method"] = opt.method == "oe" ? "output error" : "IDIM-LS";
   doc["joints"] = Json::array();
   for (const auto& r : results) doc["joints"].push_back(id::to_json(r));
   doc["refused"] = refused;
+  // The patched design (docs/identify.md "The patched design"), built before anything is written.
+  std::optional<Design> patched;
+  std::vector<std::string> skipped;
+  if (refused.empty() && !id::patched_keys(results).empty()) {
+    MeasurementSource source;
+    source.file = opt.log;
+    source.sha256 = sha256_file(opt.log);
+    source.date = today_utc();
+    source.method = std::string(rig_station.empty() ? "fivebar identify --rig motor: " : "fivebar identify --rig mechanism: ") +
+                    (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
+                    ", standard deviation";
+    patched = id::patched_design(design, results, source, &skipped);
+    patched->reset<BenchSettings>();  // written elsewhere: its bench: files would not resolve
+    doc["patched"] = id::patched_keys(results);
+    doc["not_patched"] = skipped;
+  }
   std::vector<std::string> files;
   if (!opt.no_files) {
     const std::filesystem::path dir =
         opt.out.empty() ? resolve_output_dir("outputs", design.name) / "identify" : std::filesystem::path(opt.out);
     make_directories(dir);
     WriteFence fence(dir);
+    if (patched) {
+      const std::filesystem::path f = dir / (design.name + "-identified.yaml");
+      write_file_atomic(f, to_yaml(*patched));
+      files.push_back(f.generic_string());
+    }
     for (const auto& r : results) {
       const id::JointIdentification& jr = r;
       for (bool v : {false, true}) {
@@ -348,6 +356,7 @@ int run_identify(const IdentifyCliOptions& opt) {
   } else {
     for (const auto& r : results) print_joint(r);
     for (const std::string& s : refused) std::cout << "NOT IDENTIFIABLE (asked by --fit): " << s << "\n";
+    for (const std::string& s : skipped) std::cout << "not patched: " << s << "\n";
     if (!files.empty()) std::cout << "wrote " << files.size() << " files into " << std::filesystem::path(files.front()).parent_path().generic_string() << "\n";
   }
   return refused.empty() ? kOk : kCheckFailed;
@@ -367,9 +376,11 @@ void setup_identify(CLI::App& app) {
                                    "torque_Nm or force_N), a reading (volts, counts, theta_rad or position_m) and optionally current_A")
       ->type_name("LOG.csv");
   sub->add_option("--validation", opt->validation, "A second log of the same joints: fit figures only")->type_name("LOG.csv");
-  sub->add_option("--rig", opt->rig, "What the log was taken on: motor (one motor on the bench, optional known load)")
-      ->capture_default_str()
-      ->type_name("motor|mechanism");
+  sub->add_option("--rig", opt->rig,
+                  "What the log was taken on: motor (one motor on the bench, optional known load), or mechanism "
+                  "STATION/MECHANISM (the assembled five-bar: both motors, the closed chain's inertia from the design)")
+      ->expected(1, 2)
+      ->type_name("motor|mechanism S/M");
   sub->add_option("--joint", opt->joint,
                   "Only this joint of the log (its prefix <station>_<mechanism>_theta<j>, or motor); with --plan "
                   "STATION/MECHANISM/thetaJ: its motor and usable range")
@@ -401,7 +412,8 @@ void setup_identify(CLI::App& app) {
       "Parameters are printed with their design key path (motor.terminal_resistance_ohm, in the design's units) or a "
       "rig-only name with its unit (inertia_kg_m2, viscous_Nm_s_per_rad, coulomb_Nm, offset_Nm; a linear axis: mass_kg, "
       "viscous_N_s_per_m, coulomb_N, offset_N). docs/identify.md.\nFiles: <joint>-estimation.svg|.png, "
-      "<joint>-validation.svg|.png, identify.json; with --plan identify-plan.csv.\nExit status: 0 done, 1 a parameter "
+      "<joint>-validation.svg|.png, identify.json, <design>-identified.yaml (the identified motor keys with provenance: "
+      "entries); with --plan identify-plan.csv.\nExit status: 0 done, 1 a parameter "
       "named by --fit is not identifiable from the log, 2 bad input, 3 internal error.");
   sub->callback([opt]() { finish(run_identify(*opt)); });
 }

@@ -138,6 +138,8 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
                 (unsigned long long)r.stages.not_covered, (unsigned long long)r.stages.cheap,
                 (unsigned long long)r.stages.loop, (unsigned long long)r.stages.simulation,
                 (unsigned long long)r.stages.feasible);
+    std::printf("  %llu evaluations, %llu distinct (the cache answered %llu requests without evaluating)\n",
+                (unsigned long long)r.evaluations, (unsigned long long)r.distinct, (unsigned long long)r.cache_hits);
     std::printf("  front: %zu designs; hypervolume %s (normalised)\n", r.front.size(),
                 r.hypervolume.empty() ? "-" : fixed(r.hypervolume.back().second).c_str());
     if (whole) {

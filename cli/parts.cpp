@@ -30,7 +30,7 @@ void print_table(const PartsReport& r, const std::filesystem::path& dir) {
   for (const PartResult& p : r.parts) {
     const bool link = p.spec.kind == PartKind::proximal_link || p.spec.kind == PartKind::distal_link;
     std::string render(to_string(p.render));
-    if (p.render == RenderState::rendered) render += " " + fixed(p.render_seconds, 1) + " s";
+    if (p.render == RenderState::rendered) render += p.copied_from.empty() ? " " + fixed(p.render_seconds, 1) + " s" : " (copy)";
     std::printf("%-8s %-28s %5d %10s %12s %9s %10s %-22s %s\n", p.spec.station.c_str(), p.spec.name.c_str(),
                 p.spec.count, link ? fixed(p.spec.length_mm, 3).c_str() : "-",
                 p.centre_distance_mm ? fixed(*p.centre_distance_mm, 4).c_str() : "-",

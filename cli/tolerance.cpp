@@ -36,6 +36,7 @@ struct ToleranceCliOptions {
 std::string point(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ")"; }
 
 void print_mechanism(const ToleranceMap& r) {
+  if (r.calibrated) std::cout << "  " << r.mechanism << " sigmas: " << r.spread_source << "\n";
   std::cout << "  " << r.mechanism << ": at the centre " << point(r.target.center) << ": ";
   if (r.centre.status != Status::ok) {
     std::cout << to_string(r.centre.status) << " (no first-order estimate)\n";
@@ -158,7 +159,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
         const ToleranceSources mech = tolerance_sources(design, *s, *m);
         const std::filesystem::path csv = dir / (s->name + "-" + m->name + "-devices.csv");
         AtomicFile file(csv);
-        write_devices_csv(file.stream(), tolerance_devices(*m, s->target, mech.sigma, mech.samples, mech.seed));
+        write_devices_csv(file.stream(), tolerance_devices(*m, s->target, mech.spread(), mech.samples, mech.seed));
         file.commit();
         files.push_back(csv.generic_string());
       }

@@ -46,6 +46,7 @@ WALLS = {
     "pagmo2": (r"pagmo/", ["lib/src/optimize/optimize_search.cpp"]),
     "quadmath": (r"quadmath", ["lib/src/report/quad.*"]),
     "CLI11": (r"CLI/", ["cli/*"]),
+    "cmark-gfm": (r"cmark-gfm", ["lib/src/products/html.cpp"]),
     "Ceres": (r"ceres/", ["lib/src/calibrate/fit.cpp", "lib/src/identify/ceres_output_error.cpp"]),
     "MuJoCo": (r"mujoco/", []),
 }

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -308,6 +309,74 @@ TEST(HtmlPage, RendersTheSummaryMarkdownWithEveryTextEscaped) {
   EXPECT_THAT(page, HasSubstr("<a href=\"#products-2\">"));
   // Offline: nothing is fetched from elsewhere.
   EXPECT_THAT(page, Not(HasSubstr("http")));
+}
+
+TEST(HtmlPage, RendersEmphasisCodeTablesAndListsAsCommonMarkDoes) {
+  const std::string markdown =
+      "# t\n\n"
+      "The *exact area* and _the margin_; a region *covers* it; N*mm and 2 * 3 stay as written; `a*b*c` is code.\n\n"
+      "1. first\n2. second with **bold**\n\n"
+      "| a | b |\n|:--|--:|\n| *x* | `y` |\n";
+  md::HtmlFiles files;
+  files.exists = [](const std::string&) { return false; };
+  files.read = [](const std::string&) -> std::optional<std::string> { return std::nullopt; };
+  const std::string page = md::to_html_page(markdown, "t", files);
+  EXPECT_THAT(page, HasSubstr("The <em>exact area</em> and <em>the margin</em>; a region <em>covers</em> it; "
+                              "N*mm and 2 * 3 stay as written; <code>a*b*c</code> is code."));
+  EXPECT_THAT(page, HasSubstr("<ol>\n<li>first</li>\n<li>second with <strong>bold</strong></li>\n</ol>"));
+  EXPECT_THAT(page, HasSubstr("<th>a</th><th class=\"r\">b</th>"));
+  EXPECT_THAT(page, HasSubstr("<td><em>x</em></td><td class=\"r\"><code>y</code></td>"));
+}
+
+TEST(HtmlPage, EverySectionShowsThePicturesOfItsProductInline) {
+  // The products table lists each product's files; a section names some in links or code, shows
+  // others as figures already, and names none at all (simulate): each picture is shown once, in
+  // its product's section, linking to its file, with a caption; a CSV or a missing file is not.
+  const std::string markdown =
+      "# scene\n\n## Products\n\n"
+      "| product | state | files |\n|---|---|---|\n"
+      "| `simulate` | built | `simulate/a.csv`, `simulate/a.svg`, `simulate/a.png`, `simulate/b.png` |\n"
+      "| `tolerance` | built | `tolerance/t.png` |\n"
+      "| `collision` | built | `collision/c.png` |\n"
+      "| `animate` | built | `animations/m.svg` |\n\n"
+      "## Dynamics (`simulate`)\n\nA table only.\n\n"
+      "## Tolerance (`tolerance`)\n\nPicture: [tolerance/t.png](tolerance/t.png); also [the gone one](tolerance/gone.png).\n\n"
+      "## Collision (`collision`)\n\n![collision map](collision/c.png)\n\n"
+      "## Animations (`animate`)\n\n![movie](animations/m.svg)\n";
+  const std::vector<std::string> present{"simulate/a.csv", "simulate/a.svg", "simulate/a.png", "simulate/b.png",
+                                         "tolerance/t.png", "collision/c.png", "animations/m.svg"};
+  md::HtmlFiles files;
+  files.exists = [&](const std::string& rel) { return std::find(present.begin(), present.end(), rel) != present.end(); };
+  files.read = [](const std::string& rel) -> std::optional<std::string> {
+    if (rel == "animations/m.svg") return std::string("<svg id=\"m\"><script>go()</script></svg>\n");
+    return std::string("<svg></svg>");
+  };
+  const std::string page = md::to_html_page(markdown, "t", files);
+  const auto count = [&](const std::string& needle) {
+    std::size_t n = 0;
+    for (std::size_t at = page.find(needle); at != std::string::npos; at = page.find(needle, at + 1)) ++n;
+    return n;
+  };
+  // simulate: a (its SVG shown and linked) and b, after the section's text, before the next section.
+  const std::size_t sim = page.find("<h2 id=\"dynamics-simulate\">"), tol = page.find("<h2 id=\"tolerance-tolerance\">");
+  const std::size_t a = page.find("<figure><a href=\"simulate/a.svg\"><img src=\"simulate/a.svg\" alt=\"simulate: a.png\"></a>"
+                                  "<figcaption>simulate: a.png</figcaption></figure>");
+  const std::size_t b = page.find("<img src=\"simulate/b.png\"");
+  ASSERT_NE(sim, std::string::npos);
+  ASSERT_NE(tol, std::string::npos);
+  EXPECT_TRUE(a > sim && a < tol) << page;
+  EXPECT_TRUE(b > sim && b < tol) << page;
+  EXPECT_EQ(count("src=\"simulate/a."), 1u);
+  EXPECT_THAT(page, Not(HasSubstr("<img src=\"simulate/a.csv\"")));
+  // tolerance: the linked picture inline once, in its section; the missing one is not.
+  const std::size_t t = page.find("<img src=\"tolerance/t.png\"");
+  EXPECT_TRUE(t > tol && t < page.find("<h2 id=\"collision-collision\">")) << page;
+  EXPECT_EQ(count("<img src=\"tolerance/t.png\""), 1u);
+  EXPECT_THAT(page, Not(HasSubstr("<img src=\"tolerance/gone.png\"")));
+  // A picture already shown as a figure, and an animation (inline SVG), are not repeated.
+  EXPECT_EQ(count("<img src=\"collision/c.png\""), 1u);
+  EXPECT_EQ(count("<svg id=\"m\">"), 1u);
+  EXPECT_THAT(page, HasSubstr("<figcaption>collision map</figcaption>"));
 }
 
 }  // namespace

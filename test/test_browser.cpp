@@ -2,7 +2,9 @@
 // index.html from disk with no console message and every animation's script running, every file the
 // page names exists beside it, and two screenshots of an animation at two instants (#t=SECONDS)
 // differ only where the linkages, tactors and paths of those instants are and match everywhere
-// else (PNG pixels decoded with cairo). Skipped, saying so, when Chromium is not installed.
+// else (PNG pixels decoded with cairo). The page renders the summary's Markdown (no literal `*`
+// emphasis) and shows a picture inline for every product that wrote one. Skipped, saying so, when
+// Chromium is not installed.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -138,7 +141,10 @@ double number_after(const std::string& text, const std::string& key) {
 }
 
 TEST_F(Browser, TheReportLoadsOfflineWithNoConsoleMessageAndEveryAnimationRuns) {
-  const Outcome run_scene = run({"run", kDesign, "--products", "kinematics,animate", "--out", "out", "-q"});
+  // The cheap products that write pictures beside the animations: collision, pattern, sweep and
+  // tolerance (their pictures named in the products table or in links, shown inline by the page).
+  const Outcome run_scene =
+      run({"run", kDesign, "--products", "kinematics,animate,collision,sweep,tolerance", "--out", "out", "-q"});
   ASSERT_EQ(run_scene.code, 0) << run_scene.err;
   const fs::path page = dir_ / "out" / "iros2022" / "index.html";
   ASSERT_TRUE(fs::exists(page));
@@ -169,6 +175,76 @@ TEST_F(Browser, TheReportLoadsOfflineWithNoConsoleMessageAndEveryAnimationRuns) 
   }
   EXPECT_EQ(ready, 8u);
   EXPECT_THAT(r.out, HasSubstr("<table>"));
+
+  // Every picture the page shows is a picture: a PNG (its signature) or an SVG document.
+  const std::regex img(R"re(<img src="([^"]+)")re");
+  std::size_t images = 0;
+  for (auto it = std::sregex_iterator(html.begin(), html.end(), img); it != std::sregex_iterator(); ++it) {
+    const fs::path file = page.parent_path() / (*it)[1].str();
+    const std::string bytes = slurp(file);
+    ++images;
+    const bool png = bytes.rfind("\x89PNG\r\n\x1a\n", 0) == 0;
+    const bool svg = file.extension() == ".svg" && bytes.find("<svg") != std::string::npos;
+    EXPECT_TRUE(png || svg) << file;
+  }
+  EXPECT_GE(images, 8u);  // collision and patterns (2 stations), sweep (2), tolerance (2)
+
+  // Markdown emphasis is rendered: no `*word` left in the text Chromium shows (pictures, scripts
+  // and code aside); the kinematics section's *LCI* is <em>.
+  // (By hand: std::regex recurses per character and overflows the stack on a page this size.)
+  std::string text;
+  for (std::size_t at = 0; at < r.out.size();) {
+    bool skipped = false;
+    for (const std::string tag : {"svg", "script", "style", "code"}) {
+      if (r.out.compare(at, tag.size() + 1, "<" + tag) == 0) {
+        const std::size_t end = r.out.find("</" + tag + ">", at);
+        at = end == std::string::npos ? r.out.size() : end + tag.size() + 3;
+        text += ' ';
+        skipped = true;
+        break;
+      }
+    }
+    if (skipped) continue;
+    if (r.out[at] == '<') {
+      const std::size_t end = r.out.find('>', at);
+      at = end == std::string::npos ? r.out.size() : end + 1;
+      text += ' ';
+      continue;
+    }
+    text += r.out[at++];
+  }
+  bool literal_emphasis = false;
+  for (std::size_t at = text.find('*'); at != std::string::npos; at = text.find('*', at + 1)) {
+    const bool opens = at == 0 || std::isspace(static_cast<unsigned char>(text[at - 1])) || text[at - 1] == '(';
+    std::size_t next = at;
+    while (next < text.size() && text[next] == '*') ++next;
+    if (opens && next < text.size() && std::isalpha(static_cast<unsigned char>(text[next]))) {
+      literal_emphasis = true;
+      ADD_FAILURE() << "literal emphasis in the page's text: " << text.substr(at, 40);
+    }
+  }
+  EXPECT_FALSE(literal_emphasis);
+  EXPECT_THAT(r.out, HasSubstr("<em>LCI</em>"));
+
+  // Every product that wrote a picture shows one inline (an <img> of its folder, or the inline
+  // SVG of an animation), each linking to its file.
+  const json summary = json::parse(slurp(dir_ / "out" / "iros2022" / "summary.json"));
+  std::size_t with_pictures = 0;
+  for (const json& b : summary.at("built")) {
+    std::vector<std::string> pictures;
+    for (const json& f : b.at("files")) {
+      const std::string name = f.get<std::string>();
+      if (name.size() > 4 && (name.ends_with(".png") || name.ends_with(".svg"))) pictures.push_back(name);
+    }
+    if (pictures.empty()) continue;
+    ++with_pictures;
+    const bool shown = std::any_of(pictures.begin(), pictures.end(), [&](const std::string& f) {
+      return html.find("<a href=\"" + f + "\"><img src=\"" + f + "\"") != std::string::npos ||
+             (f.rfind("animations/", 0) == 0 && html.find("data-fivebar") != std::string::npos);
+    });
+    EXPECT_TRUE(shown) << b.at("name") << " wrote pictures but the page shows none of them inline";
+  }
+  EXPECT_GE(with_pictures, 5u);  // collision, pattern, sweep, tolerance, animate
 }
 
 TEST_F(Browser, TwoInstantsDifferWhereTheLinkagesAreAndMatchElsewhere) {

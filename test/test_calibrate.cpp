@@ -19,6 +19,10 @@
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/provenance.hpp"
 #include "fivebar/sha256.hpp"
+#include "fivebar/tolerance.hpp"
+
+#include <Eigen/Cholesky>
+#include <numbers>
 
 namespace fivebar::calibrate {
 namespace {
@@ -297,6 +301,149 @@ TEST(CalibratePatch, PatchedDesignCarriesTheEstimatesAndTheirProvenance) {
   EXPECT_THAT(assumed, ::testing::Contains(::testing::HasSubstr("upper")));
   EXPECT_THAT(assumed, ::testing::Not(::testing::Contains(::testing::HasSubstr("stations.index.lower"))));
   EXPECT_THAT(assumed_groups(back), ::testing::Contains("kinematics"));
+  // The posterior covariance survives the file: sigmas and correlations read back give it again,
+  // its diagonal is each parameter's reported sigma squared (computed separately in fit.cpp, O2 with
+  // O1's share), and the correlations are real (the links and bases of a mechanism are not
+  // independent after a fit).
+  const ProvenanceCovariance pc = provenance_covariance(back, r.key_covariance_keys);
+  ASSERT_EQ(pc.covariance.rows(), r.key_covariance.rows());
+  ASSERT_EQ(r.key_covariance_keys.size(), 12u);
+  EXPECT_EQ(pc.sources, std::vector<std::string>{"bench/m.csv"});
+  double largest = 0.0;
+  for (Eigen::Index a = 0; a < pc.covariance.rows(); ++a) {
+    const auto p = std::find_if(r.parameters.begin(), r.parameters.end(),
+                                [&](const Parameter& q) { return q.key == r.key_covariance_keys[static_cast<std::size_t>(a)]; });
+    EXPECT_NEAR(r.key_covariance(a, a), p->sigma * p->sigma, 1e-12 * p->sigma * p->sigma) << p->key;
+    for (Eigen::Index b = 0; b < pc.covariance.cols(); ++b) {
+      const double scale = std::sqrt(r.key_covariance(a, a) * r.key_covariance(b, b));
+      EXPECT_NEAR(pc.covariance(a, b), r.key_covariance(a, b), 1e-12 * scale) << a << "," << b;
+      if (a != b) largest = std::max(largest, std::abs(r.key_covariance(a, b)) / scale);
+    }
+  }
+  EXPECT_GT(largest, 0.3);
+  // A later measurement of one key supersedes its entry and drops its correlations.
+  const Design again = with_measured_values(back, {{r.key_covariance_keys[0], 0.5}}, {"other.csv", sha256_hex("y"), "2026-11-27", "by hand"});
+  const ProvenanceCovariance pc2 = provenance_covariance(again, r.key_covariance_keys);
+  EXPECT_DOUBLE_EQ(pc2.covariance(0, 0), 0.25);
+  for (Eigen::Index b = 1; b < pc2.covariance.cols(); ++b) EXPECT_EQ(pc2.covariance(0, b), 0.0);
+  EXPECT_NEAR(pc2.covariance(1, 2), r.key_covariance(1, 2), 1e-12 * std::sqrt(r.key_covariance(1, 1) * r.key_covariance(2, 2)));
+}
+
+// The calibration's posterior covariance replaces the tolerance: sigmas it covers. Reference: a
+// Monte Carlo over the twelve calibration parameters drawn from the fit's own key covariance (Cholesky
+// in the test), each sampled device driven by the controller to the potentiometer voltages it
+// believes put the tactor at the target centre (theta_j = k_j (V_j - V0_j) with the device's true
+// k and V0, plus the potentiometer's linearity as a uniform error), its tactor by FK.
+TEST(CalibratedTolerance, PosteriorCovarianceReplacesTheSigmasAndMatchesAMonteCarloOfTheParameters) {
+  std::mt19937_64 rng(base_seed() + 7);
+  const Truth t = perturbed("lower", rng);
+  const auto rows = measure("lower", t, 30, rng);
+  const CalibrationResult r = calibrate(paper(), rows, {}, "synthetic");
+  const Design back = load_design_from_string(
+      to_yaml(with_provenance(patched_design(paper(), r), r, {"bench/m.csv", sha256_hex("x"), "2026-11-26"})), "patched");
+  const Station& st = *back.station("index");
+  const Mechanism& m = *st.mechanism("lower");
+  const ToleranceSources src = tolerance_sources(back, st, m);
+  ASSERT_TRUE(src.calibrated.has_value());
+  EXPECT_THAT(src.spread_source, ::testing::HasSubstr("calibration posterior covariance (bench/m.csv)"));
+  EXPECT_TRUE(src.spread().calibrated());
+  const auto keys = calibration_keys(back, "index", "lower");
+  ASSERT_EQ(std::vector<std::string>(keys.begin(), keys.end()), r.key_covariance_keys);
+  // The other mechanism keeps the tolerance: sigmas.
+  EXPECT_FALSE(tolerance_sources(back, st, *st.mechanism("upper")).calibrated.has_value());
+
+  // Nominal (calibrated) values the controller uses.
+  const auto* c = back.get<ControllerSettings>();
+  const Potentiometer p1 = c->joint("index", "lower", 1).potentiometer, p2 = c->joint("index", "lower", 2).potentiometer;
+  const Vec2 P = st.target.center;
+  const Pose nominal = ik(m, P);
+  ASSERT_EQ(nominal.status, Status::ok);
+  const double V1 = p1.volts_at_zero + nominal.theta1 / p1.rad_per_volt, V2 = p2.volts_at_zero + nominal.theta2 / p2.rad_per_volt;
+  const ToleranceSettings tol = back.get<ToleranceSettings>() ? *back.get<ToleranceSettings>() : ToleranceSettings{};
+  const double a = tol.linearity_percent / 100.0 * tol.pot_travel_deg * std::numbers::pi / 180.0;  // half band, rad
+  const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(r.key_covariance).matrixL();
+#if defined(__SANITIZE_ADDRESS__)
+  const int n = 4000;
+  const double tol_rel = 0.12;
+#else
+  const int n = 40000;
+  const double tol_rel = 0.04;
+#endif
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> lin(-a, a);
+  Mechanism printed = m;
+  printed.joint_limits.reset();
+  printed.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d second = Eigen::Matrix2d::Zero();
+  int used = 0;
+  for (int k = 0; k < n; ++k) {
+    Eigen::VectorXd z(12);
+    for (int i = 0; i < 12; ++i) z[i] = normal(rng);
+    const Eigen::VectorXd dp = L * z;
+    for (int i = 0; i < 4; ++i) printed.L[static_cast<std::size_t>(i)] = m.L[static_cast<std::size_t>(i)] + dp[i];
+    printed.O1 = m.O1 + Vec2(dp[4], dp[5]);
+    printed.O2 = m.O2 + Vec2(dp[6], dp[7]);
+    const double th1 = (p1.rad_per_volt + dp[9]) * (V1 - p1.volts_at_zero - dp[8]) + lin(rng);
+    const double th2 = (p2.rad_per_volt + dp[11]) * (V2 - p2.volts_at_zero - dp[10]) + lin(rng);
+    const PointResult f = fk_point(printed, th1, th2);
+    if (f.status != Status::ok) continue;
+    const Eigen::Vector2d e = f.P - P;
+    ++used;
+    mean += e;
+    second += e * e.transpose();
+  }
+  ASSERT_GT(used, n * 99 / 100);
+  mean /= used;
+  const Eigen::Matrix2d mc = second / used - mean * mean.transpose();
+  const ToleranceEstimate first = tolerance_first_order(m, P, src.spread(), src.rad_per_count[0]);
+  ASSERT_EQ(first.status, Status::ok);
+  const double rel = (first.covariance - mc).norm() / mc.norm();
+  EXPECT_LT(rel, tol_rel) << "first order\n" << first.covariance << "\nMonte Carlo\n" << mc;
+  EXPECT_NEAR(first.ellipse_semi_axes.x(), major_3sigma_mm(mc), 0.5 * tol_rel * major_3sigma_mm(mc));
+  // The same sigmas taken as independent miss the correlations the fit left.
+  const ParameterSpread at = src.spread().at(nominal.theta1, nominal.theta2);
+  const ToleranceEstimate independent = tolerance_first_order(m, P, at.sigma(), src.rad_per_count[0]);
+  const double rel_independent = (independent.covariance - mc).norm() / mc.norm();
+  std::printf("[calibrate] tactor covariance at the target centre vs Monte Carlo of the parameters: full %.3f, "
+              "independent %.3f (relative Frobenius); 3-sigma %.4f mm (Monte Carlo %.4f, tolerance: only %.4f)\n",
+              rel, rel_independent, first.ellipse_semi_axes.x(), major_3sigma_mm(mc),
+              tolerance_first_order(m, P, src.sigma, src.rad_per_count[0]).ellipse_semi_axes.x());
+  EXPECT_GT(rel_independent, 0.5);
+  // A calibrated device is known better than the tolerance: section's assumptions say.
+  EXPECT_LT(first.ellipse_semi_axes.x(), tolerance_first_order(m, P, src.sigma, src.rad_per_count[0]).ellipse_semi_axes.x());
+
+  // Robust coverage uses the covariance too: its sigma is sqrt(g^T C g) over the geometry block.
+  const RobustCoverage rc = robust_coverage(m, st.target, src.spread(), 0.997, 0, 1);
+  EXPECT_TRUE(rc.calibrated);
+  Eigen::VectorXd g(8);
+  for (int i = 0; i < 8; ++i) g[i] = rc.gradient[static_cast<std::size_t>(i)];
+  EXPECT_NEAR(rc.sigma_mm, std::sqrt(g.dot(r.key_covariance.topLeftCorner(8, 8) * g)), 1e-9);
+}
+
+TEST(CalibratePatch, CorrelationsThatBreakTheRulesAreRefusedNamingTheKey) {
+  const std::string head = to_yaml(paper());
+  const std::string entry = "{source: m.csv, sha256: " + sha256_hex("x") + ", date: \"2026-11-26\", method: fit, sigma: 0.01";
+  const auto load = [&](const std::string& extra) {
+    return load_design_from_string(head + "provenance:\n  \"stations.index.mechanisms.lower.links[0]\": " + entry + extra +
+                                       "}\n  \"stations.index.mechanisms.lower.links[1]\": " + entry + "}\n",
+                                   "bad.yaml");
+  };
+  EXPECT_NO_THROW(load(", correlation: {\"stations.index.mechanisms.lower.links[1]\": -0.4}"));
+  try {
+    load(", correlation: {\"stations.index.mechanisms.lower.links[1]\": 1.5}");
+    ADD_FAILURE() << "a correlation of 1.5 was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("correlation"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("[-1, 1]"));
+  }
+  try {
+    load(", correlation: {\"stations.index.mechanisms.lower.links[2]\": 0.5}");
+    ADD_FAILURE() << "a correlation with an unmeasured key was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("links[2]"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("without its own provenance entry"));
+  }
 }
 
 TEST(CalibrateHardStops, OffsetsFromTwoStopsRecoverTheTruth) {

@@ -19,6 +19,7 @@
 #include "fivebar/export/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/provenance.hpp"
+#include "fivebar/sections/bench.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sha256.hpp"
 
@@ -186,6 +187,80 @@ TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_THAT(bad.err, HasSubstr("bad.csv:2: column 'stop'"));
   EXPECT_FALSE(fs::exists(dir_ / "cal2"));
+}
+
+}  // namespace
+
+namespace {
+
+/// The first provenance sigma of `key` in a design file.
+double provenance_sigma(const fivebar::Design& d, const std::string& key) {
+  const fivebar::ProvenanceCovariance pc = fivebar::provenance_covariance(d, {key});
+  EXPECT_TRUE(pc.measured[0]) << key;
+  return std::sqrt(pc.covariance(0, 0));
+}
+
+// `fivebar run` fits the showcase to its synthetic bench files (designs/bench/make_bench.py: the
+// truth is this file's kL3, kO2x, kV0 and the motor of its docstring), writes the patched designs,
+// and its summary, page and export say what each validated figure rests on; `tolerance` on the
+// calibrated design uses the calibration's covariance for the calibrated mechanism only.
+TEST_F(CliCalibrate, RunFitsTheBenchFilesAndEveryProductSaysWhatItRestsOn) {
+  const ft::Outcome r = run({"run", kDesign, "-P", "calibrate,identify,export", "-o", "out", "-q", "-j", "1"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path root = dir_ / "out" / "iros2022";
+  const fs::path calibrated = root / "calibrate" / "iros2022-calibrated.yaml";
+  const fs::path identified = root / "identify" / "iros2022-identified.yaml";
+  for (const fs::path& f : {calibrated, identified, root / "calibrate" / "calibration-summary.md", root / "identify" / "identify.json"}) {
+    EXPECT_TRUE(fs::exists(f)) << f;
+  }
+  const fivebar::Design cal = fivebar::load_design(calibrated);
+  EXPECT_FALSE(cal.has<fivebar::BenchSettings>());
+  const std::string mk = "stations.index.mechanisms.lower.";
+  EXPECT_LE(std::abs(fivebar::design_number(cal, mk + "links[2]") - kL3), 3 * provenance_sigma(cal, mk + "links[2]"));
+  EXPECT_LE(std::abs(fivebar::design_number(cal, mk + "bases[1][0]") - kO2x), 3 * provenance_sigma(cal, mk + "bases[1][0]"));
+  const std::string v0 = "controller.stations.index.lower.theta1.potentiometer.volts_at_zero";
+  EXPECT_LE(std::abs(fivebar::design_number(cal, v0) - kV0), 3 * provenance_sigma(cal, v0));
+  const fivebar::Design ident = fivebar::load_design(identified);
+  EXPECT_TRUE(fivebar::is_measured(ident, "motor.coulomb_friction_mNm"));
+  EXPECT_LE(std::abs(fivebar::design_number(ident, "motor.coulomb_friction_mNm") - 0.8), 3 * provenance_sigma(ident, "motor.coulomb_friction_mNm"));
+  EXPECT_LE(std::abs(fivebar::design_number(ident, "motor.rotor_inertia_g_cm2") - 2.4e-3 / 4e4 * 1e7),
+            3 * provenance_sigma(ident, "motor.rotor_inertia_g_cm2"));
+
+  // Summary, page and the export's validation block: what each figure rests on.
+  const std::string tracking = "kinematics, potentiometer, motor, contact, density assumed";
+  const std::string md = ft::slurp(root / "summary.md");
+  EXPECT_THAT(md, HasSubstr("## Kinematic calibration from the bench"));
+  EXPECT_THAT(md, HasSubstr("| `index/lower` | max tracking error 0.1"));
+  EXPECT_THAT(md, HasSubstr(tracking));
+  EXPECT_THAT(ft::slurp(root / "index.html"), HasSubstr(tracking));
+  const json summary = json::parse(ft::slurp(root / "summary.json"));
+  const json& records = summary["results"]["export"]["rests_on"];
+  ASSERT_FALSE(records.empty());
+  bool found = false;
+  for (const json& rec : records) {
+    if (rec["figure"] == "max_tracking_error_m" && rec["subject"] == "index/lower") {
+      found = true;
+      EXPECT_THAT(rec["text"].get<std::string>(), HasSubstr("max tracking error"));
+      EXPECT_THAT(rec["text"].get<std::string>(), HasSubstr(tracking));
+    }
+  }
+  EXPECT_TRUE(found);
+  const json exported = json::parse(ft::slurp(root / "export" / "iros2022_controller.json"));
+  EXPECT_EQ(exported["fivebar_controller"]["ros__parameters"]["fivebar"]["validation"]["index"]["lower"]["rests_on"]
+                    ["max_tracking_error_m"],
+            tracking);
+
+  // tolerance on the calibrated design: the lower mechanism's sigmas are the calibration's.
+  const ft::Outcome t = run({"tolerance", calibrated.string(), "-s", "index", "--no-files", "--json"});
+  ASSERT_EQ(t.code, 0) << t.err;
+  const json tj = parse(t);
+  const json& mechs = tj["stations"][0]["mechanisms"];
+  ASSERT_EQ(mechs.size(), 2u);
+  EXPECT_TRUE(mechs[0]["calibrated"].get<bool>());
+  EXPECT_THAT(mechs[0]["sigmas_from"].get<std::string>(), HasSubstr("bench/calibration.csv"));
+  EXPECT_TRUE(mechs[0]["robust_coverage"]["calibrated"].get<bool>());
+  EXPECT_FALSE(mechs[1]["calibrated"].get<bool>());
+  EXPECT_LT(mechs[0]["centre_3sigma_mm"].get<double>(), mechs[1]["centre_3sigma_mm"].get<double>());
 }
 
 }  // namespace

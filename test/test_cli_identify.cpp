@@ -7,12 +7,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "cli_test.hpp"
+#include "fivebar/design.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/sections/motor.hpp"
+#include "fivebar/sections/provenance.hpp"
+#include "fivebar/sha256.hpp"
 #include "identify_synthetic.hpp"
 
 namespace fs = std::filesystem;
@@ -60,8 +66,56 @@ TEST_F(CliIdentify, SyntheticMotorLogGivesTheTruthWithinThreeSigmaAndWritesItsFi
               1e3 * parameter(joint, "coulomb_Nm")["value"].get<double>(), 1e-9);
   EXPECT_FALSE(parameter(joint, "motor.terminal_resistance_ohm")["identified"].get<bool>());
   EXPECT_GT(joint["fit"]["validation"]["idim_ls"]["drive_fit_percent"].get<double>(), 80.0);
-  EXPECT_EQ(tree(dir_ / "out"), (std::vector<std::string>{"identify.json", "motor-estimation.png", "motor-estimation.svg",
+  EXPECT_EQ(tree(dir_ / "out"), (std::vector<std::string>{"identify.json", "iros2022-identified.yaml", "motor-estimation.png", "motor-estimation.svg",
                                                          "motor-validation.png", "motor-validation.svg"}));
+}
+
+// The patch goes through calibrate's provenance writer: a design that loads, whose identified keys
+// hold the reported values and are measured (their entry names the log, its hash and the sigma),
+// and whose other motor keys stay assumptions.
+TEST_F(CliIdentify, ThePatchedDesignLoadsWithTheIdentifiedKeysMeasured) {
+  ft::SyntheticTruth truth;
+  for (const bool joint_scope : {false, true}) {
+    std::string csv = ft::synthetic_log(truth, 21).csv();
+    if (joint_scope) csv.replace(0, csv.find('\n'), "time_s,index_lower_theta1_current_A,index_lower_theta1_theta_rad");
+    const fs::path log = write(joint_scope ? "joint.csv" : "bench.csv", csv);
+    const std::string out = joint_scope ? "joint" : "bench";
+    const Outcome r = run({"identify", kDesign, log.string(), "--no-output-error", "--json", "--out", out});
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parse(r);
+    const fs::path patched = dir_ / out / "iros2022-identified.yaml";
+    ASSERT_TRUE(fs::exists(patched));
+    const fivebar::Design d = fivebar::load_design(patched);
+    const std::string mk = joint_scope ? "motor.stations.index.lower.theta1." : "motor.";
+    const std::vector<std::string> want = {mk + "rotor_inertia_g_cm2", mk + "viscous_friction_mNm_s_per_rad", mk + "coulomb_friction_mNm"};
+    EXPECT_EQ(j["patched"].get<std::vector<std::string>>(), want);
+    const auto* prov = d.get<fivebar::ProvenanceSettings>();
+    ASSERT_NE(prov, nullptr);
+    for (const std::string& key : want) {
+      const json& p = parameter(j["joints"][0], key);
+      EXPECT_TRUE(fivebar::is_measured(d, key)) << key;
+      EXPECT_EQ(fivebar::design_number(d, key), p["value"].get<double>()) << key;
+      const auto e = prov->entries.find(key);
+      ASSERT_NE(e, prov->entries.end()) << key;
+      EXPECT_EQ(e->second.source, log.string());
+      EXPECT_EQ(e->second.sha256, fivebar::sha256_file(log));
+      EXPECT_THAT(e->second.method, HasSubstr("IDIM-LS"));
+      ASSERT_TRUE(e->second.sigma.has_value());
+      EXPECT_DOUBLE_EQ(*e->second.sigma, p["sigma"].get<double>());
+    }
+    // The Coulomb friction the design now holds is the truth's, within its 3 sigma (mNm).
+    const fivebar::MotorParams m = d.get<fivebar::MotorSettings>()->joint("index", "lower", 1);
+    EXPECT_LE(std::abs(m.coulomb_friction_mNm - 1e3 * truth.c), 3.0 * parameter(j["joints"][0], mk + "coulomb_friction_mNm")["sigma"].get<double>());
+    // Held keys stay assumptions, and the motor group is still (partly) assumed.
+    EXPECT_FALSE(fivebar::is_measured(d, mk + "terminal_resistance_ohm"));
+    const auto assumed = fivebar::assumed_values(d, "motor");
+    EXPECT_EQ(std::count(assumed.begin(), assumed.end(), mk + "coulomb_friction_mNm"), 0);
+    if (joint_scope) {
+      // Another joint keeps the design's defaults.
+      EXPECT_EQ(d.get<fivebar::MotorSettings>()->joint("index", "upper", 1).coulomb_friction_mNm,
+                fivebar::load_design(kDesign).get<fivebar::MotorSettings>()->joint("index", "upper", 1).coulomb_friction_mNm);
+    }
+  }
 }
 
 TEST_F(CliIdentify, AParameterTheLogCannotSeparateIsNamedAndRefusedWhenAskedFor) {
@@ -96,6 +150,13 @@ TEST_F(CliIdentify, BadLogsExitTwoNamingTheLineAndColumnAndWriteNothing) {
   EXPECT_THAT(r.err, HasSubstr("unknown.csv:1: column 4 'rpm': unknown column"));
   r = run({"identify", kDesign, bad.string(), "--rig", "mechanism", "--out", "o"});
   EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("STATION/MECHANISM"));
+  // The assembled mechanism needs both motors' columns: a bench motor's log names what is missing.
+  ft::SyntheticTruth truth;
+  const fs::path motor = write("motor.csv", ft::synthetic_log(truth, 5).csv());
+  r = run({"identify", kDesign, motor.string(), "--out", "o", "--rig", "mechanism", "index/lower"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("no columns for joint index_lower_theta1"));
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 

@@ -147,3 +147,37 @@ TEST_F(CliReplay, BadLogsAndConfigurationsAreExitTwoNamingTheColumnOrKey) {
 }
 
 }  // namespace
+
+// The `replay` product of `fivebar run`: software in the loop with the export product's JSON as
+// written, every pattern of both stations; each run's figures equal `fivebar replay --sil --config`
+// on that same file (a second path: the CLI), and each log replays with no duty difference.
+TEST_F(CliReplay, TheRunProductRunsTheExportedFileInTheLoopAndReplaysEveryLog) {
+  const Outcome r = run({"run", kDesign, "-P", "replay", "-o", "scene", "-q", "-j", "1", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json summary = parse(r);
+  const json& result = summary["results"]["replay"];
+  const std::string config = (dir_ / "scene" / "iros2022" / result["config"].get<std::string>()).string();
+  ASSERT_TRUE(fs::exists(config)) << config;
+  ASSERT_EQ(result["runs"].size(), 8u);  // 2 stations x 4 patterns
+  for (const json& run : result["runs"]) {
+    SCOPED_TRACE(run["station"].get<std::string>() + " " + run["reference"].get<std::string>());
+    EXPECT_EQ(run["status"], "ok");
+    EXPECT_TRUE(fs::exists(dir_ / "scene" / "iros2022" / run["log"].get<std::string>()));
+    EXPECT_GT(run["replay"]["rows"].get<double>(), 100);
+    EXPECT_EQ(run["replay"]["mismatches"].get<double>(), 0);
+    EXPECT_EQ(run["replay"]["max_duty_difference"].get<double>(), 0.0);
+  }
+  const Outcome s = run({"replay", kDesign, "--sil", "-s", "index", "--pattern", "stretch", "--config", config, "--out", "sil",
+                         "--json"});
+  ASSERT_EQ(s.code, 0) << s.err;
+  const json a = parse(s)["runs"][0];
+  const json& b = result["runs"][0];
+  ASSERT_EQ(b["station"], "index");
+  ASSERT_EQ(b["reference"], "stretch");
+  ASSERT_EQ(a["mechanisms"].size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    for (const char* key : {"max_error_mm", "rms_error_mm", "peak_duty", "saturation_s", "peak_current_A"}) {
+      EXPECT_EQ(a["mechanisms"][k][key], b["mechanisms"][k][key]) << key;
+    }
+  }
+}

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -14,7 +15,10 @@
 #include <string>
 
 #include "fivebar/error.hpp"
+#include "fivebar/dynamics.hpp"
 #include "fivebar/identify.hpp"
+#include "fivebar/sections/motor.hpp"
+#include "fivebar/kinematics.hpp"
 #include "identify_synthetic.hpp"
 
 namespace fivebar {
@@ -449,6 +453,130 @@ TEST(IdentifyEmps, MatchesThePublishedIdimLsParameters) {
             << " +- " << r.idim.sigma[3] << "; force error " << r.estimation_idim.drive_relative_error_percent << " % / "
             << r.validation_idim->drive_relative_error_percent << " %; position fit " << r.estimation_idim.position_fit_percent
             << " % / " << r.validation_idim->position_fit_percent << " %\n";
+}
+
+}  // namespace
+}  // namespace fivebar
+
+// --rig mechanism: a log of both motors of the assembled lower index mechanism, simulated here with
+// the closed chain's own M(theta) and h (fivebar/dynamics.hpp) and each joint's rotor and friction as
+// the truth, the torques from a PD about the target centre plus a random multisine. The gear ratio
+// is set to 5 so that the links' inertia is not negligible against the rotors': identifying each
+// joint alone (without the chain) then misses the truth, with the chain it does not.
+namespace fivebar {
+namespace {
+
+namespace mech_rig {
+
+struct JointTruth {
+  double J, b, c, off;
+};
+
+}  // namespace mech_rig
+
+TEST(IdentifyMechanismRig, EachJointsRotorAndFrictionThroughTheClosedChain) {
+  using mech_rig::JointTruth;
+  Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  d.get<MotorSettings>()->defaults.gear_ratio = 5.0;
+  const Station& st = d.require_station("index");
+  const Mechanism& m = *st.mechanism("lower");
+  MechanismModel model;
+  model.mechanism = m;
+  model.inertia = station_inertia(d, st, nullptr, {}).at("lower");
+  model.motors = {d.get<MotorSettings>()->joint("index", "lower", 1), d.get<MotorSettings>()->joint("index", "lower", 2)};
+  for (auto& mp : model.motors) mp.rotor_inertia_g_cm2 = 0.0;  // the links alone; the rotors are the truth below
+  const Pose centre = ik(m, st.target.center);
+  ASSERT_EQ(centre.status, Status::ok);
+  model.branch = centre.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  const double links = dynamics_terms(model, Eigen::Vector2d(centre.theta1, centre.theta2), Eigen::Vector2d::Zero()).M(0, 0);
+  // Torques in units of the drive's scale (below): friction a few per cent of it.
+  const double scale = 10.0 * links;  // N m: about 10 rad/s^2 of the links alone
+  const std::array<JointTruth, 2> truth{JointTruth{1.5 * links, 0.02 * scale, 0.05 * scale, 0.02 * scale},
+                                        JointTruth{1.2 * links, 0.03 * scale, 0.04 * scale, -0.015 * scale}};
+
+  const char* seed_env = std::getenv("FIVEBAR_TEST_SEED");
+  std::mt19937_64 rng(seed_env != nullptr ? std::strtoull(seed_env, nullptr, 10) : 11);
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * std::numbers::pi);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  std::array<std::array<double, 12>, 2> ph{};
+  for (auto& p : ph)
+    for (double& x : p) x = phase(rng);
+  const double rate = 1000.0, duration = 6.0;
+  const int sub = 5;
+  const double h = 1.0 / (rate * sub);
+  Eigen::Vector2d q(centre.theta1, centre.theta2), w = Eigen::Vector2d::Zero();
+  // A gentle PD about the centre (about 1 Hz, damped): the motion stays in the band the filters keep.
+  const double kp = 100.0 * links, kd = 22.0 * links;
+  id::IdentifyLog log;
+  log.path = "mechanism.csv";
+  std::array<id::JointLog, 2> jl;
+  for (int j = 0; j < 2; ++j) {
+    jl[static_cast<std::size_t>(j)].prefix = "index_lower_theta" + std::to_string(j + 1);
+    jl[static_cast<std::size_t>(j)].station = "index";
+    jl[static_cast<std::size_t>(j)].mechanism = "lower";
+    jl[static_cast<std::size_t>(j)].joint = j + 1;
+    jl[static_cast<std::size_t>(j)].drive = id::DriveKind::torque;
+    jl[static_cast<std::size_t>(j)].drive_column = jl[static_cast<std::size_t>(j)].prefix + "_torque_Nm";
+    jl[static_cast<std::size_t>(j)].reading = id::ReadingKind::angle;
+    jl[static_cast<std::size_t>(j)].reading_column = jl[static_cast<std::size_t>(j)].prefix + "_theta_rad";
+  }
+  const auto accel = [&](const Eigen::Vector2d& qq, const Eigen::Vector2d& ww, const Eigen::Vector2d& tau) {
+    const DynamicsTerms t = dynamics_terms(model, qq, ww);
+    EXPECT_EQ(t.status, Status::ok);
+    Eigen::Matrix2d M = t.M;
+    Eigen::Vector2d rhs = tau - t.h;
+    for (int j = 0; j < 2; ++j) {
+      const JointTruth& tr = truth[static_cast<std::size_t>(j)];
+      M(j, j) += tr.J;
+      rhs[j] -= tr.b * ww[j] + tr.c * std::tanh(ww[j] / 1e-3) + tr.off;
+    }
+    return Eigen::Vector2d(M.ldlt().solve(rhs));
+  };
+  const double count = 2.0 * std::numbers::pi / 65536.0;
+  for (int n = 0; n < static_cast<int>(duration * rate); ++n) {
+    const double t = n / rate;
+    Eigen::Vector2d tau;
+    for (int j = 0; j < 2; ++j) {
+      double s = 0.0;
+      for (int k = 1; k <= 12; ++k) s += std::sin(2.0 * std::numbers::pi * 0.5 * k * t + ph[static_cast<std::size_t>(j)][static_cast<std::size_t>(k - 1)]);
+      const double ref = j == 0 ? centre.theta1 : centre.theta2;
+      tau[j] = kp * (ref - q[j]) - kd * w[j] + scale * s / std::sqrt(6.0);
+    }
+    log.time.push_back(t);
+    for (int j = 0; j < 2; ++j) {
+      jl[static_cast<std::size_t>(j)].drive_values.push_back(tau[j] + 0.002 * scale * noise(rng));
+      jl[static_cast<std::size_t>(j)].reading_values.push_back(std::round(q[j] / count) * count);
+    }
+    for (int k = 0; k < sub; ++k) {  // RK4, the torque held over the sample
+      const Eigen::Vector2d a1 = accel(q, w, tau);
+      const Eigen::Vector2d a2 = accel(q + 0.5 * h * w, w + 0.5 * h * a1, tau);
+      const Eigen::Vector2d a3 = accel(q + 0.5 * h * (w + 0.5 * h * a1), w + 0.5 * h * a2, tau);
+      const Eigen::Vector2d a4 = accel(q + h * (w + 0.5 * h * a2), w + h * a3, tau);
+      q += h / 6.0 * (w + 2.0 * (w + 0.5 * h * a1) + 2.0 * (w + 0.5 * h * a2) + (w + h * a3));
+      w += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+    }
+  }
+  log.joints = {jl[0], jl[1]};
+  id::IdentifyOptions o;
+  const auto results = id::identify_mechanism(d, log, "index", "lower", o);
+  ASSERT_EQ(results.size(), 2u);
+  for (int j = 0; j < 2; ++j) {
+    SCOPED_TRACE("theta" + std::to_string(j + 1));
+    const auto& r = results[static_cast<std::size_t>(j)];
+    const JointTruth& tr = truth[static_cast<std::size_t>(j)];
+    const std::array<double, 4> want{tr.J, tr.b, tr.c, tr.off};
+    for (int k = 0; k < 4; ++k) {
+      ASSERT_TRUE(r.idim.identified[static_cast<std::size_t>(k)]) << r.idim.names[static_cast<std::size_t>(k)];
+      EXPECT_LE(std::abs(r.idim.value[k] - want[static_cast<std::size_t>(k)]), 3.0 * r.idim.sigma[k])
+          << r.idim.names[static_cast<std::size_t>(k)] << " = " << r.idim.value[k] << " +- " << r.idim.sigma[k] << ", truth " << want[static_cast<std::size_t>(k)];
+    }
+    EXPECT_GT(r.estimation_idim.drive_fit_percent, 90.0);
+    // Alone (no closed chain), the joint's inertia takes the links' share and misses the truth.
+    id::JointPrior alone = id::joint_prior(d, "index", "lower", j + 1, 0.0, false);
+    o.output_error = false;
+    const auto single = id::identify_joint(log.joints[static_cast<std::size_t>(j)], log.time, alone, nullptr, nullptr, o);
+    EXPECT_GT(std::abs(single.idim.value[0] - tr.J), 3.0 * single.idim.sigma[0]) << single.idim.value[0];
+  }
 }
 
 }  // namespace

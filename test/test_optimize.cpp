@@ -9,6 +9,8 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 #include <random>
@@ -22,6 +24,7 @@
 #include "fivebar/sections/optimize.hpp"
 #include "fivebar/sections/sweep.hpp"
 #include "fivebar/sweep.hpp"
+#include "optimize_study.hpp"
 #include "process.hpp"
 
 namespace fivebar {
@@ -130,7 +133,10 @@ TEST(OptimizeSettings, BadInputNamesTheKey) {
   }
   t = s;
   t.population = 18;  // NSGA-II: a multiple of 4
+  t.algorithm = "nsga2";
   EXPECT_EQ(key_of(t), "optimize.population");
+  t.algorithm = "auto";  // the hybrid takes any population size
+  EXPECT_EQ(key_of(t), "accepted");
   t = s;
   t.algorithm = "cmaes";  // one objective only
   EXPECT_EQ(key_of(t), "optimize.algorithm");
@@ -371,72 +377,89 @@ TEST(RunOptimize, ShardsMergeIntoTheFrontOfTheirUnion) {
   }
 }
 
-/// The issue's check on the sweep's own two-variable problem (L34 and L12 of the index station,
-/// margin against footprint), on the showcase sweep's box at twice its resolution (57 x 49 designs,
-/// steps 0.125 mm): with a tenth of the grid's evaluations the front reaches nearly the grid's
-/// hypervolume (both normalised by the grid front's ideal and nadir: measured 0.659 against 0.713)
-/// and about half the grid-optimal points (23 of 47) have a found point within one grid step of
-/// them or one that dominates them. Every point, as the issue words it, needs more evaluations
-/// than a tenth of the grid: docs/optimize.md "Measured".
+/// The sweep's own two-variable problem (L34 and L12 of the index station, margin against
+/// footprint) on the showcase sweep's box at twice its resolution (57 x 49 designs, steps 0.125 mm),
+/// searched with a tenth of the grid's evaluations (256) for seeds 1 ... kSeeds (docs/optimize.md
+/// "Measured"): for every seed the front's hypervolume is at least 97 % of the grid front's (both
+/// normalised by the grid front's ideal and nadir), at least 80 % of the grid-optimal points have a
+/// found point within one grid step of them or one that dominates them, and the best margin is the
+/// grid's to within what one grid step changes it; the means over the seeds are printed (the docs
+/// quote them).
 TEST(RunOptimize, FrontNearlyMatchesTheGridParetoSetWithATenthOfItsEvaluations) {
   OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
   constexpr int kA = 57, kB = 49;
+#if defined(__SANITIZE_ADDRESS__)  // the sanitizer build (FIVEBAR_SANITIZE): fewer seeds
+  constexpr int kSeeds = 2;
+#else
+  constexpr int kSeeds = 8;
+#endif
   const double da = 7.0 / (kA - 1), db = 6.0 / (kB - 1);
   s.population = 16;
   s.islands = 2;
   s.evaluations = kA * kB / 10;
   s.polish = false;
-  const Design d = with(s);
-  const OptimizeProblem p(d);
+  const OptimizeProblem p(with(s));
   std::vector<OptimizeCandidate> grid;
   for (int i = 0; i < kA; ++i) {
     for (int j = 0; j < kB; ++j) grid.push_back(p.evaluate({12.0 + da * i, 6.0 + db * j}));
   }
   const auto grid_front = optimize_front(p, grid);
   ASSERT_GT(grid_front.size(), 20u);
-  ScratchDir dir("fivebar_test_optimize_grid");
-  OptimizeOptions o;
-  o.plots = false;
-  o.out_dir = dir.path();
-  const OptimizeResult r = run_optimize(d, o);
-  EXPECT_LE(r.evaluations, std::uint64_t(kA * kB / 10));
-  std::size_t matched = 0;
-  for (const auto& g : grid_front) {
-    const bool near = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
-      return std::fabs(f.x[0] - g.x[0]) <= da + 1e-9 && std::fabs(f.x[1] - g.x[1]) <= db + 1e-9;
-    });
-    const bool dominates = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
-      const auto a = p.fitness(f), b = p.fitness(g);
-      return a[0] <= b[0] && a[1] <= b[1];
-    });
-    matched += near || dominates;
-  }
   std::vector<double> ideal(2, 1e300), nadir(2, -1e300);
   for (const auto& g : grid_front) {
     const auto f = p.fitness(g);
-    for (int i = 0; i < 2; ++i) {
-      ideal[std::size_t(i)] = std::min(ideal[std::size_t(i)], f[std::size_t(i)]);
-      nadir[std::size_t(i)] = std::max(nadir[std::size_t(i)], f[std::size_t(i)]);
-    }
+    for (std::size_t i = 0; i < 2; ++i) ideal[i] = std::min(ideal[i], f[i]), nadir[i] = std::max(nadir[i], f[i]);
   }
   const std::vector<double> ref{1.1, 1.1};
   const double hv_grid = hypervolume(normalised_objectives(p, grid_front, ideal, nadir), ref);
-  const double hv_found = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
-  std::printf("grid %d x %d: %zu grid-optimal points, %zu matched; hypervolume %.4f found / %.4f grid with %llu evaluations\n",
-              kA, kB, grid_front.size(), matched, hv_found, hv_grid, (unsigned long long)r.evaluations);
-  EXPECT_GE(hv_found, 0.9 * hv_grid);
-  EXPECT_GE(double(matched), 0.45 * double(grid_front.size()));
-  // The grid's best margin is reached to within what one grid step changes it (0.125 mm of L12
-  // moves the margin by about that much).
-  double best_margin = -1e300, grid_margin = -1e300;
-  for (const auto& f : r.front) best_margin = std::max(best_margin, f.figures[0]);
+  double grid_margin = -1e300;
   for (const auto& g : grid_front) grid_margin = std::max(grid_margin, g.figures[0]);
-  EXPECT_GE(best_margin, grid_margin - 0.2);
+  ScratchDir dir("fivebar_test_optimize_grid");
+  double sum_hv = 0.0, sum_matched = 0.0;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    s.seed = std::uint64_t(seed);
+    const Design d = with(s);
+    OptimizeOptions o;
+    o.plots = false;
+    o.full_figures = false;
+    o.out_dir = dir.path() / std::to_string(seed);
+    const OptimizeResult r = run_optimize(d, o);
+    EXPECT_LE(r.evaluations, std::uint64_t(kA * kB / 10));
+    std::size_t matched = 0;
+    for (const auto& g : grid_front) {
+      const bool near = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
+        return std::fabs(f.x[0] - g.x[0]) <= da + 1e-9 && std::fabs(f.x[1] - g.x[1]) <= db + 1e-9;
+      });
+      const bool dominates = std::any_of(r.front.begin(), r.front.end(), [&](const OptimizeCandidate& f) {
+        const auto a = p.fitness(f), b = p.fitness(g);
+        return a[0] <= b[0] && a[1] <= b[1];
+      });
+      matched += near || dominates;
+    }
+    const double hv_found = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
+    std::printf("seed %d: %zu of %zu grid-optimal points matched; hypervolume %.4f found / %.4f grid with %llu evaluations\n",
+                seed, matched, grid_front.size(), hv_found, hv_grid, (unsigned long long)r.evaluations);
+    EXPECT_GE(hv_found, 0.97 * hv_grid) << "seed " << seed;
+    EXPECT_GE(double(matched), 0.8 * double(grid_front.size())) << "seed " << seed;
+    // The grid's best margin is reached to within what one grid step changes it (0.125 mm of L12
+    // moves the margin by about that much).
+    double best_margin = -1e300;
+    for (const auto& f : r.front) best_margin = std::max(best_margin, f.figures[0]);
+    EXPECT_GE(best_margin, grid_margin - 0.2) << "seed " << seed;
+    sum_hv += hv_found;
+    sum_matched += double(matched);
+  }
+  std::printf("grid %d x %d, %d seeds: mean hypervolume %.4f found / %.4f grid (%.1f %%), mean %.1f of %zu grid-optimal points matched\n",
+              kA, kB, kSeeds, sum_hv / kSeeds, hv_grid, 100.0 * sum_hv / kSeeds / hv_grid, sum_matched / kSeeds, grid_front.size());
+  // The means docs/optimize.md quotes.
+  EXPECT_GE(sum_hv / kSeeds, 0.99 * hv_grid);
+  EXPECT_GE(sum_matched / kSeeds, 45.0);
 }
 
 /// The showcase's eight-variable search of the index station (without the robust constraint, to
-/// keep the test short) against a Sobol sweep of the same number of candidates over the same box:
-/// the search's front has the larger hypervolume (both normalised by their union's ideal and nadir).
+/// keep the test short), seeds 1 to 3, against a Sobol sweep of the same number of candidates over
+/// the same box: for every seed the search's front has at least twice the hypervolume (both normalised by their union's ideal and
+/// nadir; docs/optimize.md "Measured").
 TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   Design d = paper();
   OptimizeSettings s = *d.get<OptimizeSettings>();
@@ -444,35 +467,45 @@ TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   s.constraints = {{"min_lci", true, 0.25}};
   s.evaluations = 1000;
   s.polish = false;
-  d.set(s);
-  d.validate();
-  const OptimizeProblem p(d);
+  s.atlas = false;
+#if defined(__SANITIZE_ADDRESS__)  // the sanitizer build (FIVEBAR_SANITIZE): one seed
+  constexpr int kSeeds = 1;
+#else
+  constexpr int kSeeds = 3;
+#endif
   ScratchDir dir("fivebar_test_optimize_sobol");
-  OptimizeOptions o;
-  o.plots = false;
-  o.out_dir = dir.path();
-  const OptimizeResult r = run_optimize(d, o);
-  SweepSettings sw;
-  sw.sample = "sobol";
-  sw.count = r.evaluations;
-  sw.seed = 1;
-  for (const auto& v : s.variables) sw.vary.push_back({"L1", v.lo, v.hi, 1});
-  std::vector<OptimizeCandidate> sobol;
-  for (std::uint64_t k = 0; k < r.evaluations; ++k) sobol.push_back(p.evaluate(sweep_point(sw, k)));
-  const auto sobol_front = optimize_front(p, sobol);
-  std::vector<OptimizeCandidate> both = r.front;
-  both.insert(both.end(), sobol_front.begin(), sobol_front.end());
-  std::vector<double> ideal(3, 1e300), nadir(3, -1e300);
-  for (const auto& c : both) {
-    const auto f = p.fitness(c);
-    for (std::size_t i = 0; i < 3; ++i) ideal[i] = std::min(ideal[i], f[i]), nadir[i] = std::max(nadir[i], f[i]);
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    s.seed = std::uint64_t(seed);
+    d.set(s);
+    d.validate();
+    const OptimizeProblem p(d);
+    OptimizeOptions o;
+    o.plots = false;
+    o.full_figures = false;
+    o.out_dir = dir.path() / std::to_string(seed);
+    const OptimizeResult r = run_optimize(d, o);
+    SweepSettings sw;
+    sw.sample = "sobol";
+    sw.count = r.evaluations;
+    sw.seed = 1;
+    for (const auto& v : s.variables) sw.vary.push_back({"L1", v.lo, v.hi, 1});
+    std::vector<OptimizeCandidate> sobol;
+    for (std::uint64_t k = 0; k < r.evaluations; ++k) sobol.push_back(p.evaluate(sweep_point(sw, k)));
+    const auto sobol_front = optimize_front(p, sobol);
+    std::vector<OptimizeCandidate> both = r.front;
+    both.insert(both.end(), sobol_front.begin(), sobol_front.end());
+    std::vector<double> ideal(3, 1e300), nadir(3, -1e300);
+    for (const auto& c : both) {
+      const auto f = p.fitness(c);
+      for (std::size_t i = 0; i < 3; ++i) ideal[i] = std::min(ideal[i], f[i]), nadir[i] = std::max(nadir[i], f[i]);
+    }
+    const std::vector<double> ref(3, 1.1);
+    const double hv_opt = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
+    const double hv_sobol = hypervolume(normalised_objectives(p, sobol_front, ideal, nadir), ref);
+    std::printf("eight variables, seed %d, %llu candidates: hypervolume %.4f (search) against %.4f (Sobol)\n", seed,
+                (unsigned long long)r.evaluations, hv_opt, hv_sobol);
+    EXPECT_GE(hv_opt, 2.0 * hv_sobol) << "seed " << seed;  // docs/optimize.md "Measured": at least twice
   }
-  const std::vector<double> ref(3, 1.1);
-  const double hv_opt = hypervolume(normalised_objectives(p, r.front, ideal, nadir), ref);
-  const double hv_sobol = hypervolume(normalised_objectives(p, sobol_front, ideal, nadir), ref);
-  std::printf("eight variables, %llu candidates: hypervolume %.4f (search) against %.4f (Sobol)\n",
-              (unsigned long long)r.evaluations, hv_opt, hv_sobol);
-  EXPECT_GT(hv_opt, hv_sobol);
 }
 
 /// docs/reliability.md: shard, checkpoint and merge files state what they are and every reader
@@ -562,6 +595,84 @@ TEST(OptimizeIdentity, ResumeWithoutACheckpointCreatesNothing) {
   o.resume = true;
   EXPECT_THAT(what_of([&] { (void)run_optimize(d, o); }), ::testing::HasSubstr("no checkpoint to resume from"));
   EXPECT_FALSE(fs::exists(dir.path() / "never"));
+}
+
+}  // namespace
+}  // namespace fivebar
+
+namespace fivebar {
+namespace {
+
+/// docs/optimize.md "The hybrid algorithm": the default algorithm's mean hypervolume is at least
+/// that of pagmo's NSGA-II (same population, islands, budget and seeds) on the two-variable
+/// problem over three seeds; the 8-seed study of the 2-, 3- and 8-variable problems (>= 1.05x) is
+/// BM_optimize_hybrid_vs_nsga2 (test/bench/bench_optimize.cpp).
+TEST(HybridAlgorithm, AheadOfNsga2OnTheTwoVariableProblem) {
+  ScratchDir dir("fivebar_test_optimize_hybrid");
+  const fivebar::testing::StudyRow r = fivebar::testing::algorithm_study(2, 3, dir.path());
+  fivebar::testing::print_study_row(r);
+  EXPECT_GE(r.ratio(), 1.0);
+  // No design evaluated twice by the hybrid (its children avoid the island's designs).
+  EXPECT_EQ(r.distinct_hybrid, r.evaluations_hybrid);
+}
+
+}  // namespace
+}  // namespace fivebar
+
+namespace fivebar {
+namespace {
+
+/// docs/optimize.md "Evaluation cache": on a grid of 8 x 7 designs (steps of 1 mm) a budget of
+/// 400 candidates must repeat designs; every distinct design is evaluated once (the process-wide
+/// count of OptimizeProblem::evaluate() calls against the distinct rows of candidates.csv), the
+/// repeats carry the same figures, and the JSON's counts say so. Both for pagmo's NSGA-II (which
+/// repeats designs itself) and the hybrid (which repeats only once the grid is spent).
+TEST(RunOptimize, TheCacheEvaluatesEveryDistinctDesignOnce) {
+  ScratchDir dir("fivebar_test_optimize_cache");
+  for (const char* alg : {"nsga2", "hybrid"}) {
+    OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
+    s.variables[0].step = 1.0;
+    s.variables[1].step = 1.0;
+    s.algorithm = alg;
+    s.evaluations = 400;
+    s.polish = false;
+    const Design d = with(s);
+    OptimizeOptions o;
+    o.plots = false;
+    o.full_figures = false;
+    o.threads = 2;
+    o.out_dir = dir.path() / alg;
+    const std::uint64_t before = optimize_evaluate_calls();
+    const OptimizeResult r = run_optimize(d, o);
+    const std::uint64_t work = optimize_evaluate_calls() - before;
+    std::ifstream csv(o.out_dir / "candidates.csv");
+    std::string line;
+    std::getline(csv, line);
+    std::map<std::pair<double, double>, std::string> rest;  // the figures, verdict and status of each design
+    std::uint64_t rows = 0;
+    while (std::getline(csv, line)) {
+      ++rows;
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+      ASSERT_GE(cells.size(), 6u);
+      const std::pair<double, double> x{std::stod(cells[3]), std::stod(cells[4])};
+      std::string tail;
+      for (std::size_t i = 5; i < cells.size(); ++i) tail += cells[i] + ",";
+      const auto [it, fresh] = rest.emplace(x, tail);
+      if (!fresh) EXPECT_EQ(it->second, tail) << alg << ": a repeated design with other figures";
+    }
+    EXPECT_EQ(rows, r.evaluations) << alg;
+    EXPECT_LE(rest.size(), 56u) << alg;
+    EXPECT_GT(rows, rest.size()) << alg << ": the budget exceeds the grid, repeats are certain";
+    EXPECT_EQ(r.distinct, rest.size()) << alg;
+    // The design as given is evaluated too (the comparison's reference), through the same cache.
+    const OptimizeProblem p(d);
+    const std::vector<double> ref = p.snap(p.reference_values());
+    const std::uint64_t distinct_with_reference = rest.size() + (rest.count({ref[0], ref[1]}) ? 0 : 1);
+    EXPECT_EQ(work, distinct_with_reference) << alg << ": evaluations that did work";
+    EXPECT_EQ(r.cache_hits, r.evaluations + 1 - work) << alg;
+  }
 }
 
 }  // namespace

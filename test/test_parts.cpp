@@ -697,6 +697,45 @@ TEST_F(Parts, AFailedRenderReportsOpenscadsMessageAndLeavesNoStl) {
   }
 }
 
+TEST_F(Parts, PartsWithTheSameSourceAreRenderedOnceAndTheOthersCopyThatStl) {
+  // A stand-in for openscad that logs each call and writes an STL naming the .scad it was made
+  // from (an 80-byte header, no triangle): the thumb's proximal link and tactor tip have the same
+  // source as the index station's (L1 = L2 = 9 mm in both, Table 1), the other parts differ.
+  const fs::path log = dir_ / "calls.log";
+  const fs::path fake = dir_ / "fake-openscad";
+  std::ofstream(fake) << "#!/bin/sh\necho \"$@\" >> '" << log.string()
+                      << "'\nout=; prev=; last=\nfor a in \"$@\"; do [ \"$prev\" = -o ] && out=\"$a\"; prev=\"$a\"; "
+                         "last=\"$a\"; done\n{ printf '%-80.80s' \"$(basename \"$(dirname \"$last\")\")/$(basename \"$last\")\"; "
+                         "head -c 4 /dev/zero; } > \"$out\"\n";
+  fs::permissions(fake, fs::perms::owner_all);
+  PartsOptions o = options(dir_ / "out", std::nullopt);
+  o.openscad = fake.string();
+  const PartsReport r = build_parts(paper(), o);
+  ASSERT_EQ(r.parts.size(), 10u);
+  std::istringstream calls(slurp(log));
+  std::size_t n = 0;
+  for (std::string line; std::getline(calls, line);) ++n;
+  EXPECT_EQ(n, 8u);  // 10 parts, 8 distinct sources
+  for (const PartResult& p : r.parts) {
+    const bool twin = p.spec.station == "thumb" && (p.spec.name == "proximal_link_9mm" || p.spec.name == "tactor_tip");
+    EXPECT_EQ(p.render, RenderState::rendered) << p.spec.label() << ": " << p.render_error;
+    EXPECT_EQ(p.copied_from, twin ? "index/" + p.spec.name : "") << p.spec.label();
+    // Each STL names the source it was rendered from: the twins' that of their index counterpart.
+    const std::string stl = slurp(dir_ / "out" / p.stl_file);
+    ASSERT_EQ(stl.size(), 84u) << p.spec.label();
+    const std::string from = (twin ? std::string("index") : p.spec.station) + "/" + p.spec.name + ".scad";
+    EXPECT_EQ(stl.substr(0, from.size()), from) << p.spec.label();
+    EXPECT_TRUE(fs::exists(dir_ / "out" / (p.stl_file.string() + ".hash"))) << p.spec.label();
+  }
+  // A second build finds every part up to date, the copies included, and calls openscad no more.
+  const PartsReport again = build_parts(paper(), o);
+  EXPECT_EQ(again.count(RenderState::up_to_date), 10u);
+  std::istringstream after(slurp(log));
+  n = 0;
+  for (std::string line; std::getline(after, line);) ++n;
+  EXPECT_EQ(n, 8u);
+}
+
 // --- The product ------------------------------------------------------------------------------------
 
 TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {

@@ -134,7 +134,7 @@ TEST_F(Scene, BuildsEveryAvailableProductAndWritesBothSummaries) {
   d.get<ControllerSettings>()->tune->min_damping = 0.0;
   d.get<ControllerSettings>()->tune->min_gain_margin = 1.0;
   // The optimize product: the smallest budget it accepts (the initial populations and a round), a
-  // short polish and a coarse atlas (the showcase's full search is 3,000 candidates and 729 cells).
+  // short polish and a coarse atlas (the showcase's own search is 384 candidates, a 15-cell atlas).
   ASSERT_TRUE(d.get<OptimizeSettings>() != nullptr);
   d.get<OptimizeSettings>()->evaluations = 128;
   d.get<OptimizeSettings>()->polish_evaluations = 10;
@@ -282,6 +282,37 @@ TEST_F(Scene, AThrowawayProductBuildsWithItsPrerequisitesOnly) {
   const auto json = Json::parse(slurp(r.summary_json));
   EXPECT_EQ(json["results"]["beta"]["prerequisites_seen"], 1);
   EXPECT_EQ(json["built"].size(), 3u);
+}
+
+TEST_F(Scene, OneWorkerStartsTheLongestChainFirstAndAnEarlierRunsTimesReplaceTheHints) {
+  // "quick" (0.5 s) and "slow" (1 s) need nothing; "tail" (3 s) needs slow. The chains: slow 4 s,
+  // tail 3 s, quick 0.5 s, so one worker builds slow, tail, quick although quick comes first in
+  // the list. An earlier run's summary.json in the output folder saying quick took 10 s puts it
+  // first; the results are the same either way.
+  std::vector<products::Product> list = products::registry();
+  std::vector<std::string> seen;
+  list.push_back(throwaway("quick", {}, &seen));
+  list.back().cost_s = 0.5;
+  list.push_back(throwaway("slow", {}, &seen));
+  list.back().cost_s = 1.0;
+  list.push_back(throwaway("tail", {"slow"}, &seen));
+  list.back().cost_s = 3.0;
+  const Design d = load_design(kDesign);
+  SceneOptions o = options();
+  o.products = std::vector<std::string>{"quick", "slow", "tail"};
+  o.jobs = 1;
+  const SceneReport first = products::run_scene_with(d, o, list);
+  EXPECT_EQ(seen, (std::vector<std::string>{"slow", "tail", "quick"}));
+  Json earlier = Json::parse(slurp(first.summary_json));
+  for (Json& b : earlier["built"]) b["wall_s"] = b["name"] == "quick" ? 10.0 : 0.01;
+  std::ofstream(first.summary_json, std::ios::trunc) << earlier.dump(2);
+  seen.clear();
+  const SceneReport second = products::run_scene_with(d, o, list);
+  EXPECT_EQ(seen, (std::vector<std::string>{"quick", "slow", "tail"}));
+  Json a = Json::parse(slurp(first.summary_json)), b = Json::parse(slurp(second.summary_json));
+  for (Json* j : {&a, &b})
+    for (Json& x : (*j)["built"]) x.erase("wall_s");
+  EXPECT_EQ(a["results"], b["results"]);
 }
 
 TEST_F(Scene, AProductWhosePrerequisiteCannotBeBuiltIsLeftOutWithTheReason) {

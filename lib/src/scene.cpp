@@ -235,8 +235,37 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
     pending[k] = 1;
   }
 
-  // Build: a worker takes the first product (in list order) whose dependencies are built; each sees
-  // the results of its dependencies only, so that nothing depends on the timing.
+  // Critical path: each product's time (an earlier run's, from the summary.json in the output
+  // folder, else Product::cost_s) plus the longest chain of products waiting on it. Dependencies
+  // come earlier in the list, so one pass from the end gives every chain.
+  std::map<std::string, double> measured;
+  {
+    std::ifstream in(report.out_dir / "summary.json", std::ios::binary);
+    if (in) {
+      std::ostringstream text;
+      text << in.rdbuf();
+      const json earlier = json::parse(text.str(), nullptr, false);
+      if (!earlier.is_discarded() && earlier.is_object() && earlier.contains("built") && earlier["built"].is_array()) {
+        for (const json& b : earlier["built"]) {
+          if (b.is_object() && b.contains("name") && b["name"].is_string() && b.contains("wall_s") &&
+              b["wall_s"].is_number()) {
+            measured[b["name"].get<std::string>()] = b["wall_s"].get<double>();
+          }
+        }
+      }
+    }
+  }
+  std::vector<double> chain(n, 0.0);
+  for (std::size_t k = n; k-- > 0;) {
+    if (!pending[k]) continue;
+    const auto it = measured.find(known[k]);
+    chain[k] += it != measured.end() ? it->second : product[k]->cost_s;
+    for (const std::size_t d : deps[k]) chain[d] = std::max(chain[d], chain[k]);
+  }
+
+  // Build: a worker takes, of the products whose dependencies are built, the one heading the
+  // longest chain (the first in list order among equals); each sees the results of its
+  // dependencies only, so that nothing depends on the timing.
   std::map<std::string, json> results;
   std::mutex lock;
   std::condition_variable changed;
@@ -257,9 +286,9 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
       for (std::size_t k = 0; k < n && !failure; ++k) {
         if (!pending[k] || started[k]) continue;
         left = true;
-        if (std::all_of(deps[k].begin(), deps[k].end(), [&](std::size_t d) { return done[d] != 0; })) {
+        if (std::all_of(deps[k].begin(), deps[k].end(), [&](std::size_t d) { return done[d] != 0; }) &&
+            (pick == n || chain[k] > chain[pick])) {
           pick = k;
-          break;
         }
       }
       if (failure || !left) return;

@@ -4,7 +4,8 @@
 // codes of the commanded angles plus a deterministic ripple of a few counts) and times each cycle
 // with steady_clock (counters p50_us, p99_us, max_us) and with this thread's CPU clock
 // (cpu_p50_us, cpu_p99_us, cpu_max_us: the cycle's own work, free of preemption on a shared machine). A second benchmark times the priority rule's
-// bounded search alone (both tactors of a station at its centre: the lower one is moved).
+// bounded search alone (both tactors of a station at its centre: the lower one is moved); a third
+// runs the showcase's cycles with the priority rule forced in both stations at every cycle.
 
 #include <benchmark/benchmark.h>
 
@@ -164,5 +165,53 @@ void BM_runtime_priority_search(benchmark::State& state) {
   state.counters["probe_bound"] = double(rt::kPriorityMaxProbes);
 }
 BENCHMARK(BM_runtime_priority_search)->Arg(2000)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+/// The showcase's cycles with the priority rule forced every cycle: each station's lower target is
+/// its upper target of the same sample plus an offset turning once per 97 samples (radius 0 to
+/// 3 mm over 89 samples), so both stations' lower tactors collide with the upper outlines at
+/// every cycle and every depth: four mechanisms, two priority rules per cycle.
+void BM_runtime_showcase_priority_every_cycle(benchmark::State& state) {
+  const Samples& s = showcase();
+  std::vector<std::vector<double>> targets = s.targets;
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    std::size_t k = 0;
+    for (const rt::StationConfig& st : s.config.stations) {
+      std::size_t lo = k, up = k;
+      for (std::size_t m = 0; m < st.mechanisms.size(); ++m) (st.mechanisms[m].name == "lower" ? lo : up) = k + m;
+      const double phi = 2 * M_PI * double(i % 97) / 97.0, r = 3e-3 * double(i % 89) / 88.0;
+      targets[i][2 * lo] = targets[i][2 * up] + r * std::cos(phi);
+      targets[i][2 * lo + 1] = targets[i][2 * up + 1] + r * std::sin(phi);
+      k += st.mechanisms.size();
+    }
+  }
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::vector<double> us(n), cpu(n);
+  std::vector<double> fastest(targets.size(), 1e300);
+  std::size_t moved = 0, stopped = 0;
+  for (auto _ : state) {
+    rt::Controller ctl(s.config);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t k = i % targets.size();
+      const double c0 = thread_cpu_us();
+      const auto t0 = std::chrono::steady_clock::now();
+      ctl.cycle(s.counts[k].data(), rt::Reading::counts, targets[k].data());
+      const auto t1 = std::chrono::steady_clock::now();
+      cpu[i] = thread_cpu_us() - c0;
+      benchmark::DoNotOptimize(ctl.duties());
+      us[i] = std::chrono::duration<double, std::micro>(t1 - t0).count();
+      fastest[k] = std::min(fastest[k], us[i]);
+      for (std::size_t m = 0; m < ctl.mechanism_count(); ++m) {
+        moved += ctl.mechanism(m).status == rt::Status::moved_by_priority;
+        stopped += !ctl.mechanism(m).command;
+      }
+    }
+  }
+  report(state, us, cpu);
+  state.counters["worst_input_us"] = *std::max_element(fastest.begin(), fastest.end());
+  state.counters["moved_per_cycle"] = double(moved) / double(n);
+  state.counters["stopped"] = double(stopped);
+  state.counters["probe_bound"] = double(rt::kPriorityMaxProbes);
+}
+BENCHMARK(BM_runtime_showcase_priority_every_cycle)->Arg(1'000'000)->Arg(10'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -191,6 +191,11 @@ double max_spectral_radius(const std::vector<PoseLoop>& poses, const std::array<
 
 /// The map of `loop` at `points` (mm).
 StabilityMap stability_map(const LoopModel& loop, const std::vector<Vec2>& points, const StabilityOptions& options = {});
+/// The same from poses already linearised and discretised (pose_loop() of `loop`'s model at each
+/// point, any gains): only the poles are recomputed with `loop.gains`, so the result equals
+/// stability_map() at those points without linearising again.
+StabilityMap stability_map(const LoopModel& loop, const std::vector<PoseLoop>& linearised,
+                           const StabilityOptions& options = {});
 
 /// rho over the reachable region: a grid over the mechanism's reach (the intersection of its
 /// legs' outer circles, plus a cell), rho where the working-mode IK is ok and within the joint

@@ -7,3 +7,5 @@
 #include "fivebar/identify/filter.hpp"
 #include "fivebar/identify/plan.hpp"
 #include "fivebar/identify/json.hpp"
+#include "fivebar/identify/patch.hpp"
+#include "fivebar/identify/mechanism.hpp"

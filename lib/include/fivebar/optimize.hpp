@@ -1,9 +1,11 @@
 #pragma once
 /// Dimensional synthesis of the whole device (issue "optimize"; docs/optimize.md): the design's
 /// `optimize:` section names design numbers by key path (fivebar/sections/optimize.hpp), the
-/// figures to maximise or minimise and the constraints; islands of pagmo2's NSGA-II / MOEA/D
-/// (several objectives) or CMA-ES / SADE (one) search the box of the variables, migrating in a
-/// ring between rounds; NLopt's COBYLA polishes the chosen design under the same constraints.
+/// figures to maximise or minimise and the constraints; islands of the hybrid algorithm (the
+/// default for several objectives: NSGA-II's selection, a surrogate's pre-screening, no repeated
+/// design), pagmo2's NSGA-II / MOEA/D, or CMA-ES / SADE (one objective) search the box of the
+/// variables, migrating in a ring between rounds; one evaluation cache per process evaluates each
+/// distinct design once; NLopt's COBYLA polishes the chosen design under the same constraints.
 ///
 /// Evaluation is staged (docs/optimize.md "Stages"): every candidate goes through the sweep's
 /// cheap per-design path (certified containment, conditioning, footprint, collision fraction,
@@ -84,6 +86,9 @@ class OptimizeProblem {
   /// Which stages any objective or constraint needs: [cheap, loop, simulation].
   bool needs(OptimizeStage stage) const;
 
+  /// `x` with every variable snapped (OptimizeVariable::snap()): the canonical design of `x`, the
+  /// key of the evaluation cache (tied keys take one value, and no number is set by two variables).
+  std::vector<double> snap(const std::vector<double>& x) const;
   /// The complete design with `x` applied (snapped); InputError / ValidationError when invalid.
   Design design_at(const std::vector<double>& x) const;
   /// Evaluates the candidate `x` (snapped first) through the stages.
@@ -95,6 +100,10 @@ class OptimizeProblem {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// Calls of OptimizeProblem::evaluate() in this process so far (every problem, every thread): the
+/// work done, against which a test checks that the search's cache evaluates no design twice.
+std::uint64_t optimize_evaluate_calls();
 
 /// Settings of `design` asking for every figure the design has the data for (each as a constraint
 /// that always holds), for a complete report of one design.
@@ -143,6 +152,11 @@ struct OptimizeStageCounts {
 struct OptimizeResult {
   std::string algorithm;
   std::uint64_t evaluations = 0;   ///< in the search (the polish's apart)
+  /// Distinct designs (snapped values) among the search's evaluations: the others were answered by
+  /// the evaluation cache, shared by the islands of a process (docs/optimize.md "Evaluation cache").
+  std::uint64_t distinct = 0;
+  /// Cache hits of this process (search and polish): requests answered without evaluating.
+  std::uint64_t cache_hits = 0;
   std::uint64_t rounds = 0;
   double seconds = 0.0;
   bool interrupted = false;        ///< stopped by OptimizeOptions::stop (resumable)

@@ -3,7 +3,8 @@
 /// (proximal links with a motor D-bore, distal links, the tactor post and tip) and its base, as
 /// small OpenSCAD files that `use` the hand-written library scad/fivebar.scad with the design's
 /// numbers; binary STL renders by `openscad --hardwarnings` (two jobs in parallel, skipping parts
-/// whose inputs did not change); mesh checks (closed, no self-intersection, outward oriented,
+/// whose inputs did not change, and rendering once parts whose sources are the same: the others
+/// copy that STL); mesh checks (closed, no self-intersection, outward oriented,
 /// positive volume, one shell) and design-intent checks measured on the mesh (pin-centre distance
 /// equals the link length, hole diameters equal pin + 2 * clearance); a bill of materials.
 ///
@@ -224,6 +225,9 @@ struct PartResult {
   RenderState render = RenderState::not_requested;
   double render_seconds = 0.0;       ///< openscad's wall time (0 when up to date)
   std::string render_error;          ///< openscad's warnings and errors when it failed
+  /// The part (PartSpec::label()) whose render this one copied, its source being the same; empty
+  /// when openscad rendered this one (or it was up to date).
+  std::string copied_from;
   std::optional<MeshCheck> mesh;     ///< after a render or when up to date
   std::vector<CircleFit> holes;      ///< one per spec.holes
   std::optional<double> centre_distance_mm;  ///< links: measured distance of the two joint axes

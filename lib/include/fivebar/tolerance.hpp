@@ -69,6 +69,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -90,6 +91,63 @@ using SensitivityMatrix = Eigen::Matrix<double, 2, static_cast<int>(kTolerancePa
 
 /// Names of the parameters ("L1", ..., "theta2"), in ToleranceParameter order.
 const std::array<const char*, kToleranceParameters>& tolerance_parameter_names();
+
+/// Covariance of the ten parameters (mm^2, mm rad, rad^2), ToleranceParameter order.
+using ParameterCovariance = Eigen::Matrix<double, static_cast<int>(kToleranceParameters), static_cast<int>(kToleranceParameters)>;
+
+/// A calibration's posterior covariance for one mechanism (docs/calibrate.md "Posterior covariance
+/// in the design"), as the design's provenance entries record it, over the twelve calibration
+/// parameters L1..L4, O1 x, y, O2 x, y (mm, absolute base positions), V0_1 (V), k_1 (rad/V), V0_2,
+/// k_2; rows of the parameters it does not cover hold the `tolerance:` sigma (independent) instead.
+/// The controller believes theta_j = k_j (V_j - V0_j); the device's true angle differs by
+/// dtheta_j = (theta_j / k_j) dk_j - k_j dV0_j, so the joint-angle part depends on the pose.
+struct CalibratedUncertainty {
+  Eigen::Matrix<double, 12, 12> covariance = Eigen::Matrix<double, 12, 12>::Zero();
+  std::array<bool, 12> measured{};           ///< covered by the calibration
+  std::array<double, 2> rad_per_volt{1.0, 1.0};  ///< k_j of the design (the controller's)
+  /// Independent joint-angle variance added to dtheta_j (rad^2): the potentiometer's linearity when
+  /// its V0_j is calibrated, else the whole `tolerance:` angle sigma squared.
+  std::array<double, 2> angle_variance{0.0, 0.0};
+  std::vector<std::string> keys;             ///< the design keys covered
+  std::vector<std::string> sources;          ///< their source files
+  /// The ten-parameter covariance at joint angles theta1, theta2 (rad, as the controller computes them).
+  ParameterCovariance at(double theta1, double theta2) const;
+};
+
+/// The parameters' errors as a zero-mean Gaussian: independent sigmas (the `tolerance:` section,
+/// converted implicitly from ParameterSigmas) or a full covariance (a calibration's posterior, whose
+/// joint-angle part depends on the pose: at()). Draws are F z with z ~ N(0, I) drawn in parameter
+/// order and C = F F^T (F = diag(sigma) when independent, so the draws are those of the sigmas; else
+/// F = V sqrt(Lambda) from C's eigen-decomposition); the +-k sigma box of the worst case and the
+/// corners is that of the principal components (the columns of F) when correlated.
+class ParameterSpread {
+ public:
+  ParameterSpread(const ParameterSigmas& sigma);  // NOLINT(google-explicit-constructor): a sigma array is a spread
+  explicit ParameterSpread(const ParameterCovariance& covariance);
+  explicit ParameterSpread(const CalibratedUncertainty& calibrated);
+
+  bool correlated() const { return correlated_; }
+  bool calibrated() const { return calibrated_.has_value(); }
+  /// The square roots of the diagonal (at the pose of at(); joint angles at zero otherwise).
+  const ParameterSigmas& sigma() const { return sigma_; }
+  const ParameterCovariance& covariance() const { return covariance_; }
+  /// The ten-parameter spread at joint angles theta1, theta2 (the same spread unless calibrated).
+  ParameterSpread at(double theta1, double theta2) const;
+  /// g^T C g.
+  double variance(const std::array<double, kToleranceParameters>& g) const;
+  /// F z.
+  std::array<double, kToleranceParameters> draw(const std::array<double, kToleranceParameters>& z) const;
+  /// Column k of F (the k-th independent generator; zero columns for absent components).
+  std::array<double, kToleranceParameters> generator(std::size_t k) const;
+
+ private:
+  ParameterSigmas sigma_{};
+  bool correlated_ = false;
+  ParameterCovariance covariance_ = ParameterCovariance::Zero();
+  ParameterCovariance factor_ = ParameterCovariance::Zero();
+  std::optional<CalibratedUncertainty> calibrated_;
+  void factorise();
+};
 
 /// dP/dq at a tactor point in the mechanism's working mode.
 struct Sensitivity {
@@ -143,7 +201,7 @@ double angle_per_count(int bits);
 
 /// First-order covariance, 3-sigma ellipse, worst case and resolution at P for the given sigmas
 /// and joint angle per ADC count (rad). Status as tolerance_sensitivity().
-ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const ParameterSpread& sigma,
                                         double rad_per_count);
 
 /// Monte Carlo reference: `samples` printed devices, each parameter drawn independently from
@@ -156,7 +214,7 @@ struct MonteCarloTolerance {
   Vec2 mean_error{0.0, 0.0};                             ///< mean of P_printed - P, mm
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  ///< sample covariance (n - 1), mm^2
 };
-MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSpread& sigma,
                                           std::size_t samples, std::uint64_t seed);
 /// The 3-sigma major semi-axis of a 2 x 2 covariance (mm^2 -> mm): 3 sqrt(largest eigenvalue).
 double major_3sigma_mm(const Eigen::Matrix2d& covariance);
@@ -166,7 +224,7 @@ double major_3sigma_mm(const Eigen::Matrix2d& covariance);
 /// shared out over OpenMP threads (the answer does not depend on the thread count). Element k is
 /// tolerance_monte_carlo(m, points[k], sigma, samples, seed) up to the summation order.
 std::vector<MonteCarloTolerance> tolerance_monte_carlo(const Mechanism& m, const std::vector<Vec2>& points,
-                                                       const ParameterSigmas& sigma, std::size_t samples,
+                                                       const ParameterSpread& sigma, std::size_t samples,
                                                        std::uint64_t seed);
 
 /// The nonlinear counterpart of the worst case: the printed device at every corner of the box
@@ -182,7 +240,7 @@ struct CornerEnumeration {
   std::size_t failed = 0;               ///< corners whose device cannot reach (or is singular)
   std::array<std::int8_t, kToleranceParameters> worst_corner{};  ///< signs at the worst corner
 };
-CornerEnumeration tolerance_corners(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+CornerEnumeration tolerance_corners(const Mechanism& m, const Vec2& P, const ParameterSpread& sigma,
                                     double k_sigma = 3.0);
 
 // --- Sources from a design ----------------------------------------------------------------------
@@ -193,6 +251,13 @@ struct ToleranceSources {
   /// potentiometer's linearity (uniform over +-linearity_percent of its travel: sigma = half band
   /// / sqrt(3)) in quadrature. The ADC's quantisation is the resolution, reported on its own.
   ParameterSigmas sigma{};
+  /// What the analyses use (spread()): `sigma`, or, when the design's provenance entries hold a calibration's
+  /// sigmas for this mechanism's links, bases or potentiometers, that posterior covariance in
+  /// place of the `tolerance:` sigmas it covers (docs/calibrate.md "Posterior covariance in the design").
+  std::optional<CalibratedUncertainty> calibrated;
+  ParameterSpread spread() const { return calibrated ? ParameterSpread(*calibrated) : ParameterSpread(sigma); }
+  /// "tolerance: (assumed)" or "calibration posterior (FILE) for L1, ...; tolerance: for the rest".
+  std::string spread_source;
   std::array<double, 2> rad_per_count{0.0, 0.0};  ///< joint angle of one count, joints 1 and 2
   std::string resolution_source;                   ///< where rad_per_count comes from
   std::array<double, 2> leg_play_mm{0.0, 0.0};     ///< r1, r2 of the play set (header above)
@@ -238,7 +303,7 @@ struct RobustPoint {
   double sigma_mm = 0.0;      ///< sigma_k of the arc that sets robust_mm
   std::array<double, kToleranceParameters> gradient{};  ///< g of that arc
 };
-RobustPoint robust_margin_at(const Mechanism& m, const ParameterSigmas& sigma, double z, const Vec2& b);
+RobustPoint robust_margin_at(const Mechanism& m, const ParameterSpread& sigma, double z, const Vec2& b);
 
 /// The minimum of robust_margin_at() over the boundary of `target`, certified by branch and bound
 /// on the ellipse parameter with a Lipschitz bound per arc (speed of the boundary times 1 + z
@@ -254,7 +319,7 @@ struct RobustMarginBound {
   bool capped = false;     ///< the evaluation budget ran out before tol_mm was met
   double fraction_first_order = 1.0;  ///< min Phi(d_k / sigma_k) over the points evaluated
 };
-RobustMarginBound robust_margin_min(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double z,
+RobustMarginBound robust_margin_min(const Mechanism& m, const Ellipse& target, const ParameterSpread& sigma, double z,
                                     double tol_mm);
 
 /// One-sided lower confidence bound of the p-quantile from n independent samples of a continuous
@@ -292,11 +357,12 @@ struct RobustCoverage {
   double quantile_confidence = 0.95;
   std::size_t quantile_lower_rank = 0;
   double monte_carlo_stderr = 0.0;  ///< binomial standard error of fraction_monte_carlo
+  bool calibrated = false;          ///< the spread was a calibration's posterior covariance
 };
 /// Robust coverage of `target` by `m` under `sigma` for a `fraction` of printed devices, with a
 /// Monte Carlo check of `samples` devices (0: none; OpenMP over devices, the draws made in order
 /// from `seed` first, so the answer does not depend on the thread count).
-RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const ParameterSpread& sigma,
                                double fraction, std::size_t samples, std::uint64_t seed);
 
 /// One sampled printed device: its parameter errors (ToleranceParameter order: mm, rad), where its
@@ -309,7 +375,7 @@ struct DeviceSample {
 };
 /// The devices of robust_coverage()'s Monte Carlo (the same draws from `seed`), each with its
 /// tactor error at the target centre and its margin: the rows of `fivebar tolerance --devices`.
-std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSpread& sigma,
                                             std::size_t samples, std::uint64_t seed);
 /// CSV (a row per device, for pandas): device, dL1_mm ... dO2y_mm, dtheta1_deg, dtheta2_deg,
 /// status, error_x_mm, error_y_mm, margin_mm, covers.
@@ -355,6 +421,8 @@ struct ToleranceMap {
   std::vector<Flagged> near_singular;
   bool worst_3sigma_flagged = false, worst_case_flagged = false;  ///< the reported worst point is flagged
   RobustCoverage robust;
+  std::string spread_source;  ///< ToleranceSources::spread_source
+  bool calibrated = false;    ///< the sigmas are (partly) a calibration's posterior covariance
 };
 /// The map of one mechanism with `spacing_mm` (> 0; the grid is capped at 1000 x 1000 points).
 ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const Ellipse& target,

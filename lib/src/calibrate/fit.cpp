@@ -423,6 +423,28 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     add(10, ck + "theta2.potentiometer.volts_at_zero", prior[10], blk.q[10], var(o + 10, o + 10), is(10), rq(10));
     add(11, ck + "theta2.potentiometer.rad_per_volt", prior[11], blk.q[11], var(o + 11, o + 11), is(11), rq(11));
   }
+  // The covariance of the patched keys (file units): bases[1] = O1 + (O2 - O1) carries O1's part.
+  {
+    std::vector<std::vector<int>> combos;
+    for (int b = 0; b < nb; ++b) {
+      const int o = b * kMechanismParameters;
+      for (const Parameter& p : out.parameters) {
+        if (p.mechanism != blocks[static_cast<std::size_t>(b)].name || !p.identified) continue;
+        const auto i = static_cast<int>(std::find(mnames.begin(), mnames.end(), p.name) - mnames.begin());
+        combos.push_back(i == 6 ? std::vector<int>{o + 4, o + 6} : i == 7 ? std::vector<int>{o + 5, o + 7} : std::vector<int>{o + i});
+        out.key_covariance_keys.push_back(p.key);
+      }
+    }
+    const auto nkey = static_cast<Eigen::Index>(combos.size());
+    out.key_covariance = Eigen::MatrixXd::Zero(nkey, nkey);
+    for (Eigen::Index a = 0; a < nkey; ++a) {
+      for (Eigen::Index c = 0; c < nkey; ++c) {
+        for (int x : combos[static_cast<std::size_t>(a)]) {
+          for (int y : combos[static_cast<std::size_t>(c)]) out.key_covariance(a, c) += var(x, y);
+        }
+      }
+    }
+  }
   static const std::array<const char*, 3> fkeys{"frame.rotation_deg", "frame.x_mm", "frame.y_mm"};
   if (opt.fit_frame) {
     for (int i = 0; i < kFrameParameters; ++i) {

@@ -4,7 +4,10 @@
 #include <cmath>
 
 #include "fivebar/format.hpp"
+#include "fivebar/provenance.hpp"
 #include "fivebar/sections/provenance.hpp"
+
+#include <algorithm>
 
 namespace fivebar::calibrate {
 
@@ -73,21 +76,19 @@ std::string report_markdown(const CalibrationResult& r, const Source& source) {
 }
 
 Design with_provenance(const Design& patched, const CalibrationResult& r, const Source& source) {
-  Design d = patched;
-  ProvenanceSettings p = d.get<ProvenanceSettings>() ? *d.get<ProvenanceSettings>() : ProvenanceSettings{};
-  for (const Parameter& q : r.parameters) {
-    if (!q.identified || q.mechanism.empty()) continue;
-    ProvenanceEntry e;
-    e.source = source.file;
-    e.sha256 = source.sha256;
-    e.date = source.date;
-    e.method = kMethod;
-    e.sigma = q.sigma;
-    p.entries[q.key] = e;
+  // Through the one provenance writer (fivebar/provenance.hpp), with the posterior correlations.
+  std::vector<MeasuredValue> values;
+  for (const std::string& key : r.key_covariance_keys) {
+    const auto it = std::find_if(r.parameters.begin(), r.parameters.end(), [&](const Parameter& q) { return q.key == key; });
+    values.push_back({key, it->sigma});
   }
-  d.set(std::move(p));
-  d.validate();
-  return d;
+  if (values.empty()) {  // no joint covariance (the hard stops): the sigmas alone
+    for (const Parameter& q : r.parameters) {
+      if (q.identified && !q.mechanism.empty()) values.push_back({q.key, q.sigma});
+    }
+    return with_measured_values(patched, values, {source.file, source.sha256, source.date, kMethod});
+  }
+  return with_measured_values(patched, values, {source.file, source.sha256, source.date, kMethod}, r.key_covariance);
 }
 
 Json to_json(const std::vector<MechanismPlan>& plans, const PlanOptions& o) {

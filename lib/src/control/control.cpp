@@ -261,15 +261,17 @@ double gain_margin(const std::vector<PoseLoop>& poses, const std::array<PidGains
 
 }  // namespace
 
-StabilityMap stability_map(const LoopModel& loop, const std::vector<Vec2>& points, const StabilityOptions& options) {
+namespace {
+
+/// stability_map() once its poses are computed: worst pose, least damping, margins.
+StabilityMap map_of_poses(const LoopModel& loop, std::vector<PoseLoop> poses, const StabilityOptions& options) {
   StabilityMap map;
   map.station = loop.station;
   map.mechanism = loop.model.mechanism.name;
-  map.poses.reserve(points.size());
+  map.poses = std::move(poses);
   std::size_t ok = 0;
-  for (const Vec2& p : points) {
-    map.poses.push_back(pose_loop(loop, p));
-    const PoseLoop& pl = map.poses.back();
+  for (std::size_t k = 0; k < map.poses.size(); ++k) {
+    const PoseLoop& pl = map.poses[k];
     if (pl.status != Status::ok) {
       ++map.not_ok;
       continue;
@@ -281,7 +283,7 @@ StabilityMap stability_map(const LoopModel& loop, const std::vector<Vec2>& point
     }
     if (ok == 0 || pl.poles.rho > map.max_rho) {
       map.max_rho = pl.poles.rho;
-      map.worst = map.poses.size() - 1;
+      map.worst = k;
     }
     ++ok;
   }
@@ -300,6 +302,23 @@ StabilityMap stability_map(const LoopModel& loop, const std::vector<Vec2>& point
                                 [](PidGains& g, double f) { g.kd *= f; });
   }
   return map;
+}
+
+}  // namespace
+
+StabilityMap stability_map(const LoopModel& loop, const std::vector<Vec2>& points, const StabilityOptions& options) {
+  std::vector<PoseLoop> poses;
+  poses.reserve(points.size());
+  for (const Vec2& p : points) poses.push_back(pose_loop(loop, p));
+  return map_of_poses(loop, std::move(poses), options);
+}
+
+StabilityMap stability_map(const LoopModel& loop, const std::vector<PoseLoop>& linearised, const StabilityOptions& options) {
+  std::vector<PoseLoop> poses = linearised;
+  for (PoseLoop& p : poses) {
+    if (p.status == Status::ok) p.poles = loop_poles(closed_loop(p.plant, loop.gains, loop.delay), loop.period_s);
+  }
+  return map_of_poses(loop, std::move(poses), options);
 }
 
 RhoField rho_field(const LoopModel& loop, int cells_per_axis) {

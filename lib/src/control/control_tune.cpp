@@ -289,6 +289,36 @@ std::array<PidGains, 2> pole_placement_gains(const LinearPlant& plant, const std
   return g;
 }
 
+namespace {
+
+/// max_spectral_radius() that tries the pose found worst last time first (`hint`, updated) and
+/// stops once a pose is strictly above `stop_at`: the same value whenever the maximum is at most
+/// stop_at, and a value above stop_at otherwise. A scan for the least maximum then drops most
+/// candidates at their first pose.
+double max_rho_hinted(const std::vector<PoseLoop>& poses, const std::array<PidGains, 2>& gains, bool delay,
+                      double stop_at, std::size_t& hint) {
+  double worst = 0.0;
+  std::size_t at = hint;
+  const auto visit = [&](std::size_t k) {
+    const PoseLoop& p = poses[k];
+    if (p.status != Status::ok) return false;
+    const double r = loop_poles(closed_loop(p.plant, gains, delay), p.plant.period_s).rho;
+    if (r > worst) {
+      worst = r;
+      at = k;
+    }
+    return worst > stop_at;
+  };
+  bool stopped = hint < poses.size() && visit(hint);
+  for (std::size_t k = 0; k < poses.size() && !stopped; ++k) {
+    if (k != hint) stopped = visit(k);
+  }
+  hint = at;
+  return worst;
+}
+
+}  // namespace
+
 PolePlacement pole_placement(const LoopModel& loop, const Vec2& centre_mm, const std::vector<PoseLoop>& poses,
                              bool per_joint, const std::array<PidGains, 2>& base) {
   PolePlacement out;
@@ -304,9 +334,12 @@ PolePlacement pole_placement(const LoopModel& loop, const Vec2& centre_mm, const
   const LinearPlant plant = linear_plant(model, Eigen::Vector2d(a.theta1, a.theta2), loop.contact ? &loop.skin : nullptr);
   out.status = plant.status;
   if (plant.status != Status::ok) return out;
+  // Each value exact unless it exceeds stop_at, the value it is compared with (the scan's best, the
+  // other golden-section point): the comparisons, and so the result, are those of full maxima.
+  std::size_t hint = 0;
   const auto rho = [&](double omega, double stop_at) {
-    return max_spectral_radius(poses, pole_placement_gains(plant, model.motors, omega, per_joint, base), loop.delay,
-                               stop_at);
+    return max_rho_hinted(poses, pole_placement_gains(plant, model.motors, omega, per_joint, base), loop.delay,
+                          stop_at, hint);
   };
   // Geometric scan, then golden section between the best value's neighbours.
   constexpr int kScan = 60;
@@ -325,16 +358,17 @@ PolePlacement pole_placement(const LoopModel& loop, const Vec2& centre_mm, const
   double a0 = std::log(omega_at(std::max(best - 1, 0))), b0 = std::log(omega_at(std::min(best + 1, kScan - 1)));
   const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b0 - phi * (b0 - a0), x2 = a0 + phi * (b0 - a0);
-  double f1 = rho(std::exp(x1), 1e300), f2 = rho(std::exp(x2), 1e300);
+  double f1 = rho(std::exp(x1), 1e300);
+  double f2 = rho(std::exp(x2), f1);
   for (int it = 0; it < 30 && b0 - a0 > 1e-4; ++it) {
     if (f1 < f2) {
       b0 = x2, x2 = x1, f2 = f1;
       x1 = b0 - phi * (b0 - a0);
-      f1 = rho(std::exp(x1), 1e300);
+      f1 = rho(std::exp(x1), f2);
     } else {
       a0 = x1, x1 = x2, f1 = f2;
       x2 = a0 + phi * (b0 - a0);
-      f2 = rho(std::exp(x2), 1e300);
+      f2 = rho(std::exp(x2), f1);
     }
   }
   double omega = omega_at(best);
@@ -463,10 +497,9 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     StabilityOptions so;
     LoopModel loop = job.loop;
     loop.gains = g;
-    // The margins over the constraint's grid, bisected as the stability map does.
-    std::vector<Vec2> points;
-    for (const PoseLoop& p : job.poses) points.push_back(p.P_mm);
-    const StabilityMap map = stability_map(loop, points, so);
+    // The margins over the constraint's grid, bisected as the stability map does, on the poses
+    // linearised once for the whole tuning.
+    const StabilityMap map = stability_map(loop, job.poses, so);
     const Linear l = linear_figures(job.poses, g, job.loop.delay, options.min_gain_margin);
     const double over = job.step ? step_overshoot(*job.step, g, options.rtol) : 0.0;
     ChirpFigures c{0.0, 0.0, 0.0};
@@ -509,20 +542,43 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
       // The least-rho omega may break the damping or margin floors (a fast placement meets the
       // period of delay): among placements from omega* / 0.85^4 down to omega* 0.85^8, the first
       // that meets the linear floors, else the one that misses them least.
-      const auto violation = [&](const std::array<PidGains, 2>& g) {
-        const Linear l = linear_figures(job.poses, g, job.loop.delay, options.min_gain_margin);
-        return std::max(0.0, l.rho - options.rho_limit) + std::max(0.0, options.min_damping + kDampingSafety - l.damping) +
-               std::max(0.0, l.rho_kp - (1.0 - kRhoSafety)) + std::max(0.0, l.rho_kd - (1.0 - kRhoSafety));
+      // The violation of linear_figures() pose by pose, in its order (rho_kp and rho_kd stop
+      // growing at their first pose >= 1, as max_spectral_radius() stops there): every term only
+      // grows, so once the sum reaches `stop` the candidate cannot beat it and is left there; below,
+      // the value is that of linear_figures() exactly.
+      const auto violation = [&](const std::array<PidGains, 2>& g, double stop) {
+        std::array<PidGains, 2> g_kp = g, g_kd = g;
+        for (PidGains& x : g_kp) x.kp *= options.min_gain_margin;
+        for (PidGains& x : g_kd) x.kd *= options.min_gain_margin;
+        Linear l;
+        const auto value = [&] {
+          return std::max(0.0, l.rho - options.rho_limit) + std::max(0.0, options.min_damping + kDampingSafety - l.damping) +
+                 std::max(0.0, l.rho_kp - (1.0 - kRhoSafety)) + std::max(0.0, l.rho_kd - (1.0 - kRhoSafety));
+        };
+        for (const PoseLoop& pose : job.poses) {
+          if (pose.status != Status::ok) continue;
+          const LoopPoles poles = loop_poles(closed_loop(pose.plant, g, job.loop.delay), pose.plant.period_s);
+          l.rho = std::max(l.rho, poles.rho);
+          if (poles.oscillatory_damping < l.damping) l.damping = poles.oscillatory_damping;
+          if (l.rho_kp < 1.0) {
+            l.rho_kp = std::max(l.rho_kp, loop_poles(closed_loop(pose.plant, g_kp, job.loop.delay), pose.plant.period_s).rho);
+          }
+          if (l.rho_kd < 1.0) {
+            l.rho_kd = std::max(l.rho_kd, loop_poles(closed_loop(pose.plant, g_kd, job.loop.delay), pose.plant.period_s).rho);
+          }
+          if (value() >= stop) break;
+        }
+        return value();
       };
       const double omega0 = t.start_omega_rad_s;
-      double best_violation = violation(t.start);
+      double best_violation = violation(t.start, std::numeric_limits<double>::infinity());
       for (int k = -4; k <= 8 && best_violation > 0.0; ++k) {
         if (k == 0) continue;
         const double omega = omega0 * std::pow(0.85, k);
         const std::optional<std::array<PidGains, 2>> g =
             pole_placement_at(job.loop, job.station->target.center, omega, options.per_joint, t.before);
         if (!g) continue;
-        const double v = violation(*g);
+        const double v = violation(*g, best_violation);
         if (v < best_violation) {
           best_violation = v;
           t.start = *g;

@@ -371,11 +371,17 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
       for (const Mechanism* m : s.mechanisms()) {
         say(options, "export gate: robust coverage of " + name + "/" + m->name);
         const ToleranceSources src = tolerance_sources(d, s, *m);
-        const RobustCoverage r = robust_coverage(*m, s.target, src.sigma, src.robust_fraction, 0, src.seed);
+        const RobustCoverage r = robust_coverage(*m, s.target, src.spread(), src.robust_fraction, 0, src.seed);
+        // Every link and base calibrated: the margin rests on those measurements, not on tolerance:.
+        const bool geometry_calibrated =
+            src.calibrated && std::all_of(src.calibrated->measured.begin(), src.calibrated->measured.begin() + 8, [](bool b) { return b; });
         add("robust_coverage", name + "/" + m->name, r.covered,
             fixed(100.0 * r.fraction, 1) + " % of printed devices keep a margin of " + fixed(r.robust_margin_mm, 3) +
                 " mm (design " + fixed(r.margin_mm, 3) + " mm, sigma " + fixed(r.sigma_mm, 3) + " mm at " +
-                point_text(r.robust_point) + ")" + (r.covered ? "" : ": printed devices lose the target"));
+                point_text(r.robust_point) + ")" + (r.covered ? "" : ": printed devices lose the target") +
+                (r.calibrated ? "; sigmas: the calibration's posterior covariance" : "") + "; rests on: " +
+                (geometry_calibrated ? std::string("measured (kinematics, its posterior covariance in place of the tolerance: sigmas)")
+                                     : rests_on_text(d, "robust_margin_mm", name, m->name)));
       }
     }
   }
@@ -414,6 +420,16 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
   detail::ControlGate loop = detail::control_gate(d, gate.stations, options.progress);
   for (GateCheck& check : loop.checks) gate.checks.push_back(std::move(check));
   gate.validation = std::move(loop.figures);
+  // What each validated figure rests on (fivebar/provenance.hpp figure_bases()), beside the figures.
+  for (auto& [station, mechanisms] : gate.validation.items()) {
+    for (auto& [mechanism, figures] : mechanisms.items()) {
+      Json rests = Json::object();
+      for (const FigureBasis& f : figure_bases()) {
+        if (figures.contains(f.key)) rests[f.key] = rests_on_text(d, f.key, station, mechanism);
+      }
+      figures["rests_on"] = rests;
+    }
+  }
 
   // Measured or assumed (fivebar/provenance.hpp): what the validated figures rest on, and the
   // groups controller.require_measured wants measured.

@@ -2,11 +2,13 @@
 // it passes, written as ROS 2 parameters, JSON and a C++17 header under export/ (fivebar/export/export.hpp).
 // A refused export writes nothing and fails the product's check with every reason.
 
+#include <algorithm>
 #include <numbers>
 #include <string>
 
 #include "fivebar/format.hpp"
 #include "fivebar/export/export.hpp"
+#include "fivebar/provenance.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -30,6 +32,35 @@ constexpr const char* kPreamble =
     "(gearing, rotor inertia) and an MJCF for MuJoCo with the loops closed, the motors as actuators and the "
     "reflected rotor inertia as armature (docs/urdf.md, docs/mjcf.md; masses and meshes from the parts' STL "
     "renders when the scene built them).\n\n";
+
+/// The validated figures of the export gate (its `fivebar.validation` block) with what each rests
+/// on (fivebar/provenance.hpp figure_bases(), the one table): a markdown table, a row per mechanism
+/// and set of groups, and the same per figure as JSON records for summary.json.
+void rests_on(const Design& d, const Json& validation, std::string& markdown, Json& records) {
+  records = Json::array();
+  md::Table table({"mechanism", "validated figures", "rest on"}, "lll");
+  for (const auto& [station, mechanisms] : validation.items()) {
+    for (const auto& [mechanism, figures] : mechanisms.items()) {
+      const std::string subject = station + "/" + mechanism;
+      std::vector<std::pair<std::string, std::vector<std::string>>> rows;  // rests-on text -> figures
+      for (const FigureBasis& basis : figure_bases()) {
+        if (!figures.contains(basis.key) || !figures.at(basis.key).is_number()) continue;
+        const double v = figures.at(basis.key).get<double>();
+        const std::string text = rests_on_text(d, basis.key, station, mechanism);
+        records.push_back({{"subject", subject}, {"figure", basis.key}, {"value", v}, {"groups", basis.groups},
+                           {"assumed", figure_assumed(d, basis.key, station, mechanism)},
+                           {"text", rests_on_line(d, basis.key, v, station, mechanism)}});
+        auto it = std::find_if(rows.begin(), rows.end(), [&](const auto& r) { return r.first == text; });
+        if (it == rows.end()) rows.push_back({text, {figure_text(basis.key, v)}});
+        else it->second.push_back(figure_text(basis.key, v));
+      }
+      for (const auto& [text, list] : rows) table.row({md::code(subject), format::join(list), text});
+    }
+  }
+  if (table.empty()) return;
+  markdown += "What each validated figure rests on (assumed: no `provenance:` entry; docs/calibrate.md \"What each figure "
+              "rests on\"):\n\n" + table.str() + "\n";
+}
 
 }  // namespace
 
@@ -75,6 +106,8 @@ Product export_product() {
     }
     markdown += "Rests on assumed values (no `provenance:` entry, docs/calibrate.md): " +
                 (r.gate.assumed.empty() ? std::string("none") : format::join(r.gate.assumed)) + ".\n\n";
+    Json records;
+    rests_on(d, r.gate.validation, markdown, records);
     Json files = Json::array();
     if (r.gate.passed()) {
       markdown += "Files:";
@@ -88,7 +121,7 @@ Product export_product() {
       markdown += "**Export refused**: no file written.\n";
     }
     b.result = {{"node", d.get<ControllerSettings>()->node}, {"design_hash", r.hash}, {"exported", r.gate.passed()},
-                {"files", files}, {"gate", to_json(r.gate)}};
+                {"files", files}, {"gate", to_json(r.gate)}, {"rests_on", records}};
     b.markdown = markdown;
     b.passed = r.gate.passed();
     const auto reasons = r.gate.reasons();

@@ -40,6 +40,7 @@ struct Prepared {
   Eigen::MatrixXd W;
   Eigen::VectorXd Y;
   std::vector<double> d_dec, v_dec, t_dec;
+  std::vector<double> known_dec;        // the known closed-chain torque, decimated (empty: none)
   // electrical regression (voltage drive with its current)
   Eigen::MatrixXd We;
   Eigen::VectorXd Ye;
@@ -98,6 +99,10 @@ Prepared prepare(const JointLog& j, const std::vector<double>& time, const Joint
   cols.push_back(std::vector<double>(p.v.size(), 1.0));
   std::vector<double> tau(p.v.size());
   for (std::size_t i = 0; i < tau.size(); ++i) tau[i] = s.alpha * df[i] - s.g * p.v[i];
+  if (!prior.known_torque.empty()) {  // the closed chain's share (--rig mechanism)
+    for (std::size_t i = 0; i < tau.size(); ++i) tau[i] -= prior.known_torque[i];
+    p.known_dec = decimate(prior.known_torque, s.R);
+  }
   const std::vector<double> Yd = decimate(tau, s.R);
   p.Y = to_eigen(Yd);
   p.W.resize(p.Y.size(), static_cast<Eigen::Index>(cols.size()));
@@ -126,9 +131,17 @@ Fit fit_figures(const Prepared& p, const Eigen::VectorXd& theta, const Setup& s,
   Fit f;
   const Eigen::VectorXd tau_hat = p.W * theta;
   std::vector<double> dhat(p.d_dec.size());
-  for (std::size_t i = 0; i < dhat.size(); ++i) dhat[i] = (tau_hat[static_cast<Eigen::Index>(i)] + s.g * p.v_dec[i]) / s.alpha;
+  for (std::size_t i = 0; i < dhat.size(); ++i) {
+    const double known = p.known_dec.empty() ? 0.0 : p.known_dec[i];
+    dhat[i] = (tau_hat[static_cast<Eigen::Index>(i)] + known + s.g * p.v_dec[i]) / s.alpha;
+  }
   f.drive_fit_percent = fit_percent(p.d_dec, dhat);
   f.drive_relative_error_percent = relative_error_percent(p.d_dec, dhat);
+  if (!p.known_dec.empty()) {  // one joint of a closed chain: its open-loop simulation alone means nothing
+    if (sim_out) sim_out->clear();
+    if (drive_hat_out) *drive_hat_out = dhat;
+    return f;
+  }
   const std::vector<double> sim =
       simulate_position(time, p.u, s.g, theta, s.per_direction, p.qf.front(), p.v.front(), o.coulomb_smoothing);
   bool finite = true;
@@ -352,7 +365,9 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
     r.validation_series.drive_idim = vdhat;
   }
 
-  if (o.output_error) {
+  if (o.output_error && !prior.known_torque.empty()) {
+    r.output_error_status = "not run: one joint of a closed chain (--rig mechanism) is not simulated alone";
+  } else if (o.output_error) {
     bool ok = r.idim.identified[0] && r.idim.value[0] > 0.0;
     if (!ok) {
       r.output_error_status = "not run: the inertia is not identified or not positive";

@@ -3,6 +3,7 @@
 #include "fivebar/optimize.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -157,6 +158,20 @@ std::vector<double> OptimizeProblem::reference_values() const {
   return v;
 }
 
+std::vector<double> OptimizeProblem::snap(const std::vector<double>& x) const {
+  const auto& vars = impl_->s.variables;
+  std::vector<double> out(vars.size());
+  // + 0.0: -0 and 0 are one design (and one cache key).
+  for (std::size_t d = 0; d < out.size(); ++d) out[d] = vars[d].snap(d < x.size() ? x[d] : vars[d].lo) + 0.0;
+  return out;
+}
+
+namespace {
+std::atomic<std::uint64_t> g_evaluate_calls{0};
+}  // namespace
+
+std::uint64_t optimize_evaluate_calls() { return g_evaluate_calls.load(); }
+
 Design OptimizeProblem::design_at(const std::vector<double>& x) const {
   const Impl& m = *impl_;
   std::vector<std::pair<std::string, double>> values;
@@ -171,10 +186,10 @@ Design OptimizeProblem::design_at(const std::vector<double>& x) const {
 
 OptimizeCandidate OptimizeProblem::evaluate(const std::vector<double>& x_in) const {
   const Impl& m = *impl_;
+  g_evaluate_calls.fetch_add(1, std::memory_order_relaxed);
   OptimizeCandidate c;
   c.figures.assign(optimize_figures().size(), kNaN);
-  c.x.resize(m.s.variables.size());
-  for (std::size_t d = 0; d < c.x.size(); ++d) c.x[d] = m.s.variables[d].snap(d < x_in.size() ? x_in[d] : m.s.variables[d].lo);
+  c.x = snap(x_in);
 
   // --- apply the values ---
   std::optional<Design> changed;  // the slow path's design (and the later stages')

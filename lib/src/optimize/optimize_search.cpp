@@ -17,11 +17,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <functional>
+#include <future>
 #include <limits>
 #include <map>
+#include <mutex>
+#include <random>
+#include <set>
 #include <sstream>
+#include <unordered_map>
 
 #include "fivebar/atlas.hpp"
 #include "fivebar/format.hpp"
@@ -65,8 +71,115 @@ struct Deadline {
   bool passed() const { return (stop && stop->load()) || std::chrono::steady_clock::now() >= end; }
 };
 
+/// The evaluation cache of a run (docs/optimize.md "Evaluation cache"), shared by the islands of a
+/// process: keyed by the canonical design (OptimizeProblem::snap(): the variables after their step
+/// rounding; tied keys are one variable and no number is set by two, so equal keys are equal
+/// designs). A design asked for while another thread evaluates it waits for that evaluation, so
+/// every distinct design is evaluated exactly once, whatever the thread count.
+class EvaluationCache {
+ public:
+  explicit EvaluationCache(const OptimizeProblem& p) : p_(p) {}
+  /// The candidate of `x` (snapped), evaluated only when no thread has evaluated it yet.
+  OptimizeCandidate get(const std::vector<double>& x) {
+    std::vector<double> key = p_.snap(x);
+    std::shared_future<OptimizeCandidate> pending;
+    std::promise<OptimizeCandidate> mine;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      const auto it = map_.find(key);
+      if (it != map_.end()) {
+        ++hits_;
+        pending = it->second;
+      } else {
+        map_.emplace(key, mine.get_future().share());
+      }
+    }
+    if (pending.valid()) return pending.get();
+    try {
+      OptimizeCandidate c = p_.evaluate(key);
+      mine.set_value(c);
+      return c;
+    } catch (...) {
+      mine.set_exception(std::current_exception());
+      throw;
+    }
+  }
+  /// Known candidates (a resumed run's): later requests of them are hits.
+  void insert(const OptimizeCandidate& c) {
+    std::promise<OptimizeCandidate> done;
+    OptimizeCandidate k = c;
+    k.island = -1;
+    k.round = 0;
+    k.evaluation = 0;
+    done.set_value(std::move(k));
+    std::lock_guard<std::mutex> lock(mu_);
+    map_.emplace(c.x, done.get_future().share());
+  }
+  std::uint64_t hits() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return hits_;
+  }
+
+ private:
+  struct Hash {
+    std::size_t operator()(const std::vector<double>& x) const {
+      std::uint64_t h = 0x243f6a8885a308d3ull;
+      for (double v : x) {
+        std::uint64_t bits = 0;
+        std::memcpy(&bits, &v, sizeof bits);
+        h = mix(h ^ bits);
+      }
+      return std::size_t(h);
+    }
+  };
+  const OptimizeProblem& p_;
+  mutable std::mutex mu_;
+  std::unordered_map<std::vector<double>, std::shared_future<OptimizeCandidate>, Hash> map_;
+  std::uint64_t hits_ = 0;
+};
+
+/// Distinct designs among candidates (their snapped values).
+std::uint64_t distinct_designs(const std::vector<OptimizeCandidate>& all) {
+  std::set<std::vector<double>> seen;
+  for (const auto& c : all) seen.insert(c.x);
+  return seen.size();
+}
+
+/// What an island remembers of its own evaluations (for the hybrid algorithm): every design, and
+/// the non-dominated feasible ones with their fitness (kept up to date point by point).
+struct IslandMemory {
+  std::set<std::vector<double>> seen;
+  std::vector<std::vector<double>> front_x, front_f;
+  std::vector<std::vector<double>> all_x, all_f;  ///< every design of the island and its fitness
+  std::vector<char> all_feasible;
+  void add(const std::vector<double>& x, const std::vector<double>& f, bool feasible) {
+    if (!seen.insert(x).second) return;
+    all_x.push_back(x);
+    all_f.push_back(f);
+    all_feasible.push_back(feasible);
+    if (!feasible) return;
+    for (std::size_t k = 0; k < front_f.size(); ++k) {
+      bool no_worse = true;
+      for (std::size_t i = 0; i < f.size() && no_worse; ++i) no_worse = front_f[k][i] <= f[i];
+      if (no_worse) return;  // dominated by (or equal to) a point of the front
+    }
+    for (std::size_t k = front_f.size(); k-- > 0;) {
+      bool no_worse = true;
+      for (std::size_t i = 0; i < f.size() && no_worse; ++i) no_worse = f[i] <= front_f[k][i];
+      if (no_worse) {
+        front_f.erase(front_f.begin() + std::ptrdiff_t(k));
+        front_x.erase(front_x.begin() + std::ptrdiff_t(k));
+      }
+    }
+    front_x.push_back(x);
+    front_f.push_back(f);
+  }
+};
+
 struct Udp {
   const OptimizeProblem* problem = nullptr;
+  EvaluationCache* cache = nullptr;
+  IslandMemory* memory = nullptr;  ///< the island's designs so far (the hybrid's)
   std::vector<OptimizeCandidate>* log = nullptr;
   int island = 0;
   std::uint32_t* round = nullptr;
@@ -75,11 +188,12 @@ struct Udp {
 
   pagmo::vector_double fitness(const pagmo::vector_double& x) const {
     if (deadline && deadline->passed()) throw Halt{};
-    OptimizeCandidate c = problem->evaluate(x);
+    OptimizeCandidate c = cache ? cache->get(x) : problem->evaluate(x);
     c.island = island;
     c.round = *round;
     c.evaluation = ++*counter;
     const pagmo::vector_double f = problem->fitness(c);
+    if (memory) memory->add(c.x, f, c.feasible());
     log->push_back(std::move(c));
     return f;
   }
@@ -110,11 +224,254 @@ bool on_every_island(std::size_t n, int threads, const std::function<void(std::s
   return std::find(halted.begin(), halted.end(), 1) != halted.end();
 }
 
+
+/// The default algorithm for several objectives (docs/optimize.md "The hybrid algorithm"): NSGA-II's
+/// elitist selection (non-dominated sorting and crowding over parents and children), with other
+/// variation, a surrogate's pre-screening and no repeated design. Per child:
+/// - with probability 0.25 (once the island's own front of feasible designs has 3 points), from a
+///   point of that front (of at most 400 of its points, drawn at random) picked sparse-first (its nearest neighbour in the front's normalised
+///   objectives far; the extremes of each objective first): a step toward that neighbour in design
+///   space (filling the front's gaps), or a Gaussian step of 3 % of each range (refining it);
+/// - otherwise a differential step around a tournament winner a of the population, a + F (b - c)
+///   with two other members b, c (F uniform in [0.3, 0.9], crossover 0.9 per variable, at least
+///   one): the steps shrink with the population's spread;
+/// - then polynomial mutation (index 20, probability 1/n per variable);
+/// - a child that snaps to a design this island has already evaluated (or to a member of the
+///   population) is moved by a Gaussian step of growing width until it is new (at most 16 tries);
+/// - eight such children are drawn and only one is evaluated: the one whose objectives, predicted
+///   from its nearest neighbours among the island's latest 512 designs, are dominated by the fewest points of the
+///   island's front (ties: the one farthest from every evaluated design). The prediction costs
+///   microseconds, an evaluation (the certified coverage, the conditioning, the footprint) far more.
+/// Everything is drawn from the round's seed: deterministic for a seed, whatever the thread count.
+struct Hybrid {
+  unsigned gens = 1;
+  unsigned seed = 0;
+  const OptimizeProblem* problem = nullptr;
+  const IslandMemory* memory = nullptr;
+
+  pagmo::population evolve(pagmo::population pop) const {
+    const auto& prob = pop.get_problem();
+    const std::size_t N = pop.size();
+    if (N < 4 || gens == 0) return pop;
+    const auto [lo, hi] = prob.get_bounds();
+    const std::size_t n = lo.size();
+    std::vector<double> inv_range(n);
+    for (std::size_t d = 0; d < n; ++d) inv_range[d] = 1.0 / (hi[d] - lo[d]);
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    auto pick = [&](std::size_t k) { return std::size_t(rng() % k); };
+    for (unsigned g = 0; g < gens; ++g) {
+      const auto& X = pop.get_x();
+      const auto& F = pop.get_f();
+      // Position of each member in the NSGA-II order (rank, then crowding): a tournament's winner is the earlier.
+      const std::vector<pagmo::pop_size_t> order = pagmo::sort_population_mo(F);
+      std::vector<std::size_t> position(N);
+      for (std::size_t i = 0; i < N; ++i) position[order[i]] = i;
+      auto tournament = [&] {
+        const std::size_t a = pick(N), b = pick(N);
+        return position[a] < position[b] ? a : b;
+      };
+      std::set<std::vector<double>> taken(X.begin(), X.end());
+      std::vector<pagmo::vector_double> xs = X, fs = F;
+      // The island's front so far: each point's distance to its nearest neighbour in the front's
+      // normalised objectives (the extremes of each objective: infinite), for a sparse-first pick.
+      // (A copy: the evaluations of this generation change the island's front. At most kFrontSample
+      // of its points, drawn at random, so that a generation costs a bounded time on a long run.)
+      constexpr std::size_t kFrontSample = 400;
+      std::vector<std::vector<double>> front_x, front_f;
+      if (memory) {
+        std::vector<std::size_t> idx(memory->front_x.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+        if (idx.size() > kFrontSample) {
+          std::shuffle(idx.begin(), idx.end(), rng);
+          idx.resize(kFrontSample);
+          std::sort(idx.begin(), idx.end());
+        }
+        for (std::size_t i : idx) {
+          front_x.push_back(memory->front_x[i]);
+          front_f.push_back(memory->front_f[i]);
+        }
+      }
+      const std::size_t A = front_x.size();
+      std::vector<double> sparse(A, 0.0);
+      std::vector<std::size_t> neighbour(A, 0);
+      if (A >= 3) {
+        const std::size_t m = front_f[0].size();
+        std::vector<double> fmin(m, 1e300), fmax(m, -1e300);
+        for (const auto& f : front_f) {
+          for (std::size_t i = 0; i < m; ++i) fmin[i] = std::min(fmin[i], f[i]), fmax[i] = std::max(fmax[i], f[i]);
+        }
+        std::vector<double> unit(A * m);  // the front's objectives scaled to [0, 1]
+        for (std::size_t k = 0; k < A; ++k) {
+          for (std::size_t i = 0; i < m; ++i) unit[k * m + i] = (front_f[k][i] - fmin[i]) / (fmax[i] > fmin[i] ? fmax[i] - fmin[i] : 1.0);
+        }
+        for (std::size_t k = 0; k < A; ++k) {
+          double best = std::numeric_limits<double>::infinity();
+          for (std::size_t l = 0; l < A; ++l) {
+            if (l == k) continue;
+            double d2 = 0.0;
+            for (std::size_t i = 0; i < m; ++i) {
+              const double t = unit[k * m + i] - unit[l * m + i];
+              d2 += t * t;
+            }
+            if (d2 < best) best = d2, neighbour[k] = l;
+          }
+          sparse[k] = best;
+          for (std::size_t i = 0; i < m; ++i) {
+            if (front_f[k][i] == fmin[i]) sparse[k] = std::numeric_limits<double>::infinity();
+          }
+        }
+      }
+      auto sparse_pick = [&] {
+        const std::size_t a = pick(A), b = pick(A);
+        return sparse[a] >= sparse[b] ? a : b;
+      };
+      auto make_child = [&] {
+        std::vector<double> y(n);
+        const std::size_t a = tournament();
+        const double op = U(rng);
+        if (A >= 3 && op < 0.25) {
+          // From the island's front: a step toward the nearest neighbour in objective space (filling
+          // the front's gaps), or a small local step (refining it).
+          const std::size_t k = sparse_pick();
+          const auto& xa = front_x[k];
+          const auto& xb = front_x[neighbour[k]];
+          const bool toward = U(rng) < 0.5;
+          const double u = U(rng);
+          std::normal_distribution<double> noise(0.0, toward ? 0.01 : 0.03);
+          for (std::size_t d = 0; d < n; ++d) {
+            const double base = toward ? xa[d] + u * (xb[d] - xa[d]) : xa[d];
+            y[d] = std::clamp(base + noise(rng) * (hi[d] - lo[d]), lo[d], hi[d]);
+          }
+        } else {
+          std::size_t b = pick(N), c = pick(N);
+          while (b == a) b = pick(N);
+          while (c == a || c == b) c = pick(N);
+          const double f = 0.3 + 0.6 * U(rng);
+          const std::size_t forced = pick(n);
+          for (std::size_t d = 0; d < n; ++d) {
+            y[d] = (d == forced || U(rng) < 0.9) ? X[a][d] + f * (X[b][d] - X[c][d]) : X[a][d];
+            // Out of the box: half way from the parent to the bound it crossed.
+            if (y[d] < lo[d]) y[d] = 0.5 * (X[a][d] + lo[d]);
+            if (y[d] > hi[d]) y[d] = 0.5 * (X[a][d] + hi[d]);
+          }
+        }
+        for (std::size_t d = 0; d < n; ++d) {
+          if (U(rng) >= 1.0 / double(n)) continue;
+          const double u = U(rng), range = hi[d] - lo[d];
+          const double delta = u < 0.5 ? std::pow(2.0 * u, 1.0 / 21.0) - 1.0 : 1.0 - std::pow(2.0 * (1.0 - u), 1.0 / 21.0);
+          y[d] = std::clamp(y[d] + delta * range, lo[d], hi[d]);
+        }
+        return y;
+      };
+      // The surrogate: the objectives of a design predicted from its nearest evaluated neighbours on
+      // the island (inverse-distance weights over the 4 nearest of its latest 512 designs, in the
+      // box's normalised coordinates; infeasible when the nearest is). Of kChoices children the one predicted to be
+      // dominated by the fewest points of the island's front is evaluated (ties: the farthest from
+      // every evaluated design).
+      constexpr int kChoices = 8;
+      auto score = [&](const std::vector<double>& x, double& far) {
+        constexpr std::size_t kNear = 4;
+        std::vector<std::pair<double, std::size_t>> near;
+        const auto& ax = memory->all_x;
+        // The island's latest kWindow designs only (they surround the population): a bounded cost.
+        constexpr std::size_t kWindow = 512;
+        for (std::size_t i = ax.size() > kWindow ? ax.size() - kWindow : 0; i < ax.size(); ++i) {
+          double d2 = 0.0;
+          for (std::size_t d = 0; d < n; ++d) {
+            const double t = (x[d] - ax[i][d]) * inv_range[d];
+            d2 += t * t;
+          }
+          if (near.size() < kNear || d2 < near.back().first) {
+            near.emplace_back(d2, i);
+            std::sort(near.begin(), near.end());
+            if (near.size() > kNear) near.pop_back();
+          }
+        }
+        far = near.empty() ? 0.0 : near.front().first;
+        if (near.empty()) return 0.0;
+        const auto& af = memory->all_f;
+        if (!memory->all_feasible[near.front().second]) return double(A) + 1.0;
+        const std::size_t m = af[0].size();
+        std::vector<double> f(m, 0.0);
+        double wsum = 0.0;
+        for (const auto& [d2, i] : near) {
+          if (!memory->all_feasible[i]) continue;
+          const double w = 1.0 / (d2 + 1e-12);
+          wsum += w;
+          for (std::size_t k = 0; k < m; ++k) f[k] += w * af[i][k];
+        }
+        for (auto& v : f) v /= wsum;
+        double dominated_by = 0.0;
+        for (const auto& q : front_f) {
+          bool no_worse = true;
+          for (std::size_t k = 0; k < m && no_worse; ++k) no_worse = q[k] <= f[k];
+          dominated_by += no_worse;
+        }
+        return dominated_by;
+      };
+      for (std::size_t child = 0; child < N; ++child) {
+        std::vector<double> key;
+        double best_score = 0.0, best_far = 0.0;
+        const int choices = (memory && memory->all_x.size() >= 2 * n + 2) ? kChoices : 1;
+        for (int choice = 0; choice < choices; ++choice) {
+          std::vector<double> y = make_child();
+          std::vector<double> cand = problem->snap(y);
+          for (int attempt = 1; attempt <= 16 && (taken.count(cand) || (memory && memory->seen.count(cand))); ++attempt) {
+            std::normal_distribution<double> step(0.0, 0.02 * attempt);
+            for (std::size_t d = 0; d < n; ++d) y[d] = std::clamp(cand[d] + step(rng) * (hi[d] - lo[d]), lo[d], hi[d]);
+            cand = problem->snap(y);
+          }
+          if (choices == 1) {
+            key = std::move(cand);
+            break;
+          }
+          double far = 0.0;
+          const double sc = score(cand, far);
+          if (key.empty() || sc < best_score || (sc == best_score && far > best_far)) {
+            best_score = sc;
+            best_far = far;
+            key = std::move(cand);
+          }
+        }
+        taken.insert(key);
+        fs.push_back(prob.fitness(key));
+        xs.push_back(std::move(key));
+      }
+      const std::vector<pagmo::pop_size_t> best = pagmo::select_best_N_mo(fs, N);
+      for (std::size_t i = 0; i < N; ++i) pop.set_xf(i, xs[best[i]], fs[best[i]]);
+    }
+    return pop;
+  }
+  std::string get_name() const { return "hybrid"; }
+};
+
+/// The hybrid's initial population of an island: on island 0 the design as given (most often a
+/// covering design, when random points of a wide box rarely cover), then a Latin hypercube of the
+/// box (every variable's range cut in `count` strata, one point in each), drawn from `seed`.
+std::vector<std::vector<double>> hybrid_start(const OptimizeProblem& p, std::size_t count, int island, unsigned seed) {
+  const std::size_t n = p.dimension();
+  const auto lo = p.lower(), hi = p.upper();
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::vector<std::vector<double>> xs(count, std::vector<double>(n));
+  for (std::size_t d = 0; d < n; ++d) {
+    std::vector<std::size_t> strata(count);
+    for (std::size_t i = 0; i < count; ++i) strata[i] = i;
+    std::shuffle(strata.begin(), strata.end(), rng);
+    for (std::size_t i = 0; i < count; ++i) xs[i][d] = lo[d] + (hi[d] - lo[d]) * (double(strata[i]) + U(rng)) / double(count);
+  }
+  if (island == 0 && count > 0) xs[0] = p.snap(p.reference_values());
+  return xs;
+}
+
 /// Deb's recommended NSGA-II operators: crossover probability 0.9, distribution indices 20, and a
 /// mutation probability of 1/n per variable (pagmo's default 0.01 barely mutates a problem of a
 /// few variables).
 pagmo::algorithm make_algorithm(const std::string& name, unsigned gens, unsigned seed, int population, std::size_t n,
-                                std::size_t nobj) {
+                                std::size_t nobj, const OptimizeProblem* problem = nullptr,
+                                const IslandMemory* memory = nullptr) {
+  if (name == "hybrid") return pagmo::algorithm(Hybrid{gens, seed, problem, memory});
   if (name == "nsga2") return pagmo::algorithm(pagmo::nsga2(gens, 0.9, 20.0, 1.0 / double(std::max<std::size_t>(n, 1)), 20.0, seed));
   if (name == "moead") {
     // Grid weights need a population of a binomial size beyond two objectives: low-discrepancy ones there.
@@ -233,7 +590,7 @@ std::size_t choose(const OptimizeProblem& p, const std::vector<OptimizeCandidate
 /// COBYLA from the chosen point: minimise the sum of the normalised objectives subject to
 /// feasibility and to every objective no worse than the chosen point's, so that the result is
 /// feasible and dominates (or equals) the chosen design.
-std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const OptimizeCandidate& start, const std::vector<double>& ideal,
+std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, EvaluationCache& cache, const OptimizeCandidate& start, const std::vector<double>& ideal,
                                         const std::vector<double>& nadir, std::uint64_t budget, double seconds,
                                         const std::atomic<bool>* stop, std::uint64_t& used) {
   const std::size_t n = p.dimension(), m = p.settings().objectives.size();
@@ -243,6 +600,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
   for (std::size_t i = 0; i < m; ++i) scale[i] = nadir[i] > ideal[i] ? nadir[i] - ideal[i] : 1.0;
   struct State {
     const OptimizeProblem* p;
+    EvaluationCache* cache;
     std::vector<double> last_x;
     OptimizeCandidate last;
     std::optional<OptimizeCandidate> best;
@@ -251,7 +609,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
     std::vector<double> f0, scale;
     const OptimizeCandidate& at(const std::vector<double>& x) {
       if (x != last_x || last.x.empty()) {
-        last = p->evaluate(x);
+        last = cache->get(x);
         last_x = x;
         ++evaluations;
         if (last.feasible()) {
@@ -270,7 +628,7 @@ std::optional<OptimizeCandidate> polish(const OptimizeProblem& p, const Optimize
       }
       return last;
     }
-  } st{&p, {}, {}, std::nullopt, std::numeric_limits<double>::infinity(), 0, f0, scale};
+  } st{&p, &cache, {}, {}, std::nullopt, std::numeric_limits<double>::infinity(), 0, f0, scale};
   nlopt::opt o(nlopt::LN_COBYLA, unsigned(n));
   o.set_lower_bounds(p.lower());
   o.set_upper_bounds(p.upper());
@@ -364,13 +722,15 @@ void sort_candidates(std::vector<OptimizeCandidate>& all) {
 }
 
 /// Everything after the search: front, curve, choice, polish, files.
-OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vector<OptimizeCandidate> all,
+OptimizeResult finish(const OptimizeProblem& p, EvaluationCache& cache, const Design& design, std::vector<OptimizeCandidate> all,
                       const OptimizeOptions& options, OptimizeResult r, bool whole_run, double polish_seconds) {
   // polish_seconds: what is left of the wall-time budget, for the polish and the full figures.
   sort_candidates(all);
   r.stages = {};
   for (const auto& c : all) r.stages.add(c);
   r.evaluations = all.size();
+  r.distinct = distinct_designs(all);
+  r.cache_hits = cache.hits();
   r.front = optimize_front(p, all);
   normalisation(p, r.front, r.ideal, r.nadir);
   // A front of one value in an objective (always so for one objective): its nadir is the worst
@@ -382,7 +742,7 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
     }
   }
   r.hypervolume = hypervolume_curve(p, all, r.ideal, r.nadir);
-  r.reference = p.evaluate(p.reference_values());
+  r.reference = cache.get(p.reference_values());
   const std::filesystem::path& dir = options.out_dir;
   make_directories(dir);
   auto record = [&](const std::filesystem::path& f) { r.files.push_back(f); };
@@ -399,9 +759,10 @@ OptimizeResult finish(const OptimizeProblem& p, const Design& design, std::vecto
   if (!r.front.empty()) {
     r.chosen = r.front[choose(p, r.front, r.ideal, r.nadir)];
     if (p.settings().polish) {
-      r.polished = polish(p, *r.chosen, r.ideal, r.nadir, p.settings().polish_evaluations, polish_seconds, options.stop,
+      r.polished = polish(p, cache, *r.chosen, r.ideal, r.nadir, p.settings().polish_evaluations, polish_seconds, options.stop,
                           r.polish_evaluations);
     }
+    r.cache_hits = cache.hits();
     const OptimizeCandidate& best = r.polished ? *r.polished : *r.chosen;
     Design chosen = p.design_at(best.x);
     std::string name = design.name + "-optimized";
@@ -578,6 +939,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   std::vector<std::vector<OptimizeCandidate>> logs(n);
   std::vector<std::uint64_t> counters(n, 0);
   std::vector<std::uint32_t> rounds(n, 0);
+  std::vector<IslandMemory> memory(n);  // per island: its designs so far
   std::vector<pagmo::population> pops;
   std::vector<OptimizeCandidate> all;
   std::uint32_t round = 0;
@@ -586,8 +948,9 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     return std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
   };
   Deadline deadline{t0 + span(seconds_budget), options.stop};
+  EvaluationCache cache(p);
   auto problem_of = [&](std::size_t k) {
-    return pagmo::problem(Udp{&p, &logs[k], islands[k], &rounds[k], &counters[k], &deadline});
+    return pagmo::problem(Udp{&p, &cache, &memory[k], &logs[k], islands[k], &rounds[k], &counters[k], &deadline});
   };
 
   if (options.resume) {
@@ -658,15 +1021,24 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       throw InputError(checkpoint.string() + ": a damaged checkpoint (" + e.what() + ")");
     }
     for (const auto& c : all) {
+      cache.insert(c);
       for (std::size_t k = 0; k < n; ++k) {
+        if (c.island == islands[k]) memory[k].add(c.x, p.fitness(c), c.feasible());
         if (c.island == islands[k]) counters[k] = std::max(counters[k], c.evaluation);
       }
     }
   } else {
     pops.resize(n);
     const bool halted = on_every_island(n, threads, [&](std::size_t k) {
-      pops[k] = pagmo::population(problem_of(k), pagmo::population::size_type(s.population),
-                                  seed32(s.seed, std::uint64_t(islands[k]), 0));
+      if (alg == "hybrid") {
+        pops[k] = pagmo::population(problem_of(k), 0u, seed32(s.seed, std::uint64_t(islands[k]), 0));
+        for (auto& x : hybrid_start(p, std::size_t(s.population), islands[k], seed32(s.seed, std::uint64_t(islands[k]), 0))) {
+          pops[k].push_back(x);
+        }
+      } else {
+        pops[k] = pagmo::population(problem_of(k), pagmo::population::size_type(s.population),
+                                    seed32(s.seed, std::uint64_t(islands[k]), 0));
+      }
     });
     for (auto& l : logs) {
       all.insert(all.end(), l.begin(), l.end());
@@ -684,7 +1056,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
       r.algorithm = alg;
       r.interrupted = true;
       r.seconds = elapsed();
-      return finish(p, design, std::move(all), options, r, options.shards == 1, 0.0);
+      return finish(p, cache, design, std::move(all), options, r, options.shards == 1, 0.0);
     }
   }
   // Every input checked (the checkpoint too): only now is anything created (docs/reliability.md).
@@ -725,7 +1097,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
     const bool halted = on_every_island(n, threads, [&](std::size_t k) {
       rounds[k] = round;
       const pagmo::algorithm a = make_algorithm(alg, unsigned(gens), seed32(s.seed, std::uint64_t(islands[k]), round),
-                                                s.population, p.dimension(), s.objectives.size());
+                                                s.population, p.dimension(), s.objectives.size(), &p, &memory[k]);
       pops[k] = a.evolve(pops[k]);
     });
     if (halted) {
@@ -771,7 +1143,7 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   if (round == 0 || r.interrupted || checkpoint_round != round) write_checkpoint();
   r.rounds = round;
   r.seconds = prior_seconds + elapsed();
-  OptimizeResult out = finish(p, design, std::move(all), options, r, options.shards == 1, seconds_budget - r.seconds);
+  OptimizeResult out = finish(p, cache, design, std::move(all), options, r, options.shards == 1, seconds_budget - r.seconds);
   out.files.push_back(checkpoint);
   return out;
 }
@@ -833,7 +1205,9 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
   OptimizeOptions whole = options;
   whole.shard = 0;
   whole.shards = 1;
-  return finish(p, design, std::move(all), whole, r, true, options.seconds > 0.0 ? options.seconds : p.settings().seconds);
+  EvaluationCache cache(p);
+  for (const auto& c : all) cache.insert(c);
+  return finish(p, cache, design, std::move(all), whole, r, true, options.seconds > 0.0 ? options.seconds : p.settings().seconds);
 }
 
 Json OptimizeResult::to_json(const OptimizeProblem& p) const {
@@ -844,6 +1218,8 @@ Json OptimizeResult::to_json(const OptimizeProblem& p) const {
   j["population"] = s.population;
   j["seed"] = s.seed;
   j["evaluations"] = evaluations;
+  j["distinct_evaluations"] = distinct;
+  j["cache_hits"] = cache_hits;
   j["rounds"] = rounds;
   j["seconds"] = seconds;
   j["interrupted"] = interrupted;

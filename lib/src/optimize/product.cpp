@@ -67,8 +67,9 @@ Product optimize_product() {
     }
     md += s.constraints.empty() ? "" : "; constraints ";
     for (std::size_t i = 0; i < s.constraints.size(); ++i) md += (i ? ", " : "") + s.constraints[i].text();
-    md += ". " + std::to_string(r.evaluations) + " candidates in " + md::fixed(r.seconds, 2) + " s (seed " +
-          std::to_string(s.seed) + "); the front has " + std::to_string(r.front.size()) + " designs, hypervolume " +
+    md += ". " + std::to_string(r.evaluations) + " candidates (" + std::to_string(r.distinct) +
+          " distinct designs, each evaluated once: the cache answered " + std::to_string(r.cache_hits) +
+          " requests) in " + md::fixed(r.seconds, 2) + " s (seed " + std::to_string(s.seed) + "); the front has " + std::to_string(r.front.size()) + " designs, hypervolume " +
           (r.hypervolume.empty() ? std::string("-") : md::fixed(r.hypervolume.back().second, 4)) +
           " of the normalised objectives.\n\n";
     md::Table stages({"stage", "candidates rejected"}, "lr");

@@ -1,7 +1,7 @@
 // Printable parts: planning (the distinct parts of each station and their .scad text), rendering
-// with openscad as child processes (two at a time, skipping unchanged inputs), the design-intent
-// checks and the bill of materials. Reading STL and fitting hole walls: parts_mesh.cpp; CGAL's
-// mesh checks: cgal/mesh_checks.cpp.
+// with openscad as child processes (two at a time, skipping unchanged inputs, once per distinct
+// source), the design-intent checks and the bill of materials. Reading STL and fitting hole
+// walls: parts_mesh.cpp; CGAL's mesh checks: cgal/mesh_checks.cpp.
 
 #include "fivebar/format.hpp"
 #include "fivebar/parts.hpp"
@@ -734,16 +734,30 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
       return (report.parts[a].spec.kind == PartKind::station_base) > (report.parts[b].spec.kind == PartKind::station_base);
     });
+    // Parts whose sources are the same (the hash of inputs_hash(): e.g. the proximal link and the
+    // tactor tip of two stations with equal proximal links) are rendered once: the others take a
+    // copy of that STL (a render of their very source), then their own checks.
+    std::vector<std::size_t> twin(total, total);
+    {
+      std::map<std::string, std::size_t> first;
+      for (const std::size_t k : order) {
+        const auto [it, fresh] = first.emplace(inputs_hash(report.parts[k].spec), k);
+        if (!fresh) twin[k] = it->second;
+      }
+      order.erase(std::remove_if(order.begin(), order.end(), [&](std::size_t k) { return twin[k] != total; }),
+                  order.end());
+    }
+    const std::size_t distinct = order.size();
     std::atomic<std::size_t> next{0};
     std::size_t done = 0;
     std::mutex mutex;
-    const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(total)));
-    say("parts: " + std::to_string(total) + " parts, " + std::to_string(jobs) + " openscad job" +
-        (jobs == 1 ? "" : "s"));
+    const int jobs = std::max(1, std::min<int>(options.jobs, static_cast<int>(distinct)));
+    say("parts: " + std::to_string(total) + " parts (" + std::to_string(distinct) + " distinct sources), " +
+        std::to_string(jobs) + " openscad job" + (jobs == 1 ? "" : "s"));
     const auto worker = [&]() {
       while (true) {
         const std::size_t slot = next.fetch_add(1);
-        if (slot >= total) return;
+        if (slot >= distinct) return;
         const std::size_t k = order[slot];
         PartResult& r = report.parts[k];
         const fs::path scad = options.out_dir / r.scad_file;
@@ -826,6 +840,53 @@ PartsReport build_parts(const Design& design, const PartsOptions& options) {
     for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
     worker();
     for (auto& t : threads) t.join();
+    for (std::size_t k = 0; k < total; ++k) {
+      if (twin[k] == total) continue;
+      PartResult& r = report.parts[k];
+      const PartResult& source = report.parts[twin[k]];
+      const fs::path stl = options.out_dir / r.stl_file;
+      const fs::path hash_file = fs::path(stl.string() + ".hash");
+      const std::string hash = inputs_hash(r.spec);
+      std::error_code ec;
+      if (fs::exists(stl, ec) && read_text(hash_file) == hash) {
+        r.render = RenderState::up_to_date;
+      } else if (source.render == RenderState::failed) {
+        r.render = RenderState::failed;
+        r.render_error = "not rendered: its source is the same as " + source.spec.label() + "'s, whose render failed";
+        fs::remove(stl, ec);
+        fs::remove(hash_file, ec);
+      } else {
+        try {
+          const std::string bytes = read_text(options.out_dir / source.stl_file);
+          if (bytes.empty()) throw IoError("cannot read " + source.stl_file.generic_string() + ", the STL of the same source");
+          write_file_atomic(stl, bytes);
+          r.render = RenderState::rendered;
+          r.copied_from = source.spec.label();
+          try {
+            write_file_atomic(hash_file, hash);
+          } catch (const IoError&) {
+            // Without the hash the part is only copied again next time.
+          }
+        } catch (const IoError& e) {
+          r.render = RenderState::failed;
+          r.render_error = e.what();
+          fs::remove(stl, ec);
+          fs::remove(hash_file, ec);
+        }
+      }
+      if (r.render == RenderState::failed) {
+        r.problems.push_back("openscad failed: " + r.render_error);
+      } else {
+        check_part(stl, r);
+      }
+      ++done;
+      std::string line = "parts: [" + std::to_string(done) + "/" + std::to_string(total) + "] " + r.spec.label() + ": ";
+      if (r.render == RenderState::rendered) line += "same source as " + source.spec.label() + ", its STL copied";
+      if (r.render == RenderState::up_to_date) line += "up to date";
+      if (r.render == RenderState::failed) line += "render FAILED";
+      if (r.render != RenderState::failed) line += r.passed() ? ", checks passed" : ", checks FAILED";
+      say(line);
+    }
     for (const PartResult& r : report.parts) {
       if (r.render != RenderState::failed) {
         report.files.push_back(r.stl_file);
@@ -887,6 +948,7 @@ Json to_json(const PartsReport& report) {
                                                                                          : Json(nullptr);
     j["render"] = {{"state", std::string(to_string(p.render))},
                    {"seconds", p.render_seconds},
+                   {"copied_from", p.copied_from.empty() ? Json(nullptr) : Json(p.copied_from)},
                    {"error", p.render_error.empty() ? Json(nullptr) : Json(p.render_error)}};
     if (p.mesh) {
       const MeshCheck& m = *p.mesh;

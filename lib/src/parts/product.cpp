@@ -35,7 +35,9 @@ std::string markdown(const PartsReport& r) {
               "llllrrlrrlll");
   for (const PartResult& p : r.parts) {
     std::string render(to_string(p.render));
-    if (p.render == RenderState::rendered) render += " (" + md::fixed(p.render_seconds, 1) + " s)";
+    if (p.render == RenderState::rendered) {
+      render += p.copied_from.empty() ? " (" + md::fixed(p.render_seconds, 1) + " s)" : " (copy of " + p.copied_from + ")";
+    }
     std::string bbox = "—";
     if (p.mesh) {
       const Eigen::Vector3d e = p.mesh->bbox_max_mm - p.mesh->bbox_min_mm;
@@ -68,6 +70,7 @@ Product parts_product() {
   Product p;
   p.name = "parts";
   p.title = "Printable parts";
+  p.cost_s = 3.0;  // the openscad renders (scheduler hint only, Product::cost_s)
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<Geometry>()) return "no `geometry:` section (link widths, pins, bosses, tactor sizes)";
     bool any = false;

@@ -4,8 +4,16 @@
 
 #include "fivebar/format.hpp"
 
+// GitHub's CommonMark parser with its pipe tables (Debian libcmark-gfm-dev, libcmark-gfm-extensions-dev):
+// the Markdown is parsed by it; this file renders its tree, escaping every text.
+#include <cmark-gfm-core-extensions.h>
+#include <cmark-gfm.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
+#include <map>
+#include <utility>
 #include <vector>
 
 namespace fivebar::md {
@@ -38,6 +46,9 @@ figure { margin: 16px 0 24px; }
 figure img, figure svg { display: block; max-width: 100%; height: auto; border: 1px solid var(--line);
                          border-radius: 6px; background: #ffffff; }
 figcaption { color: var(--muted); font-size: 13px; margin-top: 4px; }
+.gallery { display: grid; grid-template-columns: repeat(auto-fill, minmax(340px, 1fr)); gap: 4px 20px; }
+.gallery figure { margin: 8px 0 16px; }
+pre { background: #eef1f4; padding: 8px 12px; border-radius: 6px; overflow-x: auto; }
 nav.toc { background: var(--soft); border: 1px solid var(--line); border-radius: 6px; padding: 8px 14px;
           margin: 12px 0 8px; font-size: 13.5px; }
 nav.toc ol { margin: 4px 0; padding-left: 22px; columns: 2; }
@@ -82,21 +93,70 @@ std::string slug(std::string_view text) {
   return out.empty() ? "section" : out;
 }
 
-/// "[text](target)" starting at s[i] == '['; the end index past ')' and the parts, or npos.
-std::size_t bracket_link(std::string_view s, std::size_t i, std::string_view& text, std::string_view& target) {
-  int depth = 0;
-  std::size_t j = i;
-  for (; j < s.size(); ++j) {
-    if (s[j] == '[') ++depth;
-    if (s[j] == ']' && --depth == 0) break;
+/// The text of a node's inline children, without markup (headings' ids, images' alt text).
+std::string plain_text(cmark_node* node) {
+  std::string out;
+  for (cmark_node* c = cmark_node_first_child(node); c != nullptr; c = cmark_node_next(c)) {
+    const cmark_node_type type = cmark_node_get_type(c);
+    if (type == CMARK_NODE_TEXT || type == CMARK_NODE_CODE || type == CMARK_NODE_HTML_INLINE) {
+      const char* literal = cmark_node_get_literal(c);
+      out += literal != nullptr ? literal : "";
+    } else if (type == CMARK_NODE_SOFTBREAK || type == CMARK_NODE_LINEBREAK) {
+      out += ' ';
+    } else {
+      out += plain_text(c);
+    }
   }
-  if (j >= s.size() || j + 1 >= s.size() || s[j + 1] != '(') return std::string_view::npos;
-  const std::size_t close = s.find(')', j + 2);
-  if (close == std::string_view::npos) return std::string_view::npos;
-  text = s.substr(i + 1, j - i - 1);
-  target = s.substr(j + 2, close - j - 2);
-  return close + 1;
+  return out;
 }
+
+std::string literal_of(cmark_node* node) {
+  const char* literal = cmark_node_get_literal(node);
+  return literal != nullptr ? literal : "";
+}
+
+std::string url_of(cmark_node* node) {
+  const char* url = cmark_node_get_url(node);
+  return url != nullptr ? url : "";
+}
+
+/// The type of a node of a syntax extension ("table", "table_row", "table_header", "table_cell").
+std::string_view extension_type(cmark_node* node) {
+  const char* type = cmark_node_get_type_string(node);
+  return type != nullptr ? std::string_view(type) : std::string_view();
+}
+
+bool picture_file(std::string_view path) { return ends_with(path, ".png") || ends_with(path, ".svg"); }
+
+/// "dir/name.png" -> "dir/name": a picture and its vector twin are one picture.
+std::string picture_stem(std::string_view path) {
+  return std::string(picture_file(path) ? path.substr(0, path.size() - 4) : path);
+}
+
+/// The parsed Markdown (GitHub-flavoured: CommonMark and pipe tables), freed on scope exit.
+class Document {
+ public:
+  explicit Document(std::string_view markdown) {
+    cmark_gfm_core_extensions_ensure_registered();
+    parser_ = cmark_parser_new(CMARK_OPT_DEFAULT);
+    if (cmark_syntax_extension* table = cmark_find_syntax_extension("table")) {
+      cmark_parser_attach_syntax_extension(parser_, table);
+    }
+    cmark_parser_feed(parser_, markdown.data(), markdown.size());
+    root_ = cmark_parser_finish(parser_);
+  }
+  ~Document() {
+    if (root_ != nullptr) cmark_node_free(root_);
+    if (parser_ != nullptr) cmark_parser_free(parser_);
+  }
+  Document(const Document&) = delete;
+  Document& operator=(const Document&) = delete;
+  cmark_node* root() const { return root_; }
+
+ private:
+  cmark_parser* parser_ = nullptr;
+  cmark_node* root_ = nullptr;
+};
 
 class Renderer {
  public:
@@ -128,202 +188,248 @@ class Renderer {
     return "<a href=\"" + html_escape(pic) + "\"><img src=\"" + html_escape(pic) + "\" alt=\"" + html_escape(alt) + "\"></a>";
   }
 
-  std::string inline_text(std::string_view s) const {
-    std::string out;
-    std::size_t i = 0;
-    while (i < s.size()) {
-      const char c = s[i];
-      if (c == '\\' && i + 1 < s.size() && std::ispunct(static_cast<unsigned char>(s[i + 1]))) {
-        out += html_escape(s.substr(i + 1, 1));
-        i += 2;
-      } else if (c == '`') {
-        const std::size_t end = s.find('`', i + 1);
-        if (end == std::string_view::npos) {
-          out += "`";
-          ++i;
-          continue;
-        }
-        const std::string_view code = s.substr(i + 1, end - i - 1);
-        // A file of the scene named in code (the products' file lists) links to it.
-        const bool file = code.find('.') != std::string_view::npos && local_file(code) && files_.exists &&
-                          files_.exists(std::string(code));
-        const std::string html = "<code>" + html_escape(code) + "</code>";
-        out += file ? "<a href=\"" + html_escape(code) + "\">" + html + "</a>" : html;
-        i = end + 1;
-      } else if (c == '*' && i + 1 < s.size() && s[i + 1] == '*') {
-        const std::size_t end = s.find("**", i + 2);
-        if (end == std::string_view::npos) {
-          out += "**";
-          i += 2;
-          continue;
-        }
-        out += "<strong>" + inline_text(s.substr(i + 2, end - i - 2)) + "</strong>";
-        i = end + 2;
-      } else if (c == '!' && i + 1 < s.size() && s[i + 1] == '[') {
-        std::string_view text, target;
-        const std::size_t end = bracket_link(s, i + 1, text, target);
-        if (end == std::string_view::npos) {
-          out += "!";
-          ++i;
-          continue;
-        }
-        out += image(text, target);
-        i = end;
-      } else if (c == '[') {
-        std::string_view text, target;
-        const std::size_t end = bracket_link(s, i, text, target);
-        if (end == std::string_view::npos) {
-          out += "[";
-          ++i;
-          continue;
-        }
-        out += safe_href(target) ? "<a href=\"" + html_escape(target) + "\">" + inline_text(text) + "</a>" : inline_text(text);
-        i = end;
-      } else {
-        out += html_escape(s.substr(i, 1));
-        ++i;
-      }
-    }
-    return out;
-  }
-
-  /// Cells of a table row: split at '|' not escaped by '\'.
-  static std::vector<std::string> cells(std::string_view line) {
-    line = trim(line);
-    if (starts_with(line, "|")) line.remove_prefix(1);
-    if (ends_with(line, "|") && !ends_with(line, "\\|")) line.remove_suffix(1);
-    std::vector<std::string> out;
-    std::string cell;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-      if (line[i] == '\\' && i + 1 < line.size() && line[i + 1] == '|') {
-        cell += '|';  // an escaped pipe is text, also inside code
-        ++i;
-      } else if (line[i] == '|') {
-        out.emplace_back(trim(cell));
-        cell.clear();
-      } else {
-        cell += line[i];
-      }
-    }
-    out.emplace_back(trim(cell));
-    return out;
-  }
-
-  std::string table(const std::vector<std::string_view>& rows) const {
-    const std::vector<std::string> head = cells(rows[0]);
-    std::vector<std::string> align;
-    if (rows.size() > 1) {
-      for (const std::string& a : cells(rows[1])) {
-        const bool left = starts_with(a, ":"), right = ends_with(a, ":");
-        align.push_back(left && right ? " class=\"c\"" : (right ? " class=\"r\"" : ""));
-      }
-    }
-    const auto cls = [&](std::size_t k) { return k < align.size() ? align[k] : std::string(); };
-    std::string out = "<div class=\"table\"><table>\n<thead><tr>";
-    for (std::size_t k = 0; k < head.size(); ++k) out += "<th" + cls(k) + ">" + inline_text(head[k]) + "</th>";
-    out += "</tr></thead>\n<tbody>\n";
-    for (std::size_t r = 2; r < rows.size(); ++r) {
-      const std::vector<std::string> row = cells(rows[r]);
-      out += "<tr>";
-      for (std::size_t k = 0; k < head.size(); ++k) {
-        out += "<td" + cls(k) + ">" + (k < row.size() ? inline_text(row[k]) : std::string()) + "</td>";
-      }
-      out += "</tr>\n";
-    }
-    return out + "</tbody></table></div>\n";
-  }
-
-  /// A line that is one image: a figure (inline when it is an animation).
-  std::optional<std::string> figure(std::string_view line) const {
-    if (!starts_with(line, "![")) return std::nullopt;
-    std::string_view alt, src;
-    const std::size_t end = bracket_link(line, 1, alt, src);
-    if (end != line.size()) return std::nullopt;
+  /// A picture as a figure with its caption (inline when it is an animation).
+  std::string figure(std::string_view caption, std::string_view src) {
+    shown_.push_back(picture_stem(src));
     std::string body;
     if (auto svg = inline_svg(src)) {
       body = *svg;
       if (!body.empty() && body.back() == '\n') body.pop_back();
       body += "\n";
     } else {
-      body = image(alt, src);
+      body = image(caption, src);
     }
-    return "<figure>" + body + "<figcaption>" + html_escape(alt) + "</figcaption></figure>\n";
+    return "<figure>" + body + "<figcaption>" + html_escape(caption) + "</figcaption></figure>\n";
   }
 
-  std::string render(std::string_view markdown, std::string& toc) const {
-    std::vector<std::string_view> lines;
-    std::size_t pos = 0;
-    while (pos <= markdown.size()) {
-      const std::size_t nl = markdown.find('\n', pos);
-      if (nl == std::string_view::npos) {
-        if (pos < markdown.size()) lines.push_back(markdown.substr(pos));
-        break;
-      }
-      lines.push_back(markdown.substr(pos, nl - pos));
-      pos = nl + 1;
+  /// Notes a picture of the scene the current section names (a link or a file in code).
+  void named(std::string_view path, std::string_view caption) {
+    if (section_product_.empty() || !picture_file(path) || !local_file(path) || !files_.exists ||
+        !files_.exists(std::string(path))) {
+      return;
     }
+    named_.emplace_back(std::string(path), std::string(caption));
+  }
+
+  std::string inlines(cmark_node* node) {
     std::string out;
-    std::string paragraph;
-    bool in_list = false;
-    std::vector<std::string> ids;
-    const auto flush = [&]() {
-      if (!paragraph.empty()) out += "<p>" + paragraph + "</p>\n";
-      paragraph.clear();
-      if (in_list) out += "</ul>\n";
-      in_list = false;
-    };
-    for (std::size_t i = 0; i < lines.size(); ++i) {
-      const std::string_view line = trim(lines[i]);
-      if (line.empty()) {
-        flush();
-        continue;
-      }
-      std::size_t level = 0;
-      while (level < line.size() && line[level] == '#') ++level;
-      if (level >= 1 && level <= 6 && level < line.size() && line[level] == ' ') {
-        flush();
-        const std::string_view text = trim(line.substr(level + 1));
-        std::string id = slug(text);
-        std::string unique = id;
-        for (int k = 2; std::find(ids.begin(), ids.end(), unique) != ids.end(); ++k) unique = id + "-" + std::to_string(k);
-        ids.push_back(unique);
-        const std::string h = std::to_string(level);
-        out += "<h" + h + " id=\"" + unique + "\">" + inline_text(text) + "</h" + h + ">\n";
-        if (level == 2) toc += "<li><a href=\"#" + unique + "\">" + inline_text(text) + "</a></li>";
-        continue;
-      }
-      if (starts_with(line, "|")) {
-        flush();
-        std::vector<std::string_view> rows;
-        while (i < lines.size() && starts_with(trim(lines[i]), "|")) rows.push_back(trim(lines[i++]));
-        --i;
-        out += table(rows);
-        continue;
-      }
-      if (auto fig = figure(line)) {
-        flush();
-        out += *fig;
-        continue;
-      }
-      if (starts_with(line, "- ") || starts_with(line, "* ")) {
-        if (!paragraph.empty()) {
-          out += "<p>" + paragraph + "</p>\n";
-          paragraph.clear();
-        }
-        if (!in_list) out += "<ul>\n";
-        in_list = true;
-        out += "<li>" + inline_text(trim(line.substr(2))) + "</li>\n";
-        continue;
-      }
-      if (in_list) flush();
-      paragraph += (paragraph.empty() ? "" : "\n") + inline_text(line);
-    }
-    flush();
+    for (cmark_node* c = cmark_node_first_child(node); c != nullptr; c = cmark_node_next(c)) out += inline_node(c);
     return out;
+  }
+
+  std::string inline_node(cmark_node* node) {
+    const cmark_node_type type = cmark_node_get_type(node);
+    switch (type) {
+      case CMARK_NODE_TEXT:
+      case CMARK_NODE_HTML_INLINE:  // raw HTML is text here: every text is escaped
+        return html_escape(literal_of(node));
+      case CMARK_NODE_SOFTBREAK:
+        return "\n";
+      case CMARK_NODE_LINEBREAK:
+        return "<br>\n";
+      case CMARK_NODE_CODE: {
+        const std::string code = literal_of(node);
+        // A file of the scene named in code (the products' file lists) links to it.
+        const bool file = code.find('.') != std::string::npos && local_file(code) && files_.exists && files_.exists(code);
+        const std::string html = "<code>" + html_escape(code) + "</code>";
+        if (file) named(code, code);
+        return file ? "<a href=\"" + html_escape(code) + "\">" + html + "</a>" : html;
+      }
+      case CMARK_NODE_EMPH:
+        return "<em>" + inlines(node) + "</em>";
+      case CMARK_NODE_STRONG:
+        return "<strong>" + inlines(node) + "</strong>";
+      case CMARK_NODE_LINK: {
+        const std::string target = url_of(node);
+        const std::string text = inlines(node);
+        if (!safe_href(target)) return text;
+        named(target, plain_text(node));
+        return "<a href=\"" + html_escape(target) + "\">" + text + "</a>";
+      }
+      case CMARK_NODE_IMAGE: {
+        const std::string src = url_of(node);
+        if (local_file(src)) shown_.push_back(picture_stem(src));
+        return image(plain_text(node), src);
+      }
+      default:
+        break;
+    }
+    // Anything else inline (an extension's node): its children.
+    return inlines(node);
+  }
+
+  std::string table(cmark_node* node) {
+    const std::uint16_t columns = cmark_gfm_extensions_get_table_columns(node);
+    const std::uint8_t* alignments = cmark_gfm_extensions_get_table_alignments(node);
+    const auto cls = [&](std::size_t k) -> std::string {
+      if (alignments == nullptr || k >= columns) return "";
+      if (alignments[k] == 'r') return " class=\"r\"";
+      if (alignments[k] == 'c') return " class=\"c\"";
+      return "";
+    };
+    std::string out = "<div class=\"table\"><table>\n";
+    bool body = false;
+    for (cmark_node* row = cmark_node_first_child(node); row != nullptr; row = cmark_node_next(row)) {
+      const bool header = cmark_gfm_extensions_get_table_row_is_header(row) != 0;
+      if (header) out += "<thead>";
+      if (!header && !body) {
+        out += "<tbody>\n";
+        body = true;
+      }
+      out += "<tr>";
+      std::size_t k = 0;
+      for (cmark_node* cell = cmark_node_first_child(row); cell != nullptr; cell = cmark_node_next(cell), ++k) {
+        const char* tag = header ? "th" : "td";
+        out += std::string("<") + tag + cls(k) + ">" + inlines(cell) + "</" + tag + ">";
+      }
+      out += "</tr>";
+      out += header ? "</thead>\n" : "\n";
+    }
+    if (!body) out += "<tbody>\n";
+    return out + "</tbody></table></div>\n";
+  }
+
+  /// The pictures the section named but did not show, each as a figure (the end of a section).
+  std::string gallery() {
+    std::vector<std::pair<std::string, std::string>> pictures = named_;
+    if (auto row = product_files_.find(section_product_); row != product_files_.end()) {
+      for (const std::string& f : row->second) pictures.emplace_back(f, f);
+    }
+    std::string figures;
+    for (const auto& [path, caption] : pictures) {
+      const std::string stem = picture_stem(path);
+      if (std::find(shown_.begin(), shown_.end(), stem) != shown_.end()) continue;
+      if (inline_svg(path)) continue;  // an animation: its own section shows it
+      // The PNG when there is one (the SVG beside it is what is shown, the PNG what is linked).
+      std::string src = path;
+      if (ends_with(path, ".svg") && files_.exists(stem + ".png")) src = stem + ".png";
+      const std::string name = src.substr(src.rfind('/') + 1);
+      const std::string text = caption == path ? section_product_ + ": " + name : caption + " (" + name + ")";
+      figures += figure(text, src);
+    }
+    named_.clear();
+    if (figures.empty()) return "";
+    return "<div class=\"gallery\">\n" + figures + "</div>\n";
+  }
+
+  /// The products table's files of each product: its pictures, for the product's section.
+  void read_products_table(cmark_node* root) {
+    for (cmark_node* n = cmark_node_first_child(root); n != nullptr; n = cmark_node_next(n)) {
+      if (extension_type(n) != "table") continue;
+      cmark_node* header = cmark_node_first_child(n);
+      if (header == nullptr || trim(plain_text(cmark_node_first_child(header))) != "product") continue;
+      for (cmark_node* row = cmark_node_next(header); row != nullptr; row = cmark_node_next(row)) {
+        cmark_node* first = cmark_node_first_child(row);
+        if (first == nullptr) continue;
+        const std::string product(trim(plain_text(first)));
+        std::vector<std::string>& files = product_files_[product];
+        for (cmark_node* cell = cmark_node_next(first); cell != nullptr; cell = cmark_node_next(cell)) {
+          for (cmark_node* c = cmark_node_first_child(cell); c != nullptr; c = cmark_node_next(c)) {
+            const std::string code = literal_of(c);
+            if (cmark_node_get_type(c) == CMARK_NODE_CODE && picture_file(code) && local_file(code) &&
+                files_.exists && files_.exists(code)) {
+              files.push_back(code);
+            }
+          }
+        }
+      }
+    }
+  }
+
+  /// The product a heading names: "... (`simulate`)" -> "simulate".
+  static std::string heading_product(cmark_node* heading) {
+    std::string product;
+    for (cmark_node* c = cmark_node_first_child(heading); c != nullptr; c = cmark_node_next(c)) {
+      if (cmark_node_get_type(c) == CMARK_NODE_CODE) product = literal_of(c);
+    }
+    return product;
+  }
+
+  std::string block(cmark_node* node, bool tight, std::string& toc) {
+    const cmark_node_type type = cmark_node_get_type(node);
+    switch (type) {
+      case CMARK_NODE_HEADING: {
+        const int level = cmark_node_get_heading_level(node);
+        std::string out;
+        if (level <= 2) {
+          out += gallery();  // the end of the previous section
+          section_product_ = level == 2 ? heading_product(node) : std::string();
+        }
+        const std::string text = inlines(node);
+        std::string id = slug(plain_text(node));
+        std::string unique = id;
+        for (int k = 2; std::find(ids_.begin(), ids_.end(), unique) != ids_.end(); ++k) unique = id + "-" + std::to_string(k);
+        ids_.push_back(unique);
+        const std::string h = std::to_string(level);
+        out += "<h" + h + " id=\"" + unique + "\">" + text + "</h" + h + ">\n";
+        if (level == 2) toc += "<li><a href=\"#" + unique + "\">" + text + "</a></li>";
+        return out;
+      }
+      case CMARK_NODE_PARAGRAPH: {
+        cmark_node* only = cmark_node_first_child(node);
+        if (only != nullptr && cmark_node_next(only) == nullptr && cmark_node_get_type(only) == CMARK_NODE_IMAGE &&
+            !tight) {
+          return figure(plain_text(only), url_of(only));
+        }
+        const std::string text = inlines(node);
+        return tight ? text : "<p>" + text + "</p>\n";
+      }
+      case CMARK_NODE_LIST: {
+        const bool ordered = cmark_node_get_list_type(node) == CMARK_ORDERED_LIST;
+        const bool list_tight = cmark_node_get_list_tight(node) != 0;
+        std::string out;
+        if (ordered) {
+          const int start = cmark_node_get_list_start(node);
+          out += start != 1 ? "<ol start=\"" + std::to_string(start) + "\">\n" : "<ol>\n";
+        } else {
+          out += "<ul>\n";
+        }
+        for (cmark_node* item = cmark_node_first_child(node); item != nullptr; item = cmark_node_next(item)) {
+          std::string inner;
+          for (cmark_node* c = cmark_node_first_child(item); c != nullptr; c = cmark_node_next(c)) {
+            inner += block(c, list_tight, toc);
+          }
+          out += "<li>" + inner + "</li>\n";
+        }
+        return out + (ordered ? "</ol>\n" : "</ul>\n");
+      }
+      case CMARK_NODE_CODE_BLOCK:
+      case CMARK_NODE_HTML_BLOCK:  // raw HTML is shown as text
+        return "<pre><code>" + html_escape(literal_of(node)) + "</code></pre>\n";
+      case CMARK_NODE_THEMATIC_BREAK:
+        return "<hr>\n";
+      case CMARK_NODE_BLOCK_QUOTE: {
+        std::string out = "<blockquote>\n";
+        for (cmark_node* c = cmark_node_first_child(node); c != nullptr; c = cmark_node_next(c)) out += block(c, false, toc);
+        return out + "</blockquote>\n";
+      }
+      default:
+        break;
+    }
+    if (extension_type(node) == "table") return table(node);
+    std::string out;
+    for (cmark_node* c = cmark_node_first_child(node); c != nullptr; c = cmark_node_next(c)) out += block(c, tight, toc);
+    return out;
+  }
+
+  std::string render(std::string_view markdown, std::string& toc) {
+    const Document document(markdown);
+    if (document.root() == nullptr) return "<p>" + html_escape(markdown) + "</p>\n";
+    read_products_table(document.root());
+    std::string out;
+    for (cmark_node* c = cmark_node_first_child(document.root()); c != nullptr; c = cmark_node_next(c)) {
+      out += block(c, false, toc);
+    }
+    return out + gallery();
   }
 
  private:
   const HtmlFiles& files_;
+  std::vector<std::string> ids_;
+  std::vector<std::string> shown_;                               ///< stems of the pictures shown
+  std::vector<std::pair<std::string, std::string>> named_;       ///< pictures the section named (path, caption)
+  std::string section_product_;                                  ///< the product of the current section
+  std::map<std::string, std::vector<std::string>> product_files_;  ///< pictures of each product's row
 };
 
 }  // namespace
@@ -331,7 +437,7 @@ class Renderer {
 std::string html_escape(std::string_view text) { return format::xml_escape(text); }
 
 std::string to_html_page(std::string_view markdown, std::string_view title, const HtmlFiles& files) {
-  const Renderer renderer(files);
+  Renderer renderer(files);
   std::string toc;
   const std::string body = renderer.render(markdown, toc);
   std::string page = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";

@@ -1,11 +1,15 @@
 #pragma once
 /// The scene's index.html: summary.md rendered as one HTML page that opens offline (no network, no
-/// script or style from elsewhere), in the house style. The Markdown is the subset the products
-/// write (products/markdown.hpp): headings, paragraphs, "- " lists, pipe tables with their
-/// alignment row, images on a line of their own, and inline code, **bold** and [links](...).
-/// Every text is HTML-escaped. A picture with an SVG beside it (same stem) is shown from the SVG;
-/// an SVG that carries a script (an animation, fivebar/animation.hpp) is placed inline, since a
-/// browser runs no script of an SVG shown through <img>.
+/// script or style from elsewhere), in the house style. The Markdown is parsed by cmark-gfm
+/// (CommonMark with GitHub's pipe tables: emphasis, code, links, lists, tables with their
+/// alignment); the page's HTML is rendered here from its tree, every text HTML-escaped (raw HTML
+/// in the Markdown is shown as text). An image alone in its paragraph is a figure with its caption;
+/// a picture with an SVG beside it (same stem) is shown from the SVG, linking to it; an SVG that
+/// carries a script (an animation, fivebar/animation.hpp) is placed inline, since a browser runs no
+/// script of an SVG shown through <img>. At the end of each product's section (a level-2 heading
+/// naming the product in code, "... (`simulate`)") every picture the product wrote (its row of the
+/// products table) or the section names (a link, a file in code) and did not show yet is shown as a
+/// figure with a caption, so that no result is only a link.
 
 #include <functional>
 #include <optional>

@@ -59,6 +59,10 @@ struct Product {
   /// needing them: it then waits for them (the scene runs independent products in parallel, and
   /// what a product reads must not depend on the timing).
   std::vector<std::string> after;
+  /// Rough build time (s) of this product on the showcase, for the scene's scheduler only: it
+  /// starts the product heading the longest chain of such times first (the wall times of an earlier
+  /// run's summary.json in the output folder replace these when there). Never changes a result.
+  double cost_s = 0.1;
   /// Why this design cannot have the product (missing section, no mechanism, tool not
   /// installed), or std::nullopt when it can.
   std::function<std::optional<std::string>(const Design&)> unavailable;

@@ -180,7 +180,17 @@ struct Plan {
   std::vector<Part> parts;
   std::size_t probe_a = 0, probe_b = 0;
   std::array<V2, kPriorityRays> rays{};
-  std::array<unsigned char, kPriorityRays> free_k{}, free_k1{};
+  /// The priority rule's closed-form part (closest_free()): the radius of the lower outline's
+  /// disks centred on its tactor point P, per plane (0: none), and per search the upper shapes
+  /// inflated by it (the forbidden capsules of P), its candidate directions and their exits.
+  std::vector<double> p_disk;
+  std::vector<detail::Capsule> forbid;
+  std::vector<detail::RayCapsule> seen;
+  std::vector<double> t_in, t_out;
+  std::vector<V2> dirs;
+  std::vector<double> exits;
+  std::vector<int> steps;
+  std::vector<double> at, before;
 };
 
 }  // namespace detail
@@ -235,38 +245,164 @@ bool probe_free(Plan& plan, const MechPlan& low, const Part* upper, V2 q) {
   return !detail::collide(upper, n_parts(plan), mine, n_parts(plan), plan.config.collision.min_clearance);
 }
 
-/// The priority search (controller.hpp): at most kPriorityMaxProbes probes. True with the point.
+/// The lower mechanism at q against the upper outline: how far it may move before its outline can
+/// touch (0 when free or unusable; see closest_free()). Free: a valid command clear of the outline.
+struct Probe {
+  bool usable = false, free = false;
+  double advance = 0.0;
+};
+Probe probe(Plan& plan, const MechPlan& low, const Part* upper, V2 q) {
+  Probe r;
+  Command c;
+  if (make_command(plan, low, q, c) != Status::ok) return r;
+  r.usable = true;
+  Part* mine = outline_at(plan, plan.probe_a);
+  detail::outline(plan.tpl, c.pose, mine);
+  const double need = plan.config.collision.min_clearance;
+  const double clearance = detail::min_clearance_below(upper, n_parts(plan), mine, n_parts(plan), need);
+  r.free = !(clearance < need);
+  if (r.free) return r;
+  // Every point of the outline moves at most k times as fast as the tactor point: A_i at
+  // 1 / |sin| of the angle between L_i and L_{i+2} (the circle of A_i about O_i against the
+  // circle about P), the links' points between their ends.
+  const detail::Mech& m = low.mech;
+  const Pose& p = c.pose;
+  const double s1 = std::fabs(detail::cross(p.A1 - m.O1, p.P - p.A1)) / (m.L[0] * m.L[2]);
+  const double s2 = std::fabs(detail::cross(p.A2 - m.O2, p.P - p.A2)) / (m.L[1] * m.L[3]);
+  const double k = std::max(1.0, 1.0 / std::min(s1, s2));
+  r.advance = (need - clearance) / k;
+  return r;
+}
+
+/// The priority rule (controller.hpp, docs/runtime.md "Priority rule"): the closest point q to
+/// `origin` where the lower mechanism is free, i.e. usable and clear of the upper outline.
+///
+/// Every disk of the lower outline centred on its tactor point (tactor, post, pin P, the ends and
+/// bosses of L3 and L4) follows q one to one, so q is blocked wherever such a disk comes closer
+/// than min_clearance to an upper shape of its plane: inside the capsule of that shape inflated by
+/// the disk's radius plus min_clearance. Along any ray from `origin` the first point outside the
+/// union of those capsules is a closed form (ray_exit), and no point of the ray before it is
+/// free. Candidate directions: kPriorityRays fixed rays and, per forbidden capsule, the direction
+/// of the origin's projection onto it (where the closest point of a single capsule's boundary
+/// lies). Their exits are probed (IK, outline, clearance) best first; a free exit settles its ray
+/// exactly. The outline's links can still block an exit: such a ray advances conservatively (see
+/// below); one that leaves what the lower mechanism can hold (reach, singularities, limits) ends.
+/// At most kPriorityMaxProbes pose evaluations; true with the point.
 bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin, V2& found) {
-  const double h = kPriorityRingRel * low.mech.scale;
-  int first = -1;
-  for (int k = 1; k <= kPriorityRings && first < 0; ++k) {
-    bool any = false;
-    for (int j = 0; j < kPriorityRays; ++j) {
-      const auto uj = static_cast<std::size_t>(j);
-      plan.free_k[uj] = probe_free(plan, low, upper, origin + (k * h) * plan.rays[uj]) ? 1 : 0;
-      any = any || plan.free_k[uj];
-    }
-    if (any) first = k;
-  }
-  if (first < 0) return false;
-  for (std::size_t j = 0; j < kPriorityRays; ++j) {
-    plan.free_k1[j] = plan.free_k[j] ? 0 : (probe_free(plan, low, upper, origin + ((first + 1) * h) * plan.rays[j]) ? 1 : 0);
-  }
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t j = 0; j < kPriorityRays; ++j) {
-    if (!plan.free_k[j] && !plan.free_k1[j]) continue;
-    double lo = plan.free_k[j] ? (first - 1) * h : first * h;
-    double hi = lo + h;
-    for (int b = 0; b < kPriorityBisections; ++b) {
-      const double mid = 0.5 * (lo + hi);
-      if (probe_free(plan, low, upper, origin + mid * plan.rays[j])) hi = mid;
-      else lo = mid;
-    }
-    if (hi < best) {
-      best = hi;
-      found = origin + hi * plan.rays[j];
+  const std::size_t np = n_parts(plan);
+  const double scale = low.mech.scale;
+  // The forbidden capsules of P.
+  std::size_t nf = 0;
+  for (std::size_t i = 0; i < np; ++i) {
+    const auto plane = static_cast<std::size_t>(upper[i].plane);
+    const double r = plane < plan.p_disk.size() ? plan.p_disk[plane] : 0.0;
+    if (!(r > 0.0)) continue;
+    for (int k = 0; k < upper[i].count; ++k) {
+      detail::Capsule c = upper[i].shapes[static_cast<std::size_t>(k)];
+      c.r += r + plan.config.collision.min_clearance;
+      plan.forbid[nf++] = c;
     }
   }
+  // Candidate directions: the fixed rays, then the projections.
+  std::size_t nd = 0;
+  for (const V2 u : plan.rays) plan.dirs[nd++] = u;
+  for (std::size_t k = 0; k < nf; ++k) {
+    const detail::Capsule& c = plan.forbid[k];
+    const V2 d = c.b - c.a;
+    const double dd = dot(d, d);
+    const double t = dd > 0.0 ? std::clamp(dot(origin - c.a, d) / dd, 0.0, 1.0) : 0.0;
+    const V2 w = origin - (c.a + t * d);
+    const double len = norm(w);
+    const auto add = [&](V2 u) {  // once: shapes of several planes share their axes
+      for (std::size_t i = kPriorityRays; i < nd; ++i)
+        if (dot(u, plan.dirs[i]) > 1.0 - 1e-12) return;
+      plan.dirs[nd++] = u;
+    };
+    if (len > 1e-9 * scale) {
+      add((1.0 / len) * w);
+    } else if (dd > 0.0) {  // on the axis: both normals
+      const V2 n = (1.0 / std::sqrt(dd)) * V2{-d.y, d.x};
+      add(n);
+      add(-1.0 * n);
+    }
+  }
+  // Exits (closed form), just outside the boundary against rounding.
+  const double nudge = 1e-9 * scale;
+  for (std::size_t k = 0; k < nf; ++k) plan.seen[k] = detail::ray_capsule(origin, plan.forbid[k]);
+  for (std::size_t j = 0; j < nd; ++j) {
+    plan.exits[j] = detail::ray_exit(plan.dirs[j], plan.seen.data(), nf, plan.t_in.data(), plan.t_out.data()) + nudge;
+  }
+  // Best first over the rays: each ray's `at` is a distance before which no point of it is free
+  // (first its exit); the ray with the smallest is probed next, until it is no smaller than the
+  // best free point found. A blocked point advances its ray conservatively by the clearance
+  // missing over the fastest speed of the outline (no free point is skipped while that speed
+  // holds), at least kPriorityMinStepRel length scales. The first free point of a ray is bisected
+  // kPriorityBisections times against the blocked one before it (none when it is the exit: exact).
+  const double h_min = kPriorityMinStepRel * scale;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (std::size_t j = 0; j < nd; ++j) {
+    plan.at[j] = plan.exits[j];
+    plan.before[j] = -1.0;
+    plan.steps[j] = 0;
+  }
+  double best = inf;
+  std::size_t best_dir = 0;
+  int probes = 0;
+  // The rays that start outside every forbidden capsule share their first point, the origin.
+  bool shared = false;
+  for (std::size_t j = 0; j < nd; ++j) shared = shared || plan.exits[j] <= 2.0 * nudge;
+  if (shared) {
+    ++probes;
+    const Probe pr = probe(plan, low, upper, origin);
+    for (std::size_t j = 0; j < nd; ++j) {
+      if (!(plan.exits[j] <= 2.0 * nudge)) continue;
+      if (!pr.usable) {
+        plan.steps[j] = kPriorityAdvances + 1;
+      } else if (pr.free) {
+        best = 0.0;  // not colliding after all (the caller checked the held command)
+      } else {
+        plan.before[j] = 0.0;
+        plan.at[j] = std::max(pr.advance, h_min);
+        plan.steps[j] = 1;
+      }
+    }
+  }
+  while (probes < kPriorityMaxProbes) {
+    std::size_t j = 0;
+    double t = inf;
+    for (std::size_t i = 0; i < nd; ++i) {
+      if (plan.steps[i] <= kPriorityAdvances && plan.at[i] < t) t = plan.at[i], j = i;
+    }
+    if (!(t < best)) break;
+    const V2 u = plan.dirs[j];
+    ++probes;
+    const Probe pr = probe(plan, low, upper, origin + t * u);
+    if (!pr.usable) {
+      plan.steps[j] = kPriorityAdvances + 1;  // the ray leaves what the lower mechanism can hold
+      continue;
+    }
+    if (!pr.free) {
+      plan.before[j] = t;
+      plan.at[j] = t + std::max(pr.advance, h_min);
+      ++plan.steps[j];
+      continue;
+    }
+    if (plan.before[j] >= 0.0) {
+      double lo = plan.before[j], hi = t;
+      for (int b = 0; b < kPriorityBisections && probes < kPriorityMaxProbes; ++b) {
+        const double mid = 0.5 * (lo + hi);
+        ++probes;
+        if (probe(plan, low, upper, origin + mid * u).free) hi = mid;
+        else lo = mid;
+      }
+      t = hi;
+    }
+    best = t;
+    best_dir = j;
+    plan.steps[j] = kPriorityAdvances + 1;  // done
+  }
+  if (!(best < std::numeric_limits<double>::infinity())) return false;
+  found = origin + best * plan.dirs[best_dir];
   return true;
 }
 
@@ -318,6 +454,31 @@ Controller::Controller(Config config) {
     const double phi = kTwoPi * double(j) / kPriorityRays;
     p.rays[j] = {std::cos(phi), std::sin(phi)};
   }
+  // The lower outline's disks on P per plane (the largest; geometry.cpp outline()), and the
+  // buffers of the priority rule sized for every upper shape in those planes.
+  for (const PartTemplate& t : p.tpl) {
+    const bool on_p = (t.link < 0 && t.point == 4) || t.link == 2 || t.link == 3;
+    if (!on_p) continue;
+    const double r = t.link >= 0 && t.boss ? std::max(t.r, t.boss_r) : t.r;
+    const auto plane = static_cast<std::size_t>(t.plane);
+    if (p.p_disk.size() <= plane) p.p_disk.resize(plane + 1, 0.0);
+    p.p_disk[plane] = std::max(p.p_disk[plane], r);
+  }
+  std::size_t nf = 0;
+  for (const PartTemplate& t : p.tpl) {
+    const auto plane = static_cast<std::size_t>(t.plane);
+    if (plane < p.p_disk.size() && p.p_disk[plane] > 0.0) nf += t.link >= 0 && t.boss ? 3 : 1;
+  }
+  p.forbid.assign(nf, detail::Capsule{});
+  p.seen.assign(nf, detail::RayCapsule{});
+  p.t_in.assign(nf, 0.0);
+  p.t_out.assign(nf, 0.0);
+  const std::size_t nd = kPriorityRays + 2 * nf;
+  p.dirs.assign(nd, V2{});
+  p.exits.assign(nd, 0.0);
+  p.steps.assign(nd, 0);
+  p.at.assign(nd, 0.0);
+  p.before.assign(nd, 0.0);
   plan_ = plan.release();
 }
 

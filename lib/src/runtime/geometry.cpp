@@ -246,6 +246,20 @@ double min_clearance(const Part* a, std::size_t na, const Part* b, std::size_t n
   return best;
 }
 
+double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::size_t nb, double cap) {
+  double best = cap;
+  for (std::size_t i = 0; i < na; ++i) {
+    for (std::size_t j = 0; j < nb; ++j) {
+      if (a[i].plane != b[j].plane) continue;
+      const double gx = std::max({0.0, a[i].lo.x - b[j].hi.x, b[j].lo.x - a[i].hi.x});
+      const double gy = std::max({0.0, a[i].lo.y - b[j].hi.y, b[j].lo.y - a[i].hi.y});
+      if (gx >= best || gy >= best) continue;  // the boxes' gap bounds the pair's clearance
+      best = std::min(best, part_clearance(a[i], b[j]));
+    }
+  }
+  return best;
+}
+
 bool collide(const Part* a, std::size_t na, const Part* b, std::size_t nb, double threshold) {
   for (std::size_t i = 0; i < na; ++i) {
     for (std::size_t j = 0; j < nb; ++j) {
@@ -258,6 +272,79 @@ bool collide(const Part* a, std::size_t na, const Part* b, std::size_t nb, doubl
     }
   }
   return false;
+}
+
+RayCapsule ray_capsule(V2 o, const Capsule& c) {
+  RayCapsule r;
+  r.wa = o - c.a;
+  r.wb = o - c.b;
+  r.ca = dot(r.wa, r.wa) - c.r * c.r;
+  r.cb = dot(r.wb, r.wb) - c.r * c.r;
+  r.r = c.r;
+  const V2 d = c.b - c.a;
+  r.len = norm(d);
+  if (r.len > 0.0) {
+    r.e = (1.0 / r.len) * d;
+    r.n = {-r.e.y, r.e.x};
+    r.along = dot(r.wa, r.e);
+    r.across = dot(r.wa, r.n);
+  }
+  return r;
+}
+
+bool ray_interval(const RayCapsule& c, V2 u, double& t_in, double& t_out) {
+  double lo = kInf, hi = -kInf;
+  // End disks: |w + t u|^2 = r^2.
+  const auto disk = [&](V2 w, double cw) {
+    const double b = dot(w, u), disc = b * b - cw;
+    if (disc > 0.0) {
+      const double s = std::sqrt(disc);
+      lo = std::min(lo, -b - s);
+      hi = std::max(hi, -b + s);
+    }
+  };
+  disk(c.wa, c.ca);
+  disk(c.wb, c.cb);
+  // The rectangle: 0 < along < len and |across| < r, each a slab between two parallel lines.
+  if (c.len > 0.0) {
+    double r_lo = -kInf, r_hi = kInf;
+    const auto slab = [&](double start, double rate, double from, double to) {
+      if (rate == 0.0) {
+        if (!(start > from && start < to)) r_lo = kInf, r_hi = -kInf;
+        return;
+      }
+      const double t0 = (from - start) / rate, t1 = (to - start) / rate;
+      r_lo = std::max(r_lo, std::min(t0, t1));
+      r_hi = std::min(r_hi, std::max(t0, t1));
+    };
+    slab(c.along, dot(u, c.e), 0.0, c.len);
+    slab(c.across, dot(u, c.n), -c.r, c.r);
+    if (r_lo < r_hi) {
+      lo = std::min(lo, r_lo);
+      hi = std::max(hi, r_hi);
+    }
+  }
+  t_in = lo;
+  t_out = hi;
+  return lo < hi;
+}
+
+double ray_exit(V2 u, const RayCapsule* caps, std::size_t n, double* t_in, double* t_out) {
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!ray_interval(caps[k], u, t_in[k], t_out[k])) t_in[k] = kInf, t_out[k] = -kInf;
+  }
+  double t = 0.0;
+  for (std::size_t pass = 0; pass <= n; ++pass) {
+    bool moved = false;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (t_in[k] <= t && t < t_out[k]) {
+        t = t_out[k];
+        moved = true;
+      }
+    }
+    if (!moved) break;
+  }
+  return t;
 }
 
 }  // namespace fivebar::runtime::detail

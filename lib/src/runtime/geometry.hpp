@@ -96,5 +96,25 @@ void outline(const std::vector<PartTemplate>& tpl, const Pose& pose, Part* out);
 double min_clearance(const Part* a, std::size_t na, const Part* b, std::size_t nb);
 /// Some pair of parts in a shared plane closer than `threshold` (bounding boxes skip far pairs).
 bool collide(const Part* a, std::size_t na, const Part* b, std::size_t nb, double threshold);
+/// min_clearance() where it is below `cap`, else some value >= cap (pairs whose bounding boxes
+/// are `cap` or more apart are skipped).
+double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::size_t nb, double cap);
+
+/// A capsule seen from a fixed origin o, for rays o + t u (u a unit vector): the points inside it
+/// (distance to [a, b] < r) form one open interval of t (the capsule is convex), in closed form from
+/// the slab of the segment (two pairs of parallel lines) and the two end disks.
+struct RayCapsule {
+  V2 wa, wb;                  ///< o - a, o - b
+  double ca = 0.0, cb = 0.0;  ///< |o - a|^2 - r^2, |o - b|^2 - r^2
+  V2 e, n;                    ///< unit along and across the segment (len 0: a disk)
+  double along = 0.0, across = 0.0, len = 0.0, r = 0.0;  ///< o's coordinates, |b - a|, radius
+};
+RayCapsule ray_capsule(V2 o, const Capsule& c);
+/// The interval of the ray in the capsule: false when the line misses it.
+bool ray_interval(const RayCapsule& c, V2 u, double& t_in, double& t_out);
+/// The first t >= 0 at which o + t u is inside none of the `n` capsules (the exit of the ray from
+/// their union): each capsule is left at most once along a ray, so at most n + 1 passes over the
+/// intervals (kept in `t_in`, `t_out`, n entries each, caller's buffers).
+double ray_exit(V2 u, const RayCapsule* caps, std::size_t n, double* t_in, double* t_out);
 
 }  // namespace fivebar::runtime::detail

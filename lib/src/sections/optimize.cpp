@@ -62,7 +62,7 @@ std::string OptimizeConstraint::text() const {
 
 std::string OptimizeSettings::resolved_algorithm() const {
   if (algorithm != "auto") return algorithm;
-  return objectives.size() > 1 ? "nsga2" : "cmaes";
+  return objectives.size() > 1 ? "hybrid" : "cmaes";
 }
 
 namespace {
@@ -120,17 +120,17 @@ void OptimizeSettings::validate() const {
     if (!std::isfinite(constraints[i].bound)) throw ValidationError(detail::key_index("constraints", i), "bound must be finite");
   }
   const std::string alg = resolved_algorithm();
-  const std::vector<std::string> multi{"nsga2", "moead"}, single{"cmaes", "sade"};
+  const std::vector<std::string> multi{"hybrid", "nsga2", "moead"}, single{"cmaes", "sade"};
   const bool is_multi = std::find(multi.begin(), multi.end(), alg) != multi.end();
   const bool is_single = std::find(single.begin(), single.end(), alg) != single.end();
   if (!is_multi && !is_single) {
-    throw ValidationError("algorithm", "= " + detail::quoted(algorithm) + ": must be auto, nsga2, moead, cmaes or sade");
+    throw ValidationError("algorithm", "= " + detail::quoted(algorithm) + ": must be auto, hybrid, nsga2, moead, cmaes or sade");
   }
   if (is_multi && objectives.size() < 2) {
     throw ValidationError("algorithm", "= " + detail::quoted(alg) + ": needs two or more objectives (cmaes or sade for one)");
   }
   if (is_single && objectives.size() != 1) {
-    throw ValidationError("algorithm", "= " + detail::quoted(alg) + ": optimises one objective (nsga2 or moead for more)");
+    throw ValidationError("algorithm", "= " + detail::quoted(alg) + ": optimises one objective (hybrid, nsga2 or moead for more)");
   }
   if (population < 8 || population > 10000) {
     throw ValidationError("population", "= " + std::to_string(population) + ": must be 8 ... 10000");
@@ -263,7 +263,7 @@ void load(const Value& v, Design& design) {
       o.constraints.push_back(parse_constraint(c));
     }
   }
-  if (const Value* a = find(all, "algorithm")) o.algorithm = a->text("must be auto, nsga2, moead, cmaes or sade");
+  if (const Value* a = find(all, "algorithm")) o.algorithm = a->text("must be auto, hybrid, nsga2, moead, cmaes or sade");
   if (const Value* p = find(all, "population")) o.population = int(p->whole(8, 10000));
   if (const Value* p = find(all, "islands")) o.islands = int(p->whole(1, 64));
   if (const Value* p = find(all, "generations_per_round")) o.generations_per_round = int(p->whole(1, 1000));

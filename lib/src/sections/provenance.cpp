@@ -21,6 +21,10 @@ void ProvenanceEntry::validate() const {
   if (sigma && !(*sigma >= 0.0 && std::isfinite(*sigma))) {
     throw ValidationError("sigma", "= " + rules::plain_number(*sigma) + ": must be >= 0");
   }
+  for (const auto& [key, rho] : correlation) {
+    if (!(std::abs(rho) <= 1.0)) throw ValidationError("correlation." + key, "= " + rules::plain_number(rho) + ": must be in [-1, 1]");
+    if (!sigma) throw ValidationError("correlation", "needs this entry's sigma");
+  }
 }
 
 void ProvenanceSettings::validate() const {
@@ -28,6 +32,19 @@ void ProvenanceSettings::validate() const {
   for (const auto& item : entries) {
     const ProvenanceEntry& entry = item.second;
     rules::validate_nested(item.first, [&entry] { entry.validate(); });
+    for (const auto& c : entry.correlation) {
+      const std::string where = item.first + ".correlation." + c.first;
+      const auto other = entries.find(c.first);
+      if (c.first == item.first) throw ValidationError(where, "a value's correlation with itself is 1: leave it out");
+      if (other == entries.end() || !other->second.sigma) {
+        throw ValidationError(where, "names a key without its own provenance entry and sigma");
+      }
+      const auto back = other->second.correlation.find(item.first);
+      if (back != other->second.correlation.end() && back->second != c.second) {
+        throw ValidationError(where, "= " + rules::plain_number(c.second) + ": the entry of " + c.first + " gives " +
+                                         rules::plain_number(back->second) + " for the same pair");
+      }
+    }
   }
 }
 
@@ -38,13 +55,21 @@ void load(const Value& v, Design& design) {
   ProvenanceSettings& p = design.set(ProvenanceSettings{});
   if (v.is_null()) return;
   for (const Value& e : v.entries({}, "from key paths of the design to {source, sha256, date, method, sigma}", /*any_key=*/true)) {
-    const auto all = e.entries({"source", "sha256", "date", "method", "sigma"}, "(source, sha256, date, method, sigma)");
+    const auto all = e.entries({"source", "sha256", "date", "method", "sigma", "correlation"},
+                               "(source, sha256, date, method, sigma, correlation)");
     ProvenanceEntry entry;
     entry.source = require(all, "source", e).text("must be text (a file name)");
     entry.sha256 = require(all, "sha256", e).text("must be text (64 hex digits)");
     entry.date = require(all, "date", e).text("must be text (YYYY-MM-DD)");
     entry.method = require(all, "method", e).text("must be text");
     if (const Value* s = find(all, "sigma")) entry.sigma = s->number("");
+    if (const Value* c = find(all, "correlation")) {
+      if (!c->is_null()) {
+        for (const Value& r : c->entries({}, "from key paths of measured values to correlation coefficients", /*any_key=*/true)) {
+          entry.correlation[r.name()] = r.number("");
+        }
+      }
+    }
     p.entries[e.name()] = std::move(entry);
   }
 }
@@ -71,6 +96,10 @@ void write(const Design& design, Out& top) {
     m.add("date", Out::quoted(e.date));
     m.add("method", Out::quoted(e.method));
     if (e.sigma) m.add("sigma", Out::number(*e.sigma));
+    if (!e.correlation.empty()) {
+      Out& c = m.add("correlation", Out::map(/*flow=*/true));
+      for (const auto& [other, rho] : e.correlation) c.add(other, Out::number(rho));
+    }
   }
 }
 

@@ -324,7 +324,7 @@ SweepRow evaluate_station_figures(const Design& design, const Station& st, const
     for (const Mechanism* m : targets) {
       const ToleranceSources src = tolerance_sources(design, st, *m);
       row.robust_margin_mm = std::min(
-          row.robust_margin_mm, robust_coverage(*m, st.target, src.sigma, src.robust_fraction, 0, src.seed).robust_margin_mm);
+          row.robust_margin_mm, robust_coverage(*m, st.target, src.spread(), src.robust_fraction, 0, src.seed).robust_margin_mm);
     }
   }
   row.covered = true;

@@ -51,7 +51,7 @@ Product tolerance_product() {
                      "worst case (mm)", "play (mm)", "resolution (µm/count)", "margin (mm)", "robust margin (mm)",
                      "devices covering (MC)", "MC margin quantile (mm)"},
                     "llrrrrrrrrrr");
-    std::string flagged_md;
+    std::string flagged_md, calibrated_md;
     Json stations = Json::array();
     std::vector<std::string> failed, pictures;
     std::size_t total = 0;
@@ -83,6 +83,7 @@ Product tolerance_product() {
                                                       ? md::fixed(map.robust.quantile_lower_mm, 3)
                                                       : std::string("?")) +
                                                  " at 95 %)"});
+        if (map.calibrated) calibrated_md += "- " + s.name + "/" + map.mechanism + " sigmas: " + map.spread_source + ".\n";
         if (!map.near_singular.empty()) {
           double mc = 0.0, corners = 0.0, first = 0.0;
           for (const auto& f : map.near_singular) {
@@ -108,6 +109,10 @@ Product tolerance_product() {
     Built b;
     b.result = {{"stations", stations}};
     std::string markdown = kPreamble + table.str() + "\n";
+    if (!calibrated_md.empty()) {
+      markdown += "Calibrated mechanisms: the calibration's posterior covariance replaces the `tolerance:` sigmas it covers "
+                  "(docs/calibrate.md \"Posterior covariance in the design\"):\n\n" + calibrated_md + "\n";
+    }
     if (!flagged_md.empty()) markdown += flagged_md + "\n";
     for (const std::string& f : pictures) markdown += "Picture: [" + f + "](" + f + ").\n\n";
     markdown += "Maps for ParaView: `tolerance/<station>-<mechanism>-tolerance.vti` (3σ, worst case, resolution, "

@@ -25,6 +25,85 @@ const std::array<const char*, kToleranceParameters>& tolerance_parameter_names()
   return names;
 }
 
+// --- ParameterSpread --------------------------------------------------------------------------------
+
+ParameterCovariance CalibratedUncertainty::at(double theta1, double theta2) const {
+  // dq = T dp: the geometry as it is, dtheta_j = (theta_j / k_j) dk_j - k_j dV0_j.
+  Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 12> T = Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 12>::Zero();
+  for (int i = 0; i < 8; ++i) T(i, i) = 1.0;
+  const std::array<double, 2> theta{theta1, theta2};
+  for (int j = 0; j < 2; ++j) {
+    const double k = rad_per_volt[static_cast<std::size_t>(j)];
+    T(8 + j, 8 + 2 * j) = -k;
+    T(8 + j, 9 + 2 * j) = theta[static_cast<std::size_t>(j)] / k;
+  }
+  ParameterCovariance c = T * covariance * T.transpose();
+  c(8, 8) += angle_variance[0];
+  c(9, 9) += angle_variance[1];
+  return 0.5 * (c + c.transpose());
+}
+
+ParameterSpread::ParameterSpread(const ParameterSigmas& sigma) : sigma_(sigma) {
+  for (std::size_t j = 0; j < kToleranceParameters; ++j) {
+    const auto i = static_cast<Eigen::Index>(j);
+    covariance_(i, i) = sigma[j] * sigma[j];
+    factor_(i, i) = sigma[j];
+  }
+}
+
+ParameterSpread::ParameterSpread(const ParameterCovariance& covariance) : correlated_(true), covariance_(covariance) { factorise(); }
+
+ParameterSpread::ParameterSpread(const CalibratedUncertainty& calibrated)
+    : correlated_(true), covariance_(calibrated.at(0.0, 0.0)), calibrated_(calibrated) {
+  factorise();
+}
+
+void ParameterSpread::factorise() {
+  covariance_ = 0.5 * (covariance_ + covariance_.transpose());
+  const Eigen::SelfAdjointEigenSolver<ParameterCovariance> eig(covariance_);
+  // A posterior covariance is positive semi-definite; rounding can leave tiny negative eigenvalues.
+  const Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 1> root = eig.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+  factor_ = eig.eigenvectors() * root.asDiagonal();
+  for (std::size_t j = 0; j < kToleranceParameters; ++j) {
+    sigma_[j] = std::sqrt(std::max(covariance_(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j)), 0.0));
+  }
+}
+
+ParameterSpread ParameterSpread::at(double theta1, double theta2) const {
+  if (!calibrated_) return *this;
+  ParameterSpread out(calibrated_->at(theta1, theta2));
+  out.calibrated_ = calibrated_;
+  return out;
+}
+
+double ParameterSpread::variance(const std::array<double, kToleranceParameters>& g) const {
+  double var = 0.0;
+  if (!correlated_) {
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) var += g[j] * g[j] * sigma_[j] * sigma_[j];
+    return var;
+  }
+  const Eigen::Map<const Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 1>> v(g.data());
+  return std::max(0.0, v.dot(covariance_ * v));
+}
+
+std::array<double, kToleranceParameters> ParameterSpread::draw(const std::array<double, kToleranceParameters>& z) const {
+  std::array<double, kToleranceParameters> dq{};
+  if (!correlated_) {
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) dq[j] = sigma_[j] * z[j];
+    return dq;
+  }
+  for (std::size_t i = 0; i < kToleranceParameters; ++i) {
+    for (std::size_t k = 0; k < kToleranceParameters; ++k) dq[i] += factor_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) * z[k];
+  }
+  return dq;
+}
+
+std::array<double, kToleranceParameters> ParameterSpread::generator(std::size_t k) const {
+  std::array<double, kToleranceParameters> g{};
+  for (std::size_t i = 0; i < kToleranceParameters; ++i) g[i] = factor_(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k));
+  return g;
+}
+
 ZonotopeExtreme zonotope_farthest(const std::vector<Vec2>& generators) {
   const std::size_t n = generators.size();
   ZonotopeExtreme out;
@@ -116,15 +195,21 @@ double angle_per_count(int bits) {
   return 2.0 * std::numbers::pi / std::ldexp(1.0, std::clamp(bits, 1, 32));
 }
 
-ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const ParameterSpread& spread_any,
                                         double rad_per_count) {
   ToleranceEstimate out;
   const Sensitivity s = tolerance_sensitivity(m, P);
   out.status = s.status;
   if (s.status != Status::ok) return out;
-  Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 1> var;
-  for (std::size_t j = 0; j < kToleranceParameters; ++j) var(static_cast<Eigen::Index>(j)) = sigma[j] * sigma[j];
-  out.covariance = s.S * var.asDiagonal() * s.S.transpose();
+  const ParameterSpread spread = spread_any.at(s.pose.theta1, s.pose.theta2);
+  const ParameterSigmas& sigma = spread.sigma();
+  if (spread.correlated()) {
+    out.covariance = s.S * spread.covariance() * s.S.transpose();
+  } else {
+    Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 1> var;
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) var(static_cast<Eigen::Index>(j)) = sigma[j] * sigma[j];
+    out.covariance = s.S * var.asDiagonal() * s.S.transpose();
+  }
   const double a = out.covariance(0, 0);
   const double b = out.covariance(0, 1);
   const double c = out.covariance(1, 1);
@@ -135,12 +220,26 @@ ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const
   double worst = 0.0;
   std::vector<Vec2> generators(kToleranceParameters);
   for (std::size_t j = 0; j < kToleranceParameters; ++j) {
-    generators[j] = s.S.col(static_cast<Eigen::Index>(j)) * (3.0 * sigma[j]);
+    if (spread.correlated()) {  // the principal components' +-3 sigma
+      const auto g = spread.generator(j);
+      generators[j] = s.S * Eigen::Map<const Eigen::Matrix<double, static_cast<int>(kToleranceParameters), 1>>(g.data()) * 3.0;
+    } else {
+      generators[j] = s.S.col(static_cast<Eigen::Index>(j)) * (3.0 * sigma[j]);
+    }
     worst += generators[j].norm();
   }
   const ZonotopeExtreme z = zonotope_farthest(generators);
   out.worst_case_mm = z.norm;
-  std::copy(z.signs.begin(), z.signs.end(), out.worst_corner.begin());
+  if (spread.correlated()) {  // the sign of each parameter's displacement at that vertex
+    std::array<double, kToleranceParameters> dq{};
+    for (std::size_t k = 0; k < kToleranceParameters; ++k) {
+      const auto g = spread.generator(k);
+      for (std::size_t j = 0; j < kToleranceParameters; ++j) dq[j] += z.signs[k] * g[j];
+    }
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) out.worst_corner[j] = dq[j] < 0.0 ? -1 : 1;
+  } else {
+    std::copy(z.signs.begin(), z.signs.end(), out.worst_corner.begin());
+  }
   out.sum_of_effects_mm = worst;
   out.near_singular = worst > 0.25 * std::min(m.L[2], m.L[3]) * s.pose.type2_sin;
   const double step = std::max(s.pose.J.col(0).norm(), s.pose.J.col(1).norm()) * rad_per_count;
@@ -152,12 +251,13 @@ ToleranceEstimate tolerance_first_order(const Mechanism& m, const Vec2& P, const
   return out;
 }
 
-MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma,
+MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, const ParameterSpread& spread_any,
                                           std::size_t samples, std::uint64_t seed) {
   MonteCarloTolerance out;
   const Pose nominal = ik(m, P);
   out.status = nominal.status;
   if (nominal.status != Status::ok) return out;
+  const ParameterSpread spread = spread_any.at(nominal.theta1, nominal.theta2);
   Mechanism printed = m;
   printed.joint_limits.reset();  // a device off its limits still puts its tactor somewhere
   printed.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
@@ -166,9 +266,10 @@ MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, con
   // Welford's running mean and co-moment: one pass, no cancellation.
   Vec2 mean{0.0, 0.0};
   Eigen::Matrix2d comoment = Eigen::Matrix2d::Zero();
-  std::array<double, kToleranceParameters> dq{};
+  std::array<double, kToleranceParameters> z{};
   for (std::size_t k = 0; k < samples; ++k) {
-    for (std::size_t j = 0; j < kToleranceParameters; ++j) dq[j] = sigma[j] * normal(rng);
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) z[j] = normal(rng);
+    const std::array<double, kToleranceParameters> dq = spread.draw(z);
     for (std::size_t i = 0; i < 4; ++i) printed.L[i] = m.L[i] + dq[i];
     printed.O1 = m.O1 + Vec2(dq[4], dq[5]);
     printed.O2 = m.O2 + Vec2(dq[6], dq[7]);
@@ -194,14 +295,14 @@ MonteCarloTolerance tolerance_monte_carlo(const Mechanism& m, const Vec2& P, con
 }
 
 std::vector<MonteCarloTolerance> tolerance_monte_carlo(const Mechanism& m, const std::vector<Vec2>& points,
-                                                       const ParameterSigmas& sigma, std::size_t samples,
+                                                       const ParameterSpread& spread, std::size_t samples,
                                                        std::uint64_t seed) {
   // One table of draws for every point (common random numbers), in tolerance_monte_carlo()'s order.
   std::vector<double> draws(samples * kToleranceParameters);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   for (std::size_t k = 0; k < samples; ++k)
-    for (std::size_t j = 0; j < kToleranceParameters; ++j) draws[k * kToleranceParameters + j] = sigma[j] * normal(rng);
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) draws[k * kToleranceParameters + j] = normal(rng);
   std::vector<MonteCarloTolerance> out(points.size());
   const auto n = static_cast<std::ptrdiff_t>(points.size());
 #pragma omp parallel for schedule(dynamic, 1)
@@ -214,10 +315,13 @@ std::vector<MonteCarloTolerance> tolerance_monte_carlo(const Mechanism& m, const
     Mechanism printed = m;
     printed.joint_limits.reset();
     printed.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+    const ParameterSpread at = spread.at(nominal.theta1, nominal.theta2);
     Vec2 mean{0.0, 0.0};
     Eigen::Matrix2d comoment = Eigen::Matrix2d::Zero();
     for (std::size_t k = 0; k < samples; ++k) {
-      const double* dq = &draws[k * kToleranceParameters];
+      std::array<double, kToleranceParameters> z{};
+      std::copy_n(&draws[k * kToleranceParameters], kToleranceParameters, z.begin());
+      const std::array<double, kToleranceParameters> dq = at.draw(z);
       for (std::size_t l = 0; l < 4; ++l) printed.L[l] = m.L[l] + dq[l];
       printed.O1 = m.O1 + Vec2(dq[4], dq[5]);
       printed.O2 = m.O2 + Vec2(dq[6], dq[7]);

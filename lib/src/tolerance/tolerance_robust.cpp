@@ -49,7 +49,7 @@ struct Arc {
   double centre_sigma = 0.0;  ///< |diag(sigma) dc/dq| (Frobenius), the Lipschitz factor of sigma_k in u
 };
 
-std::vector<Arc> leg_arcs(const Mechanism& m, int leg, const ParameterSigmas& sigma) {
+std::vector<Arc> leg_arcs(const Mechanism& m, int leg, const ParameterSpread& sigma) {
   const Vec2& O = leg == 0 ? m.O1 : m.O2;
   const double lp = m.L[static_cast<std::size_t>(leg)], ld = m.L[static_cast<std::size_t>(leg + 2)];
   const std::size_t prox = static_cast<std::size_t>(leg), dist = static_cast<std::size_t>(leg + 2);
@@ -109,7 +109,16 @@ std::vector<Arc> leg_arcs(const Mechanism& m, int leg, const ParameterSigmas& si
   }
   for (Arc& a : arcs) {
     double v = 0.0;
-    for (std::size_t j = 0; j < kToleranceParameters; ++j) v += sigma[j] * sigma[j] * a.dc[j].squaredNorm();
+    if (sigma.correlated()) {  // |dc/dq F| (Frobenius) = sqrt(trace(dc C dc^T))
+      std::array<double, kToleranceParameters> gx{}, gy{};
+      for (std::size_t j = 0; j < kToleranceParameters; ++j) {
+        gx[j] = a.dc[j].x();
+        gy[j] = a.dc[j].y();
+      }
+      v = sigma.variance(gx) + sigma.variance(gy);
+    } else {
+      for (std::size_t j = 0; j < kToleranceParameters; ++j) v += sigma.sigma()[j] * sigma.sigma()[j] * a.dc[j].squaredNorm();
+    }
     a.centre_sigma = std::sqrt(v);
   }
   return arcs;
@@ -120,19 +129,15 @@ struct ArcValue {
   std::array<double, kToleranceParameters> g{};
 };
 
-ArcValue arc_value(const Arc& a, const ParameterSigmas& sigma, const Vec2& b) {
+ArcValue arc_value(const Arc& a, const ParameterSpread& sigma, const Vec2& b) {
   ArcValue v;
   const Vec2 r = b - a.c;
   v.rho = r.norm();
   const Vec2 u = v.rho > 0.0 ? Vec2(r / v.rho) : Vec2(1.0, 0.0);
   const double side = a.R - v.rho >= 0.0 ? 1.0 : -1.0;
   v.d = std::fabs(a.R - v.rho);
-  double var = 0.0;
-  for (std::size_t j = 0; j < kToleranceParameters; ++j) {
-    v.g[j] = side * (a.dR[j] - u.dot(a.dc[j]));
-    var += v.g[j] * v.g[j] * sigma[j] * sigma[j];
-  }
-  v.s = std::sqrt(var);
+  for (std::size_t j = 0; j < kToleranceParameters; ++j) v.g[j] = side * (a.dR[j] - u.dot(a.dc[j]));
+  v.s = std::sqrt(sigma.variance(v.g));
   return v;
 }
 
@@ -164,7 +169,7 @@ bool in_legs(const Mechanism& m, const Vec2& b) {
   return true;
 }
 
-RobustPoint evaluate(const std::vector<Arc>& arcs, const ParameterSigmas& sigma, double z, const Vec2& b,
+RobustPoint evaluate(const std::vector<Arc>& arcs, const ParameterSpread& sigma, double z, const Vec2& b,
                      double* fraction) {
   RobustPoint out;
   out.inside = true;
@@ -188,7 +193,7 @@ RobustPoint evaluate(const std::vector<Arc>& arcs, const ParameterSigmas& sigma,
   return out;
 }
 
-std::vector<Arc> mechanism_arcs(const Mechanism& m, const ParameterSigmas& sigma) {
+std::vector<Arc> mechanism_arcs(const Mechanism& m, const ParameterSpread& sigma) {
   std::vector<Arc> arcs = leg_arcs(m, 0, sigma);
   const std::vector<Arc> second = leg_arcs(m, 1, sigma);
   arcs.insert(arcs.end(), second.begin(), second.end());
@@ -197,12 +202,12 @@ std::vector<Arc> mechanism_arcs(const Mechanism& m, const ParameterSigmas& sigma
 
 }  // namespace
 
-RobustPoint robust_margin_at(const Mechanism& m, const ParameterSigmas& sigma, double z, const Vec2& b) {
+RobustPoint robust_margin_at(const Mechanism& m, const ParameterSpread& sigma, double z, const Vec2& b) {
   if (!in_legs(m, b)) return RobustPoint{};
   return evaluate(mechanism_arcs(m, sigma), sigma, z, b, nullptr);
 }
 
-RobustMarginBound robust_margin_min(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double z,
+RobustMarginBound robust_margin_min(const Mechanism& m, const Ellipse& target, const ParameterSpread& sigma, double z,
                                     double tol_mm) {
   RobustMarginBound out;
   const std::vector<Arc> arcs = mechanism_arcs(m, sigma);
@@ -288,7 +293,7 @@ QuantileBound quantile_lower_bound_rank(std::size_t n, double p, double confiden
   return out;
 }
 
-CornerEnumeration tolerance_corners(const Mechanism& m, const Vec2& P, const ParameterSigmas& sigma, double k_sigma) {
+CornerEnumeration tolerance_corners(const Mechanism& m, const Vec2& P, const ParameterSpread& sigma, double k_sigma) {
   CornerEnumeration out;
   const Pose nominal = ik(m, P);
   out.status = nominal.status;
@@ -296,17 +301,22 @@ CornerEnumeration tolerance_corners(const Mechanism& m, const Vec2& P, const Par
   Mechanism printed = m;
   printed.joint_limits.reset();
   printed.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
+  // Independent: the parameters with sigma > 0; correlated: the principal components (F's columns).
+  const ParameterSpread spread = sigma.at(nominal.theta1, nominal.theta2);
   std::vector<std::size_t> free;
-  for (std::size_t j = 0; j < kToleranceParameters; ++j)
-    if (sigma[j] > 0.0) free.push_back(j);
+  for (std::size_t j = 0; j < kToleranceParameters; ++j) {
+    const auto g = spread.generator(j);
+    if (std::any_of(g.begin(), g.end(), [](double x) { return x != 0.0; })) free.push_back(j);
+  }
   out.corners = std::size_t{1} << free.size();
   for (std::size_t mask = 0; mask < out.corners; ++mask) {
-    std::array<double, kToleranceParameters> dq{};
+    std::array<double, kToleranceParameters> z{};
     std::array<std::int8_t, kToleranceParameters> signs{};
     for (std::size_t b = 0; b < free.size(); ++b) {
       signs[free[b]] = (mask >> b) & 1U ? 1 : -1;
-      dq[free[b]] = signs[free[b]] * k_sigma * sigma[free[b]];
+      z[free[b]] = signs[free[b]] * k_sigma;
     }
+    const std::array<double, kToleranceParameters> dq = spread.draw(z);
     for (std::size_t i = 0; i < 4; ++i) printed.L[i] = m.L[i] + dq[i];
     printed.O1 = m.O1 + Vec2(dq[4], dq[5]);
     printed.O2 = m.O2 + Vec2(dq[6], dq[7]);

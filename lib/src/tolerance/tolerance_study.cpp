@@ -18,6 +18,7 @@
 #include "fivebar/sections/print.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/tolerance.hpp"
+#include "fivebar/provenance.hpp"
 
 namespace fivebar {
 namespace {
@@ -65,7 +66,7 @@ bool lengths_positive(const Mechanism& m) {
   return std::all_of(m.L.begin(), m.L.end(), [](double l) { return l > 0.0; });
 }
 
-void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double fraction,
+void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const ParameterSpread& sigma, double fraction,
                          std::size_t samples, std::uint64_t seed, RobustCoverage& out);
 
 }  // namespace
@@ -104,6 +105,48 @@ ToleranceSources tolerance_sources(const Design& design, const Station& station,
   for (std::size_t j = 0; j < 2; ++j) {
     const double offset = out.sigma[8 + j];
     out.sigma[8 + j] = std::sqrt(offset * offset + linearity * linearity / 3.0);
+  }
+
+  // A calibration's posterior covariance replaces the sigmas it covers (docs/calibrate.md
+  // "Posterior covariance in the design"): the provenance entries' sigmas and correlations of this
+  // mechanism's twelve calibration keys.
+  out.spread_source = given ? "tolerance: section" : "tolerance: defaults (assumptions)";
+  const std::array<std::string, 12> keys = calibration_keys(design, station.name, m.name);
+  const ProvenanceCovariance pc = provenance_covariance(design, std::vector<std::string>(keys.begin(), keys.end()));
+  if (std::find(pc.measured.begin(), pc.measured.end(), true) != pc.measured.end()) {
+    CalibratedUncertainty cu;
+    const auto& names = tolerance_parameter_names();
+    std::vector<std::string> covered, rest;
+    for (int a = 0; a < 12; ++a) {
+      const auto ua = static_cast<std::size_t>(a);
+      cu.measured[ua] = pc.measured[ua];
+      if (pc.measured[ua]) cu.keys.push_back(keys[ua]);
+      for (int b = 0; b < 12; ++b) {
+        if (pc.measured[ua] && pc.measured[static_cast<std::size_t>(b)]) cu.covariance(a, b) = pc.covariance(a, b);
+      }
+      if (a < 8) {
+        if (!pc.measured[ua]) cu.covariance(a, a) = out.sigma[ua] * out.sigma[ua];
+        (pc.measured[ua] ? covered : rest).emplace_back(names[ua]);
+      }
+    }
+    for (int j = 0; j < 2; ++j) {
+      const auto uj = static_cast<std::size_t>(j);
+      cu.rad_per_volt[uj] = controller ? controller->joint(station.name, m.name, j + 1).potentiometer.rad_per_volt
+                                       : ControllerSettings{}.potentiometer.rad_per_volt;
+      // A joint whose volts_at_zero is calibrated keeps only the linearity; otherwise the whole
+      // tolerance angle sigma (the calibration offset and the linearity) stays.
+      const bool pot = pc.measured[static_cast<std::size_t>(8 + 2 * j)];
+      cu.angle_variance[uj] = pot ? linearity * linearity / 3.0 : out.sigma[8 + uj] * out.sigma[8 + uj];
+      (pot ? covered : rest).emplace_back(names[8 + uj]);
+    }
+    cu.sources = pc.sources;
+    out.calibrated = cu;
+    out.spread_source = "calibration posterior covariance (" + format::join(pc.sources) + ") for " + format::join(covered) +
+                        (rest.empty() ? std::string() : "; " + out.spread_source + " for " + format::join(rest)) +
+                        (std::find(covered.begin(), covered.end(), "theta1") != covered.end() ||
+                                 std::find(covered.begin(), covered.end(), "theta2") != covered.end()
+                             ? "; potentiometer linearity kept"
+                             : "");
   }
 
   const PrintSettings* print = design.get<PrintSettings>();
@@ -185,10 +228,12 @@ double normal_quantile(double p) {
   return x;
 }
 
-RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const ParameterSpread& spread,
                                double fraction, std::size_t samples, std::uint64_t seed) {
   RobustCoverage out;
   out.fraction = fraction;
+  out.calibrated = spread.calibrated();
+  const ParameterSigmas& sigma = spread.sigma();
   const Containment nominal = containment(m, target);
   out.margin_mm = nominal.margin_mm;
   out.decided = nominal.decided;
@@ -216,7 +261,7 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   // (or undecided) the first-order distances do not hold across the boundary: the sampled estimate
   // below, reported as not certified.
   if (nominal.decided && nominal.margin_mm > 0.0) {
-    const RobustMarginBound b = robust_margin_min(m, target, sigma, out.z, kRobustTolRel * scale);
+    const RobustMarginBound b = robust_margin_min(m, target, spread, out.z, kRobustTolRel * scale);
     out.robust_margin_mm = b.value_mm;
     out.robust_margin_lower_mm = b.lower_mm;
     out.robust_certified = b.certified;
@@ -227,7 +272,7 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
     out.robust_margin_mm = std::min(out.robust_margin_mm, out.margin_mm);
     out.robust_margin_lower_mm = std::min(out.robust_margin_lower_mm, out.robust_margin_mm);
     out.covered = out.robust_margin_mm >= 0.0;
-    monte_carlo_margins(m, target, sigma, fraction, samples, seed, out);
+    monte_carlo_margins(m, target, spread, fraction, samples, seed, out);
     return out;
   }
   const std::vector<double> d0 = distances(m);
@@ -236,9 +281,10 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   // over the eight and d(b) - z S bounds the robust margin at b from below: the gradients are
   // needed only at the points, taken by increasing d(b), until that bound passes the best robust
   // margin found (5 % slack for the central differences at a kink).
-  double bound_var = 0.0;
-  for (std::size_t j = 0; j < 8; ++j) bound_var += sigma[j] * sigma[j];
-  const double S = 1.05 * std::sqrt(bound_var);
+  // Correlated errors: g^T C g <= (sum_j |g_j| sigma_j)^2 <= (sum_j sigma_j)^2 (|C_jk| <= sigma_j sigma_k).
+  double bound_var = 0.0, bound_sum = 0.0;
+  for (std::size_t j = 0; j < 8; ++j) bound_var += sigma[j] * sigma[j], bound_sum += sigma[j];
+  const double S = 1.05 * (spread.correlated() ? bound_sum : std::sqrt(bound_var));
   std::vector<std::size_t> order(boundary.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return d0[a] < d0[b]; });
@@ -263,14 +309,12 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   for (const std::size_t k : order) {
     if (d0[k] - out.z * S >= out.robust_margin_mm) break;  // no later point can do worse
     std::array<double, kToleranceParameters> g{};
-    double var = 0.0;
     for (std::size_t j = 0; j < 8; ++j) {
       if (!usable[j]) continue;
       g[j] = (point_distance(moved[2 * j], boundary[k]) - point_distance(moved[2 * j + 1], boundary[k])) /
              (0.02 * sigma[j]);
-      var += g[j] * g[j] * sigma[j] * sigma[j];
     }
-    const double s = std::sqrt(var);
+    const double s = std::sqrt(spread.variance(g));
     const double robust = d0[k] - out.z * s;
     if (robust < out.robust_margin_mm) {
       out.robust_margin_mm = robust;
@@ -285,13 +329,13 @@ RobustCoverage robust_coverage(const Mechanism& m, const Ellipse& target, const 
   out.robust_margin_mm = std::min(out.robust_margin_mm, out.margin_mm);
   out.robust_margin_lower_mm = out.robust_margin_mm;
   out.covered = out.robust_margin_mm >= 0.0;
-  monte_carlo_margins(m, target, sigma, fraction, samples, seed, out);
+  monte_carlo_margins(m, target, spread, fraction, samples, seed, out);
   return out;
 }
 
 namespace {
 
-void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma, double fraction,
+void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const ParameterSpread& sigma, double fraction,
                          std::size_t samples, std::uint64_t seed, RobustCoverage& out) {
   if (samples == 0) return;
 
@@ -299,8 +343,11 @@ void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const Parame
   std::vector<std::array<double, kToleranceParameters>> draws(samples);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
-  for (auto& dq : draws)
-    for (std::size_t j = 0; j < kToleranceParameters; ++j) dq[j] = sigma[j] * normal(rng);
+  for (auto& dq : draws) {
+    std::array<double, kToleranceParameters> z{};
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) z[j] = normal(rng);
+    dq = sigma.draw(z);
+  }
   std::vector<double> margins(samples);
   const auto n = static_cast<std::ptrdiff_t>(samples);
 #pragma omp parallel for schedule(dynamic, 64)
@@ -331,14 +378,18 @@ void monte_carlo_margins(const Mechanism& m, const Ellipse& target, const Parame
 
 }  // namespace
 
-std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSigmas& sigma,
+std::vector<DeviceSample> tolerance_devices(const Mechanism& m, const Ellipse& target, const ParameterSpread& spread,
                                             std::size_t samples, std::uint64_t seed) {
   std::vector<DeviceSample> out(samples);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
-  for (DeviceSample& d : out)
-    for (std::size_t j = 0; j < kToleranceParameters; ++j) d.dq[j] = sigma[j] * normal(rng);
   const Pose nominal = ik(m, target.center);
+  const ParameterSpread sigma = nominal.status == Status::ok ? spread.at(nominal.theta1, nominal.theta2) : spread;
+  for (DeviceSample& d : out) {
+    std::array<double, kToleranceParameters> z{};
+    for (std::size_t j = 0; j < kToleranceParameters; ++j) z[j] = normal(rng);
+    d.dq = sigma.draw(z);
+  }
   Mechanism free = m;
   free.joint_limits.reset();
   if (nominal.status == Status::ok) free.assembly_mode = nominal.assembly > 0 ? AssemblyMode::Plus : AssemblyMode::Minus;
@@ -382,6 +433,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
   map.mechanism = m.name;
   map.target = target;
   const double per_count = std::max(src.rad_per_count[0], src.rad_per_count[1]);
+  const ParameterSpread spread = src.spread();
   // Bounding box of the intersection of the two outer disks (the reachable region's superset).
   const double R1 = m.L[0] + m.L[2], R2 = m.L[1] + m.L[3];
   const double xlo = std::max(m.O1.x() - R1, m.O2.x() - R2), xhi = std::min(m.O1.x() + R1, m.O2.x() + R2);
@@ -405,7 +457,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
   for (std::ptrdiff_t k = 0; k < count; ++k) {
     const auto idx = static_cast<std::size_t>(k);
     const Vec2 p(map.x0 + h * static_cast<double>(k % map.nx), map.y0 + h * static_cast<double>(k / map.nx));
-    const ToleranceEstimate e = tolerance_first_order(m, p, src.sigma, per_count);
+    const ToleranceEstimate e = tolerance_first_order(m, p, spread, per_count);
     map.field_status[idx] = static_cast<std::uint8_t>(e.status);
     if (e.status != Status::ok) continue;
     map.field_3sigma_mm[idx] = e.ellipse_semi_axes.x();
@@ -415,14 +467,14 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
     map.field_play_mm[idx] = tolerance_play(m, p, src.leg_play_mm).extent_mm;
   }
 
-  map.centre = tolerance_first_order(m, target.center, src.sigma, per_count);
-  map.centre_monte_carlo = tolerance_monte_carlo(m, target.center, src.sigma, src.samples, src.seed);
+  map.centre = tolerance_first_order(m, target.center, spread, per_count);
+  map.centre_monte_carlo = tolerance_monte_carlo(m, target.center, spread, src.samples, src.seed);
   map.centre_monte_carlo_3sigma_mm = major_3sigma_mm(map.centre_monte_carlo.covariance);
   map.centre_play = tolerance_play(m, target.center, src.leg_play_mm);
   map.target_points_mm = ellipse_grid(target);
   for (const Vec2& p : map.target_points_mm) {
     ++map.target_points;
-    const ToleranceEstimate e = tolerance_first_order(m, p, src.sigma, per_count);
+    const ToleranceEstimate e = tolerance_first_order(m, p, spread, per_count);
     map.target_estimates.push_back(e);
     const PlaySet play = tolerance_play(m, p, src.leg_play_mm);
     if (e.status != Status::ok || play.status != Status::ok) {
@@ -433,7 +485,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
       ToleranceMap::Flagged f;
       f.at = p;
       f.first_order = e;
-      f.corners = tolerance_corners(m, p, src.sigma);
+      f.corners = tolerance_corners(m, p, spread);
       map.near_singular.push_back(f);
     }
     if (e.ellipse_semi_axes.x() > map.worst_3sigma_mm) {
@@ -458,13 +510,15 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
   if (!map.near_singular.empty()) {  // the Monte Carlo where the first order is not to be trusted
     std::vector<Vec2> at;
     for (const auto& f : map.near_singular) at.push_back(f.at);
-    const auto mc = tolerance_monte_carlo(m, at, src.sigma, src.samples, src.seed);
+    const auto mc = tolerance_monte_carlo(m, at, spread, src.samples, src.seed);
     for (std::size_t k = 0; k < at.size(); ++k) {
       map.near_singular[k].monte_carlo = mc[k];
       map.near_singular[k].monte_carlo_3sigma_mm = major_3sigma_mm(mc[k].covariance);
     }
   }
-  map.robust = robust_coverage(m, target, src.sigma, src.robust_fraction, src.samples, src.seed);
+  map.robust = robust_coverage(m, target, spread, src.robust_fraction, src.samples, src.seed);
+  map.spread_source = src.spread_source;
+  map.calibrated = spread.calibrated();
   return map;
 }
 
@@ -477,6 +531,7 @@ Json to_json(const RobustCoverage& r) {
   robust["margin_mm"] = r.margin_mm;
   robust["decided"] = r.decided;
   robust["margin_sigma_mm"] = r.sigma_mm;
+  robust["calibrated"] = r.calibrated;
   robust["z"] = r.z;
   robust["robust_margin_mm"] = r.robust_margin_mm;
   robust["robust_margin_lower_mm"] = r.robust_margin_lower_mm;
@@ -501,6 +556,8 @@ Json to_json(const ToleranceMap& map) {
   const auto xy = [](const Vec2& p) { return Json::array({p.x(), p.y()}); };
   Json j;
   j["mechanism"] = map.mechanism;
+  j["sigmas_from"] = map.spread_source;
+  j["calibrated"] = map.calibrated;
   j["centre_status"] = std::string(to_string(map.centre.status));
   j["centre_3sigma_mm"] = map.centre.ellipse_semi_axes.x();
   j["centre_3sigma_minor_mm"] = map.centre.ellipse_semi_axes.y();

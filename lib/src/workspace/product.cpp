@@ -64,6 +64,7 @@ Product workspace_product() {
   Product p;
   p.name = "workspace";
   p.title = "Reachable workspace";
+  p.cost_s = 1.0;  // scheduler hint only (Product::cost_s)
   p.unavailable = without_mechanisms;
   p.build = [](Context& ctx) {
     Built b;

@@ -307,6 +307,16 @@ double restriction_margin(const Mechanism& m, Restriction restriction, const Vec
     if (inner > 0.0) margin = std::min(margin, d - inner);
   }
   if (margin < 0.0) return margin;
+  if (restriction != Restriction::lci && !m.joint_limits) {
+    // Only the elbows are needed: the two circle intersections ik() starts from, the same
+    // numbers without its angles and analysis (ik() is unreachable exactly when one is).
+    const CircleIntersection x1 = intersect_circles(m.O1, m.L[0], p, m.L[2], -m.working_mode.sign1);
+    const CircleIntersection x2 = intersect_circles(m.O2, m.L[1], p, m.L[3], -m.working_mode.sign2);
+    if (x1.status == Status::unreachable || x2.status == Status::unreachable) return std::min(margin, 0.0);
+    if (restriction == Restriction::reach || m.assembly_mode == AssemblyMode::Any) return margin;
+    const double cb = detail::cross(p - x1.point, p - x2.point);
+    return std::min(margin, double(int(m.assembly_mode)) * cb / (m.L[2] + m.L[3]));
+  }
   const Pose pose = ik(m, p);
   if (pose.status == Status::unreachable) return std::min(margin, 0.0);
   if (m.joint_limits) {

@@ -108,6 +108,11 @@ struct CalibrationResult {
   bool sigma_estimated = false;           ///< from the residuals (no sigma_mm given)
   Eigen::MatrixXd covariance;             ///< over the identified parameters, in their file units
   std::vector<std::string> covariance_names;
+  /// The posterior covariance of the identified design keys (`key_covariance_keys`, the parameters'
+  /// keys in their order, file units): what the patched design's provenance entries record as
+  /// sigmas and correlations (docs/calibrate.md "Posterior covariance in the design").
+  Eigen::MatrixXd key_covariance;
+  std::vector<std::string> key_covariance_keys;
   Figures before, after, holdout_before, holdout_after;
   std::vector<PoseResidual> residuals;
   int iterations = 0;

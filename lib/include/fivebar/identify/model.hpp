@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/design.hpp"
 #include "fivebar/identify/log.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -31,7 +32,18 @@ struct JointPrior {
   double adc_lo_v = -10.0, adc_hi_v = 10.0;
   double load_inertia = 0.0;    ///< kg m^2 at the output, known (--load-inertia); 0: none
   std::string motor_key = "motor";  ///< "motor" or "motor.stations.index.lower.theta1"
+  /// A torque at this joint known from a model, N m per log row (empty: none): the closed chain's
+  /// [M_links(theta) dw/dt + h]_j of `--rig mechanism`, subtracted from the drive torque, so that
+  /// the inertia left to identify is the joint's own (the reflected rotor, N^2 J_r).
+  std::vector<double> known_torque;
 };
+
+/// The priors of a joint: its motor (the joint's overrides applied), potentiometer and ADC from the
+/// design, and the key path its motor values live at; `station` empty: a motor on the bench (the
+/// `motor:` defaults, key `motor`). InputError when `need_motor` and the design has no `motor:`
+/// section, or when the station has no such mechanism.
+JointPrior joint_prior(const Design& design, const std::string& station, const std::string& mechanism, int joint,
+                       double load_inertia, bool need_motor);
 
 /// tau_d = alpha * d - g * w for the drive kind, from the priors (output shaft, SI).
 struct ReducedDrive {

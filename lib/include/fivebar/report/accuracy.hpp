@@ -112,7 +112,7 @@ struct PrecisionStudy {
 /// One run of the dynamics at one tolerance (work-precision of fivebar/dynamics.hpp).
 struct DynamicsPoint {
   double rtol = 0.0;
-  double time_s = 0.0;       ///< wall time of the run (median of repeats after a warm-up)
+  double time_s = 0.0;       ///< wall time of the run (the median of three under 0.05 s; quick: one run)
   double error_mm = 0.0;     ///< max over the controller's samples and both tactors of |P - P_reference|
   std::size_t steps = 0;     ///< integrator steps
   std::size_t rhs_evaluations = 0;

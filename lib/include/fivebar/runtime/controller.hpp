@@ -12,8 +12,8 @@
 ///      its last valid command; before any, zero duty);
 ///   4. the priority rule on the commanded poses: when the lower mechanism's outline comes closer
 ///      than min_clearance to the upper's, the lower target moves to the closest collision-free
-///      point found by a bounded ring-and-ray search (kPriorityRays rays, kPriorityRings rings,
-///      kPriorityBisections bisections: at most kPriorityMaxProbes pose evaluations);
+///      point: closed-form exits of rays from the forbidden capsules of its tactor point, checked
+///      by at most kPriorityMaxProbes pose evaluations (a march and a bisection where links block);
 ///   5. per joint the PID with the integral clamp and a backward-difference derivative:
 ///        s_k = clamp(s_{k-1} + e_k T, -i_clamp / i, i_clamp / i)   (no clamp when i <= 0),
 ///        d_k = (e_k - e_{k-1}) / T (0 at the first sample after init, a reset or a fault),
@@ -50,15 +50,17 @@ enum class Reading : std::uint8_t {
   radians = 2,  ///< joint angles (an encoder, or a simulation without the ADC)
 };
 
-/// Priority-rule search bounds (docs/runtime.md): rings of spacing kPriorityRingRel times the
-/// lower mechanism's length scale, up to kPriorityRings, kPriorityRays directions per ring; the
-/// free rays of the first ring holding one (and of the next) are bisected kPriorityBisections times.
+/// Priority-rule bounds (docs/runtime.md "Priority rule"): the exits of kPriorityRays fixed
+/// directions and of the projections onto the forbidden capsules of the tactor point are closed
+/// forms; a ray whose exit the links block advances conservatively (at least kPriorityMinStepRel
+/// length scales), at most kPriorityAdvances times, and its first free point is bisected
+/// kPriorityBisections times. At most kPriorityMaxProbes pose evaluations (IK, outline,
+/// clearance) per station and cycle.
 inline constexpr int kPriorityRays = 32;
-inline constexpr int kPriorityRings = 40;
-inline constexpr double kPriorityRingRel = 0.025;
-inline constexpr int kPriorityBisections = 16;
-/// Pose evaluations (IK, outline, clearance) of one priority search, at most.
-inline constexpr int kPriorityMaxProbes = kPriorityRays * (kPriorityRings + 1) + kPriorityRays * kPriorityBisections;
+inline constexpr double kPriorityMinStepRel = 0.0005;
+inline constexpr int kPriorityAdvances = 24;
+inline constexpr int kPriorityBisections = 10;
+inline constexpr int kPriorityMaxProbes = 128;
 
 /// One mechanism after a cycle.
 struct MechanismState {

@@ -20,6 +20,11 @@ struct ProvenanceEntry {
   std::string date;            ///< YYYY-MM-DD (UTC)
   std::string method;          ///< "fivebar calibrate (Ceres, Levenberg-Marquardt)", "datasheet", ...
   std::optional<double> sigma; ///< standard deviation, in the key's file unit
+  /// Correlation coefficients of this value's error with other measured values (their key paths,
+  /// each with its own entry and sigma): the posterior covariance of a fit is sigma_a sigma_b rho_ab
+  /// (fivebar/provenance.hpp provenance_covariance()). A pair is written once, under the key that
+  /// sorts first; either side is read.
+  std::map<std::string, double, std::less<>> correlation;
   void validate() const;
 };
 

@@ -1,0 +1,27 @@
+#pragma once
+/// The `bench:` section of a design file: the bench measurements `fivebar run` fits the design to
+/// (docs/calibrate.md, docs/identify.md), file names relative to the design file:
+///   calibration     measurements for `calibrate` (station,mechanism,volts1,volts2,x_mm,y_mm[,sigma_mm])
+///   identification  a log for `identify --rig motor` (time_s, a drive, a reading per joint)
+/// With a file named, the `calibrate` or `identify` product writes its report and the patched
+/// design (values and provenance: entries) into the output folder. One module of the design
+/// (docs/architecture.md "Design sections"): loader and writer in lib/src/sections/bench.cpp.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "fivebar/design.hpp"
+
+namespace fivebar {
+
+struct BenchSettings {
+  static constexpr std::string_view kKey = "bench";
+  std::string calibration;     ///< as written (relative to the design file); empty: none
+  std::string identification;  ///< as written; empty: none
+  /// `file` resolved against the design file's folder (as given when absolute or without a source).
+  static std::filesystem::path resolve(const Design& design, const std::string& file);
+  void validate() const;
+};
+
+}  // namespace fivebar

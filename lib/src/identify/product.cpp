@@ -1,0 +1,93 @@
+// The `identify` product: the motor, friction and inertia of the joints of the bench log the
+// design's `bench:` section names (fivebar/identify.hpp, docs/identify.md), by IDIM-LS; writes
+// identify/identify.json and identify/<design>-identified.yaml (the identified motor keys with
+// their provenance: entries). The output-error refinement and the plots are `fivebar identify`'s.
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+#include <string>
+
+#include "fivebar/format.hpp"
+#include "fivebar/identify.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/sections/bench.hpp"
+#include "fivebar/sha256.hpp"
+#include "products/markdown.hpp"
+#include "products/product.hpp"
+
+namespace fivebar::products {
+
+Product identify_product() {
+  Product p;
+  p.name = "identify";
+  p.title = "Motor and friction identification from the bench";
+  p.unavailable = [](const Design& d) -> std::optional<std::string> {
+    const BenchSettings* b = d.get<BenchSettings>();
+    if (b == nullptr || b->identification.empty()) return "the design names no identification log (`bench.identification`)";
+    return std::nullopt;
+  };
+  p.build = [](Context& ctx) {
+    const Design& d = ctx.design;
+    const std::string& name = d.get<BenchSettings>()->identification;
+    const std::filesystem::path file = BenchSettings::resolve(d, name);
+    identify::IdentifyLog log = identify::read_identify_log(file);
+    log.path = name;
+    identify::IdentifyOptions o;
+    o.output_error = false;  // IDIM-LS only: the refinement is `fivebar identify`'s (it simulates)
+    std::vector<identify::JointIdentification> results;
+    for (const identify::JointLog& j : log.joints) {
+      const bool need_motor = !j.linear && j.drive != identify::DriveKind::torque;
+      const identify::JointPrior prior = identify::joint_prior(d, j.station, j.mechanism, j.joint, 0.0, need_motor);
+      results.push_back(identify::identify_joint(j, log.time, prior, nullptr, nullptr, o));
+    }
+    Json doc = {{"log", name}, {"method", "IDIM-LS"}, {"joints", Json::array()}};
+    for (const auto& r : results) doc["joints"].push_back(identify::to_json(r));
+    const std::vector<std::string> keys = identify::patched_keys(results);
+    std::string patched_file;
+    if (!keys.empty()) {
+      MeasurementSource source{name, sha256_file(file), today_utc(),
+                               "fivebar identify --rig motor: inverse dynamic model by least squares (IDIM-LS), standard deviation"};
+      std::vector<std::string> skipped;
+      Design patched = identify::patched_design(d, results, source, &skipped);
+      doc["not_patched"] = skipped;
+      patched.reset<BenchSettings>();  // the patched design lives in the output folder
+      patched_file = "identify/" + d.name + "-identified.yaml";
+      ctx.write_file(patched_file, to_yaml(patched));
+      doc["patched"] = keys;
+      doc["patched_design"] = patched_file;
+    }
+    ctx.write_file("identify/identify.json", doc.dump(2) + "\n");
+
+    Built b;
+    std::string md = "The bench log `" + name + "` fitted by `fivebar identify --rig motor` (IDIM-LS, docs/identify.md; the "
+                     "output-error refinement and the plots are the command's).\n\n";
+    md::Table t({"joint", "parameter", "value", "σ", ""}, "llrrl");
+    for (const auto& r : results) {
+      for (const identify::Parameter& q : r.parameters) {
+        if (!q.identified) continue;
+        char value[32], sigma[32];
+        std::snprintf(value, sizeof value, "%.5g", q.value);
+        std::snprintf(sigma, sizeof sigma, "%.3g", q.sigma);
+        t.row({md::code(r.joint), md::code(q.key), value, sigma,
+               std::find(keys.begin(), keys.end(), q.key) != keys.end() ? "patched" : ""});
+      }
+    }
+    md += t.str() + "\n";
+    for (const auto& r : results) {
+      md += "- " + md::code(r.joint) + ": drive fit " + md::fixed(r.estimation_idim.drive_fit_percent, 1) + " % (inverse model)";
+      if (!r.unidentifiable.empty()) md += "; not identifiable from this log (held at the prior): " + format::join(r.unidentifiable);
+      md += "\n";
+    }
+    md += "\nFiles: [`identify/identify.json`](identify/identify.json)";
+    if (!patched_file.empty()) md += ", [`" + patched_file + "`](" + patched_file + ") (the identified motor keys with their `provenance:` entries)";
+    md += ".\n";
+    b.markdown = md;
+    b.result = doc;
+    b.check = std::to_string(results.size()) + " joint(s), " + std::to_string(keys.size()) + " design key(s) identified";
+    return b;
+  };
+  return p;
+}
+
+}  // namespace fivebar::products
