@@ -31,13 +31,16 @@ struct AnimateOptions {
 int run_animate(const AnimateOptions& opt) {
   const auto kind = parse_pattern_kind(opt.pattern);
   if (!kind) throw InputError("--pattern '" + opt.pattern + "': expected stretch, slip, twist or pivot");
-  const std::filesystem::path out(opt.out);
-  if (out.extension() == ".gif") {
+  // --out is the directory (as for every command); the file is <station>-<pattern>.svg, as
+  // `fivebar run` names it. A file name is refused with what to write instead.
+  const std::filesystem::path given(opt.out);
+  if (given.extension() == ".gif") {
     throw InputError("--out " + opt.out + ": fivebar writes the animation as SVG only; for a GIF, take frames with "
                      "a browser at FILE.svg#t=SECONDS (README \"fivebar animate\") and join them with a GIF tool");
   }
-  if (out.extension() != ".svg" || out.filename() == ".svg") {
-    throw InputError("--out " + opt.out + ": expected a file name ending in .svg");
+  if (given.extension() == ".svg" || given.extension() == ".png") {
+    throw InputError("--out " + opt.out + ": --out is the directory of the file (written as <station>-<pattern>.svg), "
+                     "not the file");
   }
   if (!(opt.width_px >= 360.0 && opt.width_px <= 4000.0)) {
     throw InputError("--width must be between 360 and 4000 pixels");
@@ -71,7 +74,8 @@ int run_animate(const AnimateOptions& opt) {
   const std::string svg = animate_pattern_svg(s, r, options);
   const std::size_t frames = animation_frames(s, r, options.max_frames).size();
 
-  const std::filesystem::path dir = out.has_parent_path() ? out.parent_path() : std::filesystem::path(".");
+  const std::filesystem::path dir = command_output_dir(opt.out, design.name, "animations");
+  const std::filesystem::path out = dir / (s.name + "-" + std::string(to_string(*kind)) + ".svg");
   make_directories(dir);
   const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   write_file_atomic(out, svg);
@@ -116,7 +120,9 @@ void setup_animate(CLI::App& app) {
   sub->add_option("--pattern", opt->pattern, "stretch, slip, twist or pivot (from the design's patterns: section)")
       ->required()
       ->type_name("KIND");
-  sub->add_option("-o,--out", opt->out, "The SVG file to write")->required()->type_name("FILE.svg");
+  sub->add_option("-o,--out", opt->out,
+                  "Directory for <station>-<pattern>.svg (default: outputs/<design>/animations)")
+      ->type_name("DIR");
   sub->add_option("--simulated", opt->simulated,
                   "A time series CSV of `fivebar simulate` for this station and pattern: the simulated tactor is "
                   "drawn beside the reference")

@@ -202,6 +202,10 @@ Ellipse parse_ellipse(std::string_view text, std::string_view option) {
 
 // --- Output -----------------------------------------------------------------------------------
 
+std::filesystem::path command_output_dir(const std::string& out, const std::string& design_name, std::string_view sub) {
+  return out.empty() ? resolve_output_dir("outputs", design_name) / std::string(sub) : std::filesystem::path(out);
+}
+
 std::string remedy_hint(Remedy remedy) {
   switch (remedy) {
     case Remedy::none: return "";

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <atomic>
+#include <filesystem>
 #include <functional>
 #include <istream>
 #include <memory>
@@ -96,6 +97,10 @@ std::vector<std::string_view> split(std::string_view line, char sep);
 std::optional<double> parse_number(std::string_view text);
 
 // --- Output -----------------------------------------------------------------------------------
+
+/// Where a command writes: `--out` is always the directory of the command's files; without it,
+/// outputs/<design name>/<sub> (as `fivebar run` writes that product). Not created here.
+std::filesystem::path command_output_dir(const std::string& out, const std::string& design_name, std::string_view sub);
 
 /// The command line's words for a library remedy (fivebar/error.hpp): "--yes confirms it", ...;
 /// empty for Remedy::none.

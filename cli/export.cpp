@@ -107,7 +107,7 @@ int run_export(const ExportCliOptions& opt) {
   options.progress = terminal_progress("export");
   // The directory is created only once the gate has passed.
   const std::filesystem::path dir =
-      opt.out.empty() ? resolve_output_dir("outputs", design.name) / "export" : std::filesystem::path(opt.out);
+      command_output_dir(opt.out, design.name, "export");
   const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const ExportResult r = export_controller(design, formats, dir, options);
 

@@ -195,7 +195,7 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   std::vector<std::string> files;
   if (!opt.no_files) {
     const std::filesystem::path dir =
-        opt.out.empty() ? resolve_output_dir("outputs", design.name) / "identify" : std::filesystem::path(opt.out);
+        command_output_dir(opt.out, design.name, "identify");
     make_directories(dir);
     WriteFence fence(dir);
     std::ostringstream csv;
@@ -326,7 +326,7 @@ int run_identify(const IdentifyCliOptions& opt) {
   std::vector<std::string> files;
   if (!opt.no_files) {
     const std::filesystem::path dir =
-        opt.out.empty() ? resolve_output_dir("outputs", design.name) / "identify" : std::filesystem::path(opt.out);
+        command_output_dir(opt.out, design.name, "identify");
     make_directories(dir);
     WriteFence fence(dir);
     if (patched) {

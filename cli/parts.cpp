@@ -16,7 +16,7 @@ namespace {
 struct PartsCliOptions {
   std::string design;
   std::string station;
-  std::string out = "outputs";
+  std::string out;  ///< empty: outputs/<design name>/parts
   bool no_render = false;
   bool json = false;
   int jobs = 2;
@@ -57,7 +57,7 @@ void print_table(const PartsReport& r, const std::filesystem::path& dir) {
 int run_parts(const PartsCliOptions& opt) {
   const Design design = load(opt.design);
   PartsOptions options;
-  options.out_dir = resolve_output_dir(opt.out, design.name) / "parts";
+  options.out_dir = command_output_dir(opt.out, design.name, "parts");
   const WriteFence fence(options.out_dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   if (!opt.station.empty()) options.station = opt.station;
   options.render = !opt.no_render;
@@ -91,7 +91,7 @@ void setup_parts(CLI::App& app) {
   add_design_argument(*sub, opt->design);
   sub->add_option("-s,--station", opt->station, "Only this station (e.g. index); default: every station")
       ->type_name("NAME");
-  sub->add_option("-o,--out", opt->out, "Output root; parts go to OUT/<design name>/parts/")
+  sub->add_option("-o,--out", opt->out, "Directory for the parts (default: outputs/<design>/parts)")
       ->capture_default_str()
       ->type_name("DIR");
   sub->add_flag("--no-render", opt->no_render, "Write the .scad sources (and a BOM without volumes) only");

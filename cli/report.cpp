@@ -15,7 +15,7 @@ namespace {
 struct ReportOptions {
   std::string design;
   std::string station;
-  std::string out = "outputs";
+  std::string out;  ///< empty: outputs/<design name>/report
   bool json = false;
   bool quick = false;
   bool quiet = false;
@@ -33,7 +33,7 @@ int run_accuracy(const ReportOptions& opt) {
   options.station = opt.station;
   options.progress = progress_sink(opt.quiet);
   // Resolve the output directory before the long computation so that a bad --out fails early.
-  const std::filesystem::path dir = resolve_output_dir(opt.out, design.name) / "report";
+  const std::filesystem::path dir = command_output_dir(opt.out, design.name, "report");
   const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const AccuracyReport report = accuracy_report(design, options);
   const auto files = write_accuracy_plots(report, dir);
@@ -94,7 +94,7 @@ void setup_report(CLI::App& app) {
       "long double and the library's double paths against a __float128 reference, stratified by distance to "
       "singularity. Writes one SVG and PNG plot per method into OUT/<design name>/report/.");
   add_common(*a, *acc);
-  a->add_option("-o,--out", acc->out, "Output root for the plots; they go to OUT/<design name>/report/")
+  a->add_option("-o,--out", acc->out, "Directory for the plots (default: outputs/<design>/report)")
       ->capture_default_str()
       ->type_name("DIR");
   a->add_flag("--quick", acc->quick, "Coarser series and fewer samples (a few seconds instead of ~30 s)");

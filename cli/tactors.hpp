@@ -46,8 +46,7 @@ inline const Geometry& require_geometry(const Design& design) {
 
 /// --out, or outputs/<design name>/<sub> by default; created.
 inline std::filesystem::path output_dir(const Design& design, const std::string& out, const std::string& sub) {
-  const std::filesystem::path dir = out.empty() ? resolve_output_dir("outputs", design.name) / sub
-                                                : std::filesystem::path(out);
+  const std::filesystem::path dir = command_output_dir(out, design.name, sub);
   make_directories(dir);
   return dir;
 }

@@ -136,7 +136,7 @@ int run_tolerance(const ToleranceCliOptions& opt) {
   std::vector<std::string> files;
   std::filesystem::path dir;
   if (!opt.no_files) {
-    dir = opt.out.empty() ? resolve_output_dir("outputs", design.name) / "tolerance" : std::filesystem::path(opt.out);
+    dir = command_output_dir(opt.out, design.name, "tolerance");
     make_directories(dir);
   }
   std::optional<WriteFence> fence;  // nothing of this command lands outside its folder (fivebar/io.hpp)

@@ -65,7 +65,7 @@ int run_workspace(const WorkspaceCliOptions& opt) {
   const auto stations = design.select_stations(opt.station);
   if (stations.empty()) throw InputError("design '" + design.name + "' has no station with a mechanism");
   const std::filesystem::path dir =
-      opt.out.empty() ? resolve_output_dir("outputs", design.name) / "workspace" : std::filesystem::path(opt.out);
+      command_output_dir(opt.out, design.name, "workspace");
   const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const auto progress = terminal_progress("workspace");
 

@@ -143,10 +143,10 @@ def main():
     run("pattern", "pattern", ["pattern", DESIGN, "-s", "thumb", "--pattern", "twist", "--out", out + "/pat"])
     run("sweep", "sweep", ["sweep", DESIGN, "--no-plots", "--out", out + "/sweep"])
     run("optimize", "optimize", ["optimize", DESIGN, "--evaluations", "128", "--no-plots", "--out", out + "/optimize"])
-    run("parts", "parts", ["parts", DESIGN, "--no-render", "--out", out])
+    run("parts", "parts", ["parts", DESIGN, "--no-render", "--out", out + "/parts"])
     run("export", "export", ["export", DESIGN, "--out", out + "/export"])
     run("report stability", "report-stability", ["report", "stability", DESIGN, "-s", "index", "-q"])
-    run("report accuracy", "report-accuracy", ["report", "accuracy", DESIGN, "-s", "index", "--quick", "-q", "--out", out])
+    run("report accuracy", "report-accuracy", ["report", "accuracy", DESIGN, "-s", "index", "--quick", "-q", "--out", out + "/report"])
     run("simulate", "simulate", ["simulate", DESIGN, "-s", "index", "--pattern", "stretch", "--no-render", "--out", out + "/sim"])
     run("simulate --step", "simulate", ["simulate", DESIGN, "-s", "index", "--step", "--no-render", "--out", out + "/sim"])
     sil = run("replay --sil", "replay", ["replay", DESIGN, "--sil", "-s", "index", "--pattern", "stretch", "--out", out + "/replay"])
@@ -181,7 +181,7 @@ def main():
         (WORK / "meas.csv").write_text("\n".join(meas) + "\n")
         run("calibrate", "calibrate", ["calibrate", DESIGN, str(WORK / "meas.csv"), "--frame", "fit", "--holdout", "2",
                                        "--out", out + "/cal"])
-    run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/twist.svg"])
+    run("animate", "animate", ["animate", DESIGN, "-s", "index", "--pattern", "twist", "--out", out + "/anim"])
     # docs/reliability.md: the hostile and partial shapes validate too, and keep the conventions.
     if keyed_by_name({"a": {"lower": 1.0, "upper": None}}) != ["$.a"] or keyed_by_name({"lower": 1, "x": 2}):
         failures.append("self-test: the name-key walk is wrong")

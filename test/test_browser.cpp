@@ -248,9 +248,9 @@ TEST_F(Browser, TheReportLoadsOfflineWithNoConsoleMessageAndEveryAnimationRuns) 
 }
 
 TEST_F(Browser, TwoInstantsDifferWhereTheLinkagesAreAndMatchElsewhere) {
-  const Outcome made = run({"animate", kDesign, "-s", "index", "--pattern", "twist", "--out", "twist.svg"});
+  const Outcome made = run({"animate", kDesign, "-s", "index", "--pattern", "twist", "--out", "anim"});
   ASSERT_EQ(made.code, 0) << made.err;
-  const std::string svg = slurp(dir_ / "twist.svg");
+  const std::string svg = slurp(dir_ / "anim" / "index-twist.svg");
   const json d = frames_of(svg);
   ASSERT_TRUE(d.is_object());
   const int width = static_cast<int>(number_after(svg, "width=\""));
@@ -261,7 +261,7 @@ TEST_F(Browser, TwoInstantsDifferWhereTheLinkagesAreAndMatchElsewhere) {
   std::vector<Image> shots;
   for (const double t : instants) {
     const fs::path png = dir_ / ("t" + std::to_string(shots.size()) + ".png");
-    const Outcome r = chromium(file_url(dir_ / "twist.svg") + "#t=" + std::to_string(t),
+    const Outcome r = chromium(file_url(dir_ / "anim" / "index-twist.svg") + "#t=" + std::to_string(t),
                                {"--window-size=" + std::to_string(width) + "," + std::to_string(height),
                                 "--virtual-time-budget=1000", "--screenshot=" + png.string()});
     ASSERT_EQ(r.code, 0) << r.err;

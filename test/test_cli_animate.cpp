@@ -37,8 +37,8 @@ class CliAnimate : public ft::CliTest {
 };
 
 TEST_F(CliAnimate, WritesTheFramesOfThePatternWithTheDesignsLinkLengths) {
-  const fs::path out = dir_ / "movies" / "thumb-twist.svg";
-  const Outcome r = run({"animate", kDesign, "--station", "thumb", "--pattern", "twist", "--out", out.string()});
+  const fs::path out = dir_ / "movies" / "thumb-twist.svg";  // --out is the directory
+  const Outcome r = run({"animate", kDesign, "--station", "thumb", "--pattern", "twist", "--out", (dir_ / "movies").string()});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("101 frames over 1.000 s (renderable)"));
   const std::string svg = slurp(out);
@@ -69,14 +69,14 @@ TEST_F(CliAnimate, SimulatedSeriesAndJson) {
   }
   const fs::path sim = write("sim.csv", csv);
   const Outcome r = run({"animate", kDesign, "-s", "index", "--pattern", "stretch", "--simulated", sim.string(), "--out",
-                         "a.svg", "--json"});
+                         "a", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = parse(r);
   EXPECT_EQ(j["command"], "animate");
   EXPECT_EQ(j["frames"], 101);
   EXPECT_EQ(j["simulated"], true);
   EXPECT_EQ(j["renderable"], true);
-  const json d = frames_of(slurp(dir_ / "a.svg"));
+  const json d = frames_of(slurp(dir_ / "a" / "index-stretch.svg"));
   ASSERT_TRUE(d["mechanisms"][0].contains("simulated"));
   EXPECT_NEAR(d["mechanisms"][0]["simulated"][40][1].get<double>(), 19.54, 1e-4);
 }
@@ -89,17 +89,16 @@ TEST_F(CliAnimate, BadInputExitsTwoAndWritesNothing) {
     std::string message;
   };
   const std::vector<Case> cases{
-      {{"animate", kDesign, "-s", "index", "--pattern", "wiggle", "--out", "o/a.svg"}, "--pattern 'wiggle'"},
+      {{"animate", kDesign, "-s", "index", "--pattern", "wiggle", "--out", "o"}, "--pattern 'wiggle'"},
       {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o/a.gif"}, "SVG only"},
-      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o/a.png"}, "ending in .svg"},
-      {{"animate", kDesign, "-s", "ring", "--pattern", "stretch", "--out", "o/a.svg"}, "unknown station 'ring'"},
-      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o/a.svg", "--width", "nan"}, "--width"},
-      {{"animate", no_patterns.string(), "-s", "index", "--pattern", "stretch", "--out", "o/a.svg"}, "no patterns: section"},
-      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o/a.svg", "--simulated", "none.csv"},
+      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o/a.svg"}, "is the directory"},
+      {{"animate", kDesign, "-s", "ring", "--pattern", "stretch", "--out", "o"}, "unknown station 'ring'"},
+      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o", "--width", "nan"}, "--width"},
+      {{"animate", no_patterns.string(), "-s", "index", "--pattern", "stretch", "--out", "o"}, "no patterns: section"},
+      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o", "--simulated", "none.csv"},
        "--simulated none.csv"},
-      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o/a.svg", "--simulated", bad_csv.string()},
+      {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o", "--simulated", bad_csv.string()},
        "bad.csv:1: no column y_mm"},
-      {{"animate", kDesign, "-s", "index", "--pattern", "stretch"}, "--out is required"},
   };
   const std::vector<std::string> before = tree(dir_);
   for (const Case& c : cases) {

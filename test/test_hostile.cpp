@@ -354,13 +354,13 @@ std::vector<Case> cases() {
                {"rate_hz = 1000000000 Hz"}});
   c.push_back({"PatternAmplitudeNaN", sub({"pattern"}, {"-s", "index", "--pattern", "stretch", "--amplitude", "nan"}),
                {both}, {"amplitude_mm = nan"}});
-  c.push_back({"AnimateUnknownKind", {"animate", "both.yaml", "-s", "index", "--pattern", "wiggle", "--out", "out/a.svg"},
+  c.push_back({"AnimateUnknownKind", {"animate", "both.yaml", "-s", "index", "--pattern", "wiggle", "--out", "out"},
                {both}, {"--pattern 'wiggle'", "stretch"}});
   c.push_back({"AnimateGif", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.gif"}, {both},
                {"SVG only"}});
-  c.push_back({"AnimateWithoutPatterns", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg"},
+  c.push_back({"AnimateWithoutPatterns", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out"},
                {both}, {"no patterns: section"}});
-  c.push_back({"AnimateWidthHuge", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg",
+  c.push_back({"AnimateWidthHuge", {"animate", "both.yaml", "-s", "index", "--pattern", "stretch", "--out", "out",
                                     "--width", "1e300"}, {both}, {"--width"}});
   c.push_back({"ControlGridHuge", sub({"control"}, {"--grid", "1000000"}), {both}, {"--grid must be within [3, 401]"}});
   c.push_back({"ControlFieldNotANumber", sub({"control"}, {"--field", "abc"}), {both}, {"--field", "abc"}});
@@ -414,11 +414,11 @@ std::vector<Case> cases() {
                                             "    duration_s: 600\n    separation_mm: 8            # vertical"))},
                {"dense output", "is large", "GB of files", "--yes"}});
   c.push_back({"AnimateSimulatedDevZero",
-               {"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg", "--simulated", "/dev/zero"},
+               {"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out", "--simulated", "/dev/zero"},
                {showcase}, {"/dev/zero:1:", "line longer than 4096 bytes"}});
   // Family 3: bad input refused before the first byte is written; numeric flags are numbers.
   c.push_back({"AnimateSimulatedCoordinateOf1e300",
-               {"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out/a.svg", "--simulated", "sim.csv"},
+               {"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out", "--simulated", "sim.csv"},
                {showcase, text("sim.csv", "t_s,mechanism,x_mm,y_mm\n0,lower,6.25,15.5\n0.01,lower,1e300,15.5\n")},
                {"sim.csv:3:", "x_mm = 1e+300 mm", "within [-1e12, 1e12]"}});
   c.push_back({"ControlTuneWithoutATwoMechanismStation", {"control", "solo.yaml", "-s", "solo", "--tune", "--out", "out"},

@@ -814,8 +814,8 @@ TEST_F(Parts, CliSourcesOnlyMissingOpenscadAndBadInput) {
   EXPECT_EQ(j["command"], "parts");
   EXPECT_FALSE(j["rendered"].get<bool>());
   EXPECT_EQ(j["parts"].size(), 10u);
-  EXPECT_TRUE(fs::exists(dir_ / "out" / "iros2022" / "parts" / "thumb" / "distal_link_tactor_17.5mm.scad"));
-  EXPECT_FALSE(fs::exists(dir_ / "out" / "iros2022" / "parts" / "thumb" / "distal_link_tactor_17.5mm.stl"));
+  EXPECT_TRUE(fs::exists(dir_ / "out" / "thumb" / "distal_link_tactor_17.5mm.scad"));
+  EXPECT_FALSE(fs::exists(dir_ / "out" / "thumb" / "distal_link_tactor_17.5mm.stl"));
 
   // Bad input: exit 2 with file, line and key; an unknown station.
   const fs::path bad = design_with("bad.yaml", {{"links: [9, 9, 17.5, 17.5]", "links: [9, 4, 17.5, 17.5]"}});

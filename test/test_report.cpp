@@ -805,8 +805,8 @@ TEST_F(ReportCli, AccuracyQuickJsonWritesThePlots) {
   EXPECT_EQ(j["fk"]["strata"].size(), 5u);
   ASSERT_EQ(j["files"].size(), 18u);  // 5 per station, FK, IK, dynamics, stiffness; SVG and PNG
   for (const auto& f : j["files"]) EXPECT_TRUE(fs::exists(f.get<std::string>())) << f;
-  EXPECT_TRUE(fs::exists(dir_ / "o" / "iros2022" / "report" / "accuracy_index_area.png"));
-  EXPECT_TRUE(fs::exists(dir_ / "o" / "iros2022" / "report" / "accuracy_dynamics_stiffness.svg"));
+  EXPECT_TRUE(fs::exists(dir_ / "o" / "accuracy_index_area.png"));
+  EXPECT_TRUE(fs::exists(dir_ / "o" / "accuracy_dynamics_stiffness.svg"));
   EXPECT_EQ(j["dynamics"]["station"], "index");
   EXPECT_GT(j["dynamics"]["crossover_stiffness_ratio"].get<double>(), 1.0);
 }

@@ -2,6 +2,7 @@
 // section names (fivebar/calibrate.hpp, docs/calibrate.md); writes calibrate/calibration-summary.md
 // and calibrate/<design>-calibrated.yaml (the fitted values with their provenance: entries).
 
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -36,6 +37,10 @@ Product calibrate_product() {
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     const BenchSettings* b = d.get<BenchSettings>();
     if (b == nullptr || b->calibration.empty()) return "the design names no bench measurements (`bench.calibration`)";
+    // A design copied away from its bench files still runs its other products.
+    if (const auto file = BenchSettings::resolve(d, b->calibration); !std::filesystem::exists(file)) {
+      return "the bench measurements `" + b->calibration + "` (`bench.calibration`) are not there: " + file.generic_string();
+    }
     return without_mechanisms(d);
   };
   p.build = [](Context& ctx) {

@@ -522,7 +522,9 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     t.design = job.loop.gains;
     for (int k = 0; k < 2; ++k) t.before[std::size_t(k)] = ctl.hand_set_pid(t.station, t.mechanism, k + 1);
     t.rho_before = max_spectral_radius(job.poses, t.before, job.loop.delay);
-    const Tracking tb = track(job.runs, t.before, options.rtol, deadline);
+    // The time bound cuts the search only: the figures before and after are always computed, so a
+    // loaded machine gives a shorter search, never a missing (infinite) figure.
+    const Tracking tb = track(job.runs, t.before, options.rtol, Clock::time_point::max());
     t.error_before_mm = tb.ok ? tb.error_mm : std::numeric_limits<double>::infinity();
     t.saturation_before = tb.saturation;
 
@@ -634,7 +636,7 @@ TuneResult tune_controller(const Design& d, const std::vector<const Station*>& s
     t.after = with(t.before, x);
     t.rho_after = max_spectral_radius(job.poses, t.after, job.loop.delay);
     // The best point was simulated with these very inputs: its tracking is reused, not re-run.
-    const Tracking ta = found ? p.best_tracking : track(job.runs, t.after, options.rtol, deadline);
+    const Tracking ta = found ? p.best_tracking : track(job.runs, t.after, options.rtol, Clock::time_point::max());
     t.error_after_mm = ta.ok ? ta.error_mm : std::numeric_limits<double>::infinity();
     t.saturation_after = ta.saturation;
     figures_of(job, t.before, t, false);

@@ -3,6 +3,7 @@
 // identify/identify.json and identify/<design>-identified.yaml (the identified motor keys with
 // their provenance: entries). The output-error refinement and the plots are `fivebar identify`'s.
 
+#include <filesystem>
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -25,6 +26,10 @@ Product identify_product() {
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     const BenchSettings* b = d.get<BenchSettings>();
     if (b == nullptr || b->identification.empty()) return "the design names no identification log (`bench.identification`)";
+    // A design copied away from its bench files still runs its other products.
+    if (const auto file = BenchSettings::resolve(d, b->identification); !std::filesystem::exists(file)) {
+      return "the identification log `" + b->identification + "` (`bench.identification`) is not there: " + file.generic_string();
+    }
     return std::nullopt;
   };
   p.build = [](Context& ctx) {
