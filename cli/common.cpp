@@ -221,13 +221,11 @@ std::string remedy_hint(Remedy remedy) {
 void print_json(const Json& doc) { std::cout << doc.dump(2) << "\n"; }
 
 std::string fixed(double value, int digits) {
-  char buf[64];
   // A value that would print as 0.000 though it is not zero, or as an integer of 16 or more
   // digits, is shown in scientific form instead ("1e-06", "1e+308").
   const double magnitude = std::fabs(value);
   if (std::isfinite(value) && value != 0.0 && (magnitude < 0.5 * std::pow(10.0, -digits) || magnitude >= 1e15)) {
-    std::snprintf(buf, sizeof buf, "%.4g", value);
-    return buf;
+    return format::general(value, 4);
   }
   return format::fixed(value, digits);
 }
@@ -269,9 +267,7 @@ void print_pose(std::ostream& out, const Mechanism& m, const Pose& pose) {
   row("type I |sin| (legs 1, 2)", fixed(pose.type1_sin[0]) + ", " + fixed(pose.type1_sin[1]));
   row("type I distance (mm)", fixed(pose.type1_distance_mm));
   row("type II |sin|", fixed(pose.type2_sin));
-  char closure[32];
-  std::snprintf(closure, sizeof closure, "%.1e", pose.closure_error_mm);
-  row("closure error (mm)", closure);
+  row("closure error (mm)", format::sci(pose.closure_error_mm, 1));
   row("joint limits", limits_text(m, pose));
 }
 

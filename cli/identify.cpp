@@ -34,9 +34,7 @@ namespace id = fivebar::identify;
 
 /// `value` to 5 significant digits, in its shortest text.
 std::string sig(double value) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.5g", value);
-  return format::shortest(std::strtod(buf, nullptr));
+  return format::shortest(std::strtod(format::general(value, 5).c_str(), nullptr));
 }
 
 struct IdentifyCliOptions {

@@ -71,10 +71,7 @@ Product identify_product() {
     for (const auto& r : results) {
       for (const identify::Parameter& q : r.parameters) {
         if (!q.identified) continue;
-        char value[32], sigma[32];
-        std::snprintf(value, sizeof value, "%.5g", q.value);
-        std::snprintf(sigma, sizeof sigma, "%.3g", q.sigma);
-        t.row({md::code(r.joint), md::code(q.key), value, sigma,
+        t.row({md::code(r.joint), md::code(q.key), format::general(q.value, 5), format::general(q.sigma, 3),
                std::find(keys.begin(), keys.end(), q.key) != keys.end() ? "patched" : ""});
       }
     }

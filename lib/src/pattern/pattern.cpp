@@ -35,13 +35,7 @@ double wrap_pi(double d) {
   return d <= -kPi ? d + 2.0 * kPi : d;
 }
 
-std::string num(double v, int digits = 3) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  std::string s(buf);
-  if (s.front() == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
-}
+std::string num(double v, int digits = 3) { return format::fixed(v, digits); }
 
 std::string point_text(const Vec2& p) { return "(" + num(p.x()) + ", " + num(p.y()) + ")"; }
 

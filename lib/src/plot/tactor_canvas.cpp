@@ -3,6 +3,8 @@
 #include "plot/tactor_canvas.hpp"
 #include "plot/canvas.hpp"
 
+#include "fivebar/format.hpp"
+
 #include <cairo-svg.h>
 
 #include <algorithm>
@@ -167,15 +169,13 @@ void axes(cairo_t* cr, const Panel& panel, std::array<double, 4> b, double step)
   cairo_set_line_width(cr, 1.0);
   cairo_rectangle(cr, panel.x() + 0.5, panel.y() + 0.5, panel.w() - 1.0, panel.h() - 1.0);
   cairo_stroke(cr);
-  char buf[32];
   for (double x = std::ceil(b[0] / step) * step; x <= b[2] + 1e-9; x += step) {
     const auto p = panel.px(Vec2(x, b[1]));
     if (p[0] < panel.x() + 8 || p[0] > panel.x() + panel.w() - 8) continue;
     cairo_move_to(cr, p[0], panel.y() + panel.h());
     cairo_line_to(cr, p[0], panel.y() + panel.h() - 5.0);
     cairo_stroke(cr);
-    std::snprintf(buf, sizeof buf, "%g", x);
-    text(cr, p[0], panel.y() + panel.h() + 13.0, buf, 10.0, kGrey, 0.5);
+    text(cr, p[0], panel.y() + panel.h() + 13.0, format::general(x), 10.0, kGrey, 0.5);
   }
   for (double y = std::ceil(b[1] / step) * step; y <= b[3] + 1e-9; y += step) {
     const auto p = panel.px(Vec2(b[0], y));
@@ -183,8 +183,7 @@ void axes(cairo_t* cr, const Panel& panel, std::array<double, 4> b, double step)
     cairo_move_to(cr, panel.x(), p[1]);
     cairo_line_to(cr, panel.x() + 5.0, p[1]);
     cairo_stroke(cr);
-    std::snprintf(buf, sizeof buf, "%g", y);
-    text(cr, panel.x() - 4.0, p[1] + 3.5, buf, 10.0, kGrey, 1.0);
+    text(cr, panel.x() - 4.0, p[1] + 3.5, format::general(y), 10.0, kGrey, 1.0);
   }
   cairo_restore(cr);
 }

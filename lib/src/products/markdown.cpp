@@ -52,11 +52,7 @@ std::string Table::str() const {
 
 std::string fixed(double value, int digits) { return format::fixed(value, digits); }
 
-std::string sci(double value, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*e", digits, value);
-  return buf;
-}
+std::string sci(double value, int digits) { return format::sci(value, digits); }
 
 std::string pair(double x, double y, int digits) { return "(" + fixed(x, digits) + ", " + fixed(y, digits) + ")"; }
 

@@ -13,10 +13,7 @@ namespace fivebar::report_fmt {
 
 /// Scientific with `digits` decimals ("1.2e-15"); "0" for zero.
 inline std::string sci(double v, int digits = 1) {
-  if (v == 0.0) return "0";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*e", digits, v);
-  return buf;
+  return v == 0.0 ? "0" : format::sci(v, digits);
 }
 inline std::string sci(const std::optional<double>& v, int digits = 1) { return v ? sci(*v, digits) : "—"; }
 

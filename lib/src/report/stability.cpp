@@ -50,6 +50,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "fivebar/format.hpp"
 #include "fivebar/coverage/coverage.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/kinematics.hpp"
@@ -107,12 +108,7 @@ double position_bound(double e, double s, double L, double d) {
   return std::min(2.0 * e + std::min(first, 2.0 * std::sqrt(2.0 * L * e) + turn), 2.0 * L + 2.0 * e);
 }
 
-std::string num(double v) {
-  if (v == 0.0) return "0";
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.0e", v);
-  return buf;
-}
+std::string num(double v) { return v == 0.0 ? "0" : format::sci(v, 0); }
 
 /// Which of (reachable, type I, type II) the reference allows: 0 false, 1 true, 2 either.
 struct Expect {

@@ -1,6 +1,8 @@
 // A station's workspace analysed once for writing and reporting (fivebar/workspace/station.hpp).
 #include "fivebar/workspace/station.hpp"
 
+#include "fivebar/format.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -93,8 +95,7 @@ StationWorkspace analyse_workspace(const Station& station, const WorkspaceOption
   }
   const double samples = (width / h + 5.0) * (height / h + 5.0);
   if (samples > kMaxSamples) {
-    char count[32];  // a double: the count may exceed every integer type
-    std::snprintf(count, sizeof count, "%.3g", samples);
+    const std::string count = format::general(samples, 3);  // a double: it may exceed every integer type
     std::ostringstream msg;
     msg << "spacing " << h << " mm needs about " << count << " samples per field over the "
         << (bounds[2] - bounds[0]) << " x " << (bounds[3] - bounds[1]) << " mm workspace of station '" << station.name
