@@ -253,7 +253,11 @@ struct Hybrid {
     const auto& prob = pop.get_problem();
     const std::size_t N = pop.size();
     if (N < 4 || gens == 0) return pop;
-    const auto [lo, hi] = prob.get_bounds();
+    // Not a structured binding: the lambdas below use the bounds, and clang 14 (the fuzz build)
+    // refuses to capture a binding.
+    const auto bounds = prob.get_bounds();
+    const std::vector<double>& lo = bounds.first;
+    const std::vector<double>& hi = bounds.second;
     const std::size_t n = lo.size();
     std::vector<double> inv_range(n);
     for (std::size_t d = 0; d < n; ++d) inv_range[d] = 1.0 / (hi[d] - lo[d]);

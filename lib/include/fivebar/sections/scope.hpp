@@ -11,7 +11,7 @@
 
 namespace fivebar {
 
-class Design;
+struct Design;
 
 struct JointScope {
   std::string station;    ///< empty: every station (then `mechanism` is set)
