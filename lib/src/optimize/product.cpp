@@ -14,6 +14,7 @@ namespace fivebar::products {
 Product optimize_product() {
   Product p;
   p.name = "optimize";
+  p.cost_s = 1.5;  // the showcase's search (scheduler hint only, Product::cost_s)
   p.title = "Dimensional synthesis (multi-objective optimisation)";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<OptimizeSettings>()) return "the design has no optimize: section";
