@@ -73,7 +73,7 @@ Json to_json(const StabilityMap& map);
 std::string rho_field_vti(const RhoField& field);
 
 /// The picture of a station's maps (one panel per mechanism, `fields[k]` for `maps[k]`): rho over
-/// the reachable region on a colour ramp (red where >= 1), the target ellipse dashed, the worst
+/// the reachable region on the viridis map (red where >= 1), the target ellipse dashed, the worst
 /// pose on it marked, and the verdict, damping and margins below (house style, lib/src/plot/).
 RenderedPlot stability_plot(const Station& station, const std::vector<StabilityMap>& maps,
                             const std::vector<RhoField>& fields, const std::string& subtitle);
