@@ -15,6 +15,7 @@
 
 #include "common.hpp"
 #include "fivebar/calibrate.hpp"
+#include "fivebar/provenance.hpp"  // today_utc()
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
@@ -44,14 +45,6 @@ struct CalibrateCliOptions {
   std::string out;
 };
 
-std::string today_utc() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buffer[16];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%d", &tm);
-  return buffer;
-}
 
 std::string read_text(const std::string& path, const char* what) {
   std::ifstream in(path, std::ios::binary);
