@@ -338,6 +338,42 @@ TEST(Runtime, ThePriorityRuleIsNoWorseThanTheProbeSearchOnRandomCollisions) {
   EXPECT_GT(moved, compared / 4);
 }
 
+// With no clearance required (collision.min_clearance_m 0) the links may touch but not overlap:
+// bounding boxes that touch can still hold overlapping shapes, so no pair may be skipped on its box
+// alone. Every moved lower command is clear by the library's exact check at clearance 0.
+TEST(Runtime, ThePriorityRuleSeparatesOverlappingOutlinesAtZeroClearance) {
+  rt::Config c = paper_config();
+  c.collision.min_clearance = 0.0;
+  rt::Controller ctl(c);
+  Geometry g = *paper().get<Geometry>();
+  g.min_clearance = 0.0;
+  std::mt19937_64 rng(testing::test_seed());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int moved = 0;
+  for (int n = 0; n < 40; ++n) {
+    const std::string name = n % 2 ? "thumb" : "index";
+    const Station& st = paper().require_station(name);
+    const std::size_t lo = index_of(c, name, "lower"), up = index_of(c, name, "upper");
+    std::vector<Vec2> pts = centres(c, 8.0);
+    pts[up] = st.target.center + 0.5 * Vec2(st.target.axes.x() * u(rng), st.target.axes.y() * u(rng));
+    pts[lo] = pts[up] + 2.0 * Vec2(u(rng), u(rng));  // the tactors overlap
+    const Scene s = at_points(c, centres(c, 8.0));
+    std::vector<double> targets = s.targets;
+    for (std::size_t k : {lo, up}) targets[2 * k] = pts[k].x() / 1000, targets[2 * k + 1] = pts[k].y() / 1000;
+    ctl.reset();
+    ctl.cycle(s.readings.data(), rt::Reading::radians, targets.data());
+    const rt::MechanismState& l = ctl.mechanism(lo);
+    if (l.status != rt::Status::moved_by_priority) continue;
+    ++moved;
+    const Vec2 p(l.point_command[0] * 1000, l.point_command[1] * 1000);
+    const Interference after = interference(*st.upper, ik(*st.upper, pts[up]), *st.lower, ik(*st.lower, p), g);
+    EXPECT_FALSE(after.collides) << name << ": " << after.min_clearance_mm << " mm";
+    EXPECT_GE(after.min_clearance_mm, -1e-9);
+    EXPECT_GT(l.moved, 0.0);
+  }
+  EXPECT_GT(moved, 20);
+}
+
 TEST(Runtime, ThePidFollowsTheHandComputedSequenceThroughTheWholeCycle) {
   // A one-mechanism configuration with hand-set gains; the reading is the commanded angle minus e.
   rt::Config c = paper_config();

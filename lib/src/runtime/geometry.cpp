@@ -224,12 +224,31 @@ double segment_distance(V2 p0, V2 p1, V2 q0, V2 q1) {
   return best;
 }
 
-double part_clearance(const Part& a, const Part& b) {
-  double best = kInf;
+/// Whether a pair whose bounding boxes are `gap` apart (>= 0) can be skipped when only clearances
+/// below `best` matter: the pair's clearance is at least the gap, which must be positive, as boxes
+/// that touch can hold overlapping shapes (a negative clearance) whatever `best` is.
+bool skip(double gap, double best) { return gap > 0.0 && gap >= best; }
+
+/// The gap between the bounding boxes of two capsules along one axis (0 when they overlap): a
+/// lower bound on their clearance.
+double box_gap(double a0, double a1, double ra, double b0, double b1, double rb) {
+  const double alo = std::min(a0, a1) - ra, ahi = std::max(a0, a1) + ra;
+  const double blo = std::min(b0, b1) - rb, bhi = std::max(b0, b1) + rb;
+  return std::max({0.0, alo - bhi, blo - ahi});
+}
+
+/// The clearance of two parts (the least over their pairs of shapes) where it is below `cap`, else
+/// some value >= cap: a pair of shapes whose bounding boxes are `cap` or more apart is skipped (its
+/// clearance is at least that gap).
+double part_clearance_below(const Part& a, const Part& b, double cap) {
+  double best = cap;
   for (int i = 0; i < a.count; ++i) {
     for (int j = 0; j < b.count; ++j) {
       const Capsule& x = a.shapes[static_cast<std::size_t>(i)];
       const Capsule& y = b.shapes[static_cast<std::size_t>(j)];
+      if (skip(box_gap(x.a.x, x.b.x, x.r, y.a.x, y.b.x, y.r), best) || skip(box_gap(x.a.y, x.b.y, x.r, y.a.y, y.b.y, y.r), best)) {
+        continue;
+      }
       best = std::min(best, segment_distance(x.a, x.b, y.a, y.b) - x.r - y.r);
     }
   }
@@ -239,11 +258,8 @@ double part_clearance(const Part& a, const Part& b) {
 }  // namespace
 
 double min_clearance(const Part* a, std::size_t na, const Part* b, std::size_t nb) {
-  double best = kInf;
-  for (std::size_t i = 0; i < na; ++i)
-    for (std::size_t j = 0; j < nb; ++j)
-      if (a[i].plane == b[j].plane) best = std::min(best, part_clearance(a[i], b[j]));
-  return best;
+  // Every pair whose boxes are no closer than the best clearance so far cannot lower it.
+  return min_clearance_below(a, na, b, nb, kInf);
 }
 
 double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::size_t nb, double cap) {
@@ -253,8 +269,8 @@ double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::si
       if (a[i].plane != b[j].plane) continue;
       const double gx = std::max({0.0, a[i].lo.x - b[j].hi.x, b[j].lo.x - a[i].hi.x});
       const double gy = std::max({0.0, a[i].lo.y - b[j].hi.y, b[j].lo.y - a[i].hi.y});
-      if (gx >= best || gy >= best) continue;  // the boxes' gap bounds the pair's clearance
-      best = std::min(best, part_clearance(a[i], b[j]));
+      if (skip(gx, best) || skip(gy, best)) continue;  // the boxes' gap bounds the pair's clearance
+      best = std::min(best, part_clearance_below(a[i], b[j], best));
     }
   }
   return best;
@@ -268,7 +284,7 @@ bool collide(const Part* a, std::size_t na, const Part* b, std::size_t nb, doubl
       const double gy = std::max({0.0, a[i].lo.y - b[j].hi.y, b[j].lo.y - a[i].hi.y});
       const double gap = std::hypot(gx, gy);
       if (gap > 0.0 && gap >= threshold) continue;
-      if (part_clearance(a[i], b[j]) < threshold) return true;
+      if (part_clearance_below(a[i], b[j], threshold) < threshold) return true;
     }
   }
   return false;
@@ -289,6 +305,11 @@ RayCapsule ray_capsule(V2 o, const Capsule& c) {
     r.along = dot(r.wa, r.e);
     r.across = dot(r.wa, r.n);
   }
+  // The bounding disk, widened by a relative 1e-9 so that rounding never skips a capsule the ray
+  // enters.
+  const double R = (0.5 * r.len + c.r) * (1.0 + 1e-9);
+  r.wm = o - 0.5 * (c.a + c.b);
+  r.cm = dot(r.wm, r.wm) - R * R;
   return r;
 }
 
@@ -331,7 +352,11 @@ bool ray_interval(const RayCapsule& c, V2 u, double& t_in, double& t_out) {
 
 double ray_exit(V2 u, const RayCapsule* caps, std::size_t n, double* t_in, double* t_out) {
   for (std::size_t k = 0; k < n; ++k) {
-    if (!ray_interval(caps[k], u, t_in[k], t_out[k])) t_in[k] = kInf, t_out[k] = -kInf;
+    // The ray o + t u (t >= 0) misses the bounding disk |w_m + t u| < R when the line misses it or
+    // when o is outside and the ray leads away from its centre.
+    const double b = dot(caps[k].wm, u);
+    const bool misses = b * b - caps[k].cm <= 0.0 || (caps[k].cm > 0.0 && b >= 0.0);
+    if (misses || !ray_interval(caps[k], u, t_in[k], t_out[k])) t_in[k] = kInf, t_out[k] = -kInf;
   }
   double t = 0.0;
   for (std::size_t pass = 0; pass <= n; ++pass) {

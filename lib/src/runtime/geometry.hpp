@@ -108,13 +108,16 @@ struct RayCapsule {
   double ca = 0.0, cb = 0.0;  ///< |o - a|^2 - r^2, |o - b|^2 - r^2
   V2 e, n;                    ///< unit along and across the segment (len 0: a disk)
   double along = 0.0, across = 0.0, len = 0.0, r = 0.0;  ///< o's coordinates, |b - a|, radius
+  V2 wm;              ///< o - the segment's midpoint
+  double cm = 0.0;    ///< |o - midpoint|^2 - R^2 for the bounding disk's radius R (len / 2 + r, widened)
 };
 RayCapsule ray_capsule(V2 o, const Capsule& c);
 /// The interval of the ray in the capsule: false when the line misses it.
 bool ray_interval(const RayCapsule& c, V2 u, double& t_in, double& t_out);
 /// The first t >= 0 at which o + t u is inside none of the `n` capsules (the exit of the ray from
 /// their union): each capsule is left at most once along a ray, so at most n + 1 passes over the
-/// intervals (kept in `t_in`, `t_out`, n entries each, caller's buffers).
+/// intervals (kept in `t_in`, `t_out`, n entries each, caller's buffers). A capsule whose bounding
+/// disk the ray (t >= 0) misses is skipped: it cannot hold a point of the ray.
 double ray_exit(V2 u, const RayCapsule* caps, std::size_t n, double* t_in, double* t_out);
 
 }  // namespace fivebar::runtime::detail
