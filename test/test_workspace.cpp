@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -174,6 +175,49 @@ TEST(SampledArea, AssemblyAndLciRegionsAreNestedInsideReach) {
   EXPECT_LT(assembly, reach);
   EXPECT_LT(lci, assembly);
   EXPECT_GT(lci, 0.0);
+}
+
+// The margin of every restriction, written here from the full pose of ik() as the definition
+// reads (the annuli in mm, the assembly side as cross(P - A1, P - A2) / (L3 + L4), the LCI
+// shortfall times the length scale): restriction_margin() takes a leaner path without joint
+// limits and must give the same double at every point, assembly mode any included.
+TEST(SampledArea, MarginOfEachRestrictionEqualsTheOneFromTheFullPose) {
+  std::mt19937_64 rng(test_seed());
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Mechanism> ms = geometries();
+  ms[1].assembly_mode = AssemblyMode::Any;
+  int inside = 0;
+  for (Mechanism m : ms) {
+    m.min_lci = 0.3;
+    const auto b = reachable_region(m).bounds();
+    for (int k = 0; k < 400; ++k) {
+      const Vec2 p(b[0] - 1 + (b[2] - b[0] + 2) * u(rng), b[1] - 1 + (b[3] - b[1] + 2) * u(rng));
+      double reach = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < 2; ++i) {
+        const double d = (p - (i == 0 ? m.O1 : m.O2)).norm();
+        reach = std::min(reach, m.L[i] + m.L[i + 2] - d);
+        if (std::fabs(m.L[i] - m.L[i + 2]) > 0.0) reach = std::min(reach, d - std::fabs(m.L[i] - m.L[i + 2]));
+      }
+      const Pose pose = ik(m, p);
+      double assembly = reach, lci = reach;
+      if (!(reach < 0.0)) {
+        if (pose.status == Status::unreachable) {
+          reach = assembly = lci = std::min(reach, 0.0);
+        } else {
+          ++inside;
+          const Vec2 f1 = pose.P - pose.A1, f2 = pose.P - pose.A2;
+          if (m.assembly_mode != AssemblyMode::Any) {
+            assembly = std::min(assembly, double(int(m.assembly_mode)) * (f1.x() * f2.y() - f1.y() * f2.x()) / (m.L[2] + m.L[3]));
+          }
+          lci = std::min(assembly, (pose.lci - m.min_lci) * m.length_scale());
+        }
+      }
+      EXPECT_EQ(restriction_margin(m, Restriction::reach, p), reach);
+      EXPECT_EQ(restriction_margin(m, Restriction::assembly, p), assembly);
+      EXPECT_EQ(restriction_margin(m, Restriction::lci, p), lci) << p.transpose();
+    }
+  }
+  EXPECT_GT(inside, 2000);
 }
 
 TEST(Field, SamplesMatchTheScalarKinematics) {

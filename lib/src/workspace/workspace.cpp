@@ -307,15 +307,22 @@ double restriction_margin(const Mechanism& m, Restriction restriction, const Vec
     if (inner > 0.0) margin = std::min(margin, d - inner);
   }
   if (margin < 0.0) return margin;
-  if (restriction != Restriction::lci && !m.joint_limits) {
-    // Only the elbows are needed: the two circle intersections ik() starts from, the same
-    // numbers without its angles and analysis (ik() is unreachable exactly when one is).
+  if (!m.joint_limits) {
+    // Only the elbows are needed: the two circle intersections ik() starts from, and for the LCI
+    // the matrix analyse() forms from them (kinematics.cpp): the same numbers in the same order,
+    // without the angles, transmission angles and closure check that the margin does not use
+    // (ik() is unreachable exactly when one intersection is).
     const CircleIntersection x1 = intersect_circles(m.O1, m.L[0], p, m.L[2], -m.working_mode.sign1);
     const CircleIntersection x2 = intersect_circles(m.O2, m.L[1], p, m.L[3], -m.working_mode.sign2);
     if (x1.status == Status::unreachable || x2.status == Status::unreachable) return std::min(margin, 0.0);
-    if (restriction == Restriction::reach || m.assembly_mode == AssemblyMode::Any) return margin;
-    const double cb = detail::cross(p - x1.point, p - x2.point);
-    return std::min(margin, double(int(m.assembly_mode)) * cb / (m.L[2] + m.L[3]));
+    if (restriction == Restriction::reach) return margin;
+    const Vec2 f1 = p - x1.point, f2 = p - x2.point;
+    const double cb = detail::cross(f1, f2);
+    if (m.assembly_mode != AssemblyMode::Any) margin = std::min(margin, double(int(m.assembly_mode)) * cb / (m.L[2] + m.L[3]));
+    if (restriction == Restriction::assembly) return margin;
+    const double c1 = detail::cross(x1.point - m.O1, f1), c2 = detail::cross(x2.point - m.O2, f2);
+    const double lci = detail::lci2(f2.y() * c1, -f1.y() * c2, -f2.x() * c1, f1.x() * c2);
+    return std::min(margin, (lci - m.min_lci) * m.length_scale());
   }
   const Pose pose = ik(m, p);
   if (pose.status == Status::unreachable) return std::min(margin, 0.0);
@@ -483,18 +490,36 @@ SampledArea restricted_area(const Mechanism& m, Restriction restriction, const G
   auto value = [&](int i, int j) { return values[std::size_t(j) * grid.nx + i]; };
   Adaptive a;
   const double h = grid.spacing;
+  // The slope of a cell's neighbourhood: the largest difference quotient along the grid lines
+  // from the nodes (x, y), x in [i - 1, i + 2], y in [j - 1, j + 2] (to x + 1 and to y + 1 where
+  // those exist). The node's own largest quotient first, then the window's maximum in two passes
+  // (rows, then columns): maxima of the same numbers, so the same slope as the 4 x 4 loop over
+  // every cell. A NaN quotient never wins a std::max(slope, q).
+  const int nxs = grid.nx - 1;  // nodes with a right neighbour
+  std::vector<double> node_slope, row_max;
+  if (nxs > 0 && grid.ny > 0) {
+    node_slope.assign(std::size_t(nxs) * std::size_t(grid.ny), 0.0);
+    row_max.assign(node_slope.size(), 0.0);
+    for (int y = 0; y < grid.ny; ++y) {
+      for (int x = 0; x < nxs; ++x) {
+        double q = std::max(0.0, std::fabs(value(x + 1, y) - value(x, y)) / h);
+        if (y + 1 < grid.ny) q = std::max(q, std::fabs(value(x, y + 1) - value(x, y)) / h);
+        node_slope[std::size_t(y) * nxs + x] = q;
+      }
+    }
+    for (int y = 0; y < grid.ny; ++y) {
+      for (int i = 0; i < nxs; ++i) {
+        double m = 0.0;
+        for (int x = std::max(0, i - 1); x <= std::min(nxs - 1, i + 2); ++x) m = std::max(m, node_slope[std::size_t(y) * nxs + x]);
+        row_max[std::size_t(y) * nxs + i] = m;
+      }
+    }
+  }
   for (int j = 0; j + 1 < grid.ny; ++j) {
     for (int i = 0; i + 1 < grid.nx; ++i) {
       const double f[4] = {value(i, j), value(i + 1, j), value(i + 1, j + 1), value(i, j + 1)};
-      // The slope of the neighbourhood: differences to the nodes around the cell.
       double slope = 0.0;
-      for (int dj = -1; dj <= 2; ++dj)
-        for (int di = -1; di <= 2; ++di) {
-          const int x = i + di, y = j + dj;
-          if (x < 0 || y < 0 || x + 1 >= grid.nx || y >= grid.ny) continue;
-          slope = std::max(slope, std::fabs(value(x + 1, y) - value(x, y)) / h);
-          if (y + 1 < grid.ny) slope = std::max(slope, std::fabs(value(x, y + 1) - value(x, y)) / h);
-        }
+      for (int y = std::max(0, j - 1); y <= std::min(grid.ny - 1, j + 2); ++y) slope = std::max(slope, row_max[std::size_t(y) * nxs + i]);
       refine_cell(grid.point(i, j), h, f, slope, 0, max_depth, margin, a);
     }
   }
