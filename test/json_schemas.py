@@ -144,6 +144,11 @@ def main():
     run("sweep", "sweep", ["sweep", DESIGN, "--no-plots", "--out", out + "/sweep"])
     run("optimize", "optimize", ["optimize", DESIGN, "--evaluations", "128", "--no-plots", "--out", out + "/optimize"])
     run("parts", "parts", ["parts", DESIGN, "--no-render", "--out", out + "/parts"])
+    # Rendered (openscad): the STL paths, the mesh checks and the measured holes; the thumb's
+    # parts are the index's but for the base and the distal links, so one station shows every kind.
+    rendered = run("parts, rendered", "parts", ["parts", DESIGN, "-s", "index", "--out", out + "/parts-rendered"])
+    if rendered is not None and not all(p["mesh"] is not None for p in rendered["parts"]):
+        failures.append("parts, rendered: a part without its mesh checks")
     run("export", "export", ["export", DESIGN, "--out", out + "/export"])
     run("report stability", "report-stability", ["report", "stability", DESIGN, "-s", "index", "-q"])
     run("report accuracy", "report-accuracy", ["report", "accuracy", DESIGN, "-s", "index", "--quick", "-q", "--out", out + "/report"])
