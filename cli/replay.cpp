@@ -13,6 +13,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/replay.hpp"
+#include "fivebar/replay/sil.hpp"
 #include "fivebar/runtime/json_config.hpp"
 #include "tactors.hpp"
 
@@ -98,56 +99,40 @@ int run_sil(const ReplayOptions& opt) {
     if (stations.empty()) throw InputError("design '" + design.name + "' has no station with both mechanisms");
   }
   require_geometry(design);
-  std::shared_ptr<const runtime::Config> file_config;
-  if (!opt.config.empty()) file_config = std::make_shared<const runtime::Config>(read_config(opt.config));
+  SilRequest request;
+  for (const Station* s : stations) request.stations.push_back(s->name);
+  request.pattern = kind;
+  if (!opt.config.empty()) request.config = std::make_shared<const runtime::Config>(read_config(opt.config));
   const std::filesystem::path dir = output_dir(design, opt.out, "replay");
   const WriteFence fence(dir);
+  request.open_log = [&dir](const std::string& name) { return AtomicFile(dir / name); };
   Json runs = Json::array();
   std::vector<std::string> files;
   bool all_ok = true;
-  for (const Station* s : stations) {
-    SimulationRequest request;
-    request.station = s->name;
-    request.pattern = kind;
-    for (SimulationInput in : simulation_inputs(design, request, station_inertia(design, *s, nullptr, {}))) {
-      if (!in.unusable.empty()) {
-        all_ok = false;
-        runs.push_back({{"station", s->name}, {"reference", in.reference_name}, {"status", "not_simulated"}, {"reason", in.unusable}});
-        if (!opt.json) std::cout << s->name << "  " << in.reference_name << ": not simulated, " << in.unusable << "\n";
-        continue;
-      }
-      if (file_config) {
-        in.runtime = file_config;
-        in.override_runtime_joints = false;
-      }
-      const std::filesystem::path csv = dir / (s->name + "-" + in.reference_name + "-sil.csv");
-      AtomicFile file(csv);
-      bool header = false;
-      SimulationOptions so;
-      so.controller_log = [&](double t, const std::vector<double>& readings, runtime::Reading k,
-                              const std::vector<double>& targets, const runtime::Controller& ctl) {
-        if (!header) write_replay_header(file.stream(), ctl.config(), k), header = true;
-        write_replay_row(file.stream(), t, readings, targets, ctl.duties(), ctl.joint_count());
-      };
-      const SimulationResult r = simulate(in, so);
-      file.commit();
-      files.push_back(csv.generic_string());
-      Json j = to_json(in, r);
-      j["log"] = csv.generic_string();
-      j["config"] = file_config ? opt.config : std::string("the design's export, in memory");
+  for (const SilRun& run : run_sil(design, request)) {
+    all_ok = all_ok && run.ok();
+    Json j = to_json(run);
+    if (!run.simulated()) {
       runs.push_back(j);
-      all_ok = all_ok && r.ok();
-      if (!opt.json) {
-        std::cout << s->name << "  " << in.reference_name << ": " << to_string(r.status) << ", " << fixed(r.t_end, 3)
-                  << " s through the runtime (software in the loop)\n";
-        if (!r.ok()) std::cout << "  " << r.reason << "\n";
-        for (const MechanismSummary& m : r.summary) {
-          std::cout << "  " << m.name << ": tracking error max " << fixed(m.max_error_mm, 3) << " mm, rms "
-                    << fixed(m.rms_error_mm, 3) << " mm; current peak " << fixed(m.peak_current_A, 3) << " A; peak duty "
-                    << fixed(m.peak_duty, 3) << ", saturated " << fixed(m.saturation_s, 3) << " s\n";
-        }
-        std::cout << "  log: " << csv.generic_string() << " (fivebar replay LOG --config EXPORTED.json replays it)\n";
+      if (!opt.json) std::cout << run.station << "  " << run.reference << ": not simulated, " << run.unusable << "\n";
+      continue;
+    }
+    const SimulationResult& r = run.result;
+    const std::string csv = run.log.generic_string();
+    files.push_back(csv);
+    j["log"] = csv;
+    j["config"] = request.config ? opt.config : std::string("the design's export, in memory");
+    runs.push_back(j);
+    if (!opt.json) {
+      std::cout << run.station << "  " << run.reference << ": " << to_string(r.status) << ", " << fixed(r.t_end, 3)
+                << " s through the runtime (software in the loop)\n";
+      if (!r.ok()) std::cout << "  " << r.reason << "\n";
+      for (const MechanismSummary& m : r.summary) {
+        std::cout << "  " << m.name << ": tracking error max " << fixed(m.max_error_mm, 3) << " mm, rms "
+                  << fixed(m.rms_error_mm, 3) << " mm; current peak " << fixed(m.peak_current_A, 3) << " A; peak duty "
+                  << fixed(m.peak_duty, 3) << ", saturated " << fixed(m.saturation_s, 3) << " s\n";
       }
+      std::cout << "  log: " << csv << " (fivebar replay LOG --config EXPORTED.json replays it)\n";
     }
   }
   if (opt.json) {

@@ -234,7 +234,7 @@ def main():
             failures.append("export: no parameters file to --check")
 
     doc = run("run", "run", ["run", DESIGN, "-q", "--out", out + "/run", "-P",
-                             "kinematics,workspace,coverage,collision,pattern,export"])
+                             "kinematics,workspace,coverage,collision,pattern,export,bench_replay"])
     if doc is not None:
         summary = json.loads(pathlib.Path(doc["summary_json"]).read_text())
         check("run: summary.json", "run", summary)

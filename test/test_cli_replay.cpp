@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -180,4 +181,51 @@ TEST_F(CliReplay, TheRunProductRunsTheExportedFileInTheLoopAndReplaysEveryLog) {
       EXPECT_EQ(a["mechanisms"][k][key], b["mechanisms"][k][key]) << key;
     }
   }
+}
+
+// The `bench_replay` product of `fivebar run`: a device log the design names (`bench.replay_logs`)
+// replayed against the export product's JSON; its figures are those of `fivebar replay LOG
+// --config` on that same file (a second path: the command), for a log the runtime wrote (passes,
+// exit 0) and for one with a changed duty (flagged, exit 1); a bad name is the design's
+// FILE:LINE: key and exit 2.
+TEST_F(CliReplay, TheBenchReplayProductReportsTheCommandsFiguresPerLog) {
+  prepare();
+  ASSERT_FALSE(HasFailure());
+  fs::create_directories(dir_ / "logs");
+  fs::copy_file(log_, dir_ / "logs" / "good.csv");
+  std::string changed = slurp(log_);
+  // The second row's first duty (index_lower_theta1_duty, the third column) moved by 0.125.
+  const auto row2 = changed.find('\n', changed.find('\n') + 1) + 1;
+  const auto c1 = changed.find(',', row2), c2 = changed.find(',', c1 + 1), c3 = changed.find(',', c2 + 1);
+  const std::string duty = changed.substr(c2 + 1, c3 - c2 - 1);
+  changed.replace(c2 + 1, c3 - c2 - 1, std::to_string(std::stod(duty) + 0.125));
+  write("logs/changed.csv", changed);
+
+  const auto check = [&](const std::string& log, int code) {
+    SCOPED_TRACE(log);
+    const fs::path design = design_with("d.yaml", "replay_logs: [bench/replay.csv]", "replay_logs: [logs/" + log + "]");
+    const Outcome r = run({"run", design.string(), "-P", "bench_replay", "-o", "scene-" + log, "-q", "-j", "1", "--json"});
+    ASSERT_EQ(r.code, code) << r.err;
+    const json result = parse(r)["results"]["bench_replay"];
+    ASSERT_EQ(result["logs"].size(), 1u);
+    const json& p = result["logs"][0];
+    const std::string config = (dir_ / ("scene-" + log) / "iros2022" / result["config"].get<std::string>()).string();
+    const Outcome c = run({"replay", (dir_ / "logs" / log).string(), "--config", config, "--json"});
+    ASSERT_EQ(c.code, code) << c.err;
+    const json cli = parse(c);
+    for (const char* key : {"rows", "max_duty_difference", "mismatches", "passed", "first_mismatch", "joints", "mechanisms"}) {
+      EXPECT_EQ(p[key], cli[key]) << key;
+    }
+    EXPECT_TRUE(fs::exists(dir_ / ("scene-" + log) / "iros2022" / p["duties_csv"].get<std::string>()));
+  };
+  check("good.csv", 0);
+  check("changed.csv", 1);
+
+  const fs::path bad = design_with("bad.yaml", "replay_logs: [bench/replay.csv]", "replay_logs: [\"\"]");
+  const std::string text = slurp(bad);
+  const auto line = 1 + std::count(text.begin(), text.begin() + text.find("replay_logs: [\"\"]"), '\n');
+  const Outcome r = run({"run", bad.string(), "-P", "bench_replay", "-o", "scene-bad", "-q"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("bad.yaml:" + std::to_string(line) + ": bench.replay_logs[0] = \"\": must be a file name"));
+  EXPECT_FALSE(fs::exists(dir_ / "scene-bad"));
 }

@@ -22,6 +22,14 @@ with true output inertia 2.4e-3 kg m^2, viscous friction 2e-4 N m s/rad, Coulomb
 8e-4 N m and no offset; simulated by RK4 at 10 kHz (the drive held over each 2 ms sample),
 logged at 500 Hz for 4 s with 0.5 mA of noise on the logged current and the angle quantised to
 2^16 counts per turn (seed 2).
+
+replay.csv: a device log in the format of `fivebar replay LOG` (docs/runtime.md "Replay"): the
+index station following its stretch pattern, the device being `fivebar replay --sil` (the runtime
+of this design's export closed around the simulator: its motors, driver, ADC and skin, no noise
+beyond the ADC's quantisation), which logs per 10 ms cycle the ADC codes, the reference points and
+the duties. Replayed through the runtime of the same export it must give every duty again; after
+a change of the controller's gains or calibration in the design it does not (that is what the
+`bench_replay` product checks), and this script writes it again.
 """
 import argparse
 import math
@@ -110,12 +118,24 @@ def identification():
         f.write(text)
 
 
+def replay(fivebar):
+    with tempfile.TemporaryDirectory() as tmp:
+        subprocess.run([fivebar, "replay", DESIGN, "--sil", "-s", "index", "--pattern", "stretch", "--out", tmp],
+                       check=True, stdout=subprocess.DEVNULL)
+        with open(os.path.join(tmp, "index-stretch-sil.csv")) as f:
+            log = f.read()
+    text = "# Synthetic: made by designs/bench/make_bench.py (its docstring states how)\n" + log
+    with open(os.path.join(HERE, "replay.csv"), "w") as f:
+        f.write(text)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--fivebar", default=os.path.join("build", "fivebar"), help="the fivebar binary")
     args = parser.parse_args()
     calibration(args.fivebar)
     identification()
+    replay(args.fivebar)
     return 0
 
 

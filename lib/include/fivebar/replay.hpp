@@ -66,8 +66,21 @@ struct ReplayResult {
 /// `config` with only the log's stations.
 runtime::Config config_for_log(const runtime::Config& config, const ReplayLog& log);
 
-/// Runs a fresh runtime of config_for_log(config, log) over the log's rows, in order.
-ReplayResult replay_log(const runtime::Config& config, const ReplayLog& log, double tolerance);
+/// What the runtime gave at each row of a replay (optional output of replay_log).
+struct ReplayTrace {
+  std::vector<std::vector<double>> duties;             ///< per row, in the runtime's joint order
+  std::vector<std::vector<runtime::Status>> statuses;  ///< per row, per mechanism (runtime order)
+};
+
+/// Runs a fresh runtime of config_for_log(config, log) over the log's rows, in order; with `trace`
+/// also keeps its duties and statuses per row.
+ReplayResult replay_log(const runtime::Config& config, const ReplayLog& log, double tolerance, ReplayTrace* trace = nullptr);
+
+/// The replay row by row, for a notebook (CSV, header row): time_s; per joint
+/// `<joint>_logged_duty`, `<joint>_runtime_duty`, `<joint>_duty_difference` (runtime - logged);
+/// per mechanism `<station>_<mechanism>_status` (runtime::to_string). `result` and `trace` are
+/// replay_log's for `log`.
+void write_replay_comparison_csv(std::ostream& out, const ReplayLog& log, const ReplayResult& result, const ReplayTrace& trace);
 
 Json to_json(const ReplayResult& result);
 

@@ -91,6 +91,18 @@ inline std::optional<std::string> without_pairs(const Design& d, std::string_vie
   return "no station has both a lower and an upper mechanism";
 }
 
+/// The controller file (`<design>_controller.json`, relative to the scene's folder) among the
+/// files of the `export` product's result, or "" when it wrote none (refused, or not built).
+inline std::string exported_controller_json(const Json* export_result) {
+  std::string file;
+  if (export_result == nullptr || !export_result->contains("files")) return file;
+  for (const Json& f : (*export_result)["files"]) {
+    const std::string s = f.get<std::string>();
+    if (s.size() > 16 && s.compare(s.size() - 16, 16, "_controller.json") == 0) file = s;
+  }
+  return file;
+}
+
 /// Every product, in the order of products.def (the build order).
 const std::vector<Product>& registry();
 /// run_scene() over a given list of products instead of registry(): the scene knows products only

@@ -7,7 +7,6 @@
 // ones bit for bit (the field check `fivebar replay LOG --config` makes on a device's log).
 
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <string>
 
@@ -15,6 +14,7 @@
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/replay.hpp"
+#include "fivebar/replay/sil.hpp"
 #include "fivebar/runtime/json_config.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
@@ -45,13 +45,7 @@ Product replay_product() {
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
     Built b;
-    std::string json_file;
-    if (const Json* e = ctx.result_of("export"); e && e->contains("files")) {
-      for (const Json& f : (*e)["files"]) {
-        const std::string s = f.get<std::string>();
-        if (s.size() > 16 && s.compare(s.size() - 16, 16, "_controller.json") == 0) json_file = s;
-      }
-    }
+    const std::string json_file = exported_controller_json(ctx.result_of("export"));
     if (json_file.empty()) {
       b.passed = false;
       b.check = "no exported JSON to run (the export was refused or not built)";
@@ -59,62 +53,45 @@ Product replay_product() {
       b.result = {{"config", nullptr}, {"runs", Json::array()}};
       return b;
     }
-    const auto config = std::make_shared<const runtime::Config>(runtime::load_config_json((ctx.dir / json_file).string()));
+    SilRequest request;
+    request.config = std::make_shared<const runtime::Config>(runtime::load_config_json((ctx.dir / json_file).string()));
+    request.replay = true;
+    request.open_log = [&ctx](const std::string& name) { return ctx.open_file(std::filesystem::path("replay") / name); };
+    request.progress = [&ctx](const std::string& station, const std::string& reference) {
+      ctx.say("software in the loop: " + station + " " + reference);
+    };
     md::Table table({"station", "pattern", "status", "mechanism", "max error (mm)", "rms error (mm)", "peak duty",
                      "saturated (s)", "replayed rows", "max |duty difference|"},
                     "llllrrrrrr");
     Json runs = Json::array();
     std::size_t total = 0, failed = 0;
     std::string problems;
-    for (const Station& s : d.stations) {
-      if (!has_pair(s)) continue;
-      SimulationRequest request;
-      request.station = s.name;
-      for (SimulationInput in : simulation_inputs(d, request, station_inertia(d, s, nullptr, {}))) {
-        ++total;
-        if (!in.unusable.empty()) {
-          ++failed;
-          runs.push_back({{"station", s.name}, {"reference", in.reference_name}, {"status", "not_simulated"},
-                          {"reason", in.unusable}});
-          problems += "- ✗ " + s.name + " " + in.reference_name + ": not simulated, " + in.unusable + "\n";
-          continue;
-        }
-        ctx.say("software in the loop: " + s.name + " " + in.reference_name);
-        in.runtime = config;
-        in.override_runtime_joints = false;
-        const std::filesystem::path rel = std::filesystem::path("replay") / (s.name + "-" + in.reference_name + "-sil.csv");
-        AtomicFile file = ctx.open_file(rel);
-        bool header = false;
-        SimulationOptions so;
-        so.controller_log = [&](double t, const std::vector<double>& readings, runtime::Reading kind,
-                                const std::vector<double>& targets, const runtime::Controller& ctl) {
-          if (!header) write_replay_header(file.stream(), ctl.config(), kind), header = true;
-          write_replay_row(file.stream(), t, readings, targets, ctl.duties(), ctl.joint_count());
-        };
-        const SimulationResult r = simulate(in, so);
-        file.commit();
-        ctx.record(rel);
-        // The log back through a fresh runtime of the same file.
-        std::ifstream log_in(ctx.dir / rel);
-        const ReplayLog log = read_replay_log(log_in, *config, (ctx.dir / rel).string());
-        const ReplayResult rr = replay_log(*config, log, 0.0);
-        Json j = to_json(in, r);
-        j["log"] = rel.generic_string();
-        j["replay"] = to_json(rr);
+    for (const SilRun& run : run_sil(d, request)) {
+      ++total;
+      Json j = to_json(run);
+      if (!run.simulated()) {
+        ++failed;
         runs.push_back(j);
-        const bool ok = r.ok() && rr.passed();
-        if (!ok) {
-          ++failed;
-          problems += "- ✗ " + s.name + " " + in.reference_name + ": " +
-                      (r.ok() ? std::to_string(rr.mismatches) + " duties differ from the log's on replay"
-                              : std::string(to_string(r.status)) + ", " + r.reason) +
-                      "\n";
-        }
-        for (const MechanismSummary& m : r.summary) {
-          table.row({s.name, in.reference_name, std::string(to_string(r.status)), m.name, md::fixed(m.max_error_mm, 3),
-                     md::fixed(m.rms_error_mm, 3), md::fixed(m.peak_duty, 3), md::fixed(m.saturation_s, 3),
-                     std::to_string(rr.rows), format::shortest(rr.max_difference)});
-        }
+        problems += "- ✗ " + run.station + " " + run.reference + ": not simulated, " + run.unusable + "\n";
+        continue;
+      }
+      const SimulationResult& r = run.result;
+      const ReplayResult& rr = *run.replay;
+      const std::filesystem::path rel = std::filesystem::path("replay") / run.log.filename();
+      ctx.record(rel);
+      j["log"] = rel.generic_string();
+      runs.push_back(j);
+      if (!run.ok()) {
+        ++failed;
+        problems += "- ✗ " + run.station + " " + run.reference + ": " +
+                    (r.ok() ? std::to_string(rr.mismatches) + " duties differ from the log's on replay"
+                            : std::string(to_string(r.status)) + ", " + r.reason) +
+                    "\n";
+      }
+      for (const MechanismSummary& m : r.summary) {
+        table.row({run.station, run.reference, std::string(to_string(r.status)), m.name, md::fixed(m.max_error_mm, 3),
+                   md::fixed(m.rms_error_mm, 3), md::fixed(m.peak_duty, 3), md::fixed(m.saturation_s, 3),
+                   std::to_string(rr.rows), format::shortest(rr.max_difference)});
       }
     }
     b.result = {{"config", json_file}, {"runs", runs}};

@@ -2,6 +2,7 @@
 
 #include "fivebar/replay.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <istream>
 #include <map>
@@ -55,13 +56,29 @@ Columns columns_of(const runtime::Config& c) {
 
 ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const std::string& origin) {
   std::string line;
-  if (!std::getline(in, line)) throw InputError(origin + ":1: empty log (a header row is needed)");
+  std::size_t line_no = 0;
+  // Comment lines (starting with '#') and blank lines are skipped anywhere, as in the other bench
+  // files (docs/conventions.md).
+  const auto skipped = [](const std::string& l) {
+    const auto first = l.find_first_not_of(" \t\r");
+    return first == std::string::npos || l[first] == '#';
+  };
+  bool has_header = false;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!skipped(line)) {
+      has_header = true;
+      break;
+    }
+  }
+  if (!has_header) throw InputError(origin + ":" + std::to_string(line_no + 1) + ": empty log (a header row is needed)");
+  const std::string header_at = origin + ":" + std::to_string(line_no) + ": ";
   const std::vector<std::string> header = split_csv(line);
   std::map<std::string, std::size_t> at;
   for (std::size_t i = 0; i < header.size(); ++i) at[header[i]] = i;
   const auto column = [&](const std::string& name) {
     const auto it = at.find(name);
-    if (it == at.end()) throw InputError(origin + ":1: column " + name + " is missing");
+    if (it == at.end()) throw InputError(header_at + "column " + name + " is missing");
     return it->second;
   };
   ReplayLog log;
@@ -76,19 +93,19 @@ ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const
   }
   if (present.stations.empty()) {
     const std::string& j = config.stations.front().mechanisms.front().joints[0].name;
-    throw InputError(origin + ":1: column " + j + "_counts (or _volts, _theta_rad) is missing: the log has no joint of the configuration");
+    throw InputError(header_at + "column " + j + "_counts (or _volts, _theta_rad) is missing: the log has no joint of the configuration");
   }
   const Columns cols = columns_of(present);
   bool kind_found = false;
   for (runtime::Reading k : {runtime::Reading::counts, runtime::Reading::volts, runtime::Reading::radians}) {
     if (at.count(cols.joints.front() + kind_suffix(k))) {
-      if (kind_found) throw InputError(origin + ":1: " + cols.joints.front() + ": more than one reading column (counts, volts, theta_rad)");
+      if (kind_found) throw InputError(header_at + cols.joints.front() + ": more than one reading column (counts, volts, theta_rad)");
       log.kind = k;
       kind_found = true;
     }
   }
   if (!kind_found) {
-    throw InputError(origin + ":1: column " + cols.joints.front() + "_counts (or _volts, _theta_rad) is missing");
+    throw InputError(header_at + "column " + cols.joints.front() + "_counts (or _volts, _theta_rad) is missing");
   }
   const std::size_t t_col = column("time_s");
   std::vector<std::size_t> reading_col, duty_col, target_col;
@@ -100,10 +117,9 @@ ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const
     target_col.push_back(column(m + "_x_ref_mm"));
     target_col.push_back(column(m + "_y_ref_mm"));
   }
-  std::size_t line_no = 1;
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    if (skipped(line)) continue;
     const std::vector<std::string> cells = split_csv(line);
     if (cells.size() != header.size()) {
       throw InputError(origin + ":" + std::to_string(line_no) + ": " + std::to_string(cells.size()) + " cells, the header has " +
@@ -161,7 +177,7 @@ runtime::Config config_for_log(const runtime::Config& config, const ReplayLog& l
   return c;
 }
 
-ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, double tolerance) {
+ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, double tolerance, ReplayTrace* trace) {
   const runtime::Config config = config_for_log(full, log);
   runtime::Controller ctl(config);
   const Columns cols = columns_of(config);
@@ -172,9 +188,17 @@ ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, doubl
   for (const auto& s : config.stations)
     for (const auto& m : s.mechanisms) r.mechanisms.push_back(s.name + "/" + m.name);
   r.status_counts.assign(r.mechanisms.size(), {});
+  if (trace) {
+    trace->duties.assign(r.rows, {});
+    trace->statuses.assign(r.rows, {});
+  }
   for (std::size_t row = 0; row < r.rows; ++row) {
     ctl.cycle(log.readings[row].data(), log.kind, log.targets_m[row].data());
     for (std::size_t k = 0; k < r.mechanisms.size(); ++k) ++r.status_counts[k][static_cast<std::size_t>(ctl.mechanism(k).status)];
+    if (trace) {
+      trace->duties[row].assign(ctl.duties(), ctl.duties() + cols.joints.size());
+      for (std::size_t k = 0; k < r.mechanisms.size(); ++k) trace->statuses[row].push_back(ctl.mechanism(k).status);
+    }
     for (std::size_t j = 0; j < cols.joints.size(); ++j) {
       // A logged duty may be rounded by the device's logger: the difference, not bits, is compared.
       const double diff = std::fabs(ctl.duties()[j] - log.duties[row][j]);
@@ -196,6 +220,25 @@ ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, doubl
     }
   }
   return r;
+}
+
+void write_replay_comparison_csv(std::ostream& out, const ReplayLog& log, const ReplayResult& r, const ReplayTrace& trace) {
+  out << "time_s";
+  for (const ReplayJoint& j : r.joints) out << "," << j.joint << "_logged_duty," << j.joint << "_runtime_duty," << j.joint << "_duty_difference";
+  for (std::string m : r.mechanisms) {
+    std::replace(m.begin(), m.end(), '/', '_');
+    out << "," << m << "_status";
+  }
+  out << "\n";
+  for (std::size_t row = 0; row < r.rows; ++row) {
+    out << format::shortest(log.time_s[row]);
+    for (std::size_t j = 0; j < r.joints.size(); ++j) {
+      const double logged = log.duties[row][j], runtime = trace.duties[row][j];
+      out << "," << format::shortest(logged) << "," << format::shortest(runtime) << "," << format::shortest(runtime - logged);
+    }
+    for (runtime::Status st : trace.statuses[row]) out << "," << runtime::to_string(st);
+    out << "\n";
+  }
 }
 
 Json to_json(const ReplayResult& r) {

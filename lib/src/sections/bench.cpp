@@ -17,6 +17,22 @@ void BenchSettings::validate() const {
                                    std::pair<const char*, const std::string*>{"identification", &identification}}) {
     if (value->find('\0') != std::string::npos) throw ValidationError(key, "must be a file name");
   }
+  for (std::size_t k = 0; k < replay_logs.size(); ++k) {
+    const std::string key = "replay_logs[" + std::to_string(k) + "]";
+    if (replay_logs[k].empty() || replay_logs[k].find('\0') != std::string::npos) {
+      throw ValidationError(key, "must be a file name, not empty");
+    }
+    // The outputs are named by the log's file name (bench_replay/<stem>-duties.csv).
+    for (std::size_t i = 0; i < k; ++i) {
+      if (std::filesystem::path(replay_logs[i]).stem() == std::filesystem::path(replay_logs[k]).stem()) {
+        throw ValidationError(key, "= " + replay_logs[k] + ": replay_logs[" + std::to_string(i) + "] (" + replay_logs[i] +
+                                       ") has the same file name without extension (the outputs are named by it)");
+      }
+    }
+  }
+  if (!(replay_tolerance >= 0.0) || !(replay_tolerance <= 2.0)) {
+    throw ValidationError("replay_tolerance", "must be within [0, 2] (a duty difference)");
+  }
 }
 
 namespace sections {
@@ -25,17 +41,43 @@ namespace {
 void load(const Value& v, Design& design) {
   BenchSettings& b = design.set(BenchSettings{});
   if (v.is_null()) return;
-  const auto all = v.entries({"calibration", "identification"}, "of bench files (calibration, identification)");
+  const auto all = v.entries({"calibration", "identification", "replay_logs", "replay_tolerance"},
+                             "of bench files (calibration, identification, replay_logs, replay_tolerance)");
   if (const Value* c = find(all, "calibration")) b.calibration = c->text("must be a file name (CSV)");
   if (const Value* i = find(all, "identification")) b.identification = i->text("must be a file name (CSV)");
   if (const Value* c = find(all, "calibration"); c && b.calibration.empty()) c->fail_value("must be a file name, not empty");
   if (const Value* i = find(all, "identification"); i && b.identification.empty()) i->fail_value("must be a file name, not empty");
+  if (const Value* r = find(all, "replay_logs")) {
+    // One name, or a list of names.
+    const std::vector<Value> names = r->is_scalar() ? std::vector<Value>{*r} : r->list("must be a list of file names (CSV)");
+    if (names.empty()) r->fail("must name at least one log (or leave the key out)");
+    for (const Value& n : names) {
+      b.replay_logs.push_back(n.text("must be a file name (CSV)"));
+      if (b.replay_logs.back().empty()) n.fail_value("must be a file name, not empty");
+    }
+  }
+  b.replay_tolerance = number_or(all, "replay_tolerance", b.replay_tolerance, "");
+}
+
+/// A log that is there but is a directory is a wrong name, not a missing file.
+void check_replay_logs(const Design& design, const BenchSettings& b) {
+  for (std::size_t k = 0; k < b.replay_logs.size(); ++k) {
+    std::error_code ec;
+    const std::filesystem::path file = BenchSettings::resolve(design, b.replay_logs[k]);
+    if (std::filesystem::is_directory(file, ec)) {
+      throw ValidationError("replay_logs[" + std::to_string(k) + "]",
+                            "= " + b.replay_logs[k] + ": is a directory (" + file.generic_string() + "), not a log file");
+    }
+  }
 }
 
 void validate(const Design& design) {
   const BenchSettings* b = design.get<BenchSettings>();
   if (b == nullptr) return;
-  rules::validate_nested("bench", [&] { b->validate(); });
+  rules::validate_nested("bench", [&] {
+    b->validate();
+    check_replay_logs(design, *b);
+  });
 }
 
 void write(const Design& design, Out& top) {
@@ -44,6 +86,11 @@ void write(const Design& design, Out& top) {
   Out& o = top.add("bench", Out::map());
   if (!b->calibration.empty()) o.add("calibration", Out::quoted(b->calibration));
   if (!b->identification.empty()) o.add("identification", Out::quoted(b->identification));
+  if (!b->replay_logs.empty()) {
+    Out& logs = o.add("replay_logs", Out::list());
+    for (const std::string& name : b->replay_logs) logs.push(Out::quoted(name));
+  }
+  if (b->replay_tolerance != 1e-9) o.add("replay_tolerance", Out::number(b->replay_tolerance));
 }
 
 }  // namespace

@@ -3,13 +3,18 @@
 /// (docs/calibrate.md, docs/identify.md), file names relative to the design file:
 ///   calibration     measurements for `calibrate` (station,mechanism,volts1,volts2,x_mm,y_mm[,sigma_mm])
 ///   identification  a log for `identify --rig motor` (time_s, a drive, a reading per joint)
+///   replay_logs     the device's logs for `replay LOG` (fivebar/replay.hpp), each replayed through
+///                   the runtime of the design's export; replay_tolerance the largest |duty
+///                   difference| accepted (1e-9 by default, as `fivebar replay`'s --tolerance)
 /// With a file named, the `calibrate` or `identify` product writes its report and the patched
-/// design (values and provenance: entries) into the output folder. One module of the design
+/// design (values and provenance: entries) into the output folder; the `bench_replay` product
+/// reports per log whether the device runs the exported configuration. One module of the design
 /// (docs/architecture.md "Design sections"): loader and writer in lib/src/sections/bench.cpp.
 
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "fivebar/design.hpp"
 
@@ -19,6 +24,8 @@ struct BenchSettings {
   static constexpr std::string_view kKey = "bench";
   std::string calibration;     ///< as written (relative to the design file); empty: none
   std::string identification;  ///< as written; empty: none
+  std::vector<std::string> replay_logs;  ///< as written; empty: none
+  double replay_tolerance = 1e-9;        ///< duty, [0, 2]
   /// `file` resolved against the design file's folder (as given when absolute or without a source).
   static std::filesystem::path resolve(const Design& design, const std::string& file);
   void validate() const;
