@@ -187,7 +187,7 @@ TEST(Parameters, HoldThePapersDeviceInSiUnits) {
   // Gains: the station-mechanism scope of the tuned gains (controller.stations.index.lower.pid) over the
   // section's pid, whose i_clamp 0.2 it keeps.
   EXPECT_EQ(p.at("gains").at("index_lower_theta1"),
-            Json({{"p", 6.265494163504399}, {"i", 204.5452331276041}, {"d", 0.1300539404221824}, {"i_clamp", 0.2}}));
+            Json({{"p", 6.376473352297236}, {"i", 62.44954783058385}, {"d", 0.11315351641304752}, {"i_clamp", 0.2}}));
   EXPECT_EQ(p.at("gains").at("index_lower_theta2"), p.at("gains").at("index_lower_theta1"));
   EXPECT_NE(p.at("gains").at("thumb_upper_theta1"), p.at("gains").at("index_lower_theta1"));
   EXPECT_DOUBLE_EQ(p.at("potentiometers").at("index_lower_theta1").at("rad_per_volt").get<double>(), deg(60));

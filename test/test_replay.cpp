@@ -347,9 +347,9 @@ TEST_F(BenchReplayScene, ADesignWithOtherGainsDoesNotRunTheLogAndAMissingLogLeav
   // The index station's lower gains scaled by 1.25 (i_clamp too): its duties become 1.25 x the
   // logged ones, the upper mechanism's stay (the previous test's property, through the export).
   const double c = 1.25;
-  const std::string lower = "lower: {pid: {kp: 6.265494163504399, ki: 204.5452331276041, kd: 0.1300539404221824}}";
-  const std::string scaled = "lower: {pid: {kp: " + format::shortest(6.265494163504399 * c) + ", ki: " +
-                             format::shortest(204.5452331276041 * c) + ", kd: " + format::shortest(0.1300539404221824 * c) +
+  const std::string lower = "lower: {pid: {kp: 6.376473352297236, ki: 62.44954783058385, kd: 0.11315351641304752}}";
+  const std::string scaled = "lower: {pid: {kp: " + format::shortest(6.376473352297236 * c) + ", ki: " +
+                             format::shortest(62.44954783058385 * c) + ", kd: " + format::shortest(0.11315351641304752 * c) +
                              ", i_clamp: 0.25}}";
   const SceneReport r = scene("[logs/good.csv]", {{lower, scaled}});
   const ProductOutcome& p = outcome(r);
