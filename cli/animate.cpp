@@ -109,31 +109,27 @@ int run_animate(const AnimateOptions& opt) {
 }  // namespace
 
 void setup_animate(CLI::App& app) {
-  auto opt = std::make_shared<AnimateOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "animate",
+  auto [sub, opt] = add_command<AnimateOptions>(
+      app, "animate",
       "One pattern of a station as an animated SVG: both linkages moving at true speed over the reachable regions "
-      "and the target, the tactor paths drawn as they go, play/pause and a time slider");
+      "and the target, the tactor paths drawn as they go, play/pause and a time slider",
+      run_animate);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Finger station (e.g. index, thumb); default: the only one")
-      ->type_name("NAME");
+  add_station_option(*sub, opt->station, "the only one in the design");
   sub->add_option("--pattern", opt->pattern, "stretch, slip, twist or pivot (from the design's patterns: section)")
       ->required()
       ->type_name("KIND");
-  sub->add_option("-o,--out", opt->out,
-                  "Directory for <station>-<pattern>.svg (default: outputs/<design>/animations)")
-      ->type_name("DIR");
+  add_out_option(*sub, opt->out, "<station>-<pattern>.svg", "animations");
   sub->add_option("--simulated", opt->simulated,
                   "A time series CSV of `fivebar simulate` for this station and pattern: the simulated tactor is "
                   "drawn beside the reference")
       ->type_name("CSV");
   sub->add_option("--width", opt->width_px, "Width of the picture in pixels (default 1100)")->type_name("PX");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
-  sub->footer(
-      "The pattern's parameters come from the design's patterns: section, as in `fivebar run`.\n"
-      "Exit status: 0 written, 1 written but the pattern is not renderable, 2 bad input (nothing written), "
-      "3 internal error.");
-  sub->callback([opt]() { finish(run_animate(*opt)); });
+  add_json_flag(*sub, opt->json);
+  sub->footer("The pattern's parameters come from the design's patterns: section, as in `fivebar run`.\n" +
+              exit_status({.ok = "written",
+                           .failed = "written but the pattern is not renderable",
+                           .bad_input = "bad input (nothing written)"}));
 }
 
 }  // namespace fivebar::cli

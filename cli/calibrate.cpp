@@ -187,18 +187,18 @@ int run_calibrate(const CalibrateCliOptions& opt) {
 }  // namespace
 
 void setup_calibrate(CLI::App& app) {
-  auto opt = std::make_shared<CalibrateCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "calibrate",
+  auto [sub, opt] = add_command<CalibrateCliOptions>(
+      app, "calibrate",
       "Kinematic calibration from bench measurements: link lengths, base joints and potentiometer calibration of each "
       "mechanism by nonlinear least squares (Ceres), with posterior sigmas, identifiability (singular values, condition "
       "number, observability index, the parameters the poses cannot separate), residuals and a held-out check; --plan N "
-      "chooses the poses to measure, --hard-stops the potentiometer offsets from readings at the hard stops");
+      "chooses the poses to measure, --hard-stops the potentiometer offsets from readings at the hard stops",
+      run_calibrate);
   add_design_argument(*sub, opt->design);
   sub->add_option("MEAS", opt->measurements,
                   "Measurements (CSV): station,mechanism,volts1,volts2,x_mm,y_mm[,sigma_mm] or counts1,counts2 instead of volts")
       ->type_name("FILE");
-  sub->add_option("-s,--station", opt->station, "Station to calibrate (default: the one the measurements name)")->type_name("NAME");
+  add_station_option(*sub, opt->station, "the one the measurements name");
   sub->add_option("-m,--mechanism", opt->mechanism, "Only this mechanism: lower or upper")->type_name("NAME");
   sub->add_option("--frame", opt->frame, "fixed: the instrument measures in the station frame; fit: fit its planar pose too")
       ->capture_default_str();
@@ -220,15 +220,16 @@ void setup_calibrate(CLI::App& app) {
   sub->add_option("--hard-stops", opt->hard_stops, "Potentiometer calibration from readings at the hard stops (CSV "
                                                    "station,mechanism,joint,stop,volts)")
       ->type_name("LOG");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
+  add_json_flag(*sub, opt->json);
+  // Without --out nothing is written (docs/calibrate.md): not add_out_option(), which names a default folder.
   sub->add_option("-o,--out", opt->out,
                   "Write the patched design (<design>-calibrated.yaml, with provenance: entries), calibration-summary.md and "
                   "calibration-plan.csv here; default: write nothing")
       ->type_name("DIR");
   sub->footer(
-      "Model, identifiability and the bench walk-through: docs/calibrate.md.\nExit status: 0 fitted, 1 a parameter named with "
-      "--fit is not identifiable or no plan exists (nothing written), 2 bad input, 3 internal error.");
-  sub->callback([opt]() { finish(run_calibrate(*opt)); });
+      "Model, identifiability and the bench walk-through: docs/calibrate.md.\n" +
+      exit_status({.ok = "fitted",
+                   .failed = "a parameter named with --fit is not identifiable or no plan exists (nothing written)"}));
 }
 
 }  // namespace fivebar::cli

@@ -178,23 +178,24 @@ int run_collision(const CollisionOptions& opt) {
 }  // namespace
 
 void setup_collision(CLI::App& app) {
-  auto opt = std::make_shared<CollisionOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "collision",
+  auto [sub, opt] = add_command<CollisionOptions>(
+      app, "collision",
       "Interference of a station's upper and lower mechanisms: a pair of tactor points with the priority rule "
-      "(--upper, --lower), or the collision map over the target ellipse");
+      "(--upper, --lower), or the collision map over the target ellipse",
+      run_collision);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Finger station (e.g. index, thumb); default: the only one")
-      ->type_name("NAME");
+  add_station_option(*sub, opt->station, "the only one in the design");
   sub->add_option("--upper", opt->upper, "Upper tactor point X,Y (mm)")->type_name("X,Y");
   sub->add_option("--lower", opt->lower, "Lower tactor point X,Y (mm)")->type_name("X,Y");
   sub->add_option("--spacing", opt->spacing_mm, "Grid spacing of the collision map (mm)")
       ->capture_default_str()
       ->type_name("MM");
-  sub->add_option("-o,--out", opt->out, "Directory for the map's picture (default: outputs/<design>/collision)")
-      ->type_name("DIR");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
-  sub->callback([opt] { finish(run_collision(*opt)); });
+  add_out_option(*sub, opt->out, "the map's picture", "collision");
+  add_json_flag(*sub, opt->json);
+  sub->footer(exit_status({.ok = "the pair does not collide (the map: a collision-free pair exists)",
+                           .failed = "the pair collides or the priority rule finds a tactor unusable (the map: no "
+                                     "pair in the target ellipse is collision-free)",
+                           .writes = true}));
 }
 
 }  // namespace fivebar::cli

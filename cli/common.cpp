@@ -59,13 +59,36 @@ void add_design_argument(CLI::App& sub, std::string& design) {
 
 void add_target_options(CLI::App& sub, Target& target) {
   add_design_argument(sub, target.design);
-  sub.add_option("-s,--station", target.station,
-                 "Finger station (e.g. index, thumb); default: the only one in the design")
-      ->type_name("NAME");
+  add_station_option(sub, target.station, "the only one in the design");
   sub.add_option("-m,--mechanism", target.mechanism,
                  "Mechanism of the station: lower or upper; default: the only one present")
       ->check(CLI::IsMember({"lower", "upper"}))
       ->type_name("NAME");
+}
+
+CLI::Option* add_station_option(CLI::App& sub, std::string& station, std::string_view when_absent) {
+  return sub.add_option("-s,--station", station, "Finger station (e.g. index, thumb); default: " + std::string(when_absent))
+      ->type_name("NAME");
+}
+
+CLI::Option* add_out_option(CLI::App& sub, std::string& out, std::string_view what, std::string_view folder) {
+  return sub
+      .add_option("-o,--out", out,
+                  "Directory for " + std::string(what) + " (default: outputs/<design>/" + std::string(folder) + ")")
+      ->type_name("DIR");
+}
+
+CLI::Option* add_json_flag(CLI::App& sub, bool& json, std::string_view what) {
+  return sub.add_flag("--json", json, "Print " + std::string(what) + " on stdout and nothing else");
+}
+
+std::string exit_status(const ExitStatus& status) {
+  std::string text = "Exit status: 0 " + std::string(status.ok);
+  if (!status.failed.empty()) text += ", 1 " + std::string(status.failed);
+  text += ", 2 " + std::string(status.bad_input) + ", 3 internal error";
+  if (status.writes) text += " or output not writable";
+  if (status.resumable) text += ", 130 interrupted (continue with --resume)";
+  return text + ".";
 }
 
 Design load(const std::string& path) { return load_scene(path); }

@@ -16,6 +16,7 @@
 #include <ostream>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "fivebar/design.hpp"
@@ -117,25 +118,47 @@ void print_pose(std::ostream& out, const Mechanism& m, const Pose& pose);
 /// Compact description of the joint-limit verdict: "within", "OUTSIDE", "none set".
 std::string limits_text(const Mechanism& m, const Pose& pose);
 
-// --- Subcommands (one file each) ----------------------------------------------------------------
-void setup_fk(CLI::App& app);
-void setup_ik(CLI::App& app);
-void setup_sweep(CLI::App& app);
-void setup_optimize(CLI::App& app);
-void setup_run(CLI::App& app);
-void setup_workspace(CLI::App& app);
-void setup_coverage(CLI::App& app);
-void setup_parts(CLI::App& app);
-void setup_collision(CLI::App& app);
-void setup_pattern(CLI::App& app);
-void setup_report(CLI::App& app);
-void setup_export(CLI::App& app);
-void setup_simulate(CLI::App& app);
-void setup_tolerance(CLI::App& app);
-void setup_animate(CLI::App& app);
-void setup_control(CLI::App& app);
-void setup_replay(CLI::App& app);
-void setup_calibrate(CLI::App& app);
-void setup_identify(CLI::App& app);
+// --- The command scaffold ------------------------------------------------------------------------
+
+/// A subcommand and its options object, which lives as long as the command's callback.
+template <class Options>
+struct Command {
+  CLI::App* sub;
+  Options* opt;
+};
+
+/// Adds the subcommand `name` to `parent` (the app, or a command with subcommands of its own such as
+/// `report`) with a fresh `Options`; when it is chosen, its callback ends with finish(run(options)).
+template <class Options, class Run>
+Command<Options> add_command(CLI::App& parent, std::string name, std::string description, Run run) {
+  auto opt = std::make_shared<Options>();
+  CLI::App* sub = parent.add_subcommand(std::move(name), std::move(description));
+  sub->callback([opt, run] { finish(run(*opt)); });
+  return {sub, opt.get()};
+}
+
+/// -s,--station NAME: "Finger station (e.g. index, thumb); default: <when_absent>".
+CLI::Option* add_station_option(CLI::App& sub, std::string& station, std::string_view when_absent);
+/// -o,--out DIR: "Directory for <what> (default: outputs/<design>/<folder>)", where `folder` is the
+/// one the command passes to command_output_dir() (docs/conventions.md "Output files").
+CLI::Option* add_out_option(CLI::App& sub, std::string& out, std::string_view what, std::string_view folder);
+/// --json: "Print <what> on stdout and nothing else" (docs/conventions.md "Streams").
+CLI::Option* add_json_flag(CLI::App& sub, bool& json, std::string_view what = "one JSON document");
+
+/// The words of a command's exit codes (docs/conventions.md "Exit codes").
+struct ExitStatus {
+  std::string_view ok = {};                  ///< 0
+  std::string_view failed = {};              ///< 1; empty for a command with no check to fail
+  std::string_view bad_input = "bad input";  ///< 2
+  bool writes = false;                       ///< 3 also names output that could not be written
+  bool resumable = false;                    ///< 130: interrupted, continued with --resume
+};
+/// "Exit status: 0 <ok>, 1 <failed>, 2 <bad_input>, 3 internal error[ or output not writable]."
+std::string exit_status(const ExitStatus& status);
+
+// --- Subcommands: one file each, listed in cli/commands.def ---------------------------------------
+#define FIVEBAR_COMMAND(cmd) void setup_##cmd(CLI::App& app);
+#include "commands.def"
+#undef FIVEBAR_COMMAND
 
 }  // namespace fivebar::cli

@@ -189,23 +189,21 @@ int run_control(const ControlCliOptions& opt) {
 }  // namespace
 
 void setup_control(CLI::App& app) {
-  auto opt = std::make_shared<ControlCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "control",
+  auto [sub, opt] = add_command<ControlCliOptions>(
+      app, "control",
       "Stability of each mechanism's sampled PID loop over its target ellipse: spectral radius of the ZOH plant "
-      "linearised at every pose with one period of delay, worst pose, gain margins, damping; picture, VTK, CSV");
+      "linearised at every pose with one period of delay, worst pose, gain margins, damping; picture, VTK, CSV",
+      run_control);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Only this station (default: every station with a mechanism)")
-      ->type_name("NAME");
+  add_station_option(*sub, opt->station, "every station with a mechanism");
   sub->add_flag("--render", opt->render,
                 "Links' masses from the parts' STL renders (openscad) instead of the closed form (slab with bosses)");
   sub->add_option("--grid", opt->grid, "Grid points per axis over the target ellipse's box (default 41)")
       ->type_name("N");
   sub->add_option("--field", opt->field, "Grid points per axis over each mechanism's reach (default 81)")
       ->type_name("N");
-  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/control)")
-      ->type_name("DIR");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  add_out_option(*sub, opt->out, "the files", "control");
+  add_json_flag(*sub, opt->json);
   sub->add_flag("--tune", opt->tune,
                 "Tune kp, ki, kd per mechanism from the hand-set gains (NLopt COBYLA): least worst tracking error over "
                 "the patterns with max rho <= controller.tune.rho_limit (0.9); writes tuned-controller.yaml (a "
@@ -221,11 +219,10 @@ void setup_control(CLI::App& app) {
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
       "Files: <station>-stability.svg|.png, <station>-<mechanism>-rho.vti, <station>-stability.csv,\n"
-      "<station>-performance.csv; with --tune also tuned-controller.yaml (a patch of controller:) and tuning.csv.\n"
-      "Exit status: 0 stable everywhere on every target (with --tune: the tuned gains meet the constraints),\n"
-      "1 unstable somewhere, tuned gains infeasible or a part failed to render,\n"
-      "2 bad input, 3 internal error or output not writable.");
-  sub->callback([opt]() { finish(run_control(*opt)); });
+      "<station>-performance.csv; with --tune also tuned-controller.yaml (a patch of controller:) and tuning.csv.\n" +
+      exit_status({.ok = "stable everywhere on every target (with --tune: the tuned gains meet the constraints)",
+                   .failed = "unstable somewhere, tuned gains infeasible or a part failed to render",
+                   .writes = true}));
 }
 
 }  // namespace fivebar::cli

@@ -160,31 +160,30 @@ int run_export(const ExportCliOptions& opt) {
 }  // namespace
 
 void setup_export(CLI::App& app) {
-  auto opt = std::make_shared<ExportCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "export",
+  auto [sub, opt] = add_command<ExportCliOptions>(
+      app, "export",
       "Validated controller configuration: ROS 2 parameters YAML, JSON and a C++17 header, written only when the "
-      "design passes the export gate (coverage, singularities, joint limits, calibration, patterns)");
+      "design passes the export gate (coverage, singularities, joint limits, calibration, patterns)",
+      run_export);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
+  add_station_option(*sub, opt->station, "every station");
   sub->add_option("--format", opt->format,
                   "ros2, json, header, urdf, mjcf or all (default: all; urdf: one URDF with ros2_control per station; "
                   "mjcf: one MuJoCo MJCF per station, loops closed, motors as actuators)")->type_name("FORMAT");
-  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/export)")
-      ->type_name("DIR");
+  add_out_option(*sub, opt->out, "the files", "export");
   sub->add_option("--check", opt->check,
                   "Re-read an exported FILE (any format) and confirm it matches DESIGN: hash and every value")
       ->type_name("FILE");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  add_json_flag(*sub, opt->json);
   sub->footer(
       "Files: <design>_controller[_<station>].yaml|.json|.hpp, <design>_<station>.urdf and <design>_<station>.xml\n"
       "(MJCF; both with geometry:), SI "
       "units; joints <station>_<mechanism>_theta<1|2>, their limits the usable range of each joint (potentiometer\n"
-      "travel, hard stops, joint_limits).\n"
-      "Exit status: 0 exported (or --check: the file matches), 1 export refused by the gate (nothing written) or\n"
-      "--check found differences, 2 bad input (design without controller: section, unknown station, ...), "
-      "3 internal error or the files could not be written.");
-  sub->callback([opt]() { finish(run_export(*opt)); });
+      "travel, hard stops, joint_limits).\n" +
+      exit_status({.ok = "exported (or --check: the file matches)",
+                   .failed = "export refused by the gate (nothing written) or --check found differences",
+                   .bad_input = "bad input (design without controller: section, unknown station, ...)",
+                   .writes = true}));
 }
 
 }  // namespace fivebar::cli

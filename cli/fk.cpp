@@ -112,9 +112,9 @@ int run_fk(const FkOptions& opt) {
 }  // namespace
 
 void setup_fk(CLI::App& app) {
-  auto opt = std::make_shared<FkOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "fk", "Forward kinematics: motor angles theta1,theta2 (deg) -> tactor point P (mm), status, Jacobian, LCI");
+  auto [sub, opt] = add_command<FkOptions>(
+      app, "fk", "Forward kinematics: motor angles theta1,theta2 (deg) -> tactor point P (mm), status, Jacobian, LCI",
+      run_fk);
   add_target_options(*sub, opt->target);
   auto* theta = sub->add_option("-t,--theta", opt->theta,
                                 "Motor angles T1,T2 in degrees, counter-clockwise from +x (e.g. --theta 100,80)")
@@ -125,11 +125,10 @@ void setup_fk(CLI::App& app) {
                      ->check(CLI::IsMember({"+", "-", "any"}))
                      ->type_name("SIGN");
   auto* all = sub->add_flag("-a,--all", opt->all, "Both assembly branches");
-  auto* json = sub->add_flag("--json", opt->json, "Print one JSON document (mm, deg) on stdout and nothing else");
+  auto* json = add_json_flag(*sub, opt->json, "one JSON document (mm, deg)");
   all->excludes(branch);
   file->excludes(all)->excludes(json);
-  sub->footer("Exit status: 0 a configuration exists, 1 none (status says why), 2 bad input, 3 internal error.");
-  sub->callback([opt]() { finish(run_fk(*opt)); });
+  sub->footer(exit_status({.ok = "a configuration exists", .failed = "none (status says why)"}));
 }
 
 }  // namespace fivebar::cli

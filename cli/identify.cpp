@@ -363,12 +363,12 @@ int run_identify(const IdentifyCliOptions& opt) {
 }  // namespace
 
 void setup_identify(CLI::App& app) {
-  auto opt = std::make_shared<IdentifyCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "identify",
+  auto [sub, opt] = add_command<IdentifyCliOptions>(
+      app, "identify",
       "Motor, friction and inertia of a joint from bench logs: the inverse dynamic model by least squares on zero-phase "
       "filtered data (IDIM-LS) with its standard deviations and the parameters the log cannot separate, an output-error "
-      "refinement by simulation, fit percentages on the estimation and a validation log; or (--plan) the excitation to log");
+      "refinement by simulation, fit percentages on the estimation and a validation log; or (--plan) the excitation to log",
+      run_identify);
   add_design_argument(*sub, opt->design);
   sub->add_option("log", opt->log, "Estimation log: CSV with time_s and per joint a drive (duty, voltage_V, current_A, "
                                    "torque_Nm or force_N), a reading (volts, counts, theta_rad or position_m) and optionally current_A")
@@ -403,17 +403,16 @@ void setup_identify(CLI::App& app) {
   sub->add_option("--range-deg", opt->range_deg, "Joint range for the plan (deg)")->delimiter(',')->type_name("LO,HI");
   sub->add_option("--drive-noise", opt->drive_noise_mNm, "Noise of the logged drive torque the plan's sigmas assume (mNm)")
       ->capture_default_str();
-  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design>/identify)")->type_name("DIR");
+  add_out_option(*sub, opt->out, "the files", "identify");
   sub->add_flag("--no-files", opt->no_files, "Print only");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
+  add_json_flag(*sub, opt->json);
   sub->footer(
       "Parameters are printed with their design key path (motor.terminal_resistance_ohm, in the design's units) or a "
       "rig-only name with its unit (inertia_kg_m2, viscous_Nm_s_per_rad, coulomb_Nm, offset_Nm; a linear axis: mass_kg, "
       "viscous_N_s_per_m, coulomb_N, offset_N). docs/identify.md.\nFiles: <joint>-estimation.svg|.png, "
       "<joint>-validation.svg|.png, identify.json, <design>-identified.yaml (the identified motor keys with provenance: "
-      "entries); with --plan identify-plan.csv.\nExit status: 0 done, 1 a parameter "
-      "named by --fit is not identifiable from the log, 2 bad input, 3 internal error.");
-  sub->callback([opt]() { finish(run_identify(*opt)); });
+      "entries); with --plan identify-plan.csv.\n" +
+      exit_status({.ok = "done", .failed = "a parameter named by --fit is not identifiable from the log"}));
 }
 
 }  // namespace fivebar::cli

@@ -139,9 +139,8 @@ int run_ik(const IkOptions& opt) {
 }  // namespace
 
 void setup_ik(CLI::App& app) {
-  auto opt = std::make_shared<IkOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "ik", "Inverse kinematics: tactor point X,Y (mm) -> motor angles (deg) in the design's working mode");
+  auto [sub, opt] = add_command<IkOptions>(
+      app, "ik", "Inverse kinematics: tactor point X,Y (mm) -> motor angles (deg) in the design's working mode", run_ik);
   add_target_options(*sub, opt->target);
   auto* point = sub->add_option("-p,--point", opt->point, "Tactor point X,Y in mm, station frame (e.g. --point 6.25,15.5)")
                     ->type_name("X,Y");
@@ -151,13 +150,11 @@ void setup_ik(CLI::App& app) {
                                "(elbows out, lower) or +- (upper); default: the design's")
                    ->type_name("SIGNS");
   auto* all = sub->add_flag("-a,--all", opt->all, "All four working modes ++, +-, -+, --");
-  auto* json = sub->add_flag("--json", opt->json, "Print one JSON document (mm, deg) on stdout and nothing else");
+  auto* json = add_json_flag(*sub, opt->json, "one JSON document (mm, deg)");
   all->excludes(mode);
   file->excludes(all)->excludes(json);
-  sub->footer(
-      "Exit status: 0 a solution within the joint limits, 1 none (unreachable or outside the limits), 2 bad input, "
-      "3 internal error.");
-  sub->callback([opt]() { finish(run_ik(*opt)); });
+  sub->footer(exit_status({.ok = "a solution within the joint limits",
+                           .failed = "none (unreachable or outside the limits)"}));
 }
 
 }  // namespace fivebar::cli

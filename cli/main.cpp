@@ -1,6 +1,6 @@
 // fivebar: command-line front end, fivebar::cli::main (cli/cli.hpp). Subcommands live in one file
-// each (setup_<cmd> / run_<cmd>); this file maps every outcome to the exit codes of docs/conventions.md. The
-// process entry point is fivebar_main.cpp; the fuzzer (test/fuzz/fuzz_cli.cpp) calls this in-process.
+// each (setup_<cmd> / run_<cmd>), listed in cli/commands.def; this file maps every outcome to the
+// exit codes of docs/conventions.md. The process entry point is fivebar_main.cpp; the fuzzer (test/fuzz/fuzz_cli.cpp) calls this in-process.
 
 #include <algorithm>
 #include <cctype>
@@ -130,29 +130,14 @@ int run(int argc, char** argv) {
       "fivebar"};
   app.set_version_flag("--version", "fivebar " + std::string(fivebar::version()));
   app.require_subcommand(1);
-  app.footer(
-      "Run 'fivebar <subcommand> --help' for its options.\n"
-      "Exit status: 0 success, 1 a check failed or no solution, 2 bad input (usage or design file), "
-      "3 internal error.");
-  setup_fk(app);
-  setup_ik(app);
-  setup_sweep(app);
-  setup_optimize(app);
-  setup_run(app);
-  setup_workspace(app);
-  setup_coverage(app);
-  setup_parts(app);
-  setup_collision(app);
-  setup_pattern(app);
-  setup_report(app);
-  setup_export(app);
-  setup_simulate(app);
-  setup_tolerance(app);
-  setup_animate(app);
-  setup_control(app);
-  setup_identify(app);
-  setup_calibrate(app);
-  setup_replay(app);
+  app.footer("Run 'fivebar <subcommand> --help' for its options.\n" +
+             exit_status({.ok = "success",
+                          .failed = "a check failed or no solution",
+                          .bad_input = "bad input (usage or design file)"}));
+  // One subcommand per line of cli/commands.def, in its order.
+#define FIVEBAR_COMMAND(cmd) setup_##cmd(app);
+#include "commands.def"
+#undef FIVEBAR_COMMAND
   // After every subcommand: their numeric flags refuse NaN, infinities and overflow.
   guard_numeric_flags(app);
 

@@ -181,13 +181,13 @@ int run_optimize_cmd(const OptimizeCliOptions& o) {
 }  // namespace
 
 void setup_optimize(CLI::App& app) {
-  auto opt = std::make_shared<OptimizeCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "optimize",
+  auto [sub, opt] = add_command<OptimizeCliOptions>(
+      app, "optimize",
       "Optimise the design's numbers (optimize: section) with pagmo2 islands and an NLopt polish: Pareto front, chosen "
-      "design re-checked, plots");
+      "design re-checked, plots",
+      run_optimize_cmd);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-o,--out", opt->out, "Output directory (default outputs/<name>/optimize)")->type_name("DIR");
+  add_out_option(*sub, opt->out, "the front, the chosen design, its re-check and the plots", "optimize");
   sub->add_option("--evaluations", opt->evaluations, "Budget of candidates (default: optimize.evaluations)");
   sub->add_option("--seconds", opt->seconds, "Wall-time budget, checked between rounds (default: optimize.seconds)")->type_name("S");
   sub->add_option("--seed", opt->seed, "Seed (default: optimize.seed)");
@@ -199,8 +199,11 @@ void setup_optimize(CLI::App& app) {
   sub->add_flag("--no-polish", opt->no_polish, "Skip the NLopt polish of the chosen design (optimize.polish: false)");
   sub->add_flag("--no-atlas", opt->no_atlas, "Skip the performance atlas of each optimised station (optimize.atlas: false)");
   sub->add_flag("--no-check", opt->no_check, "Skip the re-check of the chosen design (the coverage, collision and pattern products, and its loop and simulated figures beside the given design's)");
-  sub->add_flag("--json", opt->json, "One JSON document on stdout");
-  sub->callback([opt] { finish(run_optimize_cmd(*opt)); });
+  add_json_flag(*sub, opt->json);
+  sub->footer(exit_status({.ok = "a design chosen and its re-check passed (or a shard finished)",
+                           .failed = "no design chosen or its re-check failed",
+                           .writes = true,
+                           .resumable = true}));
 }
 
 }  // namespace fivebar::cli

@@ -84,27 +84,23 @@ int run_parts(const PartsCliOptions& opt) {
 }  // namespace
 
 void setup_parts(CLI::App& app) {
-  auto opt = std::make_shared<PartsCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "parts",
-      "Printable parts: OpenSCAD sources, binary STL renders (openscad), mesh and fit checks, bill of materials");
+  auto [sub, opt] = add_command<PartsCliOptions>(
+      app, "parts",
+      "Printable parts: OpenSCAD sources, binary STL renders (openscad), mesh and fit checks, bill of materials",
+      run_parts);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Only this station (e.g. index); default: every station")
-      ->type_name("NAME");
-  sub->add_option("-o,--out", opt->out, "Directory for the parts (default: outputs/<design>/parts)")
-      ->capture_default_str()
-      ->type_name("DIR");
+  add_station_option(*sub, opt->station, "every station");
+  add_out_option(*sub, opt->out, "the parts", "parts");
   sub->add_flag("--no-render", opt->no_render, "Write the .scad sources (and a BOM without volumes) only");
   sub->add_option("-j,--jobs", opt->jobs, "openscad processes at once")
       ->capture_default_str()
       ->check(CLI::Range(1, 64))
       ->type_name("N");
-  sub->add_flag("--json", opt->json, "Print one JSON document (mm) on stdout and nothing else");
-  sub->footer(
-      "Parts whose .scad text and library are unchanged since their last render are not rendered again.\n"
-      "Exit status: 0 every part rendered and passed its checks, 1 a render or check failed or openscad is not "
-      "installed, 2 bad input, 3 internal error or output not writable.");
-  sub->callback([opt]() { finish(run_parts(*opt)); });
+  add_json_flag(*sub, opt->json, "one JSON document (mm)");
+  sub->footer("Parts whose .scad text and library are unchanged since their last render are not rendered again.\n" +
+              exit_status({.ok = "every part rendered and passed its checks",
+                           .failed = "a render or check failed or openscad is not installed",
+                           .writes = true}));
 }
 
 }  // namespace fivebar::cli

@@ -172,14 +172,13 @@ int run_pattern(const PatternOptions& opt) {
 }  // namespace
 
 void setup_pattern(CLI::App& app) {
-  auto opt = std::make_shared<PatternOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "pattern",
+  auto [sub, opt] = add_command<PatternOptions>(
+      app, "pattern",
       "A skin-deformation pattern for both tactors of a station (stretch, slip, twist, pivot), checked at every "
-      "sample; writes the four motors' joint trajectories (CSV) and a picture of the paths");
+      "sample; writes the four motors' joint trajectories (CSV) and a picture of the paths",
+      run_pattern);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Finger station (e.g. index, thumb); default: the only one")
-      ->type_name("NAME");
+  add_station_option(*sub, opt->station, "the only one in the design");
   sub->add_option("--pattern", opt->pattern, "stretch, slip, twist or pivot")->required()->type_name("KIND");
   sub->add_option("--amplitude", opt->amplitude_mm,
                   "Travel (mm): stretch, each tactor; slip, both; twist, arc length along the circle")
@@ -196,14 +195,11 @@ void setup_pattern(CLI::App& app) {
   sub->add_option("--max-joint-speed", opt->max_speed_deg_s,
                   "Motor speed limit (deg/s; default: patterns.max_joint_speed_deg_s, else 360)")
       ->type_name("DEG_S");
-  sub->add_option("-o,--out", opt->out, "Directory for the CSV and the picture (default: outputs/<design>/patterns)")
-      ->type_name("DIR");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  add_out_option(*sub, opt->out, "the CSV and the picture", "patterns");
+  add_json_flag(*sub, opt->json);
   sub->add_flag("--samples", opt->samples, "With --json: include every sample");
-  sub->footer(
-      "Parameters not given come from the design's patterns: section for this station, else the defaults.\n"
-      "Exit status: 0 renderable, 1 not renderable (a sample fails), 2 bad input, 3 internal error.");
-  sub->callback([opt]() { finish(run_pattern(*opt)); });
+  sub->footer("Parameters not given come from the design's patterns: section for this station, else the defaults.\n" +
+              exit_status({.ok = "renderable", .failed = "not renderable (a sample fails)"}));
 }
 
 }  // namespace fivebar::cli

@@ -148,29 +148,28 @@ int run_sil(const ReplayOptions& opt) {
 }  // namespace
 
 void setup_replay(CLI::App& app) {
-  auto opt = std::make_shared<ReplayOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "replay",
+  auto [sub, opt] = add_command<ReplayOptions>(
+      app, "replay",
       "A device log (measured joints, reference points, duties) through the runtime of an exported configuration: "
-      "its duties against the logged ones; --sil: the runtime closed around the simulator");
+      "its duties against the logged ones; --sil: the runtime closed around the simulator",
+      [](const ReplayOptions& o) { return o.sil ? run_sil(o) : run_log(o); });
   sub->add_option("input", opt->input, "The log (CSV), or with --sil the design file (YAML)")->required()->type_name("LOG|DESIGN");
   sub->add_option("-c,--config", opt->config, "The exported controller configuration (fivebar export --format json)")
       ->type_name("FILE");
   sub->add_flag("--sil", opt->sil, "Software in the loop: simulate the design's patterns with the runtime as the controller");
-  sub->add_option("-s,--station", opt->station, "--sil: the station (default: every station with both tactors)")
-      ->type_name("NAME");
+  add_station_option(*sub, opt->station, "every station with both tactors (--sil only)");
   sub->add_option("--pattern", opt->pattern, "--sil: only this pattern (stretch, slip, twist, pivot)")->type_name("KIND");
   sub->add_option("--tolerance", opt->tolerance, "Largest |duty difference| accepted per value (default 1e-9)")
       ->type_name("D");
-  sub->add_option("-o,--out", opt->out, "--sil: directory of the logs (default: outputs/<design>/replay)")->type_name("DIR");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  add_out_option(*sub, opt->out, "the logs of --sil", "replay");
+  add_json_flag(*sub, opt->json);
   sub->footer(
       "Log columns: time_s; per joint <station>_<mechanism>_theta<1|2>_counts (or _volts, _theta_rad) and _duty;\n"
       "per mechanism <station>_<mechanism>_x_ref_mm and _y_ref_mm (docs/runtime.md \"Replay\").\n"
-      "--sil uses the links' closed-form masses (no parts render).\n"
-      "Exit status: 0 every duty matched (or every simulation finished), 1 a mismatch (or a simulation failed),\n"
-      "2 bad input, 3 internal error or output not writable.");
-  sub->callback([opt]() { finish(opt->sil ? run_sil(*opt) : run_log(*opt)); });
+      "--sil uses the links' closed-form masses (no parts render).\n" +
+      exit_status({.ok = "every duty matched (or every simulation finished)",
+                   .failed = "a mismatch (or a simulation failed)",
+                   .writes = true}));
 }
 
 }  // namespace fivebar::cli

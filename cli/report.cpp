@@ -73,9 +73,8 @@ int run_stability(const ReportOptions& opt) {
 
 void add_common(CLI::App& sub, ReportOptions& opt) {
   add_design_argument(sub, opt.design);
-  sub.add_option("-s,--station", opt.station, "Only this finger station (e.g. index, thumb); default: every station")
-      ->type_name("NAME");
-  sub.add_flag("--json", opt.json, "Print one JSON document on stdout and nothing else");
+  add_station_option(sub, opt.station, "every station");
+  add_json_flag(sub, opt.json);
   sub.add_flag("-q,--quiet", opt.quiet, "No progress lines on stderr (they are shown only on a terminal anyway)");
 }
 
@@ -86,31 +85,27 @@ void setup_report(CLI::App& app) {
       "report", "Accuracy against run time (work-precision) and numerical stability on extreme cases");
   report->require_subcommand(1);
 
-  auto acc = std::make_shared<ReportOptions>();
-  CLI::App* a = report->add_subcommand(
-      "accuracy",
+  auto [a, acc] = add_command<ReportOptions>(
+      *report, "accuracy",
       "Work-precision series (error against run time) of the workspace area (cell counting, marching squares), "
       "the coverage margin and min LCI (sampling), the sampled restricted regions, and FK/IK in float, double, "
       "long double and the library's double paths against a __float128 reference, stratified by distance to "
-      "singularity. Writes one SVG and PNG plot per method into OUT/<design name>/report/.");
+      "singularity. Writes one SVG and PNG plot per method into --out.",
+      run_accuracy);
   add_common(*a, *acc);
-  a->add_option("-o,--out", acc->out, "Directory for the plots (default: outputs/<design>/report)")
-      ->capture_default_str()
-      ->type_name("DIR");
+  add_out_option(*a, acc->out, "the plots", "report");
   a->add_flag("--quick", acc->quick, "Coarser series and fewer samples (a few seconds instead of ~30 s)");
-  a->footer("Exit status: 0 success, 2 bad input, 3 internal error or output not writable.");
-  a->callback([acc]() { finish(run_accuracy(*acc)); });
+  a->footer(exit_status({.ok = "success", .writes = true}));
 
-  auto stab = std::make_shared<ReportOptions>();
-  CLI::App* s = report->add_subcommand(
-      "stability",
+  auto [s, stab] = add_command<ReportOptions>(
+      *report, "stability",
       "Extreme cases through FK, IK, Jacobian/LCI, workspace area and coverage: distances 1e-1 ... 1e-16 and 0 to "
       "type I/II singularities, link ratios 1e-4 ... 1e4, scales 1e-3 ... 1e6 mm, coincident bases, equal links, "
       "condition numbers up to 1e14, tangent ellipses; each with its status, error against a __float128 "
-      "reference, the bound its conditioning allows, and PASS/FAIL.");
+      "reference, the bound its conditioning allows, and PASS/FAIL.",
+      run_stability);
   add_common(*s, *stab);
-  s->footer("Exit status: 0 every case passed, 1 a case failed, 2 bad input, 3 internal error.");
-  s->callback([stab]() { finish(run_stability(*stab)); });
+  s->footer(exit_status({.ok = "every case passed", .failed = "a case failed"}));
 }
 
 }  // namespace fivebar::cli

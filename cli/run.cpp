@@ -77,10 +77,12 @@ int run_run(const RunOptions& opt) {
 }  // namespace
 
 void setup_run(CLI::App& app) {
-  auto opt = std::make_shared<RunOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "run", "Build the products a scene lists (default: all it has data for) into OUT/<name>/ with summary.md/.json and index.html");
+  auto [sub, opt] = add_command<RunOptions>(
+      app, "run",
+      "Build the products a scene lists (default: all it has data for) into OUT/<name>/ with summary.md/.json and index.html",
+      run_run);
   add_design_argument(*sub, opt->design);
+  // The parent of the design's folder, as docs/conventions.md "Output files" says: not add_out_option().
   sub->add_option("-o,--out", opt->out, "Output root; the scene writes OUT/<design name>/")
       ->capture_default_str()
       ->type_name("DIR");
@@ -92,16 +94,15 @@ void setup_run(CLI::App& app) {
                   }() + ")")
       ->delimiter(',')
       ->type_name("LIST");
-  sub->add_flag("--json", opt->json, "Print the summary as one JSON document on stdout and nothing else");
+  add_json_flag(*sub, opt->json, "the summary as one JSON document");
   sub->add_flag("-q,--quiet", opt->quiet, "No progress lines on stderr");
   sub->add_option("-j,--jobs", opt->jobs,
                   "Products built at once, each after its prerequisites (0: one per core); the outputs do not depend on it")
       ->capture_default_str()
       ->type_name("N");
-  sub->footer(
-      "Exit status: 0 every built product passed, 1 a check failed or a requested product could not be built, "
-      "2 bad input, 3 internal error or output not writable.");
-  sub->callback([opt]() { finish(run_run(*opt)); });
+  sub->footer(exit_status({.ok = "every built product passed",
+                           .failed = "a check failed or a requested product could not be built",
+                           .writes = true}));
 }
 
 }  // namespace fivebar::cli

@@ -237,14 +237,13 @@ int run_simulate(const SimulateOptions& opt) {
 }  // namespace
 
 void setup_simulate(CLI::App& app) {
-  auto opt = std::make_shared<SimulateOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "simulate",
+  auto [sub, opt] = add_command<SimulateOptions>(
+      app, "simulate",
       "Dynamics of a station's two tactors under the exported PID: motors, driver limits, ADC, skin stick/slip, "
-      "integrated by CVODE; tracking error, currents, saturation, shear force, CSV time series");
+      "integrated by CVODE; tracking error, currents, saturation, shear force, CSV time series",
+      run_simulate);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Finger station (e.g. index); default: every station with both tactors")
-      ->type_name("NAME");
+  add_station_option(*sub, opt->station, "every station with both tactors");
   auto* pattern = sub->add_option("--pattern", opt->pattern, "Only this pattern: stretch, slip, twist or pivot")
                       ->type_name("KIND");
   auto* step = sub->add_flag("--step", opt->step,
@@ -273,15 +272,14 @@ void setup_simulate(CLI::App& app) {
   sub->add_option("--max-wall", opt->max_wall_s, "Wall-time bound of each simulation (s, default 120): beyond it the run "
                   "stops with status wall_time_limit")
       ->type_name("S");
-  sub->add_option("-o,--out", opt->out, "Directory for the CSV files (default: outputs/<design>/simulate)")
-      ->type_name("DIR");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout");
+  add_out_option(*sub, opt->out, "the CSV files", "simulate");
+  add_json_flag(*sub, opt->json);
   sub->footer(
       "Needs the design's geometry:, motor: and controller: sections (contact: and print: take their defaults).\n"
-      "Without --pattern, --step or --chirp, every pattern of the station's patterns: section (or all four defaults).\n"
-      "Exit status: 0 every simulation finished, 1 one did not (singular pose, step or time limit) or a part\n"
-      "failed to render, 2 bad input, 3 internal error or output not writable.");
-  sub->callback([opt]() { finish(run_simulate(*opt)); });
+      "Without --pattern, --step or --chirp, every pattern of the station's patterns: section (or all four defaults).\n" +
+      exit_status({.ok = "every simulation finished",
+                   .failed = "one did not (singular pose, step or time limit) or a part failed to render",
+                   .writes = true}));
 }
 
 }  // namespace fivebar::cli

@@ -232,11 +232,11 @@ int run_sweep_cmd(const SweepCliOptions& o) {
 }  // namespace
 
 void setup_sweep(CLI::App& app) {
-  auto opt = std::make_shared<SweepCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "sweep", "Sweep link dimensions (grid, random, Sobol) in parallel: CSV per design, Pareto set, best design, plots");
+  auto [sub, opt] = add_command<SweepCliOptions>(
+      app, "sweep", "Sweep link dimensions (grid, random, Sobol) in parallel: CSV per design, Pareto set, best design, plots",
+      run_sweep_cmd);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Station to sweep (default: the sweep: section's, or the only one)");
+  add_station_option(*sub, opt->station, "the sweep: section's, or the only one");
   sub->add_option("-m,--mechanism", opt->mechanism, "lower or upper only (default: every mechanism and the shared region)");
   sub->add_option("--vary", opt->vary,
                   "NAME=LO:HI:N (mm), repeatable; NAME in L1 L2 L3 L4 L12 L34 spacing upper_height ellipse_a "
@@ -244,23 +244,25 @@ void setup_sweep(CLI::App& app) {
       ->type_name("NAME=LO:HI:N");
   sub->add_option("--sample", opt->sample, "grid, random or sobol (default grid)")->check(CLI::IsMember({"grid", "random", "sobol"}));
   sub->add_option("--count", opt->count, "Designs for random / Sobol sampling");
-  sub->add_option_function<std::uint64_t>("--seed", [opt](const std::uint64_t& v) {
-    opt->seed = v;
-    opt->seed_set = true;
+  // An init-capture: clang 14 (the fuzz build) does not capture a structured binding.
+  sub->add_option_function<std::uint64_t>("--seed", [o = opt](const std::uint64_t& v) {
+    o->seed = v;
+    o->seed_set = true;
   }, "Seed of random / Sobol sampling (recorded in the output)");
   sub->add_option("--collision-spacing", opt->collision_spacing,
                   "Grid spacing (mm) of the per-design collision fraction when the design has geometry: (0: off; default 2)")
       ->type_name("MM");
   sub->add_option("--objective", opt->objectives, "margin, min_lci, force, footprint, collision, robust (the margin robust_fraction of printed devices keep: tolerance:); repeatable, in priority order")
       ->delimiter(',');
-  sub->add_option("-o,--out", opt->out, "Output directory (default outputs/<name>/sweep)")->type_name("DIR");
+  add_out_option(*sub, opt->out, "sweep.csv, pareto.csv, best.yaml and the plots", "sweep");
   sub->add_option("--shard", opt->shard, "Run shard K of N (0-based K/N): contiguous blocks of the designs")->type_name("K/N");
   sub->add_flag("--resume", opt->resume, "Continue an interrupted sweep.csv in the output directory");
   sub->add_flag("--yes", opt->yes, "Run a sweep estimated at over an hour or a gigabyte of CSV (refused otherwise)");
   sub->add_flag("--no-plots", opt->no_plots, "Skip the SVG/PNG plots");
   sub->add_option("--threads", opt->threads, "Worker threads (default: every core)");
-  sub->add_flag("--json", opt->json, "One JSON document on stdout");
-  sub->callback([opt] { finish(run_sweep_cmd(*opt)); });
+  add_json_flag(*sub, opt->json);
+  sub->footer(exit_status(
+      {.ok = "a design covers the target", .failed = "no design covers the target", .writes = true, .resumable = true}));
 }
 
 }  // namespace fivebar::cli

@@ -179,33 +179,32 @@ int run_tolerance(const ToleranceCliOptions& opt) {
 }  // namespace
 
 void setup_tolerance(CLI::App& app) {
-  auto opt = std::make_shared<ToleranceCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "tolerance",
+  auto [sub, opt] = add_command<ToleranceCliOptions>(
+      app, "tolerance",
       "How far the printed device's tactor can be from where the controller believes it is: 3-sigma and "
       "worst-case error (mm), resolution per ADC count and clearance play at the target centre and over the target "
       "ellipse, maps over the reachable region, and robust coverage (the target covered by a fraction of printed "
-      "devices)");
+      "devices)",
+      run_tolerance);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
+  add_station_option(*sub, opt->station, "every station");
   sub->add_option("--spacing", opt->spacing_mm, "Grid spacing of the maps over the reachable region (mm)")
       ->capture_default_str()
       ->type_name("MM");
-  sub->add_option("-o,--out", opt->out, "Directory for the maps (default: outputs/<design>/tolerance)")
-      ->type_name("DIR");
+  add_out_option(*sub, opt->out, "the maps", "tolerance");
   sub->add_flag("--no-files", opt->no_files, "Print the figures only: no VTK maps, no pictures");
   sub->add_flag("--devices", opt->devices,
                 "Also write the Monte Carlo's printed devices, a CSV per mechanism (<station>-<mechanism>-devices.csv: "
                 "parameter errors, tactor error at the target centre, the device's own coverage margin)")
       ->excludes("--no-files");
-  sub->add_flag("--json", opt->json, "Print one JSON document on stdout and nothing else");
+  add_json_flag(*sub, opt->json);
   sub->add_flag("--yes", opt->yes, "Run a Monte Carlo estimated at over an hour or two gigabytes of memory (refused otherwise)");
   sub->footer(
       "Tolerances come from the design's tolerance: section (docs/design-file.md), else from its defaults, which are "
       "assumptions.\nFiles: <station>-<mechanism>-tolerance.vti (ParaView: three_sigma_mm, worst_case_mm, resolution_um, "
-      "play_mm, near_singular, status) and <station>-tolerance.svg|.png.\nExit status: 0 every mechanism covers its target for "
-      "tolerance.robust_fraction of printed devices, 1 one does not, 2 bad input, 3 internal error.");
-  sub->callback([opt]() { finish(run_tolerance(*opt)); });
+      "play_mm, near_singular, status) and <station>-tolerance.svg|.png.\n" +
+      exit_status({.ok = "every mechanism covers its target for tolerance.robust_fraction of printed devices",
+                   .failed = "one does not"}));
 }
 
 }  // namespace fivebar::cli

@@ -110,13 +110,13 @@ int run_workspace(const WorkspaceCliOptions& opt) {
 }  // namespace
 
 void setup_workspace(CLI::App& app) {
-  auto opt = std::make_shared<WorkspaceCliOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "workspace",
+  auto [sub, opt] = add_command<WorkspaceCliOptions>(
+      app, "workspace",
       "Reachable workspace per mechanism: exact area (mm2), perimeter, components, holes; assembly- and "
-      "LCI-restricted areas; the shared region; VTK files and a picture (SVG, PNG)");
+      "LCI-restricted areas; the shared region; VTK files and a picture (SVG, PNG)",
+      run_workspace);
   add_design_argument(*sub, opt->design);
-  sub->add_option("-s,--station", opt->station, "Only this station (default: every station)")->type_name("NAME");
+  add_station_option(*sub, opt->station, "every station");
   sub->add_option("-m,--mechanism", opt->mechanism, "Only this mechanism of each station: lower or upper (default: both)")
       ->check(CLI::IsMember({"lower", "upper"}))
       ->type_name("NAME");
@@ -124,15 +124,13 @@ void setup_workspace(CLI::App& app) {
                   "Sample spacing of the fields and restricted areas, in mm (smaller is finer and slower)")
       ->capture_default_str()
       ->type_name("MM");
-  sub->add_option("-o,--out", opt->out, "Directory for the files (default: outputs/<design name>/workspace)")
-      ->type_name("DIR");
-  sub->add_flag("--json", opt->json, "Print one JSON document (mm, mm2) on stdout and nothing else");
+  add_out_option(*sub, opt->out, "the files", "workspace");
+  add_json_flag(*sub, opt->json, "one JSON document (mm, mm2)");
   sub->footer(
       "Files per station S: S-regions.vtp (region boundaries, shared region, target, restricted contours), "
       "S-<mechanism>-field.vti (reach, status, assembly_ok, lci, singularity distances, transmission, force "
-      "capability), S-workspace.svg and S-workspace.png.\n"
-      "Exit status: 0 done, 1 a mechanism reaches nothing, 2 bad input, 3 internal error or files not writable.");
-  sub->callback([opt]() { finish(run_workspace(*opt)); });
+      "capability), S-workspace.svg and S-workspace.png.\n" +
+      exit_status({.ok = "done", .failed = "a mechanism reaches nothing", .writes = true}));
 }
 
 }  // namespace fivebar::cli

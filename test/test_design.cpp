@@ -858,7 +858,7 @@ TEST(PatternValidate, Rules) {
   settings = PatternSettings{};
   PatternSpec zero;
   zero.amplitude_mm = 0;
-  settings.per_station.emplace_back("index", zero);
+  settings.overrides.emplace_back("index", zero);
   EXPECT_THAT([&] { settings.validate(); }, ThrowsMessage<InputError>(HasSubstr("stations.index.stretch.amplitude_mm")));
 }
 
@@ -869,14 +869,52 @@ TEST(PatternKinds, RoundTrip) {
   EXPECT_FALSE(parse_pattern_kind("").has_value());
 }
 
+// A station's patterns are overrides at the station scope of controller: and motor:
+// (fivebar/sections/scope.hpp): they cover that station's pair only, win over the top-level entry
+// of their kind, and a later one of the same station and kind wins over an earlier one.
+TEST(PatternSettings, StationEntriesAreStationScopedOverrides) {
+  PatternSettings p;
+  PatternSpec stretch;
+  stretch.amplitude_mm = 3.0;
+  p.global.push_back(stretch);
+  stretch.amplitude_mm = 4.0;
+  p.overrides.emplace_back("index", stretch);
+  stretch.amplitude_mm = 5.0;
+  p.overrides.emplace_back("index", stretch);
+  PatternSpec slip;
+  slip.kind = PatternKind::slip;
+  slip.amplitude_mm = 2.0;
+  p.overrides.emplace_back("thumb", slip);
+
+  const PatternOverride& index = p.overrides.front();
+  EXPECT_EQ(index.key(), "stations.index");
+  EXPECT_EQ(index.level(), 2);  // stations.S: narrower than mechanisms.M, wider than stations.S.M
+  EXPECT_TRUE(index.covers("index", "lower", 1));
+  EXPECT_TRUE(index.covers("index", "upper", 2));
+  EXPECT_FALSE(index.covers("thumb", "lower", 1));
+
+  const auto on_index = p.for_station("index");
+  ASSERT_EQ(on_index.size(), 1u);
+  EXPECT_EQ(on_index[0].amplitude_mm, 5.0);
+  const auto on_thumb = p.for_station("thumb");
+  ASSERT_EQ(on_thumb.size(), 2u);
+  EXPECT_EQ(on_thumb[0].kind, PatternKind::stretch);
+  EXPECT_EQ(on_thumb[0].amplitude_mm, 3.0);
+  EXPECT_EQ(on_thumb[1].kind, PatternKind::slip);
+  EXPECT_EQ(on_thumb[1].amplitude_mm, 2.0);
+}
+
 TEST(DesignValidate, PatternStationsMustExist) {
   Design d = valid_design();
   d.set<PatternSettings>(PatternSettings{});
   PatternSpec spec;
-  d.get<PatternSettings>()->per_station.emplace_back("middle", spec);
+  d.get<PatternSettings>()->overrides.emplace_back("middle", spec);
   EXPECT_THAT([&] { d.validate(); },
               ThrowsMessage<InputError>(HasSubstr("patterns.stations.middle: no such station in this design (stations: index)")));
-  d.get<PatternSettings>()->per_station.front().first = "index";
+  d.get<PatternSettings>()->overrides.front().station = "";  // a key "" is no station, not every one
+  EXPECT_THAT([&] { d.validate(); },
+              ThrowsMessage<InputError>(HasSubstr("patterns.stations[\"\"]: no such station in this design")));
+  d.get<PatternSettings>()->overrides.front().station = "index";
   EXPECT_NO_THROW(d.validate());
 }
 
@@ -1130,7 +1168,7 @@ TEST(DesignWriter, PatternsWithoutControllerKeepTheirSpeedAndPivotContactPoints)
   PatternSpec slip;
   slip.kind = PatternKind::slip;
   slip.amplitude_mm = 0.1 + 0.2;  // not a short decimal: must still come back bit for bit
-  ps.per_station.emplace_back("thumb", slip);
+  ps.overrides.emplace_back("thumb", slip);
   d.set<PatternSettings>(ps);
   d.validate();
   const Design back = load_design_from_string(to_yaml(d), "<to_yaml>");

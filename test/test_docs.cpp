@@ -81,7 +81,7 @@ TEST(DesignFileDoc, FixtureIsAValidDesignWithEverySection) {
   }
   EXPECT_EQ(d.stations[0].mechanisms().size(), 2u);
   EXPECT_EQ(d.get<PatternSettings>()->global.size(), 4u);
-  EXPECT_EQ(d.get<PatternSettings>()->per_station.size(), 4u);
+  EXPECT_EQ(d.get<PatternSettings>()->overrides.size(), 4u);
   // Every override scope once: mechanisms.<m>, mechanisms.<m>.theta<j> (6), stations.<s>, its
   // mechanisms and their joints (7).
   EXPECT_EQ(d.get<ControllerSettings>()->overrides.size(), 13u);

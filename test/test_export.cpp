@@ -327,8 +327,8 @@ TEST(Formats, KeysYaml11ReadsAsBooleansOrNullAreQuoted) {
   for (auto& o : d.get<ControllerSettings>()->overrides) {
     if (o.station == "index") o.station = "on";
   }
-  for (auto& e : d.get<PatternSettings>()->per_station) {
-    if (e.first == "index") e.first = "on";
+  for (auto& o : d.get<PatternSettings>()->overrides) {
+    if (o.station == "index") o.station = "on";
   }
   Json tree = controller_parameters(d, {});
   // And every other spelling of a YAML 1.1 boolean or null as a key, in a scratch map.
@@ -524,7 +524,7 @@ TEST(Gate, EveryFailureIsListedAtOnce) {
   d.get<ControllerSettings>()->overrides.push_back(o);
   PatternSpec twist;  // index twist beyond the ~5.3 mm where L3 meets the upper's tactor joint
   twist.kind = PatternKind::twist, twist.amplitude_mm = 7.0, twist.separation_mm = 8.0;
-  d.get<PatternSettings>()->per_station.emplace_back("index", twist);
+  d.get<PatternSettings>()->overrides.emplace_back("index", twist);
   d.validate();
   const ExportGate g = export_gate(d);
   const auto failed = failed_kinds(g);
@@ -547,8 +547,8 @@ TEST(Gate, NamesMustBeIdentifiersInEveryFormat) {
   for (auto& o : d.get<ControllerSettings>()->overrides) {
     if (o.station == "index") o.station = "int";
   }
-  for (auto& e : d.get<PatternSettings>()->per_station) {
-    if (e.first == "index") e.first = "int";
+  for (auto& o : d.get<PatternSettings>()->overrides) {
+    if (o.station == "index") o.station = "int";
   }
   d.validate();
   const ExportGate g = export_gate(d);

@@ -753,7 +753,7 @@ TEST_F(Parts, ProductBuildsTheSceneStationsOrSaysWhyNot) {
   Design d = paper();
   d.stations.pop_back();  // the scene has the index station only
   if (d.get<PatternSettings>()) {       // and so no per-station pattern settings for the thumb
-    std::erase_if(d.get<PatternSettings>()->per_station, [](const auto& entry) { return entry.first == "thumb"; });
+    std::erase_if(d.get<PatternSettings>()->overrides, [](const PatternOverride& o) { return o.station == "thumb"; });
   }
   if (d.get<ControllerSettings>()) {  // nor the controller's gains for it (controller.stations.thumb)
     std::erase_if(d.get<ControllerSettings>()->overrides, [](const ControlOverride& o) { return o.station == "thumb"; });

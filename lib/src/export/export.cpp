@@ -474,7 +474,7 @@ Design export_view(const Design& d, const std::vector<std::string>& wanted) {
   }
   if (const Geometry* g = d.get<Geometry>()) v.set(*g);
   if (const PatternSettings* p = d.get<PatternSettings>()) {
-    std::erase_if(v.set(*p).per_station, [&](const auto& e) { return !kept(e.first); });
+    std::erase_if(v.set(*p).overrides, [&](const PatternOverride& o) { return !kept(o.station); });
   }
   if (const ControllerSettings* c = d.get<ControllerSettings>()) {
     std::erase_if(v.set(*c).overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });

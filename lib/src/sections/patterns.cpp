@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <sstream>
+#include <utility>
 
 #include "fivebar/sections/controller.hpp"
 #include "sections/rules.hpp"
@@ -88,18 +89,20 @@ void PatternSpec::validate() const {
   }
 }
 
+PatternOverride::PatternOverride(std::string station_name, PatternSpec pattern)
+    : JointScope{std::move(station_name), "", 0}, spec(std::move(pattern)) {}
+
 std::vector<PatternSpec> PatternSettings::for_station(std::string_view station) const {
   std::vector<PatternSpec> out;
   for (PatternKind kind : all_pattern_kinds()) {
     const PatternSpec* chosen = nullptr;
-    for (const auto& [name, spec] : per_station) {
-      if (name == station && spec.kind == kind) chosen = &spec;
+    for (const PatternSpec& spec : global) {
+      if (spec.kind == kind) chosen = &spec;
     }
-    if (chosen == nullptr) {
-      for (const PatternSpec& spec : global) {
-        if (spec.kind == kind) chosen = &spec;
-      }
-    }
+    // The station's pair: no mechanism, no joint; its own entries are narrower than the top level.
+    apply_overrides(overrides, station, "", 0, [&](const PatternOverride& o) {
+      if (o.spec.kind == kind) chosen = &o.spec;
+    });
     if (chosen != nullptr) out.push_back(*chosen);
   }
   return out;
@@ -114,10 +117,9 @@ void PatternSettings::validate() const {
   for (const PatternSpec& spec : global) {
     rules::validate_nested(std::string(to_string(spec.kind)), [&] { spec.validate(); });
   }
-  for (const auto& entry : per_station) {  // no structured binding: clang 14 cannot capture one
-    const PatternSpec& spec = entry.second;
-    rules::validate_nested(detail::key_join(detail::key_child("stations", entry.first), to_string(spec.kind)),
-                           [&] { spec.validate(); });
+  for (const PatternOverride& o : overrides) {
+    rules::validate_nested(detail::key_join(detail::key_child("stations", o.station), to_string(o.spec.kind)),
+                           [&] { o.spec.validate(); });
   }
 }
 
@@ -200,7 +202,7 @@ void load(const Value& v, Design& design) {
         for (const PatternSpec& g : ps.global) {
           if (g.kind == kind) base = g;
         }
-        ps.per_station.emplace_back(st.name(), load_spec(k, base));
+        ps.overrides.emplace_back(st.name(), load_spec(k, base));
       }
     }
   }
@@ -211,12 +213,7 @@ void validate(const Design& design) {
   const PatternSettings* patterns = design.get<PatternSettings>();
   if (patterns == nullptr) return;
   rules::validate_nested("patterns", [&] { patterns->validate(); });
-  for (const auto& [station_name, spec] : patterns->per_station) {
-    if (design.station(station_name) == nullptr) {
-      throw ValidationError(detail::key_child("patterns.stations", station_name),
-                            "no such station in this design (stations: " + rules::station_list(design) + ")");
-    }
-  }
+  for (const PatternOverride& o : patterns->overrides) o.validate_in(design, "patterns");
   // One source of truth for the joint speed limit (ControllerSettings).
   const ControllerSettings* controller = design.get<ControllerSettings>();
   if (controller && patterns->max_joint_speed != controller->max_velocity) {
@@ -258,18 +255,18 @@ void write(const Design& design, Out& top) {
     o.add("max_joint_speed_deg_s", Out::degrees(ps->max_joint_speed));
   }
   for (const PatternSpec& spec : ps->global) o.add(std::string(to_string(spec.kind)), spec_out(spec));
-  if (!ps->per_station.empty()) {
+  if (!ps->overrides.empty()) {
     Out& stations = o.add("stations", Out::map());
     std::vector<std::string> names;  // first-appearance order; entries of one station together
-    for (const auto& [station, spec] : ps->per_station) {
-      if (std::find(names.begin(), names.end(), station) == names.end()) names.push_back(station);
+    for (const PatternOverride& e : ps->overrides) {
+      if (std::find(names.begin(), names.end(), e.station) == names.end()) names.push_back(e.station);
     }
     for (const std::string& station : names) {
       Out& kinds = stations.add(station, Out::map());
       for (PatternKind kind : all_pattern_kinds()) {
         const PatternSpec* last = nullptr;  // a later entry of the same kind replaces an earlier one
-        for (const auto& [name, spec] : ps->per_station) {
-          if (name == station && spec.kind == kind) last = &spec;
+        for (const PatternOverride& e : ps->overrides) {
+          if (e.station == station && e.spec.kind == kind) last = &e.spec;
         }
         if (last != nullptr) kinds.add(std::string(to_string(kind)), spec_out(*last));
       }

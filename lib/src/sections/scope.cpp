@@ -39,7 +39,9 @@ void JointScope::validate() const {
 }
 
 void JointScope::validate_in(const Design& design, std::string_view section) const {
-  if (station.empty()) return;  // every station's lower / upper: none is fine
+  // Every station's lower / upper: none is fine. A scope with neither is a station named "" (a
+  // `patterns:` entry, which has no mechanism; validate() refuses one of controller: or motor:).
+  if (station.empty() && !mechanism.empty()) return;
   const Station* st = design.station(station);
   if (st == nullptr) {
     throw ValidationError(detail::key_join(section, detail::key_child("stations", station)),

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/scope.hpp"
 
 namespace fivebar {
 
@@ -48,6 +49,15 @@ struct PatternSpec {
   void validate() const;
 };
 
+/// A station's own pattern of one kind (`patterns.stations.<station>.<kind>`): an override with the
+/// scope rule of `controller:` and `motor:` (fivebar/sections/scope.hpp) at station level; a
+/// pattern drives the station's pair, so `mechanism` and `joint` stay empty.
+struct PatternOverride : JointScope {
+  PatternSpec spec;  ///< already merged over the top-level entry of its kind
+  PatternOverride() = default;
+  PatternOverride(std::string station_name, PatternSpec pattern);
+};
+
 /// `patterns:`: which patterns to check, on which stations, at what rate and motor speed.
 struct PatternSettings {
   static constexpr std::string_view kKey = "patterns";
@@ -56,10 +66,11 @@ struct PatternSettings {
   /// with a `controller:` section this is controller.max_velocity (its max_velocity_deg_s).
   double max_joint_speed = 6.283185307179586;
   std::vector<PatternSpec> global;  ///< kinds given at the top level: checked on every station
-  /// Kinds given under `stations.<name>`, already merged over the top-level entry of that kind.
-  std::vector<std::pair<std::string, PatternSpec>> per_station;
+  /// Kinds given under `stations.<name>`, in file order (a later entry of a station's kind replaces
+  /// an earlier one).
+  std::vector<PatternOverride> overrides;
   /// The patterns of a station: for each kind in the order stretch, slip, twist, pivot, its own
-  /// entry if any, else the top-level one.
+  /// entry if any (apply_overrides() at the station's level), else the top-level one.
   std::vector<PatternSpec> for_station(std::string_view station) const;
   void validate() const;
 };

@@ -3,7 +3,9 @@
 /// lower or upper mechanism (`mechanisms.lower`), one station (`stations.index`), one of its
 /// mechanisms (`stations.index.upper`) or one joint of a mechanism (`...theta1`). Narrower scopes
 /// win over wider ones whatever their order in the file. One definition of the scope rule for every
-/// section that has one (docs/design-file.md, `controller.<scope>` and `motor.<scope>`).
+/// section that has one (docs/design-file.md, `controller.<scope>` and `motor.<scope>`, and
+/// `patterns.stations.<station>`, whose overrides are at station level and looked up for a
+/// station's pair: mechanism "" and joint 0).
 
 #include <string>
 #include <string_view>
@@ -30,7 +32,7 @@ struct JointScope {
   /// a joint only within a mechanism, not every station and mechanism at once).
   void validate() const;
   /// Throws ValidationError("<section>.<key>", rule) when the scope names a station or a
-  /// mechanism the design does not have.
+  /// mechanism the design does not have (a station "", when no mechanism is set, is one).
   void validate_in(const Design& design, std::string_view section) const;
 };
 
