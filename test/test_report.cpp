@@ -420,6 +420,62 @@ TEST(Accuracy, RestrictedAreasAgainstTheSixteenTimesFinerGrid) {
   }
 }
 
+// The upper mechanism of each paper station is the lower one reflected across the target's
+// centre line (y = 15.5 mm, 17.5 mm for the thumb), and the report takes a mirror image's figures
+// from its twin. The rule compares every number exactly; the figures are checked against the
+// upper mechanism's own region, coverage and restricted areas, computed here on its coordinates.
+TEST(Accuracy, AMirrorImageIsDetectedExactlyAndHasItsTwinsFigures) {
+  const Mechanism lower = paper("index", "lower"), upper = paper("index", "upper");
+  const Ellipse t = index_target();
+  EXPECT_EQ(mirror_line(lower, t, upper, t), 15.5);
+  EXPECT_EQ(mirror_line(upper, t, lower, t), 15.5);
+  Ellipse tt = t;
+  tt.center = {6.25, 17.5};
+  tt.axes = {15.0, 14.0};
+  EXPECT_EQ(mirror_line(paper("thumb", "lower"), tt, paper("thumb", "upper"), tt), 17.5);
+  EXPECT_FALSE(mirror_line(lower, t, paper("thumb", "upper"), t));  // other links and line
+  Mechanism b = upper;
+  b.O2.y() = std::nextafter(31.0, 32.0);
+  EXPECT_FALSE(mirror_line(lower, t, b, t));
+  b = upper;
+  b.working_mode = lower.working_mode;  // not reflected
+  EXPECT_FALSE(mirror_line(lower, t, b, t));
+  b = upper;
+  b.assembly_mode = AssemblyMode::Any;
+  EXPECT_FALSE(mirror_line(lower, t, b, t));
+  Ellipse moved = t;
+  moved.center.y() += 0.1;
+  EXPECT_FALSE(mirror_line(lower, t, upper, moved));
+  Ellipse turned = t;
+  turned.angle = 0.2;
+  EXPECT_FALSE(mirror_line(lower, turned, upper, turned));
+  Ellipse reflected = turned;
+  reflected.angle = -0.2;
+  EXPECT_EQ(mirror_line(lower, turned, upper, reflected), 15.5);
+  Mechanism la = lower, ub = upper;  // joint arcs: theta -> -theta reverses each arc
+  la.joint_limits = std::array<JointRange, 2>{JointRange{0.5, 3.0}, JointRange{-1.0, 1.5}};
+  ub.joint_limits = std::array<JointRange, 2>{JointRange{-3.0, -0.5}, JointRange{-1.5, 1.0}};
+  EXPECT_EQ(mirror_line(la, t, ub, t), 15.5);
+  ub.joint_limits = la.joint_limits;
+  EXPECT_FALSE(mirror_line(la, t, ub, t));
+
+  // The twin's figures hold for the upper mechanism measured on its own coordinates.
+  const MechanismAccuracy& a = index_lower_accuracy();
+  EXPECT_NEAR(reachable_region(upper).area_mm2(), a.exact_area_mm2, 1e-12 * a.exact_area_mm2);
+  const CoverageResult c = coverage(upper, t);
+  EXPECT_NEAR(c.margin_mm, a.margin_mm, 1e-12);
+  EXPECT_NEAR(c.min_lci, a.min_lci, 1e-9);
+  Mechanism ul = upper;
+  ul.min_lci = a.lci_threshold;
+  const auto bb = reachable_region(upper).bounds();
+  for (const char* method : {"assembly-restricted area", "LCI-restricted area"}) {
+    const WorkPoint& p = series(a.restricted, method).points.back();
+    const Restriction r = std::string(method) == "LCI-restricted area" ? Restriction::lci : Restriction::assembly;
+    const double mine = restricted_area(ul, r, Grid::covering(bb, p.resolution, p.resolution)).area_mm2;
+    EXPECT_NEAR(mine, p.value, 1e-6 * p.value) << method;
+  }
+}
+
 TEST(Accuracy, ToleranceEstimatesAgainstManyDevicesAndTheExactPlaySet) {
   const MechanismAccuracy& a = index_lower_accuracy();
   ASSERT_GT(a.tolerance_reference_samples, 0u);
@@ -757,6 +813,10 @@ TEST_F(Output, TheReportProductStatesTheAccuracyOfTheMainNumbers) {
   expect_finite(res);
   ASSERT_EQ(res["mechanisms"].size(), 2u);
   const Json& m0 = res["mechanisms"][0];
+  // index/upper is index/lower's mirror image: measured once, said so.
+  EXPECT_TRUE(m0["mirror_of"].is_null());
+  EXPECT_EQ(res["mechanisms"][1]["mirror_of"], "index/lower");
+  EXPECT_THAT(p->markdown, HasSubstr("(mirror image of `index/lower`)"));
   // The coverage margin and its error against the quad margin.
   EXPECT_LT(m0["coverage_margin"]["error_mm"].get<double>(), 1e-12);
   EXPECT_GT(m0["assembly_restricted_area"]["error_mm2"].get<double>(), 0.0);

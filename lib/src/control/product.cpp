@@ -70,7 +70,7 @@ Product control_product() {
   Product p;
   p.name = "control";
   p.title = "Loop stability over the target";
-  p.cost_s = 4.0;  // the tuning (scheduler hint only, Product::cost_s)
+  p.cost_s = 3.5;  // the tuning (scheduler hint only, Product::cost_s)
   p.prerequisites = {"parts"};
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<MotorSettings>()) return "the design has no `motor:` section (the motors' data)";

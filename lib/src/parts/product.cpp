@@ -70,7 +70,7 @@ Product parts_product() {
   Product p;
   p.name = "parts";
   p.title = "Printable parts";
-  p.cost_s = 3.0;  // the openscad renders (scheduler hint only, Product::cost_s)
+  p.cost_s = 2.2;  // the openscad renders (scheduler hint only, Product::cost_s)
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<Geometry>()) return "no `geometry:` section (link widths, pins, bosses, tactor sizes)";
     bool any = false;

@@ -805,6 +805,25 @@ PrecisionStudy precision_study(const std::vector<const Mechanism*>& mechanisms, 
   return study;
 }
 
+std::optional<double> mirror_line(const Mechanism& a, const Ellipse& ta, const Mechanism& b, const Ellipse& tb) {
+  // y -> 2c - y maps a onto b: the same x, the y coordinates summing to 2c, every sign of a
+  // cross product (working and assembly modes) flipped, and theta -> -theta on the joint arcs.
+  const double two_c = a.O1.y() + b.O1.y();
+  const bool bases = a.O1.x() == b.O1.x() && a.O2.x() == b.O2.x() && a.O2.y() + b.O2.y() == two_c;
+  const bool modes = a.working_mode.sign1 == -b.working_mode.sign1 && a.working_mode.sign2 == -b.working_mode.sign2 &&
+                     int(a.assembly_mode) == -int(b.assembly_mode);
+  bool limits = a.joint_limits.has_value() == b.joint_limits.has_value();
+  if (limits && a.joint_limits) {
+    for (std::size_t i = 0; i < 2; ++i) {
+      limits = limits && (*b.joint_limits)[i].lo == -(*a.joint_limits)[i].hi && (*b.joint_limits)[i].hi == -(*a.joint_limits)[i].lo;
+    }
+  }
+  const bool target = ta.center.x() == tb.center.x() && ta.center.y() + tb.center.y() == two_c && ta.axes == tb.axes &&
+                      tb.angle == -ta.angle;
+  if (!(bases && modes && limits && target && a.L == b.L && a.min_lci == b.min_lci)) return std::nullopt;
+  return 0.5 * two_c;
+}
+
 AccuracyReport accuracy_report(const Design& design, const AccuracyOptions& o) {
   const auto t0 = Clock::now();
   AccuracyReport report;
@@ -812,13 +831,33 @@ AccuracyReport accuracy_report(const Design& design, const AccuracyOptions& o) {
   report.quick = o.quick;
   const std::vector<const Station*> stations = design.select_stations(o.station);
   std::vector<const Mechanism*> all;
+  std::vector<const Ellipse*> targets;
   for (const Station* s : stations) {
     for (const Mechanism* m : s->mechanisms()) {
-      say(o, "accuracy: " + s->name + "/" + m->name);
-      MechanismAccuracy ma = mechanism_accuracy(*m, s->target, o);
+      // A mirror image of a mechanism already measured has the same figures (the regions, margins
+      // and LCI are invariant under the reflection): they are that mechanism's, said so.
+      std::optional<std::size_t> twin;
+      std::optional<double> line;
+      for (std::size_t k = 0; k < all.size() && !twin; ++k) {
+        if (!report.mechanisms[k].mirror_of.empty()) continue;
+        if ((line = mirror_line(*all[k], *targets[k], *m, s->target))) twin = k;
+      }
+      MechanismAccuracy ma;
+      if (twin) {
+        say(o, "accuracy: " + s->name + "/" + m->name + ": the mirror image of " + report.mechanisms[*twin].station + "/" +
+                   report.mechanisms[*twin].mechanism);
+        ma = report.mechanisms[*twin];
+        ma.mirror_of = report.mechanisms[*twin].station + "/" + report.mechanisms[*twin].mechanism;
+        ma.mirror_line_y_mm = *line;
+        ma.mechanism = m->name;
+      } else {
+        say(o, "accuracy: " + s->name + "/" + m->name);
+        ma = mechanism_accuracy(*m, s->target, o);
+      }
       ma.station = s->name;
       report.mechanisms.push_back(std::move(ma));
       all.push_back(m);
+      targets.push_back(&s->target);
     }
   }
   say(o, "accuracy: FK precision study");

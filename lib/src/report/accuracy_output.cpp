@@ -220,7 +220,7 @@ plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station,
   plot::PlotSpec spec;
   spec.x_label = "run time (s), median of repeats after a warm-up";
   for (const MechanismAccuracy& m : r.mechanisms) {
-    if (m.station != station) continue;
+    if (m.station != station || !m.mirror_of.empty()) continue;  // a mirror image repeats its twin's lines
     const std::vector<WorkSeries>* list = kind == "area"         ? &m.area
                                           : kind == "restricted" ? &m.restricted
                                           : kind == "tolerance"  ? &m.tolerance
@@ -262,6 +262,11 @@ plot::PlotSpec station_plot(const AccuracyReport& r, const std::string& station,
     spec.y_label = "|min LCI - refined minimum| (LCI is dimensionless)";
     spec.footnote = "Sampled: 1 + 8 n² points over the filled ellipse (n doubles along the line); coverage(): its "
                     "sampling plus compass search.";
+  }
+  for (const MechanismAccuracy& m : r.mechanisms) {
+    if (m.station == station && !m.mirror_of.empty()) {
+      spec.footnote += " " + label(m) + " is the mirror image of " + m.mirror_of + ": the same lines.";
+    }
   }
   return spec;
 }
@@ -351,6 +356,8 @@ Json to_json(const AccuracyReport& r) {
     Json a;
     a["station"] = m.station;
     a["mechanism"] = m.mechanism;
+    a["mirror_of"] = m.mirror_of.empty() ? Json(nullptr) : Json(m.mirror_of);
+    a["mirror_line_y_mm"] = m.mirror_of.empty() ? Json(nullptr) : Json(m.mirror_line_y_mm);
     Json area;
     area["exact_mm2"] = m.exact_area_mm2;
     area["closed_form_mm2"] = opt(m.closed_form_area_mm2);
@@ -400,6 +407,13 @@ std::string to_text(const AccuracyReport& r) {
   out << "Times are medians of repeated runs after a warm-up; errors against exact or __float128 references.\n";
   for (const MechanismAccuracy& m : r.mechanisms) {
     out << "\n== " << label(m) << " ==\n";
+    if (!m.mirror_of.empty()) {
+      out << "The mirror image of " << m.mirror_of << " across y = " << fixed(m.mirror_line_y_mm, 3)
+          << " mm (bases, modes, joint limits and target reflected): the same regions, margins and conditioning; "
+             "its figures are "
+          << m.mirror_of << "'s, not measured again.\n";
+      continue;
+    }
     out << "Workspace area: exact (CGAL) " << fixed(m.exact_area_mm2, 9) << " mm²";
     if (m.quad_area_mm2) {
       out << "; annuli closed form in quad " << fixed(*m.quad_area_mm2, 9) << " mm² (CGAL differs by "

@@ -49,6 +49,12 @@ std::optional<double> fit_log_slope(const std::vector<double>& x, const std::vec
 struct MechanismAccuracy {
   std::string station;
   std::string mechanism;
+  /// "station/mechanism" of an earlier mechanism of the report whose exact mirror image this one
+  /// is (bases, working and assembly modes, joint limits and target reflected across a line
+  /// y = const, links and min_lci equal): the same regions, margins and conditioning, so its
+  /// figures are that mechanism's, not measured again. Empty when measured.
+  std::string mirror_of;
+  double mirror_line_y_mm = 0.0;  ///< the mirror line's y when mirror_of is set
   // Reachable workspace.
   double exact_area_mm2 = 0.0;                 ///< exact CGAL region (reachable_region)
   std::optional<double> closed_form_area_mm2;  ///< annuli_intersection_area (no joint limits)
@@ -176,6 +182,9 @@ struct AccuracyReport {
 
 /// Work-precision of one mechanism's areas and coverage numbers (`target` is the station's).
 MechanismAccuracy mechanism_accuracy(const Mechanism& m, const Ellipse& target, const AccuracyOptions& options = {});
+/// The line y = c across which mechanism `b` with target `tb` is the exact mirror image of `a` with
+/// `ta` (every number of b the reflection of a's, compared exactly), if it is one.
+std::optional<double> mirror_line(const Mechanism& a, const Ellipse& ta, const Mechanism& b, const Ellipse& tb);
 /// FK (`problem` "fk") or IK ("ik") precision study over the given mechanisms (samples pooled).
 PrecisionStudy precision_study(const std::vector<const Mechanism*>& mechanisms, std::string_view problem,
                                const AccuracyOptions& options = {});
