@@ -509,9 +509,11 @@ SampledArea restricted_area(const Mechanism& m, Restriction restriction, const G
     }
     for (int y = 0; y < grid.ny; ++y) {
       for (int i = 0; i < nxs; ++i) {
-        double m = 0.0;
-        for (int x = std::max(0, i - 1); x <= std::min(nxs - 1, i + 2); ++x) m = std::max(m, node_slope[std::size_t(y) * nxs + x]);
-        row_max[std::size_t(y) * nxs + i] = m;
+        double widest = 0.0;
+        for (int x = std::max(0, i - 1); x <= std::min(nxs - 1, i + 2); ++x) {
+          widest = std::max(widest, node_slope[std::size_t(y) * nxs + x]);
+        }
+        row_max[std::size_t(y) * nxs + i] = widest;
       }
     }
   }
