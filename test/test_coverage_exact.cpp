@@ -219,7 +219,7 @@ TEST(CoverageExact, MarginCountsTheJointLimitArcs) {
   const Ellipse e = ellipse(5.638437, 16.094459, 18.132973, 8.067587, 178.5325);
   const CoverageResult r = coverage(kJl, e);
   const double ref = double(ref_margin(kJl, e));
-  EXPECT_NEAR(ref, -8.18e-4, 5e-6);  // the mpmath figure
+  EXPECT_NEAR(ref, -8.18e-4, 5e-6);  // an independent mpmath computation
   EXPECT_FALSE(r.inside);
   EXPECT_TRUE(r.decided);
   EXPECT_NEAR(r.margin_mm, ref, r.margin_error_mm + 1e-12);
@@ -260,7 +260,7 @@ TEST(CoverageExact, TheExactTestNeverContradictsTheMarginItPrints) {
   const Ellipse e = ellipse(7.465390825909455, 11.35042948436331, 6.348544556540768, 5.837976669112061,
                             49.27058527214055);
   const CoverageResult r = coverage(m, e);
-  EXPECT_NEAR(r.margin_mm, 4.65273e-9, 1e-14);  // the mpmath figure
+  EXPECT_NEAR(r.margin_mm, 4.65273e-9, 1e-14);  // an independent mpmath computation
   EXPECT_TRUE(r.decided);
   EXPECT_TRUE(r.inside);
   EXPECT_LT(r.margin_error_mm, 1e-11);
@@ -286,7 +286,7 @@ TEST(CoverageExact, TheExactTestNeverContradictsTheMarginItPrints) {
 
 // --- Randomised, near the thresholds ------------------------------------------------------------
 
-/// A random design with joint limits wide enough to leave a region, as in the set.
+/// A random design with joint limits wide enough to leave a region, as in the reviewed set of random designs.
 Mechanism random_mechanism(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const char* modes[4] = {"++", "+-", "-+", "--"};
@@ -426,7 +426,7 @@ std::optional<LD> ref_lci(const Ref& ref, P2 p) {
 }
 
 TEST(RestrictedArea, ThinRegionsAgreeWithMonteCarloWithinTheirErrorBars) {
-  // The ws27 (LCI >= 0.15: a thin region) and ws22 (assembly and LCI >= 0.3).
+  // Two designs of a review's random set: ws27 (LCI >= 0.15: a thin region) and ws22 (assembly and LCI >= 0.3).
   const Mechanism ws27 = mechanism({10.337237, -2.510651}, {11.026993, 12.81285, 13.13652, 16.906478}, "--", 1,
                                    Limits{{{87.121, 228.946}, {-84.714, 96.375}}}, 0.15);
   const Mechanism ws22 = mechanism({9.493489, -2.11873}, {8.399513, 7.191329, 14.753548, 8.448609}, "-+", -1,
@@ -463,7 +463,7 @@ TEST(RestrictedArea, ThinRegionsAgreeWithMonteCarloWithinTheirErrorBars) {
       EXPECT_LE(std::fabs(sa.area_mm2 - mc), sa.error_mm2 + 4 * se);
     }
   }
-  // The reference figures (mpmath and 1e7-sample Monte Carlo).
+  // Their reference figures from an independent computation (mpmath and a 1e7-sample Monte Carlo).
   const Grid g27 = Grid::covering(reachable_region(ws27).bounds(), 0.2, 0.2);
   const SampledArea lci27 = restricted_area(ws27, Restriction::lci, g27);
   EXPECT_NEAR(lci27.area_mm2, 0.08147, lci27.error_mm2 + 1e-4);

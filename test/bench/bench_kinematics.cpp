@@ -7,7 +7,7 @@
 // function of d^2). Items per second = evaluations per second. Compare ratios within one run:
 //   ./build/fivebar_bench --benchmark_filter='fk|ik'
 // The batch IK takes its angles with detail::fast_angle, which knows the elbow offset's length
-// (the proximal link) and needs one division where the general fast_atan2 needs two. The issue's
+// (the proximal link) and needs one division where the general fast_atan2 needs two. The plain
 // floor has two general atan2 (ik_floor*); ik_floor16_known_length has two fast_angle instead, the
 // stricter floor by the same reasoning that took the centre distance's root out: both are here so
 // that the ratio can be read against either.
