@@ -41,7 +41,7 @@ class CsvIo : public DeviceIo {
  public:
   CsvIo(std::istream& in, std::ostream& out, const rt::Config& c) : in_(in), out_(out) {
     std::string line;
-    if (!std::getline(in_, line)) throw std::runtime_error("input: no header row");
+    if (!next_line(line)) throw std::runtime_error("input: no header row");
     const std::vector<std::string> header = split(line);
     std::map<std::string, std::size_t> at;
     for (std::size_t i = 0; i < header.size(); ++i) at[header[i]] = i;
@@ -71,7 +71,7 @@ class CsvIo : public DeviceIo {
   }
   bool read(double& t, double* readings, double* targets) override {
     std::string line;
-    if (!std::getline(in_, line)) return false;
+    if (!next_line(line)) return false;
     const std::vector<std::string> cells = split(line);
     const auto cell = [&](std::size_t i) { return i < cells.size() ? std::strtod(cells[i].c_str(), nullptr) : 0.0; };
     t = cell(time_);
@@ -88,6 +88,15 @@ class CsvIo : public DeviceIo {
   rt::Reading kind() const override { return kind_; }
 
  private:
+  /// The next line that is neither blank nor a `#` comment (the logs' notes, as `fivebar replay` reads them).
+  bool next_line(std::string& line) {
+    while (std::getline(in_, line)) {
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      const std::size_t first = line.find_first_not_of(" \t");
+      if (first != std::string::npos && line[first] != '#') return true;
+    }
+    return false;
+  }
   static std::vector<std::string> split(const std::string& line) {
     std::vector<std::string> out;
     std::stringstream s(line);

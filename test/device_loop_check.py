@@ -42,6 +42,13 @@ for i, (a, b) in enumerate(zip(logged, looped)):
     for c in status_cols:
         if b[c] != "ok":
             failures.append(f"row {i + 1} {c}: {b[c]}")
+# A log with notes (`#` lines and blank lines, as designs/bench/replay.csv carries) runs the same.
+noted = WORK / "noted.csv"
+text = log.read_text().splitlines(keepends=True)
+noted.write_text("# a note before the header\n" + text[0] + "\n# a note between rows\n" + "".join(text[1:]))
+again = subprocess.run([LOOP, str(config), str(noted)], check=True, capture_output=True, text=True).stdout
+if again != out:
+    failures.append("the log with # notes and a blank line gives other output")
 if nonzero < len(logged):
     failures.append(f"only {nonzero} non-zero duties: the pattern does not drive the motors")
 for f in failures[:20]:
