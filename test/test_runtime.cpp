@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <initializer_list>
 #include <random>
 #include <string>
 #include <type_traits>
@@ -272,6 +273,19 @@ double ring_search(const Mechanism& upper, const Vec2& upper_target, const Mecha
   return best;
 }
 
+/// One cycle from rest, every joint at its pose for the station centres 8 mm apart, with the
+/// reference points of the mechanisms `moved` at `pts` (mm) and the others at those centres; the
+/// state of the first of `moved`.
+const rt::MechanismState& cycle_from_rest(rt::Controller& ctl, const rt::Config& c, const std::vector<Vec2>& pts,
+                                          std::initializer_list<std::size_t> moved) {
+  const Scene s = at_points(c, centres(c, 8.0));
+  std::vector<double> targets = s.targets;
+  for (std::size_t k : moved) targets[2 * k] = pts[k].x() / 1000, targets[2 * k + 1] = pts[k].y() / 1000;
+  ctl.reset();
+  ctl.cycle(s.readings.data(), rt::Reading::radians, targets.data());
+  return ctl.mechanism(*moved.begin());
+}
+
 // The closed-form priority rule against the probe search it replaced (ring_search above, on the
 // library's kinematics and outlines) on random colliding pairs about both stations' centres: every
 // moved target is free by the library's exact check and usable, and no farther from the target
@@ -302,12 +316,7 @@ TEST(Runtime, ThePriorityRuleIsNoWorseThanTheProbeSearchOnRandomCollisions) {
     pts[lo] = pts[up] + 4.0 * Vec2(u(rng), u(rng));
     const PriorityResult dense = apply_priority(*st.upper, *st.lower, g, pts[up], pts[lo]);
     if (dense.status == PriorityStatus::upper_unusable || dense.status == PriorityStatus::lower_unusable) continue;
-    const Scene s = at_points(c, centres(c, 8.0));
-    std::vector<double> targets = s.targets;
-    for (std::size_t k : {lo, up}) targets[2 * k] = pts[k].x() / 1000, targets[2 * k + 1] = pts[k].y() / 1000;
-    ctl.reset();
-    ctl.cycle(s.readings.data(), rt::Reading::radians, targets.data());
-    const rt::MechanismState& l = ctl.mechanism(lo);
+    const rt::MechanismState& l = cycle_from_rest(ctl, c, pts, {lo, up});
     SCOPED_TRACE(::testing::Message() << name << " upper " << pts[up].transpose() << " lower " << pts[lo].transpose());
     ++compared;
     ASSERT_EQ(ctl.mechanism(up).status, rt::Status::ok);
@@ -357,12 +366,7 @@ TEST(Runtime, ThePriorityRuleSeparatesOverlappingOutlinesAtZeroClearance) {
     std::vector<Vec2> pts = centres(c, 8.0);
     pts[up] = st.target.center + 0.5 * Vec2(st.target.axes.x() * u(rng), st.target.axes.y() * u(rng));
     pts[lo] = pts[up] + 2.0 * Vec2(u(rng), u(rng));  // the tactors overlap
-    const Scene s = at_points(c, centres(c, 8.0));
-    std::vector<double> targets = s.targets;
-    for (std::size_t k : {lo, up}) targets[2 * k] = pts[k].x() / 1000, targets[2 * k + 1] = pts[k].y() / 1000;
-    ctl.reset();
-    ctl.cycle(s.readings.data(), rt::Reading::radians, targets.data());
-    const rt::MechanismState& l = ctl.mechanism(lo);
+    const rt::MechanismState& l = cycle_from_rest(ctl, c, pts, {lo, up});
     if (l.status != rt::Status::moved_by_priority) continue;
     ++moved;
     const Vec2 p(l.point_command[0] * 1000, l.point_command[1] * 1000);
