@@ -236,15 +236,6 @@ Status make_command(const Plan& plan, const MechPlan& mp, V2 point, Command& c) 
   return Status::ok;
 }
 
-/// Is the lower mechanism free at q (a valid command clear of the upper outline)?
-bool probe_free(Plan& plan, const MechPlan& low, const Part* upper, V2 q) {
-  Command c;
-  if (make_command(plan, low, q, c) != Status::ok) return false;
-  Part* mine = outline_at(plan, plan.probe_a);
-  detail::outline(plan.tpl, c.pose, mine);
-  return !detail::collide(upper, n_parts(plan), mine, n_parts(plan), plan.config.collision.min_clearance);
-}
-
 /// The lower mechanism at q against the upper outline: how far it may move before its outline can
 /// touch (0 when free or unusable; see closest_free()). Free: a valid command clear of the outline.
 struct Probe {
