@@ -97,7 +97,7 @@ double min_clearance(const Part* a, std::size_t na, const Part* b, std::size_t n
 /// Some pair of parts in a shared plane closer than `threshold` (bounding boxes skip far pairs).
 bool collide(const Part* a, std::size_t na, const Part* b, std::size_t nb, double threshold);
 /// min_clearance() where it is below `cap`, else some value >= cap (pairs whose bounding boxes
-/// are `cap` or more apart are skipped).
+/// are apart, by `cap` or more, are skipped; boxes that touch never are).
 double min_clearance_below(const Part* a, std::size_t na, const Part* b, std::size_t nb, double cap);
 
 /// A capsule seen from a fixed origin o, for rays o + t u (u a unit vector): the points inside it
