@@ -1,5 +1,5 @@
 #pragma once
-// CSV cells shared by the sweep's and the optimiser's files (private to lib): numbers in their
+// CSV cells shared by the sweep's, the optimiser's and bench_replay's files (private to lib): numbers in their
 // shortest round-trip form, empty for "no value"; text quoted when it holds a comma, a quote or a
 // line break (RFC 4180; a line break becomes a space so that a row stays one line).
 

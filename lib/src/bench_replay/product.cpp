@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "csv.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/replay.hpp"
@@ -23,14 +24,6 @@ namespace fivebar::products {
 namespace {
 
 std::string key_of(std::size_t k) { return "bench.replay_logs[" + std::to_string(k) + "]"; }
-
-/// A CSV cell: quoted (RFC 4180) when it holds a comma, a quote or a line break.
-std::string csv_cell(const std::string& text) {
-  if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
-  std::string out = "\"";
-  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
 
 }  // namespace
 
@@ -95,7 +88,7 @@ Product bench_replay_product() {
       for (const ReplayJoint& j : r.joints) {
         table.row({md::code(name), verdict, std::to_string(r.rows), md::code(j.joint), format::shortest(j.max_difference),
                    std::to_string(j.mismatches)});
-        csv << csv_cell(name) << "," << j.joint << "," << r.rows << "," << format::shortest(tolerance) << ","
+        csv << csv::field(name) << "," << j.joint << "," << r.rows << "," << format::shortest(tolerance) << ","
             << format::shortest(j.max_difference) << "," << j.mismatches << "," << (r.passed() ? "true" : "false") << "\n";
       }
       details += "- " + md::code(name) + " (stations: " + format::join(log.stations) + "): ";
