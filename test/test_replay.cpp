@@ -5,12 +5,10 @@
 // `bench.replay_logs` key's bad names are the design file's FILE:LINE: key messages.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -23,6 +21,7 @@
 #include "fivebar/runtime/json_config.hpp"
 #include "fivebar/scene.hpp"
 #include "fivebar/sections/bench.hpp"
+#include "process.hpp"
 
 namespace fivebar {
 namespace {
@@ -33,12 +32,7 @@ using ::testing::HasSubstr;
 
 const fs::path kDesign = fs::path(FIVEBAR_SOURCE_DIR) / "designs" / "iros2022.yaml";
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using fivebar::testing::slurp;
 
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> out;
@@ -49,15 +43,6 @@ std::vector<std::string> split(const std::string& line) {
 
 class Replay : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::random_device rd;
-    dir_ = fs::temp_directory_path() / ("fivebar_test_replay_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
 
   static const Design& paper() {
     static const Design d = load_design(kDesign.string());
@@ -87,7 +72,8 @@ class Replay : public ::testing::Test {
     return read_replay_log(in, config, "log.csv");
   }
 
-  fs::path dir_;
+  fivebar::testing::ScratchDir scratch_{"fivebar_test_replay"};
+  const fs::path& dir_ = scratch_.path();
 };
 
 TEST_F(Replay, ALogTheRuntimeWroteInTheLoopReplaysWithNoDutyDifference) {
