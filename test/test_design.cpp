@@ -999,6 +999,18 @@ controller:
   }
 }
 
+// A station key "" would read as the scope of every station: controller: and motor: refuse it at
+// its own line, as patterns: does.
+TEST(Loader, AnEmptyStationNameIsRefusedAtItsLineInControllerAndMotor) {
+  for (const std::string section : {"controller", "motor"}) {
+    const std::string override = section == "controller" ? "{pid: {kp: 4}}" : "{terminal_resistance_ohm: 3}";
+    const std::string text = "name: c\n" + section + ":\n  stations:\n    \"\": " + override + "\n" + kPaperStations;
+    EXPECT_THAT([&] { (void)load_design_from_string(text, "d.yaml"); },
+                ThrowsMessage<InputError>(HasSubstr("d.yaml:4: " + section + ".stations[\"\"]: a station name must not be empty")))
+        << section;
+  }
+}
+
 TEST(Loader, ControllerMechanismScopesApplyToEveryStationBelowAnyStationScope) {
   const Design d = load_design_from_string(R"(name: c
 controller:

@@ -313,6 +313,8 @@ void load(const Value& v, Design& design) {
   }
   if (const Value* stations = find(all, "stations")) {
     for (const Value& st : stations->entries({}, "of station names to their overrides", /*any_key=*/true)) {
+      // An empty name would read as every station's scope (JointScope): refused here, at its line.
+      if (st.name().empty()) st.fail("a station name must not be empty");
       const auto station_keys = st.entries({"pid", "potentiometer", "lower", "upper"}, "(pid, potentiometer, lower, upper)");
       ControlOverride so;
       so.station = st.name();

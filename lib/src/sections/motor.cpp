@@ -119,6 +119,8 @@ void load(const Value& v, Design& design) {
   }
   if (const Value* stations = find(all, "stations")) {
     for (const Value& st : stations->entries({}, "of station names to their overrides", /*any_key=*/true)) {
+      // An empty name would read as every station's scope (JointScope): refused here, at its line.
+      if (st.name().empty()) st.fail("a station name must not be empty");
       const auto keys = st.entries({FIVEBAR_MOTOR_KEYS, "lower", "upper"}, "of motor keys, lower, upper");
       MotorOverride so;
       so.station = st.name();
