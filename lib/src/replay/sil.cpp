@@ -19,9 +19,7 @@ std::vector<const Station*> pair_stations(const Design& design, const std::vecto
     return out;
   }
   for (const std::string& name : names) {
-    const Station* found = nullptr;
-    for (const Station& s : design.stations)
-      if (s.name == name) found = &s;
+    const Station* found = design.station(name);
     if (found == nullptr) throw InputError("station '" + name + "' is not in design '" + design.name + "'");
     if (!found->lower || !found->upper) throw InputError("station '" + name + "' does not have both mechanisms");
     out.push_back(found);
