@@ -23,7 +23,28 @@ LIMIT = 150
 
 # Functions longer than LIMIT when this check was written, with their length then: each may only
 # shrink. Split one and remove its line; a new function over the limit fails the check.
-KNOWN: dict[str, int] = {}
+KNOWN: dict[str, int] = {
+    "lib/src/calibrate/fit.cpp:calibrate": 392,
+    "lib/src/simulate/simulate.cpp:simulate": 309,
+    "lib/src/animate/animation.cpp:animate_pattern_svg": 297,
+    "lib/src/parts/parts.cpp:build_parts": 250,
+    "lib/src/control/control_tune.cpp:tune_controller": 248,
+    "lib/src/optimize/optimize_search.cpp:run_optimize": 242,
+    "lib/src/atlas/atlas_plot.cpp:plot_atlas": 236,
+    "lib/src/scene.cpp:products::run_scene_with": 216,
+    "lib/src/export/urdf.cpp:render_urdf": 206,
+    "lib/src/optimize/optimize_search.cpp:evolve": 198,
+    "lib/src/export/export.cpp:export_gate": 193,
+    "lib/src/optimize/optimize.cpp:OptimizeProblem::evaluate": 183,
+    "lib/src/export/mjcf.cpp:render_mjcf": 181,
+    "lib/src/identify/identify.cpp:identify_joint": 180,
+    "cli/simulate.cpp:run_simulate": 179,
+    "lib/src/identify/log.cpp:read_identify_log": 172,
+    "lib/src/sweep/sweep.cpp:run_sweep": 171,
+    "lib/src/workspace/station_plot.cpp:draw": 166,
+    "lib/src/control/product.cpp:control_product": 153,
+    "lib/src/optimize/optimize_search.cpp:finish": 152,
+}
 
 CONTROL = re.compile(r"\b(if|for|while|switch|catch|do|else|return|try)\s*(\(|\{|$)")
 HEAD = re.compile(r"\)\s*(const\s*)?(noexcept(\s*\([^)]*\))?\s*)?(override\s*)?(final\s*)?(->\s*[^{;]+)?\s*$")
