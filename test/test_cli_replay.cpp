@@ -141,7 +141,7 @@ TEST_F(CliReplay, BadLogsAndConfigurationsAreExitTwoNamingTheColumnOrKey) {
   for (const auto& f : fs::directory_iterator(dir_ / "export")) good = f.path().string();
   r = run({"replay", log.string(), "--config", good});
   EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, HasSubstr("column index_lower_theta1_duty is missing"));
+  EXPECT_THAT(r.err, HasSubstr("column 'index_lower_theta1_duty' is missing"));
   const fs::path nan = write("nan.csv", slurp(log).substr(0, slurp(log).find('\n') + 1) + "0,abc\n");
   r = run({"replay", nan.string(), "--config", good});
   EXPECT_EQ(r.code, 2);

@@ -12,9 +12,16 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/design.hpp"
 
 namespace fivebar::calibrate {
+
+/// Bounds of a measurement or hard-stop file (docs/bench-files.md): lines of 4096 bytes, 64 MiB,
+/// 1,000,000 rows (a bench session is hundreds of poses; the fit is linear in rows).
+inline constexpr csv::Limits kMeasurementLimits{4096, 64ull << 20, 1'000'000};
+/// |x_mm|, |y_mm| at most this many times the mechanism's largest length (Mechanism::length_scale).
+inline constexpr double kMaxPointScale = 1000.0;
 
 /// One measured pose.
 struct Measurement {
