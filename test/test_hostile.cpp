@@ -463,6 +463,12 @@ std::vector<Case> cases() {
   c.push_back({"CalibrateDuplicatedColumn", {"calibrate", "show.yaml", "m.csv"},
                {showcase, text("m.csv", "station,mechanism,volts1,volts2,x_mm,y_mm,x_mm\n")},
                {"m.csv:1: column 7 'x_mm': duplicate of column 5"}});
+  {
+    std::string copies = meas_header;
+    for (int k = 0; k < 12; ++k) copies += meas_row;
+    c.push_back({"CalibrateTwelveCopiesOfOneRow", {"calibrate", "show.yaml", "m.csv"}, {showcase, text("m.csv", copies)},
+                 {"m.csv:3: a copy of line 2"}});
+  }
   c.push_back({"CalibrateSigmaInfinite", {"calibrate", "show.yaml", "m.csv", "--sigma", "inf"},
                {showcase, text("m.csv", meas_header + meas_row)}, {"--sigma", "inf", "finite"}});
   c.push_back({"CalibratePlanSigmaZero", {"calibrate", "show.yaml", "-s", "index", "--plan", "6", "--plan-sigma", "0", "--out", "out"},

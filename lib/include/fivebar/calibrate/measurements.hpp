@@ -6,7 +6,8 @@
 /// `counts1,counts2` instead of the volts (converted through `controller.adc`: V = low + counts
 /// (high - low) / 2^bits, the one ADC model of fivebar/export/export.hpp). Any column order; an unknown,
 /// repeated or missing column, a cell that is not a finite number, a station or mechanism the
-/// design lacks: InputError naming the file, the line and the column.
+/// design lacks, a value out of range (docs/bench-files.md), a row that copies an earlier one:
+/// InputError naming the file, the line and the column.
 
 #include <filesystem>
 #include <string>
