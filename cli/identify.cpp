@@ -17,6 +17,7 @@
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
+#include "fivebar/resources/estimates.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/provenance.hpp"
@@ -60,6 +61,7 @@ struct IdentifyCliOptions {
   std::vector<double> plan_band_hz{0.2, 5.0};
   std::vector<double> range_deg;
   double drive_noise_mNm = 1.0;
+  bool yes = false;
 };
 
 /// The priors of a joint (fivebar/identify/model.hpp joint_prior()).
@@ -257,6 +259,9 @@ int run_identify(const IdentifyCliOptions& opt) {
   const id::IdentifyLog est = id::read_identify_log(std::filesystem::path(opt.log));
   std::optional<id::IdentifyLog> val;
   if (!opt.validation.empty()) val = id::read_identify_log(std::filesystem::path(opt.validation));
+  // The study's memory and time from the logs' size, before the work (docs/reliability.md).
+  check_budget(identify_estimate(est.time.size() + (val ? val->time.size() : 0), est.joints.size()), opt.yes,
+               "confirm with fivebar identify --yes");
   if (!(opt.load_inertia >= 0.0) || !std::isfinite(opt.load_inertia)) throw InputError("--load-inertia: must be >= 0 kg m^2");
   if (opt.method != "idim" && opt.method != "oe") throw InputError("--method: idim or oe");
   id::IdentifyOptions o;
@@ -415,6 +420,7 @@ void setup_identify(CLI::App& app) {
       ->capture_default_str();
   add_out_option(*sub, opt->out, "the files", "identify");
   sub->add_flag("--no-files", opt->no_files, "Print only");
+  sub->add_flag("--yes", opt->yes, "Run an identification estimated at over an hour or two gigabytes of memory (refused otherwise)");
   add_json_flag(*sub, opt->json);
   sub->footer(
       "Parameters are printed with their design key path (motor.terminal_resistance_ohm, in the design's units) or a "
