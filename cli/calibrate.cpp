@@ -3,6 +3,7 @@
 // (fivebar/calibrate.hpp, docs/calibrate.md).
 
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 
 #include "common.hpp"
 #include "fivebar/calibrate.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/provenance.hpp"  // today_utc()
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
@@ -47,11 +49,8 @@ struct CalibrateCliOptions {
 
 
 std::string read_text(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot read the " + std::string(what));
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  // Bounded while reading (fivebar/csv_reader.hpp): /dev/zero is refused, not read whole.
+  return csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, what);
 }
 
 void print_result(const calibrate::CalibrationResult& r) {
@@ -81,8 +80,15 @@ int run_calibrate(const CalibrateCliOptions& opt) {
   const Design design = load(opt.design);
   if (opt.frame != "fixed" && opt.frame != "fit") throw InputError("--frame = '" + opt.frame + "': must be fixed or fit");
   if (opt.loss != "none" && opt.loss != "huber" && opt.loss != "cauchy") throw InputError("--loss = '" + opt.loss + "': must be none, huber or cauchy");
-  if (!(opt.loss_scale > 0.0)) throw InputError("--loss-scale must be > 0 (measurement sigmas)");
-  if (opt.sigma_mm && !(*opt.sigma_mm > 0.0)) throw InputError("--sigma must be > 0 mm");
+  // A sigma or scale is a positive finite number, named with its flag and value (docs/reliability.md).
+  const auto positive = [](const char* flag, double v, const char* unit) {
+    if (!(v > 0.0) || !std::isfinite(v) || v > csv::kMaxBenchValue) {
+      throw InputError(std::string(flag) + " = " + format::shortest(v) + ": must be a finite number > 0 and at most 1e9 (" + unit + ")");
+    }
+  };
+  positive("--loss-scale", opt.loss_scale, "measurement sigmas");
+  if (opt.sigma_mm) positive("--sigma", *opt.sigma_mm, "mm");
+  if (opt.plan) positive("--plan-sigma", opt.plan_sigma_mm, "mm");
   const bool fitting = !opt.measurements.empty();
   if (!fitting && !opt.plan && opt.hard_stops.empty()) {
     throw InputError("give a measurement file (MEAS.csv), --plan N or --hard-stops LOG");

@@ -17,6 +17,7 @@
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
+#include "fivebar/resources/estimates.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/provenance.hpp"
@@ -46,9 +47,9 @@ struct IdentifyCliOptions {
   std::string out;
   std::vector<std::string> fit;
   double load_inertia = 0.0;
-  double cutoff_hz = 0.0;
+  std::optional<double> cutoff_hz;  ///< given: > 0 (never replaced by the default)
   int filter_order = 4;
-  int decimation = 0;
+  std::optional<int> decimation;  ///< given: >= 1
   bool per_direction = false;
   bool instant_drive = false;
   bool no_output_error = false;
@@ -60,6 +61,7 @@ struct IdentifyCliOptions {
   std::vector<double> plan_band_hz{0.2, 5.0};
   std::vector<double> range_deg;
   double drive_noise_mNm = 1.0;
+  bool yes = false;
 };
 
 /// The priors of a joint (fivebar/identify/model.hpp joint_prior()).
@@ -146,6 +148,9 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   po.f_max_hz = opt.plan_band_hz[1];
   po.current_limit = prior.motor.current_limit_A;
   po.per_direction = opt.per_direction;
+  if (!(opt.drive_noise_mNm > 0.0) || !std::isfinite(opt.drive_noise_mNm)) {
+    throw InputError("--drive-noise = " + format::shortest(opt.drive_noise_mNm) + ": must be a finite number > 0 (mNm)");
+  }
   po.drive_noise = opt.drive_noise_mNm * 1e-3;
   const ControllerSettings* cs = design.get<ControllerSettings>();
   if (cs) po.max_speed = cs->max_velocity;
@@ -242,17 +247,27 @@ int run_identify(const IdentifyCliOptions& opt) {
   } else if (rig != "motor" || opt.rig.size() != 1) {
     throw InputError("--rig: motor, or mechanism STATION/MECHANISM");
   }
+  // A flag given is used or refused, never replaced by its default (docs/reliability.md).
+  if (opt.cutoff_hz && (!(*opt.cutoff_hz > 0.0) || !std::isfinite(*opt.cutoff_hz))) {
+    throw InputError("--cutoff = " + format::shortest(*opt.cutoff_hz) + ": must be a finite number > 0 Hz (leave it out for a tenth of the sample rate)");
+  }
+  if (opt.decimation && *opt.decimation < 1) {
+    throw InputError("--decimation = " + std::to_string(*opt.decimation) + ": must be a whole number >= 1 (leave it out for 10)");
+  }
   if (opt.plan) return run_plan(opt, design);
   if (opt.log.empty()) throw InputError("LOG: an identification log is required (or --plan)");
   const id::IdentifyLog est = id::read_identify_log(std::filesystem::path(opt.log));
   std::optional<id::IdentifyLog> val;
   if (!opt.validation.empty()) val = id::read_identify_log(std::filesystem::path(opt.validation));
+  // The study's memory and time from the logs' size, before the work (docs/reliability.md).
+  check_budget(identify_estimate(est.time.size() + (val ? val->time.size() : 0), est.joints.size()), opt.yes,
+               "confirm with fivebar identify --yes");
   if (!(opt.load_inertia >= 0.0) || !std::isfinite(opt.load_inertia)) throw InputError("--load-inertia: must be >= 0 kg m^2");
   if (opt.method != "idim" && opt.method != "oe") throw InputError("--method: idim or oe");
   id::IdentifyOptions o;
-  o.cutoff_hz = opt.cutoff_hz;
+  o.cutoff_hz = opt.cutoff_hz.value_or(0.0);  // 0: the library's default
   o.filter_order = opt.filter_order;
-  o.decimation = opt.decimation;
+  o.decimation = opt.decimation.value_or(0);  // 0: the library's default
   o.per_direction = opt.per_direction;
   o.zero_order_hold = !opt.instant_drive;
   o.output_error = !opt.no_output_error;
@@ -405,6 +420,7 @@ void setup_identify(CLI::App& app) {
       ->capture_default_str();
   add_out_option(*sub, opt->out, "the files", "identify");
   sub->add_flag("--no-files", opt->no_files, "Print only");
+  sub->add_flag("--yes", opt->yes, "Run an identification estimated at over an hour or two gigabytes of memory (refused otherwise)");
   add_json_flag(*sub, opt->json);
   sub->footer(
       "Parameters are printed with their design key path (motor.terminal_resistance_ohm, in the design's units) or a "

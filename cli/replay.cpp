@@ -49,12 +49,9 @@ int run_log(const ReplayOptions& opt) {
   const ReplayLog log = read_replay_log(in, config, opt.input);
   const ReplayResult r = replay_log(config, log, opt.tolerance);
   if (opt.json) {
-    Json j = to_json(r);
-    j["command"] = "replay";
-    j["mode"] = "log";
-    j["log"] = opt.input;
-    j["config"] = opt.config;
-    j["design"] = config.design;
+    // command and design lead, as in every --json document (docs/conventions.md).
+    Json j = {{"command", "replay"}, {"design", config.design}, {"mode", "log"}, {"log", opt.input}, {"config", opt.config}};
+    for (const auto& [key, value] : to_json(r).items()) j[key] = value;
     print_json(j);
   } else {
     std::cout << opt.input << ": " << r.rows << " cycles through the runtime of " << opt.config << " (design "
@@ -103,6 +100,7 @@ int run_sil(const ReplayOptions& opt) {
   for (const Station* s : stations) request.stations.push_back(s->name);
   request.pattern = kind;
   if (!opt.config.empty()) request.config = std::make_shared<const runtime::Config>(read_config(opt.config));
+  check_sil_config(design, request, "--config " + opt.config);  // before the output folder exists
   const std::filesystem::path dir = output_dir(design, opt.out, "replay");
   const WriteFence fence(dir);
   request.open_log = [&dir](const std::string& name) { return AtomicFile(dir / name); };

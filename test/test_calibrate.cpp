@@ -446,6 +446,49 @@ TEST(CalibratePatch, CorrelationsThatBreakTheRulesAreRefusedNamingTheKey) {
   }
 }
 
+// Provenance is validated as a whole (issue 45): dates of the calendar, and correlations that some
+// covariance has. For three keys with rho01 = rho02 = a and rho12 = b the matrix is positive
+// semi-definite iff 1 + 2 a^2 b - 2 a^2 - b^2 >= 0 (its determinant; the 2 x 2 minors are 1 - rho^2
+// >= 0): a = 0.99, b = -0.99 gives -2.88 (refused), a = b = 0.5 gives 0.5 (accepted).
+TEST(CalibratePatch, ProvenanceDatesAndCorrelationMatricesAreValidated) {
+  const std::string head = to_yaml(paper());
+  const auto entry = [](const std::string& date, const std::string& corr) {
+    return "{source: m.csv, sha256: " + sha256_hex("x") + ", date: \"" + date + "\", method: fit, sigma: 0.01" +
+           (corr.empty() ? "" : ", correlation: {" + corr + "}") + "}";
+  };
+  const std::string L = "stations.index.mechanisms.lower.links";
+  const auto load_three = [&](double a, double b) {
+    return load_design_from_string(head + "provenance:\n  \"" + L + "[0]\": " +
+                                       entry("2026-11-26", "\"" + L + "[1]\": " + std::to_string(a) + ", \"" + L + "[2]\": " + std::to_string(a)) +
+                                       "\n  \"" + L + "[1]\": " + entry("2026-11-26", "\"" + L + "[2]\": " + std::to_string(b)) +
+                                       "\n  \"" + L + "[2]\": " + entry("2026-11-26", "") + "\n",
+                                   "bad.yaml");
+  };
+  const auto det = [](double a, double b) { return 1 + 2 * a * a * b - 2 * a * a - b * b; };
+  ASSERT_GT(det(0.5, 0.5), 0.0);
+  ASSERT_LT(det(0.99, -0.99), 0.0);
+  EXPECT_NO_THROW(load_three(0.5, 0.5));
+  try {
+    load_three(0.99, -0.99);
+    ADD_FAILURE() << "correlations that no covariance has were accepted";
+  } catch (const std::exception& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("bad.yaml:"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("not positive semi-definite"));
+  }
+  const auto load_date = [&](const std::string& date) {
+    return load_design_from_string(head + "provenance:\n  \"" + L + "[0]\": " + entry(date, "") + "\n", "bad.yaml");
+  };
+  EXPECT_NO_THROW(load_date("2024-02-29"));  // a leap year
+  for (const std::string bad : {"2024-13-45", "2023-02-29", "2100-02-29", "2026-04-31", "2026-00-10", "2026-01-00"}) {
+    try {
+      load_date(bad);
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const std::exception& e) {
+      EXPECT_THAT(e.what(), ::testing::HasSubstr("date = " + bad + ": not a date of the calendar"));
+    }
+  }
+}
+
 TEST(CalibrateHardStops, OffsetsFromTwoStopsRecoverTheTruth) {
   // The paper design has hard stops where a proximal link meets the other motor's round end.
   const Design& d = paper();

@@ -5,6 +5,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -178,6 +180,9 @@ TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
   const json* p = param(doc["hard_stops"], key);
   ASSERT_NE(p, nullptr);
   EXPECT_NEAR((*p)["value"].get<double>(), 0.3, 1e-9);
+  // No pose was fitted: the pose figures do not exist (null, docs/conventions.md), they are not 0.
+  EXPECT_TRUE(doc["hard_stops"]["identifiability"]["condition_number"].is_null());
+  EXPECT_TRUE(doc["hard_stops"]["identifiability"]["observability_index"].is_null());
   const fivebar::Design patched = fivebar::load_design(dir_ / "cal" / "iros2022-calibrated.yaml");
   EXPECT_NEAR(fivebar::design_number(patched, key), 0.3, 1e-9);
   EXPECT_TRUE(fivebar::is_measured(patched, key));
@@ -187,6 +192,13 @@ TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
   EXPECT_EQ(bad.code, 2);
   EXPECT_THAT(bad.err, HasSubstr("bad.csv:2: column 'stop'"));
   EXPECT_FALSE(fs::exists(dir_ / "cal2"));
+  // A reading outside the converter (controller.adc.range_v) is a fault, named at its line.
+  write("volts.csv", text + "index,lower,1,lo,99\n");
+  const ft::Outcome out_of_range = run({"calibrate", kDesign, "--hard-stops", "volts.csv", "--out", "cal3"});
+  EXPECT_EQ(out_of_range.code, 2);
+  EXPECT_THAT(out_of_range.err, HasSubstr("volts.csv:" + std::to_string(2 + std::count(text.begin(), text.end(), '\n') - 1) +
+                                          ": column 'volts' = '99': outside controller.adc.range_v"));
+  EXPECT_FALSE(fs::exists(dir_ / "cal3"));
 }
 
 }  // namespace

@@ -160,6 +160,42 @@ TEST_F(CliIdentify, BadLogsExitTwoNamingTheLineAndColumnAndWriteNothing) {
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 
+// One log format (docs/bench-files.md): the device's own log, which `replay` reads, is identified as
+// it is (its x_ref_mm/y_ref_mm targets are the log's columns, not unknown ones); a duplicated
+// column is refused at the header; /dev/zero after one bounded line.
+TEST_F(CliIdentify, TheDeviceLogOfReplayIsIdentified) {
+  const std::string log = (fs::path(FIVEBAR_SOURCE_DIR) / "designs/bench/replay.csv").string();
+  Outcome r = run({"identify", kDesign, log, "--rig", "mechanism", "index/lower", "--no-files", "--no-output-error", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = ft::slurp(log);
+  std::string dup = text;
+  dup.replace(dup.find("index_upper_x_ref_mm"), std::string("index_upper_x_ref_mm").size(), "index_lower_x_ref_mm");
+  r = run({"identify", kDesign, write("dup.csv", dup).string(), "--rig", "mechanism", "index/lower", "--no-files"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("column 12 'index_lower_x_ref_mm': duplicate of column 10"));
+  r = run({"identify", kDesign, "/dev/zero", "--no-files"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("/dev/zero:1: line longer than 4096 bytes"));
+}
+
+// A flag given is used or refused, never replaced by its default: --cutoff 0 ran with a tenth of
+// the sample rate, --decimation 0 with 10. Refused before the log is read or a file is written.
+TEST_F(CliIdentify, FlagsOutsideTheirRangeAreRefusedNotDefaulted) {
+  ft::SyntheticTruth truth;
+  const fs::path motor = write("motor.csv", ft::synthetic_log(truth, 5).csv());
+  for (const auto& [flag, value] : std::vector<std::pair<std::string, std::string>>{
+           {"--cutoff", "0"}, {"--cutoff", "-1"}, {"--decimation", "0"}, {"--decimation", "-1"}}) {
+    const Outcome r = run({"identify", kDesign, motor.string(), flag, value, "--out", "o"});
+    EXPECT_EQ(r.code, 2) << flag << " " << value;
+    EXPECT_THAT(r.err, HasSubstr(flag)) << r.err;
+    EXPECT_THAT(r.err, HasSubstr(value)) << r.err;
+  }
+  const Outcome p = run({"identify", kDesign, "--plan", "--drive-noise", "0", "--out", "o"});
+  EXPECT_EQ(p.code, 2);
+  EXPECT_THAT(p.err, HasSubstr("--drive-noise = 0"));
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
 TEST_F(CliIdentify, PlanWritesAnExcitationWithinTheLimits) {
   const Outcome r = run({"identify", kDesign, "--plan", "--range-deg", "-60,60", "--json", "--out", "plan"});
   ASSERT_EQ(r.code, 0) << r.err;

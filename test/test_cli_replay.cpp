@@ -141,10 +141,69 @@ TEST_F(CliReplay, BadLogsAndConfigurationsAreExitTwoNamingTheColumnOrKey) {
   for (const auto& f : fs::directory_iterator(dir_ / "export")) good = f.path().string();
   r = run({"replay", log.string(), "--config", good});
   EXPECT_EQ(r.code, 2);
-  EXPECT_THAT(r.err, HasSubstr("column index_lower_theta1_duty is missing"));
+  EXPECT_THAT(r.err, HasSubstr("column 'index_lower_theta1_duty' is missing"));
   const fs::path nan = write("nan.csv", slurp(log).substr(0, slurp(log).find('\n') + 1) + "0,abc\n");
   r = run({"replay", nan.string(), "--config", good});
   EXPECT_EQ(r.code, 2);
+}
+
+// The device log goes through the bench's one reader (docs/bench-files.md): the showcase's log with
+// one cell or the header changed is refused at its line and column, exit 2; /dev/zero is refused
+// after one bounded line; --json leads with command and design (docs/conventions.md).
+TEST_F(CliReplay, TheDeviceLogIsReadStrictlyAndBounded) {
+  const Outcome e = run({"export", kDesign, "-s", "index", "--format", "json", "--out", "export"});
+  ASSERT_EQ(e.code, 0) << e.err;
+  std::string good;
+  for (const auto& f : fs::directory_iterator(dir_ / "export"))
+    if (f.path().extension() == ".json") good = f.path().string();
+  const std::string text = slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/bench/replay.csv");
+  const std::size_t header_end = text.find('\n', text.find("time_s"));
+  const std::size_t header_line = 1 + std::count(text.begin(), text.begin() + header_end, '\n');
+  // The unchanged log replays (the reference for the changed ones below).
+  const fs::path ok = write("ok.csv", text);
+  Outcome r = run({"replay", ok.string(), "--config", good, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("{\"command\":\"replay\",\"design\":\"iros2022\""), 0u) << r.out.substr(0, 80);
+  // A counts cell in hexadecimal, or with text after the number: refused, not read as 16 or 41496.
+  const std::string first_row = text.substr(header_end + 1, text.find(',', header_end + 1) - header_end);  // "0,"
+  for (const std::string cell : {"0x10", "41496junk", "1e999", "nan"}) {
+    std::string t = text;
+    const std::size_t at = header_end + 1 + first_row.size();
+    t.replace(at, t.find(',', at) - at, cell);
+    const fs::path bad = write("bad.csv", t);
+    r = run({"replay", bad.string(), "--config", good});
+    EXPECT_EQ(r.code, 2) << cell;
+    EXPECT_THAT(r.err, HasSubstr("bad.csv:" + std::to_string(header_line + 1) + ": column 'index_lower_theta1_counts' = '" + cell + "'"));
+  }
+  // A duplicated column: refused at the header, not replayed against one of the two.
+  {
+    std::string t = text;
+    t.replace(t.find("index_upper_theta1_counts"), std::string("index_upper_theta1_counts").size(), "index_lower_theta1_counts");
+    const fs::path bad = write("dup.csv", t);
+    r = run({"replay", bad.string(), "--config", good});
+    EXPECT_EQ(r.code, 2);
+    EXPECT_THAT(r.err, HasSubstr("dup.csv:" + std::to_string(header_line) + ": column 6 'index_lower_theta1_counts': duplicate of column 2"));
+  }
+  r = run({"replay", "/dev/zero", "--config", good});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("/dev/zero:1: line longer than 4096 bytes"));
+  r = run({"replay", ok.string(), "--config", "/dev/zero"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("larger than 16777216 bytes"));
+}
+
+// `replay --sil --config` with a configuration that lacks the station: refused before the output
+// folder is created.
+TEST_F(CliReplay, SilWithAConfigurationWithoutTheStationWritesNothing) {
+  const Outcome e = run({"export", kDesign, "-s", "index", "--format", "json", "--out", "export"});
+  ASSERT_EQ(e.code, 0) << e.err;
+  std::string index_only;
+  for (const auto& f : fs::directory_iterator(dir_ / "export"))
+    if (f.path().extension() == ".json") index_only = f.path().string();
+  const Outcome r = run({"replay", kDesign, "--sil", "-s", "thumb", "--pattern", "stretch", "--config", index_only, "--out", "sil"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("has no station 'thumb'"));
+  EXPECT_FALSE(fs::exists(dir_ / "sil"));
 }
 
 }  // namespace

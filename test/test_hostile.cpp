@@ -444,6 +444,60 @@ std::vector<Case> cases() {
   c.push_back({"ExportCheckNumberBeyondADouble", {"export", "--check", "f.json", "show.yaml"},
                {showcase, text("f.json", "{\"fivebar_controller\": {\"ros__parameters\": {\"x\": 1e999}}}\n")},
                {"f.json", "not a file fivebar exports"}});
+  // --- Issue 45: the bench files (docs/bench-files.md): one bounded reader, ranged cells, flags -------
+  const std::string meas_header = "station,mechanism,volts1,volts2,x_mm,y_mm\n";
+  const std::string meas_row = "index,lower,2.138656037954923,2.861343962045077,6.5124,19.9215\n";
+  c.push_back({"CalibrateDevZero", {"calibrate", "show.yaml", "/dev/zero"}, {showcase}, {"/dev/zero", "larger than 67108864 bytes"}});
+  c.push_back({"CalibrateYOf1e13", {"calibrate", "show.yaml", "m.csv"},
+               {showcase, text("m.csv", meas_header + meas_row + "index,lower,2.1,2.8,6.5,1e13\n")},
+               {"m.csv:3: column 'y_mm' = '1e13': outside"}});
+  c.push_back({"CalibrateYOf1e308", {"calibrate", "show.yaml", "m.csv"},
+               {showcase, text("m.csv", meas_header + meas_row + "index,lower,2.1,2.8,6.5,1e308\n")},
+               {"m.csv:3: column 'y_mm' = '1e308': outside"}, 2, false, {"inf", "nan"}});
+  c.push_back({"CalibrateVoltsOutsideTheConverter", {"calibrate", "show.yaml", "m.csv"},
+               {showcase, text("m.csv", meas_header + meas_row + "index,lower,50,2.8,6.5,19.9\n")},
+               {"m.csv:3: column 'volts1' = '50': outside controller.adc.range_v"}});
+  c.push_back({"CalibrateCountsInHexadecimal", {"calibrate", "show.yaml", "m.csv"},
+               {showcase, text("m.csv", "station,mechanism,counts1,counts2,x_mm,y_mm\nindex,lower,0x10,40000,6.5,19.9\n")},
+               {"m.csv:2: column 'counts1' = '0x10': not a finite decimal number"}});
+  c.push_back({"CalibrateDuplicatedColumn", {"calibrate", "show.yaml", "m.csv"},
+               {showcase, text("m.csv", "station,mechanism,volts1,volts2,x_mm,y_mm,x_mm\n")},
+               {"m.csv:1: column 7 'x_mm': duplicate of column 5"}});
+  {
+    std::string copies = meas_header;
+    for (int k = 0; k < 12; ++k) copies += meas_row;
+    c.push_back({"CalibrateTwelveCopiesOfOneRow", {"calibrate", "show.yaml", "m.csv"}, {showcase, text("m.csv", copies)},
+                 {"m.csv:3: a copy of line 2"}});
+  }
+  c.push_back({"CalibrateSigmaInfinite", {"calibrate", "show.yaml", "m.csv", "--sigma", "inf"},
+               {showcase, text("m.csv", meas_header + meas_row)}, {"--sigma", "inf", "finite"}});
+  c.push_back({"CalibratePlanSigmaZero", {"calibrate", "show.yaml", "-s", "index", "--plan", "6", "--plan-sigma", "0", "--out", "out"},
+               {showcase}, {"--plan-sigma = 0"}});
+  c.push_back({"HardStopOf99Volts", {"calibrate", "show.yaml", "--hard-stops", "h.csv"},
+               {showcase, text("h.csv", "station,mechanism,joint,stop,volts\nindex,lower,1,lo,99\n")},
+               {"h.csv:2: column 'volts' = '99': outside controller.adc.range_v"}});
+  // Bench paths stay beside the design; a refused file is neither read nor echoed.
+  c.push_back({"RunBenchCalibrationAbsolute", {"run", "b.yaml", "--out", "out"},
+               {text("b.yaml", show_with("calibration: bench/calibration.csv", "calibration: /etc/passwd"))},
+               {"b.yaml:", "bench.calibration = /etc/passwd: must be a path relative"}, 2, false, {"root"}});
+  c.push_back({"RunBenchReplayLogDotDot", {"run", "b.yaml", "--out", "out"},
+               {text("b.yaml", show_with("replay_logs: [bench/replay.csv]", "replay_logs: [bench/../../r.csv]"))},
+               {"b.yaml:", "bench.replay_logs[0] = bench/../../r.csv: must not leave"}});
+  c.push_back({"RunBenchCalibrationLinkLeadingOut", {"run", "b.yaml", "--out", "out"},
+               {text("b.yaml", show_with("calibration: bench/calibration.csv", "calibration: cal.csv")),
+                {"cal.csv", [](const fs::path& p) { fs::create_symlink("/etc/passwd", p); }}},
+               {"bench.calibration = cal.csv: a symbolic link that leads out"}, 2, false, {"root", "passwd"}});
+  // A bad bench file leaves no empty output folder behind.
+  c.push_back({"RunBenchCalibrationMalformed", {"run", "b.yaml", "--out", "out"},
+               {text("b.yaml", show_with("calibration: bench/calibration.csv", "calibration: cal.csv")),
+                text("cal.csv", meas_header + "index,lower,2.1,2.8,6.5,junk\n")},
+               {"cal.csv:2: column 'y_mm' = 'junk'"}});
+  c.push_back({"IdentifyCutoffZero", {"identify", "show.yaml", "id.csv", "--cutoff", "0", "--out", "out"},
+               {showcase, text("id.csv", ft::slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/bench/identification.csv"))},
+               {"--cutoff = 0"}});
+  c.push_back({"IdentifyDecimationZero", {"identify", "show.yaml", "id.csv", "--decimation", "0", "--out", "out"},
+               {showcase, text("id.csv", ft::slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/bench/identification.csv"))},
+               {"--decimation = 0"}});
   return c;
 }
 

@@ -241,7 +241,24 @@ TEST(ReplayDesign, BadLogNamesAreTheDesignFilesLineAndKey) {
   EXPECT_THAT(message("replay_logs: [a.csv]\n  replay_tolerance: -1"),
               HasSubstr("d.yaml:" + std::to_string(line + 1) + ": bench.replay_tolerance"));
   // A directory is a wrong name (the file is looked for beside the design file).
-  EXPECT_THAT(message("replay_logs: [/]"), HasSubstr(at + "[0] = /: is a directory"));
+  EXPECT_THAT(message("replay_logs: [.]"), HasSubstr(at + "[0] = .: is a directory"));
+  // Bench files stay beside the design (docs/bench-files.md): no absolute path, no '..'.
+  EXPECT_THAT(message("replay_logs: [/]"), HasSubstr(at + "[0] = /: must be a path relative to the design file's folder"));
+  EXPECT_THAT(message("replay_logs: [/etc/passwd]"), HasSubstr(at + "[0] = /etc/passwd: must be a path relative"));
+  EXPECT_THAT(message("replay_logs: [logs/../../x.csv]"), HasSubstr(at + "[0] = logs/../../x.csv: must not leave the design file's folder"));
+  const auto other = [&](const std::string& from_key, const std::string& to) {
+    std::string t = text;
+    t.replace(t.find(from_key), from_key.size(), to);
+    try {
+      (void)load_design_from_string(t, "d.yaml");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  EXPECT_THAT(other("calibration: bench/calibration.csv", "calibration: ../m.csv"), HasSubstr("bench.calibration = ../m.csv: must not leave"));
+  EXPECT_THAT(other("identification: bench/identification.csv", "identification: /dev/zero"),
+              HasSubstr("bench.identification = /dev/zero: must be a path relative"));
   // One name without a list, written back as a list.
   const Design one = load_design_from_string(with("replay_logs: x/log.csv"), "d.yaml");
   ASSERT_NE(one.get<BenchSettings>(), nullptr);

@@ -188,6 +188,13 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
     for (const auto& pre : find(name)->prerequisites) stack.push_back(pre);
   }
 
+  // Every input file of what will be built is checked before the output folder exists.
+  for (const auto& name : known) {
+    const Product* p = find(name);
+    if (needed.count(name) == 0 || !p->check_inputs) continue;
+    if (p->unavailable && p->unavailable(design)) continue;
+    p->check_inputs(design);
+  }
   report.out_dir = resolve_output_dir(options.out_root, design.name);
   make_directories(report.out_dir);
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target of a FIVEBAR_FUZZ build for a bounded time (README "Hardening").
 #
-#   test/fuzz/run_fuzzers.sh BUILD_DIR [TARGET...]      (default targets: design_loader cli)
+#   test/fuzz/run_fuzzers.sh BUILD_DIR [TARGET...]      (default targets: design_loader cli bench_csv)
 #
 #   FIVEBAR_FUZZ_SECONDS   time per target, default 60
 #   FIVEBAR_FUZZ_FLAGS     extra libFuzzer flags (e.g. "-jobs=2 -workers=2" or "-seed=1")
@@ -15,7 +15,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="$(cd "${1:?usage: run_fuzzers.sh BUILD_DIR [TARGET...]}" && pwd)"
 shift
 targets=("$@")
-((${#targets[@]} > 0)) || targets=(design_loader cli)
+((${#targets[@]} > 0)) || targets=(design_loader cli bench_csv)
 seconds="${FIVEBAR_FUZZ_SECONDS:-60}"
 read -r -a extra <<<"${FIVEBAR_FUZZ_FLAGS:-}"
 
@@ -35,6 +35,7 @@ for target in "${targets[@]}"; do
   case "$target" in
     design_loader) seeds=("$root/designs" "$root/test/data/malformed") ;;
     cli) seeds=("$build/test/fuzz/seeds/cli") ;;
+    bench_csv) seeds=("$root/test/data/fuzz-seeds/bench_csv") ;;
     *) seeds=() ;;
   esac
   seeds+=("$root/test/data/fuzz-regressions/$target")

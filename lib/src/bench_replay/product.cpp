@@ -11,6 +11,7 @@
 #include <string>
 
 #include "csv.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/replay.hpp"
@@ -43,6 +44,16 @@ Product bench_replay_product() {
       }
     }
     return std::nullopt;
+  };
+  p.check_inputs = [](const Design& d) {
+    // The header of each log, through the bench's one reader (the rows need the export's configuration).
+    const BenchSettings& bench = *d.get<BenchSettings>();
+    for (std::size_t k = 0; k < bench.replay_logs.size(); ++k) {
+      const std::filesystem::path file = BenchSettings::resolve(d, bench.replay_logs[k]);
+      std::ifstream in(file, std::ios::binary);
+      if (!in) throw InputError(file.generic_string() + ": cannot be read (" + key_of(k) + ")");
+      (void)csv::Reader(in, file.generic_string());
+    }
   };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;

@@ -249,7 +249,9 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     if (opt.fit_given) out.requested_unidentifiable = true;
   }
 
-  // Figures at the design values.
+  // Figures at the design values. residual_of[i]: row i's entry of out.residuals, so that the
+  // figures after the fit are linear in rows (one lookup per row, not a scan of every residual).
+  std::vector<std::size_t> residual_of(all.size(), 0);
   const auto figures = [&](bool holdout, bool after) {
     Figures f;
     int n = 0;
@@ -262,11 +264,11 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
         f.rms_mm += e * e;
         f.max_mm = std::max(f.max_mm, e);
         ++n;
-        if (!after) out.residuals.push_back({all[i].line, blk.name, holdout, e, 0.0});
-        else {
-          for (PoseResidual& pr : out.residuals) {
-            if (pr.line == all[i].line) pr.after_mm = e;
-          }
+        if (!after) {
+          residual_of[i] = out.residuals.size();
+          out.residuals.push_back({all[i].line, blk.name, holdout, e, 0.0});
+        } else {
+          out.residuals[residual_of[i]].after_mm = e;
         }
       }
     }

@@ -1,13 +1,15 @@
 // Potentiometer offsets from readings at the hard stops (fivebar/calibrate/hard_stops.hpp).
 #include "fivebar/calibrate/hard_stops.hpp"
 
-#include <charconv>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
 #include <tuple>
 #include <vector>
 
+#include "fivebar/calibrate/measurements.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/export/joint_limits.hpp"
@@ -15,49 +17,32 @@
 
 namespace fivebar::calibrate {
 
-namespace {
-std::string trim(std::string s) {
-  while (!s.empty() && (s.back() == '\r' || s.back() == ' ')) s.pop_back();
-  while (!s.empty() && s.front() == ' ') s.erase(s.begin());
-  return s;
-}
-}  // namespace
-
 CalibrationResult hard_stop_calibration(const Design& design, const std::string& text, const std::string& origin) {
   std::istringstream in(text);
-  std::string line;
-  int number = 0;
-  const auto fail = [&](const std::string& what) { throw InputError(origin + ":" + std::to_string(number) + ": " + what); };
-  // (station, mechanism, joint, stop) -> readings
+  // The bench's one reader (fivebar/csv_reader.hpp, docs/bench-files.md).
+  csv::Reader reader(in, origin, kMeasurementLimits);
+  if (reader.header() != std::vector<std::string>{"station", "mechanism", "joint", "stop", "volts"}) {
+    throw InputError(reader.where() + "the header must be station,mechanism,joint,stop,volts");
+  }
+  const ControllerSettings* adc = design.get<ControllerSettings>();
+  // (station, mechanism, joint, stop) -> readings, and the line of the first one (for messages)
   std::map<std::tuple<std::string, std::string, int, std::string>, std::vector<double>> readings;
-  std::vector<std::string> header;
-  while (std::getline(in, line)) {
-    ++number;
-    line = trim(line);
-    if (line.empty() || line.front() == '#') continue;
-    std::vector<std::string> cells;
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) cells.push_back(trim(c));
-    if (header.empty()) {
-      if (cells != std::vector<std::string>{"station", "mechanism", "joint", "stop", "volts"}) {
-        fail("the header must be station,mechanism,joint,stop,volts");
-      }
-      header = cells;
-      continue;
-    }
-    if (cells.size() != 5) fail(std::to_string(cells.size()) + " cells, the header has 5");
+  std::map<std::tuple<std::string, std::string, int>, std::size_t> first_line;
+  while (reader.next()) {
+    const std::vector<std::string>& cells = reader.cells();
     const Station* s = design.station(cells[0]);
-    if (s == nullptr) fail("column 'station' = '" + cells[0] + "': the design has no such station");
-    if (s->mechanism(cells[1]) == nullptr) fail("column 'mechanism' = '" + cells[1] + "': no such mechanism in station " + cells[0]);
-    if (cells[2] != "1" && cells[2] != "2") fail("column 'joint' = '" + cells[2] + "': must be 1 or 2");
-    if (cells[3] != "lo" && cells[3] != "hi") fail("column 'stop' = '" + cells[3] + "': must be lo or hi");
-    double v = 0.0;
-    const auto r = std::from_chars(cells[4].data(), cells[4].data() + cells[4].size(), v);
-    if (cells[4].empty() || r.ec != std::errc{} || r.ptr != cells[4].data() + cells[4].size() || !std::isfinite(v)) {
-      fail("column 'volts' = '" + cells[4] + "': must be a finite number (V)");
+    if (s == nullptr) throw InputError(reader.at(0) + "the design has no such station");
+    if (s->mechanism(cells[1]) == nullptr) throw InputError(reader.at(1) + "no such mechanism in station " + csv::shown(cells[0]));
+    if (cells[2] != "1" && cells[2] != "2") throw InputError(reader.at(2) + "must be 1 or 2");
+    if (cells[3] != "lo" && cells[3] != "hi") throw InputError(reader.at(3) + "must be lo or hi");
+    const double v = reader.number(4, csv::kMaxBenchValue, "V");
+    // A reading outside the converter's input range is a fault, as in the runtime.
+    if (adc != nullptr && (v < adc->adc_range_v[0] || v > adc->adc_range_v[1])) {
+      throw InputError(reader.at(4) + "outside controller.adc.range_v [" + format::shortest(adc->adc_range_v[0]) + ", " +
+                       format::shortest(adc->adc_range_v[1]) + "] V: not a reading of the converter");
     }
     readings[{cells[0], cells[1], cells[2][0] - '0', cells[3]}].push_back(v);
+    first_line.emplace(std::tuple{cells[0], cells[1], cells[2][0] - '0'}, reader.line());
   }
   if (readings.empty()) throw InputError(origin + ": no readings (header station,mechanism,joint,stop,volts)");
   CalibrationResult out;
@@ -68,7 +53,8 @@ CalibrationResult hard_stop_calibration(const Design& design, const std::string&
     if (done.count({station, mechanism, joint}) != 0) continue;
     done[{station, mechanism, joint}] = true;
     if (out.station.empty()) out.station = station;
-    if (station != out.station) throw InputError(origin + ": readings of stations " + out.station + " and " + station + ": one station per file");
+    const std::string at = origin + ":" + std::to_string(first_line.at({station, mechanism, joint})) + ": ";
+    if (station != out.station) throw InputError(at + "readings of stations " + out.station + " and " + station + ": one station per file");
     const Station& st = *design.station(station);
     const Mechanism& m = *st.mechanism(mechanism);
     const UsableRange range = usable_ranges(design, st, m)[static_cast<std::size_t>(joint - 1)];
@@ -84,7 +70,7 @@ CalibrationResult hard_stop_calibration(const Design& design, const std::string&
       if (it == readings.end()) continue;
       const std::string& by = e == 0 ? range.lo_by : range.hi_by;
       if (by.rfind("hard stop", 0) != 0) {
-        throw InputError(origin + ": the " + which + " end of " + range.joint + " is set by " + (by.empty() ? std::string("nothing") : by) +
+        throw InputError(at + "the " + which + " end of " + range.joint + " is set by " + (by.empty() ? std::string("nothing") : by) +
                          ", not a hard stop: its angle is not known from the geometry");
       }
       Stop& s = stops[static_cast<std::size_t>(e)];
@@ -111,7 +97,7 @@ CalibrationResult hard_stop_calibration(const Design& design, const std::string&
     v0.requested = k.requested = true;
     if (stops[0].have && stops[1].have) {
       const double dv = stops[1].mean - stops[0].mean;
-      if (std::abs(dv) < 1e-9) throw InputError(origin + ": the lo and hi readings of " + range.joint + " are equal: no sensitivity");
+      if (std::abs(dv) < 1e-9) throw InputError(at + "the lo and hi readings of " + range.joint + " are equal: no sensitivity");
       k.value = (stops[1].theta - stops[0].theta) / dv;
       k.sigma = std::abs(k.value / dv) * std::hypot(stops[0].sigma, stops[1].sigma);
       k.identified = true;

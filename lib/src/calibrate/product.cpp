@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fivebar/calibrate.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/provenance.hpp"
@@ -21,11 +22,7 @@ namespace fivebar::products {
 namespace {
 
 std::string read_bench_file(const std::filesystem::path& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.generic_string() + ": cannot read the " + what + " (bench: section)");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, std::string(what) + " (bench: section)");
 }
 
 }  // namespace
@@ -42,6 +39,10 @@ Product calibrate_product() {
       return "the bench measurements `" + b->calibration + "` (`bench.calibration`) are not there: " + file.generic_string();
     }
     return without_mechanisms(d);
+  };
+  p.check_inputs = [](const Design& d) {
+    const std::string& name = d.get<BenchSettings>()->calibration;
+    (void)calibrate::parse_measurements(read_bench_file(BenchSettings::resolve(d, name), "calibration measurements"), name, d);
   };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;

@@ -40,8 +40,9 @@ Json to_json(const CalibrationResult& r) {
           {"parameters", params},
           {"identifiability",
            {{"singular_values", r.singular_values},
-            {"condition_number", finite_or_null(r.condition_number)},
-            {"observability_index", r.observability_index},
+            // Without poses (hard-stop readings) neither exists: null, not 0 (docs/conventions.md).
+            {"condition_number", r.poses > 0 ? finite_or_null(r.condition_number) : Json(nullptr)},
+            {"observability_index", r.poses > 0 ? finite_or_null(r.observability_index) : Json(nullptr)},
             {"unidentifiable", unid},
             {"requested_unidentifiable", r.requested_unidentifiable}}},
           {"sigma_mm", r.sigma_mm},

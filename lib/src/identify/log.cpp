@@ -10,6 +10,7 @@
 #include <optional>
 #include <system_error>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 
@@ -39,25 +40,19 @@ constexpr ColumnKind kColumns[] = {
 
 std::string where(const std::string& path, std::size_t line) { return path + ":" + std::to_string(line) + ": "; }
 
-std::string trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return std::string(s);
-}
-
-std::vector<std::string> split(const std::string& line) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = line.find(',', start);
-    out.push_back(trim(std::string_view(line).substr(start, comma == std::string::npos ? std::string::npos : comma - start)));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
-
 /// Joint part of a column name: "" or "<station>_<mechanism>_theta<1|2>_"; false when malformed.
+/// `x_ref_mm`, `y_ref_mm`, or either after "<station>_<mechanism>_": the targets of the device log.
+bool is_reference_column(const std::string& name) {
+  for (const std::string suffix : {"x_ref_mm", "y_ref_mm"}) {
+    if (name == suffix) return true;
+    if (name.size() > suffix.size() + 1 && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        name[name.size() - suffix.size() - 1] == '_') {
+      return true;
+    }
+  }
+  return false;
+}
+
 bool parse_prefix(const std::string& prefix, JointLog& j) {
   if (prefix.empty()) return true;
   const std::size_t theta = prefix.rfind("_theta");
@@ -86,27 +81,9 @@ double IdentifyLog::sample_time() const {
 IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
   IdentifyLog log;
   log.path = path;
-  std::string line;
-  std::size_t line_no = 0;
-  auto next_line = [&]() -> bool {
-    if (!std::getline(in, line)) return false;
-    ++line_no;
-    if (line.size() > kMaxLogLine) {
-      throw InputError(where(path, line_no) + "line longer than " + std::to_string(kMaxLogLine) + " characters");
-    }
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    return true;
-  };
-  // Header (comment lines starting with '#' are skipped anywhere).
-  bool have_header = false;
-  while (next_line()) {
-    if (trim(line).empty() || trim(line).front() == '#') continue;
-    have_header = true;
-    break;
-  }
-  if (!have_header) throw InputError(path + ": empty log (expected a header line: time_s, drive and reading columns)");
-  const std::vector<std::string> header = split(line);
-  const std::size_t header_line = line_no;
+  csv::Reader reader(in, path, csv::Limits{kMaxLogLine, kMaxLogBytes, kMaxLogRows});
+  const std::vector<std::string>& header = reader.header();
+  const std::size_t header_line = reader.header_line();
   int time_col = -1;
   std::map<std::string, std::size_t> joint_index;  // prefix -> joints[]
   struct Binding {
@@ -114,17 +91,14 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     const ColumnKind* kind;
   };
   std::vector<std::optional<Binding>> bind(header.size());
-  std::map<std::string, std::size_t> seen;
   for (std::size_t c = 0; c < header.size(); ++c) {
     const std::string& name = header[c];
-    const std::string at = where(path, header_line) + "column " + std::to_string(c + 1) + " '" + name + "': ";
-    if (name.empty()) throw InputError(at + "empty column name");
-    if (seen.count(name)) throw InputError(at + "duplicate of column " + std::to_string(seen[name] + 1));
-    seen[name] = c;
+    const std::string at = where(path, header_line) + "column " + std::to_string(c + 1) + " '" + csv::shown(name) + "': ";
     if (name == "time_s") {
       time_col = static_cast<int>(c);
       continue;
     }
+    if (is_reference_column(name)) continue;  // the device log's targets (docs/bench-files.md): read, not used
     const ColumnKind* kind = nullptr;
     std::string prefix;
     for (const ColumnKind& k : kColumns) {
@@ -140,7 +114,8 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     if (kind == nullptr || !parse_prefix(prefix, probe)) {
       throw InputError(at +
                        "unknown column (expected time_s and, per joint, [<station>_<mechanism>_theta<1|2>_] followed by "
-                       "duty, voltage_V, current_A, torque_Nm or force_N, and volts, counts, theta_rad or position_m)");
+                       "duty, voltage_V, current_A, torque_Nm or force_N, and volts, counts, theta_rad or position_m; "
+                       "[<station>_<mechanism>_]x_ref_mm and y_ref_mm are the device log's targets)");
     }
     auto [it, added] = joint_index.emplace(prefix, log.joints.size());
     if (added) {
@@ -202,31 +177,11 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     jl.reading_column = header[static_cast<std::size_t>(r.reading)];
   }
   // Rows.
-  std::size_t rows = 0;
   std::vector<std::size_t> row_lines;
-  while (next_line()) {
-    const std::string t = trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    if (++rows > kMaxLogRows) throw InputError(where(path, line_no) + "more than " + std::to_string(kMaxLogRows) + " rows");
-    const std::vector<std::string> cells = split(line);
-    if (cells.size() != header.size()) {
-      throw InputError(where(path, line_no) + std::to_string(cells.size()) + " cells, the header has " + std::to_string(header.size()));
-    }
-    std::vector<double> v(cells.size());
-    for (std::size_t c = 0; c < cells.size(); ++c) {
-      const std::string& s = cells[c];
-      const char* b = s.data();
-      const char* e = s.data() + s.size();
-      if (!s.empty() && *b == '+') ++b;
-      const auto [p, ec] = std::from_chars(b, e, v[c]);
-      if (s.empty() || ec != std::errc() || p != e || !std::isfinite(v[c])) {
-        throw InputError(where(path, line_no) + "column '" + header[c] + "': '" + s + "' is not a finite number");
-      }
-      if (std::abs(v[c]) > kMaxLogValue) {
-        throw InputError(where(path, line_no) + "column '" + header[c] + "': " + s + " is outside +-" +
-                         format::shortest(kMaxLogValue) + " (no bench quantity is that large in SI units)");
-      }
-    }
+  std::vector<double> v(header.size());
+  while (reader.next()) {
+    const std::size_t line_no = reader.line();
+    for (std::size_t c = 0; c < header.size(); ++c) v[c] = reader.number(c, kMaxLogValue, "no bench quantity is that large in SI units");
     const double time = v[static_cast<std::size_t>(time_col)];
     if (!log.time.empty() && !(time > log.time.back())) {
       throw InputError(where(path, line_no) + "column 'time_s': " + format::shortest(time) + " does not increase (previous row " +
@@ -240,7 +195,6 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
       if (roles[j].current >= 0) log.joints[j].current.push_back(v[static_cast<std::size_t>(roles[j].current)]);
     }
   }
-  if (in.bad()) throw InputError(path + ": read error");
   if (log.time.size() < 16) {
     throw InputError(path + ": " + std::to_string(log.time.size()) + " data rows; an identification log needs at least 16");
   }
@@ -257,10 +211,8 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
 }
 
 IdentifyLog read_identify_log(const std::filesystem::path& path) {
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (ec) throw InputError(path.string() + ": cannot read the log (" + ec.message() + ")");
-  if (size > kMaxLogBytes) throw InputError(path.string() + ": log larger than " + std::to_string(kMaxLogBytes >> 20) + " MiB");
+  // Bounded while reading (kMaxLogBytes, kMaxLogLine), so a device or a pipe is refused as early
+  // as a large regular file.
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot open the log");
   return read_identify_log(in, path.string());

@@ -6,9 +6,12 @@
 #include <filesystem>
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <sstream>
 #include <string>
 
+#include "fivebar/csv_reader.hpp"
+#include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/provenance.hpp"
@@ -31,6 +34,13 @@ Product identify_product() {
       return "the identification log `" + b->identification + "` (`bench.identification`) is not there: " + file.generic_string();
     }
     return std::nullopt;
+  };
+  p.check_inputs = [](const Design& d) {
+    // Readable, with a header, before the output folder exists (the rows are read by build).
+    const std::filesystem::path file = BenchSettings::resolve(d, d.get<BenchSettings>()->identification);
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw InputError(file.generic_string() + ": cannot be read (bench.identification)");
+    (void)csv::Reader(in, file.generic_string());
   };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;

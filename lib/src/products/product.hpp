@@ -67,6 +67,10 @@ struct Product {
   /// installed), or std::nullopt when it can.
   std::function<std::optional<std::string>(const Design&)> unavailable;
   std::function<Built(Context&)> build;
+  /// Reads and checks the product's own input files (a bench file: InputError naming FILE:LINE:
+  /// column), called by the scene for every product it will build before the output folder is
+  /// created, so that a bad input leaves nothing written (docs/reliability.md). May be empty.
+  std::function<void(const Design&)> check_inputs;
   /// One of the exact checks a study's proposed design is re-run through (check_design(): a
   /// design's coverage, collision, patterns), whenever the design has the data for it.
   bool checks_designs = false;

@@ -8,31 +8,13 @@
 #include <map>
 #include <ostream>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 
 namespace fivebar {
 
 namespace {
-
-std::vector<std::string> split_csv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  for (char c : line) {
-    if (c == ',') {
-      out.push_back(cell);
-      cell.clear();
-    } else if (c != '\r') {
-      cell.push_back(c);
-    }
-  }
-  out.push_back(cell);
-  for (std::string& s : out) {
-    const auto a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
-    s = a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
-  }
-  return out;
-}
 
 const char* kind_suffix(runtime::Reading k) {
   return k == runtime::Reading::counts ? "_counts" : k == runtime::Reading::volts ? "_volts" : "_theta_rad";
@@ -55,32 +37,14 @@ Columns columns_of(const runtime::Config& c) {
 }  // namespace
 
 ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const std::string& origin) {
-  std::string line;
-  std::size_t line_no = 0;
-  // Comment lines (starting with '#') and blank lines are skipped anywhere, as in the other bench
-  // files (docs/conventions.md).
-  const auto skipped = [](const std::string& l) {
-    const auto first = l.find_first_not_of(" \t\r");
-    return first == std::string::npos || l[first] == '#';
-  };
-  bool has_header = false;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (!skipped(line)) {
-      has_header = true;
-      break;
-    }
-  }
-  if (!has_header) throw InputError(origin + ":" + std::to_string(line_no + 1) + ": empty log (a header row is needed)");
-  const std::string header_at = origin + ":" + std::to_string(line_no) + ": ";
-  const std::vector<std::string> header = split_csv(line);
+  // The bench's one reader (fivebar/csv_reader.hpp, docs/bench-files.md): bounded, comment and
+  // blank lines skipped, a duplicated column refused.
+  csv::Reader reader(in, origin);
+  const std::string header_at = reader.where();
+  const std::vector<std::string>& header = reader.header();
   std::map<std::string, std::size_t> at;
   for (std::size_t i = 0; i < header.size(); ++i) at[header[i]] = i;
-  const auto column = [&](const std::string& name) {
-    const auto it = at.find(name);
-    if (it == at.end()) throw InputError(header_at + "column " + name + " is missing");
-    return it->second;
-  };
+  const auto column = [&](const std::string& name) { return reader.require(name); };
   ReplayLog log;
   runtime::Config present = config;
   present.stations.clear();
@@ -117,28 +81,8 @@ ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const
     target_col.push_back(column(m + "_x_ref_mm"));
     target_col.push_back(column(m + "_y_ref_mm"));
   }
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (skipped(line)) continue;
-    const std::vector<std::string> cells = split_csv(line);
-    if (cells.size() != header.size()) {
-      throw InputError(origin + ":" + std::to_string(line_no) + ": " + std::to_string(cells.size()) + " cells, the header has " +
-                       std::to_string(header.size()));
-    }
-    const auto number = [&](std::size_t c) {
-      const std::string& s = cells[c];
-      std::size_t used = 0;
-      double v = 0.0;
-      try {
-        v = std::stod(s, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (s.empty() || used != s.size() || !std::isfinite(v)) {
-        throw InputError(origin + ":" + std::to_string(line_no) + ": column " + header[c] + ": '" + s + "' is not a finite number");
-      }
-      return v;
-    };
+  while (reader.next()) {
+    const auto number = [&](std::size_t c) { return reader.number(c, csv::kMaxBenchValue); };
     log.time_s.push_back(number(t_col));
     std::vector<double> r, t, d;
     for (std::size_t c : reading_col) r.push_back(number(c));

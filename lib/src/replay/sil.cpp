@@ -3,6 +3,7 @@
 
 #include "fivebar/replay/sil.hpp"
 
+#include <algorithm>
 #include <fstream>
 
 #include "fivebar/error.hpp"
@@ -29,9 +30,27 @@ std::vector<const Station*> pair_stations(const Design& design, const std::vecto
 
 }  // namespace
 
+void check_sil_config(const Design& design, const SilRequest& request, const std::string& origin) {
+  if (!request.config) return;
+  for (const Station* s : pair_stations(design, request.stations)) {
+    const runtime::Config& c = *request.config;
+    const auto st = std::find_if(c.stations.begin(), c.stations.end(), [&](const auto& x) { return x.name == s->name; });
+    if (st == c.stations.end()) {
+      throw InputError(origin + ": the configuration (design '" + c.design + "') has no station '" + s->name +
+                       "': export it from this design (fivebar export --format json)");
+    }
+    for (const char* m : {"lower", "upper"}) {
+      if (std::none_of(st->mechanisms.begin(), st->mechanisms.end(), [&](const auto& x) { return x.name == m; })) {
+        throw InputError(origin + ": station '" + s->name + "' of the configuration has no " + m + " mechanism");
+      }
+    }
+  }
+}
+
 std::vector<SilRun> run_sil(const Design& design, const SilRequest& request) {
   if (!request.open_log) throw std::invalid_argument("run_sil: open_log is required");
   if (request.replay && !request.config) throw std::invalid_argument("run_sil: replay needs the configuration");
+  check_sil_config(design, request, "the configuration");  // before the first log is opened
   std::vector<SilRun> runs;
   for (const Station* s : pair_stations(design, request.stations)) {
     SimulationRequest sim;

@@ -45,4 +45,14 @@ ResourceEstimate dense_output_estimate(const std::vector<SimulationInput>& runs,
   return e;
 }
 
+ResourceEstimate identify_estimate(std::size_t rows, std::size_t joints) {
+  ResourceEstimate e;
+  const double cells = double(rows) * double(std::max<std::size_t>(joints, 1));
+  e.what = "the identification (" + std::to_string(rows) + " log rows of " + std::to_string(joints) + " joint" +
+           (joints == 1 ? "" : "s") + ")";
+  e.memory_bytes = kIdentifyBytesPerRowJoint * cells;
+  e.seconds = kIdentifySecondsPerRowJoint * cells;
+  return e;
+}
+
 }  // namespace fivebar

@@ -362,9 +362,19 @@ Config parse_config_json(std::string_view text, const std::string& origin) {
 Config load_config_json(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ConfigError(path + ": cannot be read");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return parse_config_json(s.str(), path);
+  // Bounded while reading (docs/reliability.md): an exported configuration is a few kilobytes;
+  // /dev/zero or a wrong file is refused after kMaxBytes + 1 bytes, not read whole.
+  constexpr std::size_t kMaxBytes = std::size_t{16} << 20;
+  std::string text;
+  char chunk[65536];
+  while (in.read(chunk, sizeof chunk) || in.gcount() > 0) {
+    if (text.size() + static_cast<std::size_t>(in.gcount()) > kMaxBytes) {
+      throw ConfigError(path + ": larger than " + std::to_string(kMaxBytes) + " bytes: not a runtime configuration");
+    }
+    text.append(chunk, static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw ConfigError(path + ": read error");
+  return parse_config_json(text, path);
 }
 
 }  // namespace fivebar::runtime

@@ -38,6 +38,19 @@ void BenchSettings::validate() const {
 namespace sections {
 namespace {
 
+/// A bench file stays beside the design (docs/bench-files.md "Where bench files may be"): a
+/// relative path without a `..` component. A design shared by someone else cannot name
+/// /etc/passwd or ~/.ssh/id_rsa for `fivebar run` to read.
+void check_confined(const Value& v, const std::string& name) {
+  const std::filesystem::path p(name);
+  if (p.is_absolute() || (!name.empty() && (name.front() == '/' || name.front() == '~'))) {
+    v.fail_value("must be a path relative to the design file's folder (bench files stay beside the design)");
+  }
+  for (const auto& part : p) {
+    if (part == "..") v.fail_value("must not leave the design file's folder ('..'): bench files stay beside the design");
+  }
+}
+
 void load(const Value& v, Design& design) {
   BenchSettings& b = design.set(BenchSettings{});
   if (v.is_null()) return;
@@ -47,6 +60,8 @@ void load(const Value& v, Design& design) {
   if (const Value* i = find(all, "identification")) b.identification = i->text("must be a file name (CSV)");
   if (const Value* c = find(all, "calibration"); c && b.calibration.empty()) c->fail_value("must be a file name, not empty");
   if (const Value* i = find(all, "identification"); i && b.identification.empty()) i->fail_value("must be a file name, not empty");
+  if (const Value* c = find(all, "calibration")) check_confined(*c, b.calibration);
+  if (const Value* i = find(all, "identification")) check_confined(*i, b.identification);
   if (const Value* r = find(all, "replay_logs")) {
     // One name, or a list of names.
     const std::vector<Value> names = r->is_scalar() ? std::vector<Value>{*r} : r->list("must be a list of file names (CSV)");
@@ -54,13 +69,36 @@ void load(const Value& v, Design& design) {
     for (const Value& n : names) {
       b.replay_logs.push_back(n.text("must be a file name (CSV)"));
       if (b.replay_logs.back().empty()) n.fail_value("must be a file name, not empty");
+      check_confined(n, b.replay_logs.back());
     }
   }
   b.replay_tolerance = number_or(all, "replay_tolerance", b.replay_tolerance, "");
 }
 
+/// A bench file that is there must resolve, links followed, inside the design file's folder.
+void check_links(const Design& design, const char* key, const std::string& name) {
+  if (name.empty() || design.source.empty()) return;
+  std::error_code ec;
+  const std::filesystem::path file = BenchSettings::resolve(design, name);
+  if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) return;  // missing: the product says so
+  const std::filesystem::path parent = design.source.parent_path().empty() ? std::filesystem::path(".") : design.source.parent_path();
+  const std::filesystem::path root = std::filesystem::weakly_canonical(parent, ec);
+  const std::filesystem::path real = std::filesystem::weakly_canonical(file, ec);
+  if (ec) return;
+  const auto rel = real.lexically_relative(root);
+  if (rel.empty() || *rel.begin() == "..") {
+    // The target is not named: a refused file's place or content is not echoed.
+    throw ValidationError(key, "= " + name + ": a symbolic link that leads out of the design file's folder (bench files stay beside the design)");
+  }
+}
+
 /// A log that is there but is a directory is a wrong name, not a missing file.
 void check_replay_logs(const Design& design, const BenchSettings& b) {
+  check_links(design, "calibration", b.calibration);
+  check_links(design, "identification", b.identification);
+  for (std::size_t k = 0; k < b.replay_logs.size(); ++k) {
+    check_links(design, ("replay_logs[" + std::to_string(k) + "]").c_str(), b.replay_logs[k]);
+  }
   for (std::size_t k = 0; k < b.replay_logs.size(); ++k) {
     std::error_code ec;
     const std::filesystem::path file = BenchSettings::resolve(design, b.replay_logs[k]);

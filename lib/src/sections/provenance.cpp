@@ -1,13 +1,59 @@
 // The `provenance:` section (fivebar/sections/provenance.hpp): key path -> where the value came from.
 #include "fivebar/sections/provenance.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
 
 #include "fivebar/design.hpp"
 #include "sections/rules.hpp"
 #include "sections/section.hpp"
 
 namespace fivebar {
+
+namespace {
+
+/// YYYY-MM-DD (digits already checked) names a day of the Gregorian calendar.
+bool calendar_date(const std::string& date) {
+  const int y = std::stoi(date.substr(0, 4)), m = std::stoi(date.substr(5, 2)), d = std::stoi(date.substr(8, 2));
+  if (m < 1 || m > 12 || d < 1) return false;
+  static constexpr int kDays[] = {31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31};
+  const bool leap = (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+  return d <= kDays[m - 1] + (m == 2 && leap ? 1 : 0);
+}
+
+/// The correlations of the entries that have any, as one matrix (unit diagonal, 0 where none is
+/// given), must be a correlation matrix: positive semi-definite (ρ01 = ρ02 = 0.99 with ρ12 = -0.99
+/// is no covariance's), within rounding.
+void check_correlations_psd(const std::map<std::string, ProvenanceEntry, std::less<>>& entries) {
+  std::vector<std::string> keys;
+  for (const auto& item : entries)
+    if (!item.second.correlation.empty()) keys.push_back(item.first);
+  for (const auto& item : entries)
+    for (const auto& c : item.second.correlation)
+      if (std::find(keys.begin(), keys.end(), c.first) == keys.end()) keys.push_back(c.first);
+  if (keys.size() < 3) return;  // each |rho| <= 1 already makes a 2 x 2 matrix valid
+  const auto n = static_cast<Eigen::Index>(keys.size());
+  Eigen::MatrixXd R = Eigen::MatrixXd::Identity(n, n);
+  for (Eigen::Index a = 0; a < n; ++a) {
+    for (const auto& c : entries.at(keys[static_cast<std::size_t>(a)]).correlation) {
+      const auto b = static_cast<Eigen::Index>(std::find(keys.begin(), keys.end(), c.first) - keys.begin());
+      R(a, b) = R(b, a) = c.second;
+    }
+  }
+  const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(R, Eigen::EigenvaluesOnly).eigenvalues().minCoeff();
+  if (smallest < -1e-9) {
+    throw ValidationError(keys.front() + ".correlation", "the correlations of " + std::to_string(keys.size()) +
+                                                             " keys are no covariance's (the matrix has the eigenvalue " +
+                                                             rules::plain_number(smallest) + " < 0: not positive semi-definite)");
+  }
+}
+
+}  // namespace
 
 void ProvenanceEntry::validate() const {
   if (source.empty()) throw ValidationError("source", "must not be empty");
@@ -18,6 +64,7 @@ void ProvenanceEntry::validate() const {
   bool date_ok = date.size() == 10 && date[4] == '-' && date[7] == '-';
   for (std::size_t i = 0; i < date.size() && date_ok; ++i) date_ok = i == 4 || i == 7 || (date[i] >= '0' && date[i] <= '9');
   if (!date_ok) throw ValidationError("date", "= " + date + ": must be YYYY-MM-DD");
+  if (!calendar_date(date)) throw ValidationError("date", "= " + date + ": not a date of the calendar (month 01-12, day within the month)");
   if (sigma && !(*sigma >= 0.0 && std::isfinite(*sigma))) {
     throw ValidationError("sigma", "= " + rules::plain_number(*sigma) + ": must be >= 0");
   }
@@ -46,6 +93,7 @@ void ProvenanceSettings::validate() const {
       }
     }
   }
+  check_correlations_psd(entries);
 }
 
 namespace sections {

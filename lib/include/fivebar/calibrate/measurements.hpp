@@ -6,15 +6,23 @@
 /// `counts1,counts2` instead of the volts (converted through `controller.adc`: V = low + counts
 /// (high - low) / 2^bits, the one ADC model of fivebar/export/export.hpp). Any column order; an unknown,
 /// repeated or missing column, a cell that is not a finite number, a station or mechanism the
-/// design lacks: InputError naming the file, the line and the column.
+/// design lacks, a value out of range (docs/bench-files.md), a row that copies an earlier one:
+/// InputError naming the file, the line and the column.
 
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/design.hpp"
 
 namespace fivebar::calibrate {
+
+/// Bounds of a measurement or hard-stop file (docs/bench-files.md): lines of 4096 bytes, 64 MiB,
+/// 1,000,000 rows (a bench session is hundreds of poses; the fit is linear in rows).
+inline constexpr csv::Limits kMeasurementLimits{4096, 64ull << 20, 1'000'000};
+/// |x_mm|, |y_mm| at most this many times the mechanism's largest length (Mechanism::length_scale).
+inline constexpr double kMaxPointScale = 1000.0;
 
 /// One measured pose.
 struct Measurement {

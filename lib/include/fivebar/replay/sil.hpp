@@ -52,6 +52,11 @@ struct SilRun {
   bool ok() const { return simulated() && result.ok() && (!replay || replay->passed()); }
 };
 
+/// InputError naming `origin` when request.config lacks a requested station or one of its two
+/// mechanisms (checked by run_sil() before it writes anything; a caller that creates an output
+/// folder calls it first).
+void check_sil_config(const Design& design, const SilRequest& request, const std::string& origin);
+
 /// Runs the request (the links' closed-form masses: no parts render). Throws InputError for a
 /// station that is not the design's or lacks a mechanism, or a design without `geometry:`,
 /// `motor:` or `controller:`; an unusable reference is a SilRun with `unusable`, not an error.
