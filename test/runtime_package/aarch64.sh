@@ -14,8 +14,7 @@ done
 FIVEBAR_RUNTIME_EMULATOR="qemu-aarch64 -L /usr/aarch64-linux-gnu" \
   sh "$src/test/runtime_package/check.sh" "$src" "$scratch" "$json" \
   -DCMAKE_SYSTEM_NAME=Linux -DCMAKE_SYSTEM_PROCESSOR=aarch64 \
-  -DCMAKE_C_COMPILER=aarch64-linux-gnu-gcc -DCMAKE_CXX_COMPILER=aarch64-linux-gnu-g++ \
-  -DCMAKE_FIND_ROOT_PATH_MODE_PACKAGE=BOTH
+  -DCMAKE_C_COMPILER=aarch64-linux-gnu-gcc -DCMAKE_CXX_COMPILER=aarch64-linux-gnu-g++
 file "$scratch/consumer/consumer" 2>/dev/null | grep -q aarch64 || file "$scratch/consumer/consumer" | grep -qi "arm"
 "$native" "$json" "$scratch/x86_64.txt" >/dev/null
 qemu-aarch64 -L /usr/aarch64-linux-gnu "$scratch/consumer/consumer" "$json" "$scratch/aarch64.txt" >/dev/null

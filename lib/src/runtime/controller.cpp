@@ -4,6 +4,7 @@
 #include "fivebar/runtime/controller.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -24,6 +25,16 @@ using detail::V2;
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 2.0 * kPi;
+
+// The priority rule's second stage (docs/runtime.md "Priority rule"), when the rays' march finds no
+// free point: rings from kPriorityRingFirstRel length scales about the target, each
+// kPriorityRingGrowth times the last (at most kPriorityRings), up to kPrioritySearchRadiusRel length
+// scales, kPriorityRays points each. Within that radius the rule does not stop the lower mechanism
+// while a free point exists (test_runtime checks it against a dense brute-force search).
+constexpr double kPrioritySearchRadiusRel = 1.0;
+constexpr double kPriorityRingFirstRel = 0.005;
+constexpr double kPriorityRingGrowth = 1.2;
+constexpr int kPriorityRings = 32;
 }  // namespace
 
 // --- Config -------------------------------------------------------------------------------------
@@ -142,6 +153,12 @@ double on_branch(const JointConfig& j, double theta) {
   return t;
 }
 
+/// The centre of the one turn a joint's reading may lie in: its range's centre with limits, else
+/// the calibration's zero.
+double turn_centre(const JointConfig& j) {
+  return j.has_position_limits ? 0.5 * (j.min_position + j.max_position) : 0.0;
+}
+
 /// IK of `point` for mechanism `mp` into `c`; the status of the attempt.
 Status make_command(const Plan& plan, const MechPlan& mp, V2 point, Command& c) {
   c.valid = false;
@@ -193,6 +210,63 @@ Probe probe(Plan& plan, const MechPlan& low, const Part* upper, V2 q) {
   const double k = std::max(1.0, 1.0 / std::min(s1, s2));
   r.advance = (need - clearance) / k;
   return r;
+}
+
+/// Whether q lies inside one of the first `nf` forbidden capsules of the tactor point (closed form:
+/// blocked without a probe).
+bool forbidden(const Plan& plan, std::size_t nf, V2 q) {
+  for (std::size_t k = 0; k < nf; ++k) {
+    const detail::Capsule& c = plan.forbid[k];
+    const V2 d = c.b - c.a;
+    const double dd = dot(d, d);
+    const double t = dd > 0.0 ? std::clamp(dot(q - c.a, d) / dd, 0.0, 1.0) : 0.0;
+    const V2 w = q - (c.a + t * d);
+    if (dot(w, w) < c.r * c.r) return true;
+  }
+  return false;
+}
+
+/// The rule's second stage, when the rays' march found no free point (links block every exit
+/// within its steps) or a far one: rings about `origin` at radii r_k = kPriorityRingFirstRel * scale *
+/// kPriorityRingGrowth^(k-1) up to `radius` (the search radius, or the rays' point), kPriorityRays fixed
+/// directions each (a point inside a forbidden capsule of the tactor is blocked without a probe); on
+/// the first ring with a free point every free ray is bisected kPriorityBisections times against the
+/// ring before, and the closest result wins. A ring point that cannot be held is not free, and its
+/// ray goes on (points beyond it can be). At most kPriorityRings * kPriorityRays probes plus the
+/// bisections.
+bool ring_search(Plan& plan, const MechPlan& low, const Part* upper, V2 origin, std::size_t nf, double radius, V2& found) {
+  const double scale = low.mech.scale;
+  std::array<bool, kPriorityRays> hit{};
+  double r_prev = 0.0, r = kPriorityRingFirstRel * scale;
+  for (int k = 0; k < kPriorityRings && r_prev < radius; ++k) {
+    r = std::min(r, radius);
+    bool any = false;
+    for (std::size_t j = 0; j < kPriorityRays; ++j) {
+      const V2 q = origin + r * plan.rays[j];
+      hit[j] = !forbidden(plan, nf, q) && probe(plan, low, upper, q).free;
+      any = any || hit[j];
+    }
+    if (any) {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t best_j = 0;
+      for (std::size_t j = 0; j < kPriorityRays; ++j) {
+        if (!hit[j]) continue;
+        double lo = r_prev, hi = r;
+        for (int b = 0; b < kPriorityBisections; ++b) {
+          const double mid = 0.5 * (lo + hi);
+          const V2 q = origin + mid * plan.rays[j];
+          if (!forbidden(plan, nf, q) && probe(plan, low, upper, q).free) hi = mid;
+          else lo = mid;
+        }
+        if (hi < best) best = hi, best_j = j;
+      }
+      found = origin + best * plan.rays[best_j];
+      return true;
+    }
+    r_prev = r;
+    r *= kPriorityRingGrowth;
+  }
+  return false;
 }
 
 /// The priority rule (controller.hpp, docs/runtime.md "Priority rule"): the closest point q to
@@ -322,8 +396,16 @@ bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin,
     best_dir = j;
     plan.steps[j] = kPriorityAdvances + 1;  // done
   }
-  if (!(best < std::numeric_limits<double>::infinity())) return false;
+  const double radius = kPrioritySearchRadiusRel * low.mech.scale;
+  if (!(best < inf)) return ring_search(plan, low, upper, origin, nf, radius, found);
   found = origin + best * plan.dirs[best_dir];
+  // A far point of the rays (links blocked the nearer exits) can be much farther than the closest
+  // free point between them: the rings up to it look for a closer one.
+  V2 ring;
+  if (best > kPriorityRingFirstRel * low.mech.scale &&
+      ring_search(plan, low, upper, origin, nf, std::min(best, radius), ring) && norm(ring - origin) < best) {
+    found = ring;
+  }
   return true;
 }
 
@@ -441,20 +523,27 @@ void Controller::cycle(const double* readings, Reading kind, const double* targe
       const double r = readings[2 * k + j];
       const JointConfig& jc = mp.config->joints[j];
       double volts = 0.0;
+      const double centre = turn_centre(jc);
       if (!std::isfinite(r)) {
         fault = true;
       } else if (kind == Reading::radians) {
-        st.theta_measured[j] = r;
+        // An angle (an encoder's, any representation) more than a turn from the joint's range.
+        fault = !(std::fabs(r - centre) <= kTwoPi);
+        st.theta_measured[j] = fault ? 0.0 : r;
         continue;
       } else if (kind == Reading::counts) {
-        fault = !(r > 0.0 && r < p.top_code);  // outside the ADC or at a rail
+        fault = !(r > 0.5 && r < p.top_code - 0.5);  // outside the ADC or within half a code of a rail
         volts = c.adc_range_v[0] + r * c.volts_per_count;
       } else {
         const double half = 0.5 * c.volts_per_count;
         fault = !(r > c.adc_range_v[0] + half && r < c.adc_range_v[0] + (p.top_code - 0.5) * c.volts_per_count);
         volts = r;
       }
-      st.theta_measured[j] = fault ? 0.0 : jc.rad_per_volt * (volts - jc.volts_at_zero);
+      const double theta = jc.rad_per_volt * (volts - jc.volts_at_zero);
+      // A potentiometer turns at most once: an angle more than half a turn from the joint's
+      // range's centre is not one the calibration can read (the converter spans more).
+      fault = fault || !(std::fabs(theta - centre) <= kPi);
+      st.theta_measured[j] = fault ? 0.0 : theta;
     }
     if (!fault) {
       mp.measured = detail::fk(mp.mech, st.theta_measured[0], st.theta_measured[1]);

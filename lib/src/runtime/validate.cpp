@@ -11,6 +11,19 @@ namespace fivebar::runtime {
 
 namespace {
 constexpr double kTwoPi = 2.0 * 3.14159265358979323846;
+
+// The physical bounds of what the loop takes, the design loader's (lib/src/sections/controller.cpp):
+// a gain above 1e6 (duty per rad, per rad s, or s per rad) saturates the duty at an error far
+// below any potentiometer's resolution, so no motor loop uses one; within these bounds and a loop
+// rate of at most 1e5 Hz every term of the PID (p e, i s, d de/dt, with |e| <= pi) is finite, so
+// no duty is NaN. A calibration's volts and slope as the loader's.
+constexpr double kMaxGain = 1e6;
+constexpr const char* kGainRule = "must be in [0, 1000000] (no motor loop uses more; it keeps the duty finite)";
+constexpr double kMaxLoopRateHz = 1e5;
+constexpr double kMaxVolts = 1000.0;
+constexpr double kMinRadPerVolt = 1e-6, kMaxRadPerVolt = 1e6;
+
+bool gain_ok(double g) { return g >= 0.0 && g <= kMaxGain; }
 }  // namespace
 
 namespace {
@@ -25,7 +38,7 @@ bool finite_all(std::initializer_list<double> v) {
 }  // namespace
 
 void Config::validate() const {
-  require(std::isfinite(loop_rate_hz) && loop_rate_hz > 0.0, "loop_rate_hz", "must be a finite number > 0");
+  require(loop_rate_hz > 0.0 && loop_rate_hz <= kMaxLoopRateHz, "loop_rate_hz", "must be in (0, 100000] Hz");
   require(adc_bits >= 1 && adc_bits <= 31, "adc.bits", "must be in [1, 31]");
   require(finite_all({adc_range_v[0], adc_range_v[1]}) && adc_range_v[1] > adc_range_v[0], "adc.range_v",
           "must be two finite volts, low < high");
@@ -64,11 +77,14 @@ void Config::validate() const {
         require(m.working_mode[j] == 1 || m.working_mode[j] == -1, mp + ".working_mode", "two signs");
         const JointConfig& jc = m.joints[j];
         const std::string g = "gains." + jc.name;
-        require(finite_all({jc.gains.p, jc.gains.i, jc.gains.d, jc.gains.i_clamp}), g, "gains must be finite");
-        require(jc.gains.i_clamp >= 0.0, g + ".i_clamp", "must be >= 0");
+        require(gain_ok(jc.gains.p), g + ".p", kGainRule);
+        require(gain_ok(jc.gains.i), g + ".i", kGainRule);
+        require(gain_ok(jc.gains.d), g + ".d", kGainRule);
+        require(jc.gains.i_clamp >= 0.0 && jc.gains.i_clamp <= 1.0, g + ".i_clamp", "must be in [0, 1] (a duty)");
         const std::string pp = "potentiometers." + jc.name;
-        require(std::isfinite(jc.volts_at_zero), pp + ".volts_at_zero", "must be finite");
-        require(std::isfinite(jc.rad_per_volt) && jc.rad_per_volt != 0.0, pp + ".rad_per_volt", "must be finite and not 0");
+        require(std::fabs(jc.volts_at_zero) <= kMaxVolts, pp + ".volts_at_zero", "must be within [-1000, 1000] V");
+        require(std::fabs(jc.rad_per_volt) >= kMinRadPerVolt && std::fabs(jc.rad_per_volt) <= kMaxRadPerVolt,
+                pp + ".rad_per_volt", "|rad_per_volt| must be in [1e-6, 1e6] rad/V (never 0)");
         if (jc.has_position_limits) {
           const std::string lp = "joint_limits." + jc.name;
           require(finite_all({jc.min_position, jc.max_position}) && jc.max_position > jc.min_position &&
