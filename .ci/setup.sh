@@ -45,6 +45,11 @@ FIVEBAR_TEST_PACKAGES=(
   python3-pytest
   # Tests of what users open: PrusaSlicer slices the parts (with unzip to read its .sl1 archive).
   prusa-slicer unzip
+  # The runtime for a Raspberry Pi (ctest runtime_aarch64, test/runtime_package/aarch64.sh): Debian's
+  # aarch64 cross compiler builds the runtime package alone, qemu-user runs its C test and compares
+  # its duties with the x86-64 build's bit for bit.
+  g++-aarch64-linux-gnu
+  qemu-user
 )
 FIVEBAR_HARDENING_PACKAGES=(
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.

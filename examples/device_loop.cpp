@@ -12,12 +12,15 @@
 // implementation of DeviceIo over its DAQ driver, its PWM outputs and its reference topic, and the
 // loop by a wall timer at loop_rate_hz. Nothing in the loop allocates after the controller is built.
 
+#include <charconv>
 #include <chrono>
 #include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -43,6 +46,7 @@ class CsvIo : public DeviceIo {
     std::string line;
     if (!next_line(line)) throw std::runtime_error("input: no header row");
     const std::vector<std::string> header = split(line);
+    header_ = header;
     std::map<std::string, std::size_t> at;
     for (std::size_t i = 0; i < header.size(); ++i) at[header[i]] = i;
     const auto column = [&](const std::string& name) {
@@ -73,7 +77,19 @@ class CsvIo : public DeviceIo {
     std::string line;
     if (!next_line(line)) return false;
     const std::vector<std::string> cells = split(line);
-    const auto cell = [&](std::size_t i) { return i < cells.size() ? std::strtod(cells[i].c_str(), nullptr) : 0.0; };
+    // The whole cell is the number (std::from_chars: no locale, no `41496junk` read as 41496, no
+    // hex); a short row or a cell that is not one is an error naming its line and column.
+    const auto cell = [&](std::size_t i) {
+      if (i >= cells.size()) throw std::runtime_error("input:" + std::to_string(line_) + ": column " + header_[i] + " is missing");
+      const std::string& text = cells[i];
+      double x = 0.0;
+      const auto r = std::from_chars(text.data(), text.data() + text.size(), x);
+      if (text.empty() || r.ec != std::errc() || r.ptr != text.data() + text.size()) {
+        throw std::runtime_error("input:" + std::to_string(line_) + ": " + header_[i] + ": '" + text.substr(0, 32) +
+                                 "' is not a number");
+      }
+      return x;
+    };
     t = cell(time_);
     for (std::size_t i = 0; i < reading_.size(); ++i) readings[i] = cell(reading_[i]);
     for (std::size_t i = 0; i < target_.size(); ++i) targets[i] = cell(target_[i]) / 1000.0;
@@ -91,6 +107,7 @@ class CsvIo : public DeviceIo {
   /// The next line that is neither blank nor a `#` comment (the logs' notes, as `fivebar replay` reads them).
   bool next_line(std::string& line) {
     while (std::getline(in_, line)) {
+      ++line_;
       if (!line.empty() && line.back() == '\r') line.pop_back();
       const std::size_t first = line.find_first_not_of(" \t");
       if (first != std::string::npos && line[first] != '#') return true;
@@ -107,6 +124,8 @@ class CsvIo : public DeviceIo {
   std::ostream& out_;
   rt::Reading kind_ = rt::Reading::counts;
   std::size_t time_ = 0;
+  std::size_t line_ = 0;  ///< 1-based line of the last line read
+  std::vector<std::string> header_;
   std::vector<std::size_t> reading_, target_;
 };
 

@@ -49,6 +49,23 @@ noted.write_text("# a note before the header\n" + text[0] + "\n# a note between 
 again = subprocess.run([LOOP, str(config), str(noted)], check=True, capture_output=True, text=True).stdout
 if again != out:
     failures.append("the log with # notes and a blank line gives other output")
+# A cell that is not wholly a number (`41496junk` was read as 41496) stops the loop naming its line
+# and column, exit 2, as does a short row.
+header = text[0].rstrip("\n").split(",")
+counts_col = next(i for i, c in enumerate(header) if c.endswith("_counts") or c.endswith("_theta_rad") or c.endswith("_volts"))
+for bad_cell in ["41496junk", "0x10", "", " 5"]:
+    row = text[1].rstrip("\n").split(",")
+    row[counts_col] = bad_cell
+    junk = WORK / "junk.csv"
+    junk.write_text(text[0] + ",".join(row) + "\n")
+    r = subprocess.run([LOOP, str(config), str(junk)], capture_output=True, text=True)
+    if r.returncode != 2 or f"input:2: {header[counts_col]}" not in r.stderr:
+        failures.append(f"cell {bad_cell!r}: exit {r.returncode}, {r.stderr.strip()!r}")
+short = WORK / "short.csv"
+short.write_text(text[0] + ",".join(text[1].split(",")[:2]) + "\n")
+r = subprocess.run([LOOP, str(config), str(short)], capture_output=True, text=True)
+if r.returncode != 2 or "input:2: column" not in r.stderr:
+    failures.append(f"short row: exit {r.returncode}, {r.stderr.strip()!r}")
 if nonzero < len(logged):
     failures.append(f"only {nonzero} non-zero duties: the pattern does not drive the motors")
 for f in failures[:20]:

@@ -331,7 +331,7 @@ TEST_F(BenchReplayScene, TheRuntimesOwnLogPassesAndAChangedOneIsFlagged) {
   EXPECT_FALSE(logs[1]["passed"].get<bool>());
   EXPECT_EQ(logs[1]["mismatches"], 1);
   EXPECT_NEAR(logs[1]["max_duty_difference"].get<double>(), 0.03, 1e-15);
-  EXPECT_EQ(logs[1]["first_mismatch"]["row"], 20);
+  EXPECT_EQ(logs[1]["first_mismatch"]["row"], 21);  // from 1, as the markdown below
   EXPECT_EQ(logs[1]["first_mismatch"]["joint"], "index_upper_theta2");
   EXPECT_THAT(p.markdown, HasSubstr("✗ does not run this configuration"));
   EXPECT_THAT(p.markdown, HasSubstr("first mismatch at row 21"));

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -347,6 +348,90 @@ TEST(Runtime, ThePriorityRuleIsNoWorseThanTheProbeSearchOnRandomCollisions) {
   EXPECT_GT(moved, compared / 4);
 }
 
+// Random crossings (issue 46): per station, pairs of targets drawn over the station's target area
+// whose outlines collide (the library's exact check), the lower one anywhere within 8 mm of the
+// upper. The library's dense search (apply_priority: 256 rays, rings 0.01 length scales apart up to
+// the lower mechanism's reach, golden-section refinement of the angle) is the brute-force
+// reference: wherever it finds a free point within the documented search radius
+// (kPrioritySearchRadiusRel length scales) the runtime moves the lower target (never stops it),
+// to a point free by the library's exact check, no farther than kPriorityDistanceFactor times the
+// reference's distance plus the reference's own resolution (one ring). FIVEBAR_PRIORITY_PAIRS sets
+// the pairs per station: 500 by default (about 75 s), 10^4 in ctest runtime_priority_random (label
+// long, about 25 min of CPU).
+// docs/runtime.md "Priority rule": the radius (lower mechanism's length scales) within which the
+// rule never stops the lower mechanism while the dense search finds a free point (it searches up to
+// 1 length scale; beyond 0.5 its rings are too sparse to promise it), and the factor stated for the
+// distance (against the reference's distance plus one of its rings).
+constexpr double kSearchRadiusRel = 0.5;
+constexpr double kDistanceFactor = 2.0;
+
+TEST(Runtime, ThePriorityRuleNeverStopsWhereTheDenseSearchFindsAFreePoint) {
+#ifdef FIVEBAR_SANITIZE
+  int pairs = 50;
+#else
+  int pairs = 500;
+#endif
+  if (const char* e = std::getenv("FIVEBAR_PRIORITY_PAIRS")) pairs = std::atoi(e);
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  const Geometry& g = *paper().get<Geometry>();
+  std::mt19937_64 rng(testing::test_seed());
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const std::string name : {"index", "thumb"}) {
+    const Station& st = paper().require_station(name);
+    const std::size_t lo = index_of(c, name, "lower"), up = index_of(c, name, "upper");
+    const double scale = st.lower->length_scale();
+    const double radius = kSearchRadiusRel * scale, step = 0.01 * scale;
+    int colliding = 0, moved = 0, stops = 0, needless = 0, stops_free_beyond = 0;
+    double worst_factor = 0.0;
+    std::vector<double> factors;
+    for (int n = 0; colliding < pairs && n < 50 * pairs; ++n) {
+      std::vector<Vec2> pts = centres(c, 8.0);
+      pts[up] = st.target.center + Vec2(st.target.axes.x() * u(rng), st.target.axes.y() * u(rng));
+      pts[lo] = pts[up] + 8.0 * Vec2(u(rng), u(rng));
+      const Pose pu = ik(*st.upper, pts[up]), pl = ik(*st.lower, pts[lo]);
+      if (!usable(*st.upper, pu) || !usable(*st.lower, pl)) continue;
+      if (!interference(*st.upper, pu, *st.lower, pl, g).collides) continue;
+      ++colliding;
+      const rt::MechanismState& l = cycle_from_rest(ctl, c, pts, {lo, up});
+      SCOPED_TRACE(::testing::Message() << name << " upper " << pts[up].transpose() << " lower " << pts[lo].transpose());
+      ASSERT_EQ(ctl.mechanism(up).status, rt::Status::ok);
+      const PriorityResult ref = apply_priority(*st.upper, *st.lower, g, pts[up], pts[lo]);
+      const bool ref_found = ref.status == PriorityStatus::moved;
+      if (l.status != rt::Status::moved_by_priority) {
+        EXPECT_EQ(l.status, rt::Status::unreachable);
+        ++stops;
+        stops_free_beyond += ref_found && ref.moved_mm > radius;
+        if (ref_found && ref.moved_mm <= radius) {
+          ++needless;
+          ADD_FAILURE() << "stopped, the dense search moves it by " << ref.moved_mm << " mm";
+        }
+        continue;
+      }
+      ++moved;
+      const Vec2 p(l.point_command[0] * 1000, l.point_command[1] * 1000);
+      const Pose pm = ik(*st.lower, p);
+      EXPECT_TRUE(usable(*st.lower, pm));
+      const Interference after = interference(*st.upper, pu, *st.lower, pm, g);
+      EXPECT_FALSE(after.collides) << after.min_clearance_mm;
+      EXPECT_NEAR(l.moved * 1000, (p - pts[lo]).norm(), 1e-9);
+      if (!ref_found) continue;  // the runtime found a point the rings missed
+      const double f = l.moved * 1000 / (ref.moved_mm + step);
+      factors.push_back(l.moved * 1000 / ref.moved_mm);
+      worst_factor = std::max(worst_factor, f);
+      EXPECT_LE(f, kDistanceFactor) << "runtime " << l.moved * 1000 << " mm, reference " << ref.moved_mm;
+    }
+    std::sort(factors.begin(), factors.end());
+    const auto q = [&](double x) { return factors.empty() ? 0.0 : factors[std::size_t(x * double(factors.size() - 1))]; };
+    std::printf("[priority %s] %d colliding pairs: %d moved, %d stopped (%d needlessly, %d with a free point beyond the "
+                "radius); distance / reference: median %.4f, p99 %.4f, max %.4f; worst against reference + one ring %.4f\n",
+                name.c_str(), colliding, moved, stops, needless, stops_free_beyond, q(0.5), q(0.99),
+                factors.empty() ? 0.0 : factors.back(), worst_factor);
+    EXPECT_EQ(colliding, pairs);
+    EXPECT_EQ(needless, 0);
+  }
+}
+
 // With no clearance required (collision.min_clearance_m 0) the links may touch but not overlap:
 // bounding boxes that touch can still hold overlapping shapes, so no pair may be skipped on its box
 // alone. Every moved lower command is clear by the library's exact check at clearance 0.
@@ -520,7 +605,7 @@ TEST(Runtime, RefusesBadConfigurationsNamingTheKey) {
   {
     nlohmann::json j = nlohmann::json::parse(good);
     j.begin().value()["ros__parameters"]["potentiometers"]["index_upper_theta2"]["rad_per_volt"] = 0.0;
-    refuse(j.dump(), "potentiometers.index_upper_theta2.rad_per_volt: must be finite and not 0");
+    refuse(j.dump(), "potentiometers.index_upper_theta2.rad_per_volt: |rad_per_volt| must be in [1e-6, 1e6] rad/V");
   }
   {
     nlohmann::json j = nlohmann::json::parse(good);
@@ -530,6 +615,163 @@ TEST(Runtime, RefusesBadConfigurationsNamingTheKey) {
   refuse("{\"a\": NaN}", "x.json:1: unexpected character 'N'");
   refuse(good.substr(0, good.size() / 2), "x.json:");
   EXPECT_THROW((void)rt::load_config_json("/nonexistent/controller.json"), rt::ConfigError);
+}
+
+// Gains and the loop rate within the physical bounds the design loader applies
+// (lib/src/sections/controller.cpp): p = d = 1e308 gave a NaN duty before; numbers in the strict
+// JSON grammar only (RFC 8259: no leading zero, no bare point).
+TEST(Runtime, RefusesGainsOutsideTheirBoundsAndNumbersOutsideTheJsonGrammar) {
+  const std::string good = export_text();
+  const auto refuse = [](const std::string& text, const std::string& key) {
+    SCOPED_TRACE(key);
+    EXPECT_THAT([&] { (void)rt::parse_config_json(text, "x.json"); }, ::testing::ThrowsMessage<rt::ConfigError>(HasSubstr(key)));
+  };
+  const auto with = [&](const std::string& joint, const std::string& key, double v) {
+    nlohmann::json j = nlohmann::json::parse(good);
+    j.begin().value()["ros__parameters"]["gains"][joint][key] = v;
+    return j.dump();
+  };
+  refuse(with("index_lower_theta1", "p", 1e308), "gains.index_lower_theta1.p: must be in [0, 1000000]");
+  refuse(with("index_lower_theta2", "d", 1e308), "gains.index_lower_theta2.d: must be in [0, 1000000]");
+  refuse(with("thumb_upper_theta1", "i", -1.0), "gains.thumb_upper_theta1.i: must be in [0, 1000000]");
+  refuse(with("thumb_upper_theta1", "i_clamp", 1.5), "gains.thumb_upper_theta1.i_clamp: must be in [0, 1]");
+  EXPECT_NO_THROW((void)rt::parse_config_json(with("index_lower_theta1", "p", 1e6), "x.json"));
+  {
+    nlohmann::json j = nlohmann::json::parse(good);
+    j.begin().value()["ros__parameters"]["loop_rate_hz"] = 1e9;
+    refuse(j.dump(), "loop_rate_hz: must be in (0, 100000] Hz");
+    j.begin().value()["ros__parameters"]["loop_rate_hz"] = 100.0;
+    j.begin().value()["ros__parameters"]["potentiometers"]["index_lower_theta1"]["volts_at_zero"] = 1e5;
+    refuse(j.dump(), "potentiometers.index_lower_theta1.volts_at_zero: must be within [-1000, 1000] V");
+  }
+  // The loop rate written as other numbers: JSON's grammar decides, not from_chars.
+  nlohmann::json j = nlohmann::json::parse(good);
+  j.begin().value()["ros__parameters"]["loop_rate_hz"] = 123456789;  // a marker to replace
+  const std::string marked = j.dump();
+  const auto as = [&](const std::string& number) {
+    std::string t = marked;
+    t.replace(t.find("123456789"), 9, number);
+    return t;
+  };
+  for (const std::string bad : {"05", "5.", ".5", "+5", "-", "1e", "1e+", "0x10", "1.e3", "--5", "00"}) {
+    refuse(as(bad), "x.json:");
+  }
+  for (const std::string ok : {"50", "0.5e2", "5E1", "500e-1", "50.0"}) {
+    SCOPED_TRACE(ok);
+    EXPECT_EQ(rt::parse_config_json(as(ok), "x.json").loop_rate_hz, 50.0);
+  }
+}
+
+// Readings within half a code of a rail (0.4, 65534.6 and 1e-320 were ok) and angles a potentiometer
+// cannot give (more than half a turn from the joint's range: the converter spans 3.3 turns of the
+// showcase's calibration, so code 1 read as -10.7 rad) or an encoder more than a turn away (1e15
+// rad) are sensor faults: zero duty.
+TEST(Runtime, ReadingsNearARailOrOutsideOneTurnAreFaults) {
+  const rt::Config c = paper_config();
+  rt::Controller ctl(c);
+  const Scene s = at_points(c, centres(c));
+  const rt::JointConfig& j0 = c.stations[0].mechanisms[0].joints[0];
+  std::vector<double> counts(s.readings.size());
+  std::size_t q = 0;
+  for (const auto& st : c.stations)
+    for (const auto& m : st.mechanisms)
+      for (const auto& j : m.joints) {
+        counts[q] = rt::adc_code(j.volts_at_zero + s.readings[q] / j.rad_per_volt, c.adc_bits, c.adc_range_v, c.volts_per_count);
+        ++q;
+      }
+  ctl.cycle(counts.data(), rt::Reading::counts, s.targets.data());
+  ASSERT_EQ(ctl.mechanism(0).status, rt::Status::ok);
+  const double top = std::ldexp(1.0, c.adc_bits) - 1.0;
+  const double centre = j0.has_position_limits ? 0.5 * (j0.min_position + j0.max_position) : 0.0;
+  // The code whose angle is half a turn and a bit beyond the centre, on either side (inside the ADC).
+  const auto code_of = [&](double theta) {
+    return (j0.volts_at_zero + theta / j0.rad_per_volt - c.adc_range_v[0]) / c.volts_per_count;
+  };
+  std::vector<double> bad = {0.4, 0.5, top - 0.4, top - 0.5, 1e-320, 1.0};
+  for (double theta : {centre + M_PI + 0.05, centre - M_PI - 0.05}) {
+    const double code = std::round(code_of(theta));
+    if (code > 1 && code < top - 1) bad.push_back(code);
+  }
+  ASSERT_GE(bad.size(), 7u) << "the calibration spans more than a turn: at least one code beyond it";
+  for (double b : bad) {
+    SCOPED_TRACE(b);
+    std::vector<double> r = counts;
+    r[0] = b;
+    ctl.cycle(r.data(), rt::Reading::counts, s.targets.data());
+    EXPECT_EQ(ctl.mechanism(0).status, rt::Status::sensor_fault);
+    EXPECT_EQ(ctl.duties()[0], 0.0);
+    EXPECT_EQ(ctl.duties()[1], 0.0);
+  }
+  // Half a turn less a bit from the centre (a code inside the ADC): not a fault of the reading.
+  const double inside = std::round(code_of(centre + M_PI - 0.05));
+  if (inside > 1 && inside < top - 1) {
+    std::vector<double> r = counts;
+    r[0] = inside;
+    ctl.cycle(r.data(), rt::Reading::counts, s.targets.data());
+    EXPECT_NE(ctl.mechanism(0).status, rt::Status::sensor_fault);
+  }
+  for (double b : {1e15, 1e300, -1e300, centre + 2 * M_PI + 0.01, centre - 2 * M_PI - 0.01}) {
+    SCOPED_TRACE(b);
+    std::vector<double> r = s.readings;
+    r[0] = b;
+    ctl.cycle(r.data(), rt::Reading::radians, s.targets.data());
+    EXPECT_EQ(ctl.mechanism(0).status, rt::Status::sensor_fault);
+    EXPECT_EQ(ctl.duties()[0], 0.0);
+  }
+}
+
+// No NaN in any output: the largest gains accepted (1e6, i_clamp 1) at the fastest loop rate
+// accepted (1e5 Hz), and every reading and target from a sweep of extreme finite values (the
+// largest and smallest doubles, subnormals, the rails and their neighbours), in every kind.
+TEST(Runtime, ExtremeFiniteInputsNeverGiveANaN) {
+  rt::Config c = paper_config();
+  c.loop_rate_hz = 1e5;
+  for (auto& st : c.stations)
+    for (auto& m : st.mechanisms)
+      for (auto& j : m.joints) j.gains = {1e6, 1e6, 1e6, 1.0};
+  rt::Controller ctl(c);
+  const Scene s = at_points(c, centres(c));
+  const double big = std::numeric_limits<double>::max(), tiny = std::numeric_limits<double>::denorm_min();
+  const std::vector<double> values = {big, -big, 1e300, -1e300, 1e15, -1e15, tiny, -tiny, 1e-320, DBL_MIN, 0.0, -0.0,
+                                      0.5, 1.0, 65534.0, 65534.5, 65535.0, 3.0, -3.0, 10.0, -10.0, 1e-3, -1e-3};
+  std::mt19937_64 rng(testing::test_seed());
+  std::uniform_int_distribution<std::size_t> pick(0, values.size() - 1);
+  std::uniform_int_distribution<int> coin(0, 3);
+  const auto finite_state = [&](const char* what) {
+    for (std::size_t i = 0; i < ctl.joint_count(); ++i) {
+      ASSERT_TRUE(std::isfinite(ctl.duties()[i]) && std::fabs(ctl.duties()[i]) <= 1.0) << what;
+    }
+    for (std::size_t k = 0; k < ctl.mechanism_count(); ++k) {
+      const rt::MechanismState& m = ctl.mechanism(k);
+      for (double v : {m.theta_measured[0], m.theta_measured[1], m.point_measured[0], m.point_measured[1], m.target[0],
+                       m.target[1], m.point_command[0], m.point_command[1], m.theta_command[0], m.theta_command[1],
+                       m.moved, m.duty[0], m.duty[1]}) {
+        ASSERT_TRUE(std::isfinite(v)) << what << " mechanism " << k;
+      }
+    }
+    for (std::size_t st = 0; st < c.stations.size(); ++st) ASSERT_TRUE(std::isfinite(ctl.station(st).measured_clearance));
+  };
+  for (int n = 0; n < 5000; ++n) {
+    std::vector<double> r = s.readings, t = s.targets;
+    const auto kind = static_cast<rt::Reading>(n % 3);
+    for (double& x : r)
+      if (coin(rng) == 0) x = values[pick(rng)];
+    for (double& x : t)
+      if (coin(rng) == 0) x = values[pick(rng)] * (coin(rng) ? 1.0 : 1e-3);
+    ctl.cycle(r.data(), kind, t.data());
+    finite_state("random");
+    if (HasFatalFailure()) return;
+  }
+  // Every joint at every extreme value, targets at the centres: one at a time per kind.
+  for (int kind = 0; kind < 3; ++kind)
+    for (double v : values)
+      for (std::size_t i = 0; i < s.readings.size(); ++i) {
+        std::vector<double> r = s.readings;
+        r[i] = v;
+        ctl.cycle(r.data(), static_cast<rt::Reading>(kind), s.targets.data());
+        finite_state("sweep");
+        if (HasFatalFailure()) return;
+      }
 }
 
 TEST(Runtime, SameInputsGiveTheSameDutiesBitForBit) {

@@ -14,9 +14,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <random>
 #include <string>
 #include <vector>
 
+#include "fivebar/collision.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/pattern.hpp"
@@ -213,5 +215,72 @@ void BM_runtime_showcase_priority_every_cycle(benchmark::State& state) {
   state.counters["probe_bound"] = double(rt::kPriorityMaxProbes);
 }
 BENCHMARK(BM_runtime_showcase_priority_every_cycle)->Arg(1'000'000)->Arg(10'000)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+namespace {
+
+/// Random crossings (issue 46): per cycle, in both stations, an upper target uniform over the
+/// station's target box (centre +- its half axes) and a lower target uniform within 8 mm of it in x
+/// and y, kept only when their outlines collide by the library's exact check (both usable): every
+/// cycle runs two priority rules on a new input. state.range(0) cycles; the joints' codes are the
+/// first showcase sample's (the rule works on the commanded poses). Counters: the distribution of
+/// the cycle's wall time and this thread's CPU time (max_us / cpu_max_us: p100), the cycles whose
+/// rule stopped a lower tactor, and the probe bounds.
+void BM_runtime_random_crossings(benchmark::State& state) {
+  const Samples& s = showcase();
+  const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  const Geometry& g = *d.get<Geometry>();
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::mt19937_64 rng(46);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<std::vector<double>> targets(n, s.targets.front());
+  std::size_t k0 = 0;
+  for (const rt::StationConfig& st : s.config.stations) {
+    std::size_t lo = k0, up = k0;
+    for (std::size_t m = 0; m < st.mechanisms.size(); ++m) (st.mechanisms[m].name == "lower" ? lo : up) = k0 + m;
+    k0 += st.mechanisms.size();
+    if (st.mechanisms.size() != 2) continue;
+    const Station& station = d.require_station(st.name);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (;;) {
+        const Vec2 pu = station.target.center + Vec2(station.target.axes.x() * u(rng), station.target.axes.y() * u(rng));
+        const Vec2 pl = pu + 8.0 * Vec2(u(rng), u(rng));
+        const Pose a = ik(*station.upper, pu), b = ik(*station.lower, pl);
+        if (!usable(*station.upper, a) || !usable(*station.lower, b)) continue;
+        if (!interference(*station.upper, a, *station.lower, b, g).collides) continue;
+        targets[i][2 * up] = pu.x() / 1000, targets[i][2 * up + 1] = pu.y() / 1000;
+        targets[i][2 * lo] = pl.x() / 1000, targets[i][2 * lo + 1] = pl.y() / 1000;
+        break;
+      }
+    }
+  }
+  std::vector<double> us(n), cpu(n);
+  std::size_t moved = 0, stopped = 0;
+  for (auto _ : state) {
+    rt::Controller ctl(s.config);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double c0 = thread_cpu_us();
+      const auto t0 = std::chrono::steady_clock::now();
+      ctl.cycle(s.counts.front().data(), rt::Reading::counts, targets[i].data());
+      const auto t1 = std::chrono::steady_clock::now();
+      cpu[i] = thread_cpu_us() - c0;
+      benchmark::DoNotOptimize(ctl.duties());
+      us[i] = std::chrono::duration<double, std::micro>(t1 - t0).count();
+      for (std::size_t m = 0; m < ctl.mechanism_count(); ++m) {
+        moved += ctl.mechanism(m).status == rt::Status::moved_by_priority;
+        stopped += ctl.mechanism(m).status == rt::Status::unreachable;
+      }
+    }
+  }
+  report(state, us, cpu);
+  std::vector<double> sorted = cpu;
+  std::sort(sorted.begin(), sorted.end());
+  state.counters["cpu_p99_9_us"] = sorted[std::min(n - 1, static_cast<std::size_t>(0.999 * double(n)))];
+  state.counters["moved"] = double(moved);
+  state.counters["stopped"] = double(stopped);
+  state.counters["probe_bound"] = double(rt::kPriorityMaxProbes + 32 * rt::kPriorityRays);  // + kPriorityRings rings
+}
+BENCHMARK(BM_runtime_random_crossings)->Arg(100'000)->Arg(2'000)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -192,7 +192,7 @@ Json to_json(const ReplayResult& r) {
   j["max_duty_difference"] = r.max_difference;
   j["mismatches"] = r.mismatches;
   j["passed"] = r.passed();
-  j["first_mismatch"] = r.first_mismatch ? Json{{"row", r.first_row},
+  j["first_mismatch"] = r.first_mismatch ? Json{{"row", r.first_row + 1},  // data rows from 1, as the text
                                                 {"time_s", r.first_time_s},
                                                 {"joint", r.first_joint},
                                                 {"logged_duty", r.first_logged},

@@ -110,6 +110,29 @@ int fivebar_runtime_joint_commands(const fivebar_runtime* r, double* theta) {
   return 0;
 }
 
+int fivebar_runtime_moved(const fivebar_runtime* r, double* moved) {
+  if (r == nullptr || moved == nullptr) return -1;
+  for (std::size_t k = 0; k < r->controller.mechanism_count(); ++k) moved[k] = r->controller.mechanism(k).moved;
+  return 0;
+}
+
+size_t fivebar_runtime_station_count(const fivebar_runtime* r) { return r ? r->controller.config().stations.size() : 0; }
+
+int fivebar_runtime_measured_clearance(const fivebar_runtime* r, size_t station, double* clearance, int* collision) {
+  if (r == nullptr || clearance == nullptr || station >= r->controller.config().stations.size()) return -1;
+  const fivebar::runtime::StationState& s = r->controller.station(station);
+  *clearance = s.checked ? s.measured_clearance : 0.0;
+  if (collision) *collision = s.checked && s.measured_collision ? 1 : 0;
+  return s.checked ? 1 : 0;
+}
+
+#define FIVEBAR_STR2(x) #x
+#define FIVEBAR_STR(x) FIVEBAR_STR2(x)
+const char* fivebar_runtime_version(void) {
+  return FIVEBAR_STR(FIVEBAR_RUNTIME_VERSION_MAJOR) "." FIVEBAR_STR(FIVEBAR_RUNTIME_VERSION_MINOR) "." FIVEBAR_STR(
+      FIVEBAR_RUNTIME_VERSION_PATCH);
+}
+
 void fivebar_runtime_reset(fivebar_runtime* r) {
   if (r) r->controller.reset();
 }

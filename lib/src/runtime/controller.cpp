@@ -4,8 +4,8 @@
 #include "fivebar/runtime/controller.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <initializer_list>
 #include <limits>
 #include <memory>
 #include <string>
@@ -25,6 +25,16 @@ using detail::V2;
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kTwoPi = 2.0 * kPi;
+
+// The priority rule's second stage (docs/runtime.md "Priority rule"), when the rays' march finds no
+// free point: rings from kPriorityRingFirstRel length scales about the target, each
+// kPriorityRingGrowth times the last (at most kPriorityRings), up to kPrioritySearchRadiusRel length
+// scales, kPriorityRays points each. Within that radius the rule does not stop the lower mechanism
+// while a free point exists (test_runtime checks it against a dense brute-force search).
+constexpr double kPrioritySearchRadiusRel = 1.0;
+constexpr double kPriorityRingFirstRel = 0.005;
+constexpr double kPriorityRingGrowth = 1.2;
+constexpr int kPriorityRings = 32;
 }  // namespace
 
 // --- Config -------------------------------------------------------------------------------------
@@ -38,75 +48,6 @@ std::size_t Config::mechanism_count() const {
   std::size_t n = 0;
   for (const StationConfig& s : stations) n += s.mechanisms.size();
   return n;
-}
-
-namespace {
-void require(bool ok, const std::string& key, const std::string& what) {
-  if (!ok) throw ConfigError(key + ": " + what);
-}
-bool finite_all(std::initializer_list<double> v) {
-  for (double x : v)
-    if (!std::isfinite(x)) return false;
-  return true;
-}
-}  // namespace
-
-void Config::validate() const {
-  require(std::isfinite(loop_rate_hz) && loop_rate_hz > 0.0, "loop_rate_hz", "must be a finite number > 0");
-  require(adc_bits >= 1 && adc_bits <= 31, "adc.bits", "must be in [1, 31]");
-  require(finite_all({adc_range_v[0], adc_range_v[1]}) && adc_range_v[1] > adc_range_v[0], "adc.range_v",
-          "must be two finite volts, low < high");
-  const double expected = (adc_range_v[1] - adc_range_v[0]) / std::ldexp(1.0, adc_bits);
-  require(std::isfinite(volts_per_count) && volts_per_count > 0.0 &&
-              std::fabs(volts_per_count - expected) <= 1e-9 * expected,
-          "adc.volts_per_count", "must be (range_v[1] - range_v[0]) / 2^bits");
-  require(std::isfinite(joint_margin) && joint_margin >= 0.0, "joint_margin_rad", "must be a finite number >= 0");
-  if (collision.checked) {
-    const CollisionConfig& c = collision;
-    require(std::isfinite(c.min_clearance) && c.min_clearance >= 0.0, "collision.min_clearance_m", "must be >= 0");
-    for (std::size_t i = 0; i < 4; ++i) {
-      require(std::isfinite(c.link_widths[i]) && c.link_widths[i] > 0.0, "collision.link_widths_m[" + std::to_string(i) + "]",
-              "must be > 0");
-      require(c.layers[i] >= 0 && c.layers[i] <= 32, "collision.layers[" + std::to_string(i) + "]", "must be in [0, 32]");
-    }
-    require(finite_all({c.pin_diameter, c.boss_diameter, c.tactor_diameter, c.motor_shaft_diameter}) && c.pin_diameter > 0.0 &&
-                c.boss_diameter >= 0.0 && c.tactor_diameter > 0.0 && c.motor_shaft_diameter >= 0.0,
-            "collision", "pin, boss, tactor and motor shaft diameters must be finite, pin and tactor > 0");
-  }
-  require(!stations.empty(), "station_names", "no station");
-  for (const StationConfig& s : stations) {
-    const std::string sp = "stations." + s.name;
-    require(!s.mechanisms.empty() && s.mechanisms.size() <= 2, sp + ".mechanisms", "one or two mechanisms");
-    if (s.mechanisms.size() == 2) {
-      require(s.mechanisms[0].name != s.mechanisms[1].name, sp + ".mechanisms", "a lower and an upper mechanism");
-    }
-    for (const MechanismConfig& m : s.mechanisms) {
-      const std::string mp = sp + "." + m.name;
-      require(m.name == "lower" || m.name == "upper", mp, "a mechanism is \"lower\" or \"upper\"");
-      require(finite_all({m.o1[0], m.o1[1], m.o2[0], m.o2[1]}), mp + ".o1_m", "base joints must be finite");
-      for (std::size_t i = 0; i < 4; ++i) {
-        require(std::isfinite(m.L[i]) && m.L[i] > 0.0, mp + ".link_lengths_m[" + std::to_string(i) + "]", "must be > 0");
-      }
-      for (std::size_t j = 0; j < 2; ++j) {
-        require(m.working_mode[j] == 1 || m.working_mode[j] == -1, mp + ".working_mode", "two signs");
-        const JointConfig& jc = m.joints[j];
-        const std::string g = "gains." + jc.name;
-        require(finite_all({jc.gains.p, jc.gains.i, jc.gains.d, jc.gains.i_clamp}), g, "gains must be finite");
-        require(jc.gains.i_clamp >= 0.0, g + ".i_clamp", "must be >= 0");
-        const std::string pp = "potentiometers." + jc.name;
-        require(std::isfinite(jc.volts_at_zero), pp + ".volts_at_zero", "must be finite");
-        require(std::isfinite(jc.rad_per_volt) && jc.rad_per_volt != 0.0, pp + ".rad_per_volt", "must be finite and not 0");
-        if (jc.has_position_limits) {
-          const std::string lp = "joint_limits." + jc.name;
-          require(finite_all({jc.min_position, jc.max_position}) && jc.max_position > jc.min_position &&
-                      jc.max_position - jc.min_position <= kTwoPi + 1e-12,
-                  lp, "min_position < max_position, at most one turn apart");
-          require(jc.max_position - jc.min_position > 2.0 * joint_margin, lp,
-                  "the range must be wider than twice joint_margin_rad");
-        }
-      }
-    }
-  }
 }
 
 const char* to_string(Status s) noexcept {
@@ -212,6 +153,12 @@ double on_branch(const JointConfig& j, double theta) {
   return t;
 }
 
+/// The centre of the one turn a joint's reading may lie in: its range's centre with limits, else
+/// the calibration's zero.
+double turn_centre(const JointConfig& j) {
+  return j.has_position_limits ? 0.5 * (j.min_position + j.max_position) : 0.0;
+}
+
 /// IK of `point` for mechanism `mp` into `c`; the status of the attempt.
 Status make_command(const Plan& plan, const MechPlan& mp, V2 point, Command& c) {
   c.valid = false;
@@ -263,6 +210,63 @@ Probe probe(Plan& plan, const MechPlan& low, const Part* upper, V2 q) {
   const double k = std::max(1.0, 1.0 / std::min(s1, s2));
   r.advance = (need - clearance) / k;
   return r;
+}
+
+/// Whether q lies inside one of the first `nf` forbidden capsules of the tactor point (closed form:
+/// blocked without a probe).
+bool forbidden(const Plan& plan, std::size_t nf, V2 q) {
+  for (std::size_t k = 0; k < nf; ++k) {
+    const detail::Capsule& c = plan.forbid[k];
+    const V2 d = c.b - c.a;
+    const double dd = dot(d, d);
+    const double t = dd > 0.0 ? std::clamp(dot(q - c.a, d) / dd, 0.0, 1.0) : 0.0;
+    const V2 w = q - (c.a + t * d);
+    if (dot(w, w) < c.r * c.r) return true;
+  }
+  return false;
+}
+
+/// The rule's second stage, when the rays' march found no free point (links block every exit
+/// within its steps) or a far one: rings about `origin` at radii r_k = kPriorityRingFirstRel * scale *
+/// kPriorityRingGrowth^(k-1) up to `radius` (the search radius, or the rays' point), kPriorityRays fixed
+/// directions each (a point inside a forbidden capsule of the tactor is blocked without a probe); on
+/// the first ring with a free point every free ray is bisected kPriorityBisections times against the
+/// ring before, and the closest result wins. A ring point that cannot be held is not free, and its
+/// ray goes on (points beyond it can be). At most kPriorityRings * kPriorityRays probes plus the
+/// bisections.
+bool ring_search(Plan& plan, const MechPlan& low, const Part* upper, V2 origin, std::size_t nf, double radius, V2& found) {
+  const double scale = low.mech.scale;
+  std::array<bool, kPriorityRays> hit{};
+  double r_prev = 0.0, r = kPriorityRingFirstRel * scale;
+  for (int k = 0; k < kPriorityRings && r_prev < radius; ++k) {
+    r = std::min(r, radius);
+    bool any = false;
+    for (std::size_t j = 0; j < kPriorityRays; ++j) {
+      const V2 q = origin + r * plan.rays[j];
+      hit[j] = !forbidden(plan, nf, q) && probe(plan, low, upper, q).free;
+      any = any || hit[j];
+    }
+    if (any) {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t best_j = 0;
+      for (std::size_t j = 0; j < kPriorityRays; ++j) {
+        if (!hit[j]) continue;
+        double lo = r_prev, hi = r;
+        for (int b = 0; b < kPriorityBisections; ++b) {
+          const double mid = 0.5 * (lo + hi);
+          const V2 q = origin + mid * plan.rays[j];
+          if (!forbidden(plan, nf, q) && probe(plan, low, upper, q).free) hi = mid;
+          else lo = mid;
+        }
+        if (hi < best) best = hi, best_j = j;
+      }
+      found = origin + best * plan.rays[best_j];
+      return true;
+    }
+    r_prev = r;
+    r *= kPriorityRingGrowth;
+  }
+  return false;
 }
 
 /// The priority rule (controller.hpp, docs/runtime.md "Priority rule"): the closest point q to
@@ -392,8 +396,16 @@ bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin,
     best_dir = j;
     plan.steps[j] = kPriorityAdvances + 1;  // done
   }
-  if (!(best < std::numeric_limits<double>::infinity())) return false;
+  const double radius = kPrioritySearchRadiusRel * low.mech.scale;
+  if (!(best < inf)) return ring_search(plan, low, upper, origin, nf, radius, found);
   found = origin + best * plan.dirs[best_dir];
+  // A far point of the rays (links blocked the nearer exits) can be much farther than the closest
+  // free point between them: the rings up to it look for a closer one.
+  V2 ring;
+  if (best > kPriorityRingFirstRel * low.mech.scale &&
+      ring_search(plan, low, upper, origin, nf, std::min(best, radius), ring) && norm(ring - origin) < best) {
+    found = ring;
+  }
   return true;
 }
 
@@ -511,20 +523,27 @@ void Controller::cycle(const double* readings, Reading kind, const double* targe
       const double r = readings[2 * k + j];
       const JointConfig& jc = mp.config->joints[j];
       double volts = 0.0;
+      const double centre = turn_centre(jc);
       if (!std::isfinite(r)) {
         fault = true;
       } else if (kind == Reading::radians) {
-        st.theta_measured[j] = r;
+        // An angle (an encoder's, any representation) more than a turn from the joint's range.
+        fault = !(std::fabs(r - centre) <= kTwoPi);
+        st.theta_measured[j] = fault ? 0.0 : r;
         continue;
       } else if (kind == Reading::counts) {
-        fault = !(r > 0.0 && r < p.top_code);  // outside the ADC or at a rail
+        fault = !(r > 0.5 && r < p.top_code - 0.5);  // outside the ADC or within half a code of a rail
         volts = c.adc_range_v[0] + r * c.volts_per_count;
       } else {
         const double half = 0.5 * c.volts_per_count;
         fault = !(r > c.adc_range_v[0] + half && r < c.adc_range_v[0] + (p.top_code - 0.5) * c.volts_per_count);
         volts = r;
       }
-      st.theta_measured[j] = fault ? 0.0 : jc.rad_per_volt * (volts - jc.volts_at_zero);
+      const double theta = jc.rad_per_volt * (volts - jc.volts_at_zero);
+      // A potentiometer turns at most once: an angle more than half a turn from the joint's
+      // range's centre is not one the calibration can read (the converter spans more).
+      fault = fault || !(std::fabs(theta - centre) <= kPi);
+      st.theta_measured[j] = fault ? 0.0 : theta;
     }
     if (!fault) {
       mp.measured = detail::fk(mp.mech, st.theta_measured[0], st.theta_measured[1]);

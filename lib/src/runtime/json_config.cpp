@@ -158,12 +158,31 @@ class Parser {
     } else if (word("null")) {
       v.kind = Value::Kind::null;
     } else if (c == '-' || (c >= '0' && c <= '9')) {
+      // RFC 8259: -? (0 | [1-9][0-9]*) (. [0-9]+)? ([eE] [+-]? [0-9]+)?  (no `05`, `5.`, `.5`, `+5`).
       std::size_t j = i_;
       bool integer = true;
-      while (j < t_.size() && (std::isdigit(static_cast<unsigned char>(t_[j])) || t_[j] == '-' || t_[j] == '+' ||
-                               t_[j] == '.' || t_[j] == 'e' || t_[j] == 'E')) {
-        if (t_[j] == '.' || t_[j] == 'e' || t_[j] == 'E') integer = false;
+      const auto digit = [&](std::size_t at) { return at < t_.size() && t_[at] >= '0' && t_[at] <= '9'; };
+      const auto digits = [&] {
+        if (!digit(j)) fail("bad number");
+        while (digit(j)) ++j;
+      };
+      if (t_[j] == '-') ++j;
+      if (j < t_.size() && t_[j] == '0') {
         ++j;
+        if (digit(j)) fail("bad number: a leading zero");
+      } else {
+        digits();
+      }
+      if (j < t_.size() && t_[j] == '.') {
+        integer = false;
+        ++j;
+        digits();
+      }
+      if (j < t_.size() && (t_[j] == 'e' || t_[j] == 'E')) {
+        integer = false;
+        ++j;
+        if (j < t_.size() && (t_[j] == '+' || t_[j] == '-')) ++j;
+        digits();
       }
       double x = 0.0;
       const auto r = std::from_chars(t_.data() + i_, t_.data() + j, x);

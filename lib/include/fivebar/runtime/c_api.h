@@ -10,6 +10,12 @@
 extern "C" {
 #endif
 
+/* The version of this header; fivebar_runtime_version() gives the library's (the same when they
+ * match). */
+#define FIVEBAR_RUNTIME_VERSION_MAJOR 0
+#define FIVEBAR_RUNTIME_VERSION_MINOR 1
+#define FIVEBAR_RUNTIME_VERSION_PATCH 0
+
 typedef struct fivebar_runtime fivebar_runtime;
 
 /* What the readings are (fivebar::runtime::Reading). */
@@ -47,7 +53,19 @@ int fivebar_runtime_cycle(fivebar_runtime* runtime, const double* readings, int 
 int fivebar_runtime_points(const fivebar_runtime* runtime, double* measured_m, double* commanded_m);
 /* Commanded joint angles of the last cycle, joint_count values (rad, on each joint's branch). */
 int fivebar_runtime_joint_commands(const fivebar_runtime* runtime, double* theta_rad);
+/* The priority rule's distance moved per mechanism of the last cycle (m; 0 unless its status is
+ * moved_by_priority), mechanism_count values. Returns 0, or -1 for a NULL handle or pointer. */
+int fivebar_runtime_moved(const fivebar_runtime* runtime, double* moved_m);
+/* The measured clearance of station `station` (export order) between its two mechanisms' outlines
+ * in the last cycle (m; negative: overlap). Returns 1 when measured (both mechanisms, the collision
+ * geometry and both measured poses), 0 when not (then *clearance_m is 0), -1 for a NULL handle or
+ * pointer or a station out of range. `collision` (when not NULL): 1 when below min_clearance. */
+int fivebar_runtime_measured_clearance(const fivebar_runtime* runtime, size_t station, double* clearance_m,
+                                       int* collision);
+size_t fivebar_runtime_station_count(const fivebar_runtime* runtime);
 void fivebar_runtime_reset(fivebar_runtime* runtime);
+/* The runtime's version, "MAJOR.MINOR.PATCH" (FIVEBAR_RUNTIME_VERSION_*: the package's). */
+const char* fivebar_runtime_version(void);
 /* "ok", "moved_by_priority", ...; "unknown" for other values. */
 const char* fivebar_runtime_status_name(int status);
 
