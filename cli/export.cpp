@@ -62,7 +62,8 @@ int run_check(const ExportCliOptions& opt) {
     print_json({{"command", "export"},
                 {"check", opt.check},
                 {"design", design.name},
-                {"format", to_string(c.format)},
+                {"format", c.format},
+                {"not_compared", c.not_compared},
                 {"matches", c.matches()},
                 {"hash_matches", c.hash_matches()},
                 {"file_design", c.file_design},
@@ -72,13 +73,14 @@ int run_check(const ExportCliOptions& opt) {
                 {"stations", c.stations},
                 {"differences", diffs}});
   } else {
-    std::cout << opt.check << " (" << to_string(c.format) << ") against design " << design.name << "\n";
+    std::cout << opt.check << " (" << c.format << ") against design " << design.name << "\n";
     std::cout << "  design in file    " << c.file_design << "\n";
     std::cout << "  stations          ";
     for (std::size_t i = 0; i < c.stations.size(); ++i) std::cout << (i ? ", " : "") << c.stations[i];
     std::cout << "\n  hash in file      " << c.file_hash << "\n";
     std::cout << "  hash of design    " << c.design_hash << (c.hash_matches() ? "  (same)" : "  (STALE: differs)") << "\n";
     std::cout << "  written by        fivebar " << c.file_tool_version << "\n";
+    for (const std::string& n : c.not_compared) std::cout << "  not compared      " << n << "\n";
     if (c.matches()) {
       std::cout << "the file matches the design\n";
     } else {

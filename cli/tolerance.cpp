@@ -41,9 +41,10 @@ void print_mechanism(const ToleranceMap& r) {
   if (r.centre.status != Status::ok) {
     std::cout << to_string(r.centre.status) << " (no first-order estimate)\n";
   } else {
-    std::cout << "3-sigma " << fixed(r.centre.ellipse_semi_axes.x(), 4) << " mm (Monte Carlo "
-              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst case (+-3-sigma corner) " << fixed(r.centre.worst_case_mm, 4)
-              << " mm (separate effects added: " << fixed(r.centre.sum_of_effects_mm, 4) << " mm), resolution "
+    std::cout << "3-sigma " << fixed(r.centre.ellipse_semi_axes.x(), 4) << " mm first order (Monte Carlo "
+              << fixed(r.centre_monte_carlo_3sigma_mm, 4) << " mm), worst case (+-3-sigma corner, nonlinear) "
+              << fixed(r.centre_corners.worst_mm, 4) << " mm (first order " << fixed(r.centre.worst_case_mm, 4)
+              << " mm; separate effects added, first order: " << fixed(r.centre.sum_of_effects_mm, 4) << " mm), resolution "
               << fixed(r.centre.resolution_um, 3) << " um per count, play " << fixed(r.centre_play.extent_mm, 4) << " mm"
               << (r.centre.near_singular ? " [near singular: first order not trusted]" : "") << "\n";
   }
@@ -51,9 +52,11 @@ void print_mechanism(const ToleranceMap& r) {
     std::cout << "    over the target (" << r.target_points << " points): no point is reachable and regular (no estimate)";
   } else {
   std::cout << "    over the target (" << r.target_points << " points): 3-sigma up to " << fixed(r.worst_3sigma_mm, 4)
-            << " mm at " << point(r.worst_3sigma_at) << (r.worst_3sigma_flagged ? " [near singular]" : "")
-            << ", worst case up to " << fixed(r.worst_case_mm, 4) << " mm at "
-            << point(r.worst_case_at) << (r.worst_case_flagged ? " [near singular]" : "") << ", resolution up to "
+            << " mm first order at " << point(r.worst_3sigma_at) << (r.worst_3sigma_flagged ? " [near singular]" : "")
+            << ", worst case (nonlinear corners) up to " << fixed(r.worst_case_mm, 4) << " mm at "
+            << point(r.worst_case_at) << (r.worst_case_flagged ? " [near singular]" : "") << " (first order up to "
+            << fixed(r.worst_case_first_order_mm, 4) << " mm at " << point(r.worst_case_first_order_at) << "; "
+            << r.first_order_low_by_10_percent << " regular points where it is > 10 % low), resolution up to "
             << fixed(r.worst_resolution_um, 3)
             << " um per count, play up to " << fixed(r.worst_play_mm, 4) << " mm at " << point(r.worst_play_at);
   if (r.target_not_ok > 0) std::cout << "; " << r.target_not_ok << " points unreachable or singular (no estimate)";
@@ -72,14 +75,18 @@ void print_mechanism(const ToleranceMap& r) {
     }
   }
   const RobustCoverage& c = r.robust;
-  std::cout << "    robust coverage: margin " << fixed(c.margin_mm, 4) << " mm, sigma " << fixed(c.sigma_mm, 4)
-            << " mm per printed device: " << fixed(100.0 * c.fraction, 1) << " % of devices keep "
-            << fixed(c.robust_margin_mm, 4) << " mm (first order, "
+  // The first-order certified margin and the Monte Carlo's fraction and quantile side by side.
+  std::cout << "    robust coverage at " << fixed(100.0 * c.fraction, 1) << " % of printed devices: margin " << fixed(c.margin_mm, 4)
+            << " mm; first order: " << fixed(c.robust_margin_mm, 4) << " mm kept ("
             << (c.robust_certified ? "certified >= " + fixed(c.robust_margin_lower_mm, 4) + " mm" : std::string("sampled, not certified"))
-            << ") -> " << (c.covered ? "covered" : "NOT covered")
-            << " at " << point(c.robust_point) << " (first order: at most " << fixed(100.0 * c.fraction_first_order, 2)
-            << " % cover; Monte Carlo "
-            << fixed(100.0 * c.fraction_monte_carlo, 2) << " % of " << c.samples << ")\n";
+            << ", sigma " << fixed(c.sigma_mm, 4) << " mm at " << point(c.robust_point) << ", at most "
+            << fixed(100.0 * c.fraction_first_order, 2) << " % cover) -> " << (c.covered ? "covered" : "NOT covered");
+  if (c.samples > 0) {
+    std::cout << "; Monte Carlo (" << c.samples << " devices, nonlinear): " << fixed(100.0 * c.fraction_monte_carlo, 2)
+              << " % cover, " << fixed(100.0 * (1.0 - c.fraction), 1) << " % quantile of the margins "
+              << fixed(c.quantile_margin_mm, 4) << " mm";
+  }
+  std::cout << "\n";
   if (c.samples > 0) {
     std::cout << "    Monte Carlo: the " << fixed(100.0 * (1.0 - c.fraction), 1) << " % quantile of the devices' margins "
               << fixed(c.quantile_margin_mm, 4) << " mm, >= "
@@ -201,7 +208,7 @@ void setup_tolerance(CLI::App& app) {
   sub->add_flag("--yes", opt->yes, "Run a Monte Carlo estimated at over an hour or two gigabytes of memory (refused otherwise)");
   sub->footer(
       "Tolerances come from the design's tolerance: section (docs/design-file.md), else from its defaults, which are "
-      "assumptions.\nFiles: <station>-<mechanism>-tolerance.vti (ParaView: three_sigma_mm, worst_case_mm, resolution_um, "
+      "assumptions.\nFiles: <station>-<mechanism>-tolerance.vti (ParaView: three_sigma_first_order_mm, worst_case_first_order_mm, resolution_um, "
       "play_mm, near_singular, status) and <station>-tolerance.svg|.png.\n" +
       exit_status({.ok = "every mechanism covers its target for tolerance.robust_fraction of printed devices",
                    .failed = "one does not"}));

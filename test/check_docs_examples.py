@@ -66,6 +66,7 @@ MASKS = [
     # Design hashes: the scratch copy's lifted wall-time bound (WALL_TIME_BOUNDS) changes the text
     # they hash; the pages show the repository design's.
     (re.compile(r"\bfnv1a64:[0-9a-f]{16}\b"), "fnv1a64:<HASH>"),
+    (re.compile(r"\bsha256:[0-9a-f]{64}\b"), "sha256:<HASH>"),
     (re.compile(r"\b\d{4}-\d\d-\d\d(?:[T ]\d\d:\d\d(?::\d\d(?:\.\d+)?)?(?:Z|[+-]\d\d:?\d\d)?)?"), "<DATE>"),
     (re.compile(r"/tmp/[^\s'\"`),:]*"), "/tmp/<PATH>"),
 ]

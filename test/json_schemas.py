@@ -223,7 +223,7 @@ def main():
     if tol is not None:
         for st in tol["stations"]:
             for m in st["mechanisms"]:
-                if m["target_points_not_ok"] >= m["target_points"] and m["target_worst_3sigma_at_mm"] is not None:
+                if m["target_points_not_ok"] >= m["target_points"] and m["target_worst_3sigma_first_order_at_mm"] is not None:
                     failures.append(f"tolerance, unreachable target: {m['mechanism']}: a worst point where none exists (null)")
     exported = run("export for --check", "export", ["export", DESIGN, "--out", out + "/export-check"])
     if exported is not None:

@@ -272,7 +272,7 @@ TEST_F(CliCalibrate, RunFitsTheBenchFilesAndEveryProductSaysWhatItRestsOn) {
   EXPECT_THAT(mechs[0]["sigmas_from"].get<std::string>(), HasSubstr("bench/calibration.csv"));
   EXPECT_TRUE(mechs[0]["robust_coverage"]["calibrated"].get<bool>());
   EXPECT_FALSE(mechs[1]["calibrated"].get<bool>());
-  EXPECT_LT(mechs[0]["centre_3sigma_mm"].get<double>(), mechs[1]["centre_3sigma_mm"].get<double>());
+  EXPECT_LT(mechs[0]["centre_3sigma_first_order_mm"].get<double>(), mechs[1]["centre_3sigma_first_order_mm"].get<double>());
 }
 
 }  // namespace

@@ -241,7 +241,7 @@ TEST_F(CliWorkspace, RobustCoverageAsksThePrintedDevicesToo) {
   const json& r = m["robust"];
   EXPECT_FALSE(r["covered"].get<bool>());
   EXPECT_GT(r["margin_mm"].get<double>(), 0.0);
-  EXPECT_LT(r["robust_margin_mm"].get<double>(), 0.0);
+  EXPECT_LT(r["robust_margin_first_order_mm"].get<double>(), 0.0);
   EXPECT_LT(r["fraction_monte_carlo"].get<double>(), 0.9);
   EXPECT_LE(r["fraction_monte_carlo"].get<double>(), r["fraction_first_order_at_most"].get<double>() + 0.02);
   // The paper's own target keeps a robust margin.
@@ -249,7 +249,7 @@ TEST_F(CliWorkspace, RobustCoverageAsksThePrintedDevicesToo) {
   EXPECT_EQ(paper.code, 0) << paper.err;
   const json paper_doc = parse(paper);
   for (const json& mech : ft::station(paper_doc, "index")["mechanisms"]) {
-    EXPECT_GT(mech["robust"]["robust_margin_mm"].get<double>(), 0.5);
+    EXPECT_GT(mech["robust"]["robust_margin_first_order_mm"].get<double>(), 0.5);
     EXPECT_EQ(mech["robust"]["fraction_monte_carlo"].get<double>(), 1.0);
   }
 }

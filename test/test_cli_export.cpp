@@ -50,7 +50,7 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   const Outcome r = run({"export", kDesign, "--out", "ctl"});
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.out, AllOf(HasSubstr("export of design iros2022 for node fivebar_controller"),
-                           HasSubstr("design hash fnv1a64:"), HasSubstr("index/lower"), HasSubstr("thumb pivot")));
+                           HasSubstr("design hash sha256:"), HasSubstr("index/lower"), HasSubstr("thumb pivot")));
   EXPECT_THAT(r.out, Not(HasSubstr("FAILED")));
   EXPECT_EQ(listing(dir_ / "ctl"), (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
                                                              "iros2022_controller.yaml", "iros2022_index.urdf",
@@ -67,7 +67,8 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["has_position_limits"].as<bool>(), true);
   EXPECT_NEAR(p["joint_limits"]["index_upper_theta1"]["min_position"].as<double>(), -285.0 * std::numbers::pi / 180, 1e-12);
   EXPECT_NEAR(p["joint_limits"]["index_upper_theta1"]["max_position"].as<double>(), -std::acos(212.25 / 225.0), 1e-12);
-  EXPECT_EQ(p["joint_limits"]["index_upper_theta1"]["max_velocity"].Scalar(), "6.283185307179586");  // 360 deg/s
+  // The motor's steady speed at 6 V less friction (343.5 deg/s), below the controller's 360 deg/s.
+  EXPECT_NEAR(p["joint_limits"]["index_upper_theta1"]["max_velocity"].as<double>() * 180.0 / std::numbers::pi, 343.5, 0.05);
   // The tuned gains of the showcase's controller.stations.index.upper scope, in shortest round-trip form.
   EXPECT_EQ(p["gains"]["index_upper_theta1"]["p"].Scalar(), "6.376242079532782");
   EXPECT_EQ(p["collision"]["priority"].as<std::string>(), "upper");
@@ -76,11 +77,27 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   EXPECT_EQ(j["stations"]["thumb"]["lower"]["link_lengths_m"][3], 0.0175);
   EXPECT_EQ(j["fivebar"]["design_hash"], p["fivebar"]["design_hash"].as<std::string>());
 
-  for (const char* file : {"iros2022_controller.yaml", "iros2022_controller.json", "iros2022_controller.hpp"}) {
+  // Every file export writes reads back through --check (issue 39), the URDF and MJCF included.
+  for (const std::string& file : listing(dir_ / "ctl")) {
     const Outcome c = run({"export", "--check", (dir_ / "ctl" / file).string(), kDesign});
     EXPECT_EQ(c.code, 0) << file << "\n" << c.out << c.err;
     EXPECT_THAT(c.out, AllOf(HasSubstr("the file matches the design"), HasSubstr("(same)")));
   }
+  // A changed motor value: every file is stale, and the URDF names the gearing's key.
+  const fs::path geared = design_with("geared.yaml", "  gear_ratio: 200", "  gear_ratio: 150");
+  for (const std::string& file : listing(dir_ / "ctl")) {
+    const Outcome c = run({"export", "--check", (dir_ / "ctl" / file).string(), geared.string()});
+    EXPECT_EQ(c.code, 1) << file << "\n" << c.out << c.err;
+    EXPECT_THAT(c.out, HasSubstr("STALE")) << file;
+  }
+  const Outcome u = run({"export", "--check", (dir_ / "ctl" / "iros2022_index.urdf").string(), geared.string(), "--json"});
+  EXPECT_EQ(u.code, 1);
+  const json doc = parse(u);
+  EXPECT_EQ(doc["format"], "urdf");
+  std::vector<std::string> paths;
+  for (const auto& d : doc["differences"]) paths.push_back(d["path"].get<std::string>() + ": " + d["expected"].get<std::string>() + " / " + d["found"].get<std::string>());
+  EXPECT_THAT(paths, Contains(std::string("robot/transmission[index_lower_theta1_transmission]/actuator[index_lower_theta1_motor]/"
+                                          "mechanicalReduction[#0]#text: 150 / 200")));
 }
 
 TEST_F(CliExport, JsonOutputAndOneFormatForOneStation) {

@@ -15,6 +15,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <optional>
 #include <limits>
 #include <numbers>
 #include <random>
@@ -30,6 +32,14 @@
 #include "fivebar/sections/print.hpp"
 #include "fivebar/sections/optimize.hpp"
 #include "fivebar/sections/sweep.hpp"
+#include "fivebar/sections/bench.hpp"
+#include "fivebar/sections/contact.hpp"
+#include "fivebar/sections/motor.hpp"
+#include "fivebar/sections/tolerance.hpp"
+#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/export/mjcf.hpp"
+#include "fivebar/export/urdf.hpp"
+#include "fivebar/sha256.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/format.hpp"
@@ -108,16 +118,17 @@ TEST(Hash, Fnv1a64KnownVectors) {
   EXPECT_EQ(format::fnv1a64("foobar"), 0x85944171f73967e8ULL);
 }
 
-TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
+TEST(Hash, Sha256OfTheCanonicalTextOfTheExportedStations) {
   const Design d = paper();
   const std::string h = design_hash(d, {});
-  EXPECT_THAT(h, StartsWith("fnv1a64:"));
-  EXPECT_EQ(h.size(), 8u + 16u);
-  char expected[32];
-  std::snprintf(expected, sizeof expected, "fnv1a64:%016llx",
-                static_cast<unsigned long long>(format::fnv1a64(to_yaml(export_view(d, {})))));
-  EXPECT_EQ(h, expected);
+  EXPECT_THAT(h, StartsWith("sha256:"));
+  EXPECT_EQ(h.size(), 7u + 64u);
+  EXPECT_EQ(h, "sha256:" + sha256_hex(to_yaml(export_view(d, {}))));
   EXPECT_EQ(design_hash(paper(), {}), h);  // deterministic
+  // The view keeps every section but the four no exported byte reads.
+  const Design v = export_view(d, {});
+  EXPECT_TRUE(v.has<PrintSettings>() && v.has<MotorSettings>() && v.has<ContactSettings>() && v.has<ToleranceSettings>());
+  EXPECT_FALSE(v.has<SweepSettings>() || v.has<OptimizeSettings>() || v.has<BenchSettings>() || v.products.has_value());
 
   const auto changed = [&](auto edit) {
     Design e = paper();
@@ -128,9 +139,12 @@ TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
   EXPECT_NE(changed([](Design& e) { e.stations[0].lower->L[2] = 15.25; }), h);
   EXPECT_NE(changed([](Design& e) { e.get<PatternSettings>()->global[0].amplitude_mm = 2.5; }), h);
   EXPECT_NE(changed([](Design& e) { e.get<Geometry>()->min_clearance = 0.25; }), h);
-  // Printing, sweeping and the product list do not make a controller file stale.
-  EXPECT_EQ(changed([](Design& e) { e.get<PrintSettings>()->fn = 24; }), h);
+  // Issue 39: the motor and the resin change the URDF and the MJCF, hence the hash.
+  EXPECT_NE(changed([](Design& e) { e.get<MotorSettings>()->defaults.gear_ratio = 150.0; }), h);
+  EXPECT_NE(changed([](Design& e) { e.get<PrintSettings>()->density_g_cm3 = 2.0; }), h);
+  // Sweeping, optimising and the product list do not make a controller file stale.
   EXPECT_EQ(changed([](Design& e) { e.reset<SweepSettings>(); }), h);
+  EXPECT_EQ(changed([](Design& e) { e.reset<OptimizeSettings>(); }), h);
   EXPECT_EQ(changed([](Design& e) { e.products = std::vector<std::string>{"export"}; }), h);
   // A one-station export hashes its station only: the thumb's gains do not touch it.
   const std::string index_only = design_hash(d, {"index"});
@@ -141,6 +155,82 @@ TEST(Hash, FollowsWhatTheControllerDependsOnOnly) {
   e.get<ControllerSettings>()->overrides.push_back(o);
   EXPECT_EQ(design_hash(e, {"index"}), index_only);
   EXPECT_NE(design_hash(e, {}), h);
+}
+
+/// Every byte `fivebar export` writes for the whole design but the gate's measured figures
+/// (fivebar.validation, a function of the same design): the three controller formats and the URDF
+/// and MJCF of every station, each with its design hash replaced by a placeholder.
+std::string exported_bytes_without_hash(const Design& d) {
+  const auto unstamped = [](std::string text, const std::string& hash) {
+    for (std::size_t at = text.find(hash); at != std::string::npos; at = text.find(hash, at)) text.replace(at, hash.size(), "HASH");
+    return text;
+  };
+  std::string out;
+  const Json tree = controller_parameters(d, {});
+  for (ExportFormat f : all_export_formats()) out += unstamped(render(f, tree), design_hash(d, {}));
+  for (const Station& s : d.stations) {
+    out += unstamped(render_urdf(d, s), design_hash(d, {s.name}));
+    out += unstamped(render_mjcf(d, s), design_hash(d, {s.name}));
+  }
+  return out;
+}
+
+/// Every number of a YAML tree, as "a.b[2].c" (the showcase's names are plain words).
+void yaml_numbers(const YAML::Node& node, const std::string& path, std::vector<std::string>& out) {
+  if (node.IsMap()) {
+    for (const auto& e : node) yaml_numbers(e.second, path + (path.empty() ? "" : ".") + e.first.as<std::string>(), out);
+  } else if (node.IsSequence()) {
+    for (std::size_t i = 0; i < node.size(); ++i) yaml_numbers(node[i], path + "[" + std::to_string(i) + "]", out);
+  } else if (node.IsScalar()) {
+    double v = 0.0;
+    if (node.Tag() != "!" && YAML::convert<double>::decode(node, v)) out.push_back(path);
+  }
+}
+
+// Issue 39 "a hash that covers what it certifies": every number of the showcase, perturbed one at a
+// time; whenever an exported file changes (hash aside), the hash changes. The keys come from the
+// design writer (design_number_keys, defaults included); that the writer leaves out no number of
+// the file itself is checked against yaml-cpp's own reading of designs/iros2022.yaml.
+TEST(Hash, ChangesWheneverAnExportedFileChangesForEveryNumberOfTheShowcase) {
+  const Design d = paper();
+  const std::vector<std::string> keys = design_number_keys(d, "");
+  std::vector<std::string> in_file;
+  yaml_numbers(YAML::LoadFile((kSource / "designs" / "iros2022.yaml").string()), "", in_file);
+  ASSERT_GT(in_file.size(), 100u);
+  for (const std::string& k : in_file) EXPECT_THAT(keys, Contains(k)) << "the design writer drops " << k;
+
+  const std::string bytes = exported_bytes_without_hash(d);
+  const std::string hash = design_hash(d, {});
+  int changed_files = 0, unchanged_files = 0, untried = 0;
+  for (const std::string& key : keys) {
+    const double v = design_number(d, key);
+    // The first perturbation the loader accepts (integers and ranges refuse some).
+    std::optional<Design> e;
+    for (double to : {v * (1.0 + 1e-3) + (v == 0.0 ? 1e-3 : 0.0), v + 1.0, v - 1.0, v * (1.0 - 1e-3), v + 0.5}) {
+      try {
+        e = with_design_numbers(d, {{key, to}});
+        break;
+      } catch (const std::exception&) {
+      }
+    }
+    if (!e) {
+      ++untried;
+      ADD_FAILURE() << key << " = " << v << ": no perturbation loads";
+      continue;
+    }
+    const bool files_change = exported_bytes_without_hash(*e) != bytes;
+    const bool hash_changes = design_hash(*e, {}) != hash;
+    (files_change ? changed_files : unchanged_files)++;
+    if (files_change) EXPECT_TRUE(hash_changes) << key << ": an exported file changes, the hash does not";
+    // What the view leaves out changes no exported byte.
+    if (key.starts_with("sweep.") || key.starts_with("optimize.") || key.starts_with("bench.")) {
+      EXPECT_FALSE(files_change) << key;
+      EXPECT_FALSE(hash_changes) << key;
+    }
+  }
+  std::cout << keys.size() << " numbers: " << changed_files << " change an exported file, " << unchanged_files
+            << " do not, " << untried << " could not be perturbed\n";
+  EXPECT_GT(changed_files, 50);
 }
 
 // --- The parameter tree against the design --------------------------------------------------------
@@ -176,14 +266,18 @@ TEST(Parameters, HoldThePapersDeviceInSiUnits) {
   EXPECT_EQ(index.at("upper").at("working_mode"), "+-");
   EXPECT_EQ(index.at("upper").at("assembly_mode"), "-");
   // The showcase: limits from the hardware (below the boss of O1 at 180 deg + acos(212.25 / 225),
-  // above the potentiometer's end: 3.25 V at 0 deg, 60 deg/V over 0 ... 5 V); 360 deg/s; pots 5 V
+  // above the potentiometer's end: 3.25 V at 0 deg, 60 deg/V over 0 ... 5 V); 343.5 deg/s; pots 5 V
   // over 300 deg; mid-travel offsets.
   const Json& lim = p.at("joint_limits").at("thumb_upper_theta2");
   EXPECT_EQ(lim.at("has_position_limits"), true);
   EXPECT_NEAR(lim.at("min_position").get<double>(), -kPi + std::acos(212.25 / 225.0), 1e-12);
   EXPECT_NEAR(lim.at("max_position").get<double>(), deg(105), 1e-12);
   EXPECT_EQ(lim.at("has_velocity_limits"), true);
-  EXPECT_DOUBLE_EQ(lim.at("max_velocity").get<double>(), 2.0 * kPi);
+  // The one joint speed: below the controller's 360 deg/s, the assumed motor's steady speed at 6 V
+  // less its friction, (eta N k_t V / R - tau_c) / (eta N^2 k_t k_e / R + b) from motor: typed here.
+  const double ke_out = 0.5235987755982988e-3 * 60.0 / (2.0 * kPi) * 200.0;  // V s/rad at the output
+  const double free_speed = (0.7 * 200.0 * 0.005 * 6.0 / 5.0 - 0.5e-3) / (0.7 * 200.0 * 0.005 * ke_out / 5.0 + 0.01e-3);
+  EXPECT_NEAR(lim.at("max_velocity").get<double>(), free_speed, 1e-12 * free_speed);
   // Gains: the station-mechanism scope of the tuned gains (controller.stations.index.lower.pid) over the
   // section's pid, whose i_clamp 0.2 it keeps.
   EXPECT_EQ(p.at("gains").at("index_lower_theta1"),
@@ -468,6 +562,12 @@ TEST(Gate, ThePapersDevicePassesEveryCheck) {
                                "index stretch pattern", "thumb pivot pattern"}) {
     EXPECT_THAT(kinds, Contains(std::string(expected)));
   }
+  // The patterns are checked against the one joint speed (JointSpeed below), not the controller's 360 deg/s.
+  const std::string limit = "(limit " + format::fixed(motor_free_speed(paper().get<MotorSettings>()->defaults) * 180.0 / kPi, 1) + ")";
+  EXPECT_EQ(limit, "(limit 343.5)");
+  for (const GateCheck& c : g.checks) {
+    if (c.kind == "pattern") EXPECT_THAT(c.detail, HasSubstr(limit)) << c.subject;
+  }
   // Joint ranges over the index ellipse, against an independent boundary walk with ik().
   const Design d = paper();  // owned here: a Station reference into a temporary would dangle
   const Station& s = d.stations[0];
@@ -482,6 +582,57 @@ TEST(Gate, ThePapersDevicePassesEveryCheck) {
   ASSERT_NE(it, g.joints.end());
   EXPECT_NEAR(it->lo, lo, 1e-3);
   EXPECT_NEAR(it->hi, hi, 1e-3);
+}
+
+// Issue 39 "one joint speed": the motor's steady speed at full duty against a bisection of its
+// torque balance (a second formulation, with the driver's current limit), and that one number in
+// the three controller formats and the URDF of every station.
+TEST(JointSpeed, OneValueFromTheMotorInEveryExportedFile) {
+  const Design d = paper();
+  const MotorParams p = d.get<MotorSettings>()->defaults;
+  const auto balance = [](const MotorParams& q, double w) {
+    const double i = std::min((q.supply_voltage_V - q.back_emf_constant() * q.gear_ratio * w) / q.resistance(), q.current_limit_A);
+    return q.gearbox_efficiency * q.gear_ratio * q.torque_constant() * i - q.viscous_friction() * w - q.coulomb_friction();
+  };
+  const auto bisect = [&](const MotorParams& q) {
+    if (balance(q, 0.0) <= 0.0) return 0.0;
+    double lo = 0.0, hi = q.supply_voltage_V / (q.back_emf_constant() * q.gear_ratio);
+    for (int k = 0; k < 200; ++k) (balance(q, 0.5 * (lo + hi)) > 0.0 ? lo : hi) = 0.5 * (lo + hi);
+    return 0.5 * (lo + hi);
+  };
+  const double no_load = p.supply_voltage_V / (p.back_emf_constant() * p.gear_ratio);
+  EXPECT_NEAR(motor_free_speed(p), bisect(p), 1e-12);
+  EXPECT_LT(motor_free_speed(p), no_load);
+  EXPECT_NEAR(no_load * 180.0 / kPi, 343.77, 0.01);  // V / (k_e N): 6 V, 5 mV s/rad, 200
+  EXPECT_NEAR(motor_free_speed(p) * 180.0 / kPi, 343.5, 0.05);
+  MotorParams limited = p;  // a driver limit that binds before the speed settles
+  limited.terminal_resistance_ohm = 0.05;
+  limited.viscous_friction_mNm_s_per_rad = 100.0;
+  limited.current_limit_A = 0.2;
+  EXPECT_NEAR(motor_free_speed(limited), bisect(limited), 1e-9);
+  EXPECT_NEAR(motor_free_speed(limited), (0.7 * 0.2 - 0.0005) / 0.1, 1e-12);
+  limited.coulomb_friction_mNm = 1e6;  // friction holds it at rest
+  EXPECT_EQ(motor_free_speed(limited), 0.0);
+
+  const double v = std::min(d.get<ControllerSettings>()->max_velocity, motor_free_speed(p));
+  EXPECT_EQ(station_joint_speed_limit(d, *d.station("index")), v);
+  const Json tree = controller_parameters(d, {});
+  for (ExportFormat f : all_export_formats()) {
+    const Json back = parse_export(f, render(f, tree), "f");
+    ASSERT_EQ(params_of(back).at("joint_limits").size(), 8u);
+    for (const auto& [joint, lim] : params_of(back).at("joint_limits").items()) {
+      EXPECT_EQ(lim.at("max_velocity").get<double>(), v) << to_string(f) << " " << joint;
+    }
+  }
+  for (const Station& s : d.stations) {
+    const std::string urdf = render_urdf(d, s);
+    const std::regex velocity("velocity=\"([^\"]+)\"");
+    int found = 0;
+    for (auto it = std::sregex_iterator(urdf.begin(), urdf.end(), velocity); it != std::sregex_iterator(); ++it, ++found) {
+      EXPECT_EQ(std::strtod((*it)[1].str().c_str(), nullptr), v) << s.name;
+    }
+    EXPECT_EQ(found, 4) << s.name;  // the four motor joints
+  }
 }
 
 TEST(Gate, SingularityThresholdAgainstTheLciAtTheEllipsesBottom) {
@@ -607,7 +758,7 @@ TEST_F(ExportFiles, AllFormatsWrittenAndReadBackEqual) {
     const ExportCheck c = check_export_file(r.files[i], d);
     EXPECT_TRUE(c.matches()) << to_string(f);
     EXPECT_TRUE(c.hash_matches());
-    EXPECT_EQ(c.format, f);
+    EXPECT_EQ(c.format, to_string(f));
   }
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(dir_ / "out")) names.push_back(e.path().filename().string());
@@ -716,6 +867,62 @@ TEST(Check, AStaleFileIsReportedByHashAndValue) {
   // A one-station file is compared with that station's export.
   const std::string index = render_json(controller_parameters(paper(), {"index"}));
   EXPECT_TRUE(check_export(index, ExportFormat::json, paper(), "i.json").matches());
+}
+
+// Issue 39: --check reads every format export writes, and a changed motor value is named.
+TEST(Check, EveryFormatExportWritesRoundTripsAndAChangedGearRatioIsNamed) {
+  const Design d = paper();
+  Design geared = paper();
+  geared.get<MotorSettings>()->defaults.gear_ratio = 150.0;
+  const Json tree = controller_parameters(d, {});
+  for (ExportFormat f : all_export_formats()) {
+    const ExportCheck same = check_export(render(f, tree), f, d, "f");
+    EXPECT_TRUE(same.matches()) << to_string(f);
+    const ExportCheck stale = check_export(render(f, tree), f, geared, "f");
+    ASSERT_FALSE(stale.matches()) << to_string(f);
+    EXPECT_EQ(stale.differences.front().path, "fivebar_controller.ros__parameters.fivebar.design_hash");
+  }
+  const auto paths = [](const ExportCheck& c) {
+    std::vector<std::string> out;
+    for (const ExportDifference& x : c.differences) out.push_back(x.path + " = " + x.found + " (design " + x.expected + ")");
+    return out;
+  };
+  for (const Station& s : d.stations) {
+    const std::string urdf = render_urdf(d, s), mjcf = render_mjcf(d, s);
+    const ExportCheck u = check_robot_export(urdf, d, "f.urdf");
+    EXPECT_EQ(u.format, "urdf");
+    EXPECT_EQ(u.stations, std::vector<std::string>{s.name});
+    EXPECT_EQ(u.file_hash, design_hash(d, {s.name}));
+    EXPECT_TRUE(u.matches()) << ::testing::PrintToString(paths(u));
+    const ExportCheck x = check_robot_export(mjcf, d, "f.xml");
+    EXPECT_EQ(x.format, "mjcf");
+    EXPECT_TRUE(x.matches()) << ::testing::PrintToString(paths(x));
+
+    const ExportCheck ug = check_robot_export(urdf, geared, "f.urdf");
+    ASSERT_FALSE(ug.matches());
+    EXPECT_EQ(ug.differences.front().path, "(stamp) design hash");
+    const std::string joint = s.name + "_lower_theta1";
+    EXPECT_THAT(paths(ug), Contains(HasSubstr("mechanicalReduction[#0]#text = 200 (design 150)")));
+    const ExportCheck xg = check_robot_export(mjcf, geared, "f.xml");
+    ASSERT_FALSE(xg.matches());
+    EXPECT_THAT(paths(xg), Contains(HasSubstr("joint[" + joint + "]@armature")));
+  }
+  // A value changed in the file is named with its key; the hash alone still matches.
+  const Station& index = *d.station("index");
+  std::string urdf = render_urdf(d, index);
+  const std::string from = "<mechanicalReduction>200</mechanicalReduction>";
+  ASSERT_NE(urdf.find(from), std::string::npos);
+  urdf.replace(urdf.find(from), from.size(), "<mechanicalReduction>100</mechanicalReduction>");
+  const ExportCheck edited = check_robot_export(urdf, d, "f.urdf");
+  EXPECT_TRUE(edited.hash_matches());
+  ASSERT_EQ(edited.differences.size(), 1u);
+  EXPECT_EQ(edited.differences[0].expected, "200");
+  EXPECT_EQ(edited.differences[0].found, "100");
+  EXPECT_THAT(edited.differences[0].path, AllOf(StartsWith("robot/transmission["), HasSubstr("mechanicalReduction")));
+  EXPECT_THAT([&] { check_robot_export("<robot><link name=\"a\"></robot>", d, "x.urdf"); },
+              ThrowsMessage<InputError>(StartsWith("x.urdf:1: not an XML document fivebar export writes")));
+  EXPECT_THAT([&] { check_robot_export("<robot/>", d, "x.urdf"); },
+              ThrowsMessage<InputError>(HasSubstr("no comment \"Generated by fivebar")));
 }
 
 TEST(Check, MissingAndExtraKeysAndForeignFiles) {

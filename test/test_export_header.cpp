@@ -84,7 +84,8 @@ TEST(ExportedHeader, EveryCompiledValueEqualsTheDesign) {
     EXPECT_EQ(hj.has_position_limits,
               with_usable_limits(d, *d.station(hm.station)).mechanism(hm.name)->joint_limits.has_value());
     EXPECT_TRUE(hj.has_velocity_limits);
-    EXPECT_EQ(hj.max_velocity, c.max_velocity);
+    EXPECT_EQ(hj.max_velocity, joint_speed_limit(d, *d.station(hm.station), *d.station(hm.station)->mechanism(hm.name),
+                                                 int(i % 2) + 1));
   }
   EXPECT_EQ(v.collision_priority, "upper");
   EXPECT_EQ(v.min_clearance, d.get<Geometry>()->min_clearance / 1000);
@@ -97,7 +98,7 @@ TEST(ExportedHeader, EveryCompiledValueEqualsTheDesign) {
 TEST(ExportedHeader, TheGeneratedFilePassesCheck) {
   const Design d = load_design(kSource / "designs" / "iros2022.yaml");
   const ExportCheck c = check_export_file(FIVEBAR_EXPORTED_HEADER, d);
-  EXPECT_EQ(c.format, ExportFormat::header);
+  EXPECT_EQ(c.format, "header");
   EXPECT_TRUE(c.matches()) << ::testing::PrintToString(c.differences.size());
 }
 

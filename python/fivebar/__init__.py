@@ -193,9 +193,10 @@ class Simulation(Record):
 
 
 class ToleranceMap(Record):
-    """One mechanism's tolerance study (fivebar tolerance): grid, fields (status, three_sigma_mm,
-    worst_case_mm, resolution_um, play_mm: 2-D views), robust_covered, robust_margin_mm,
-    worst_3sigma_mm, worst_case_mm."""
+    """One mechanism's tolerance study (fivebar tolerance): grid, fields (status, three_sigma_mm and
+    worst_case_first_order_mm, first order; resolution_um, play_mm: 2-D views), robust_covered,
+    robust_margin_mm (first order), worst_3sigma_mm (first order), worst_case_mm (the +-3 sigma
+    corner on the real kinematics) beside worst_case_first_order_mm."""
 
     __slots__ = ()
 

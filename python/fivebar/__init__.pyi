@@ -231,6 +231,7 @@ class ToleranceMap(Record):
     robust_margin_mm: float
     worst_3sigma_mm: float
     worst_case_mm: float
+    worst_case_first_order_mm: float
 
 class ControlStudy(Record):
     station: str

@@ -481,7 +481,7 @@ py::list tolerance(const Design& design, const std::string& station, double spac
     py::dict fields;
     fields["status"] = view(map, map->field_status.data(), shape);
     fields["three_sigma_mm"] = view(map, map->field_3sigma_mm.data(), shape);
-    fields["worst_case_mm"] = view(map, map->field_worst_case_mm.data(), shape);
+    fields["worst_case_first_order_mm"] = view(map, map->field_worst_case_mm.data(), shape);
     fields["resolution_um"] = view(map, map->field_resolution_um.data(), shape);
     fields["play_mm"] = view(map, map->field_play_mm.data(), shape);
     d["fields"] = fields;
@@ -489,6 +489,7 @@ py::list tolerance(const Design& design, const std::string& station, double spac
     d["robust_margin_mm"] = map->robust.robust_margin_mm;
     d["worst_3sigma_mm"] = map->worst_3sigma_mm;
     d["worst_case_mm"] = map->worst_case_mm;
+    d["worst_case_first_order_mm"] = map->worst_case_first_order_mm;
     d["summary"] = to_python(to_json(*map));
     out.append(d);
   }

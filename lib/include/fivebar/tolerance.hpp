@@ -405,8 +405,18 @@ struct ToleranceMap {
   double centre_monte_carlo_3sigma_mm = 0.0;
   PlaySet centre_play;
   std::size_t target_points = 0, target_not_ok = 0;
-  double worst_3sigma_mm = 0.0, worst_case_mm = 0.0, worst_resolution_um = 0.0, worst_play_mm = 0.0;
-  Vec2 worst_3sigma_at{0.0, 0.0}, worst_case_at{0.0, 0.0}, worst_resolution_at{0.0, 0.0}, worst_play_at{0.0, 0.0};
+  /// The headline worst case at the centre: the +-3 sigma corners on the real (nonlinear)
+  /// kinematics (tolerance_corners()); centre.worst_case_mm beside it is its first-order estimate.
+  CornerEnumeration centre_corners;
+  /// worst_3sigma: the first-order 3-sigma ellipse's major semi-axis. worst_case: the nonlinear
+  /// +-3 sigma corners (tolerance_corners()) at every regular target point, the largest;
+  /// worst_case_first_order: the first-order corner (ToleranceEstimate::worst_case_mm), the largest.
+  double worst_3sigma_mm = 0.0, worst_case_mm = 0.0, worst_case_first_order_mm = 0.0, worst_resolution_um = 0.0,
+         worst_play_mm = 0.0;
+  Vec2 worst_3sigma_at{0.0, 0.0}, worst_case_at{0.0, 0.0}, worst_case_first_order_at{0.0, 0.0},
+      worst_resolution_at{0.0, 0.0}, worst_play_at{0.0, 0.0};
+  /// Target points where the nonlinear corner exceeds the first-order one by more than 10 %.
+  std::size_t first_order_low_by_10_percent = 0;
   std::vector<Vec2> target_points_mm;                  ///< the target grid's points
   std::vector<ToleranceEstimate> target_estimates;     ///< first order at each of them
   /// The target points where the first order is flagged (near_singular), with the Monte Carlo
@@ -419,7 +429,8 @@ struct ToleranceMap {
     CornerEnumeration corners;
   };
   std::vector<Flagged> near_singular;
-  bool worst_3sigma_flagged = false, worst_case_flagged = false;  ///< the reported worst point is flagged
+  bool worst_3sigma_flagged = false, worst_case_flagged = false,  ///< the reported worst point is flagged
+      worst_case_first_order_flagged = false;
   RobustCoverage robust;
   std::string spread_source;  ///< ToleranceSources::spread_source
   bool calibrated = false;    ///< the sigmas are (partly) a calibration's posterior covariance
@@ -442,7 +453,7 @@ Json to_json(const ToleranceMap& map);
 RenderedPlot plot_tolerance(const Station& station, const std::vector<ToleranceMap>& maps);
 
 /// The files of a station's maps, name and bytes: `<station>-<mechanism>-tolerance.vti` per map
-/// (ParaView: three_sigma_mm, worst_case_mm, resolution_um, play_mm, near_singular, status) and
+/// (ParaView: three_sigma_first_order_mm, worst_case_first_order_mm, resolution_um, play_mm, near_singular, status) and
 /// `<station>-tolerance.svg`, `.png`.
 std::vector<std::pair<std::string, std::string>> tolerance_files(const Station& station,
                                                                  const std::vector<ToleranceMap>& maps);

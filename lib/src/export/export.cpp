@@ -7,10 +7,15 @@
 #include "fivebar/provenance.hpp"
 #include "fivebar/export/mjcf.hpp"
 #include "fivebar/sections/tolerance.hpp"
+#include "fivebar/sections/bench.hpp"
+#include "fivebar/sections/optimize.hpp"
+#include "fivebar/sections/sweep.hpp"
+#include "fivebar/sha256.hpp"
 #include "fivebar/tolerance.hpp"
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -401,7 +406,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
           continue;
         }
         say(options, "export gate: pattern " + subject);
-        const PatternResult r = check_pattern(s, *d.get<Geometry>(), spec, d.get<PatternSettings>()->max_joint_speed);
+        const PatternResult r = check_pattern(s, *d.get<Geometry>(), spec, station_joint_speed_limit(d, s));
         if (r.passed) {
           add("pattern", subject, true,
               "renderable: " + std::to_string(r.samples.size()) + " samples, peak motor speed " +
@@ -467,26 +472,29 @@ Json to_json(const ExportGate& gate) {
 Design export_view(const Design& d, const std::vector<std::string>& wanted) {
   const std::vector<std::string> stations = chosen_stations(d, wanted);
   const auto kept = [&](const std::string& s) { return std::find(stations.begin(), stations.end(), s) != stations.end(); };
-  Design v;
-  v.name = d.name;
-  for (const Station& s : d.stations) {
-    if (kept(s.name)) v.stations.push_back(s);
+  // Every section stays (kinematics, geometry, print, patterns, controller, motor, contact,
+  // tolerance, provenance, ...) but the three no exported byte or gate figure reads: sweep: and
+  // optimize: (studies that propose designs) and bench: (the bench files' names; what was fitted
+  // from them is in the design's values and provenance:). `products:` only chooses what `fivebar
+  // run` builds. test_export's walk over every number of the showcase holds this list.
+  Design v = d;
+  v.source.clear();
+  v.products.reset();
+  v.reset<SweepSettings>();
+  v.reset<OptimizeSettings>();
+  v.reset<BenchSettings>();
+  std::erase_if(v.stations, [&](const Station& s) { return !kept(s.name); });
+  if (PatternSettings* p = v.get<PatternSettings>()) {
+    std::erase_if(p->overrides, [&](const PatternOverride& o) { return !kept(o.station); });
   }
-  if (const Geometry* g = d.get<Geometry>()) v.set(*g);
-  if (const PatternSettings* p = d.get<PatternSettings>()) {
-    std::erase_if(v.set(*p).overrides, [&](const PatternOverride& o) { return !kept(o.station); });
-  }
-  if (const ControllerSettings* c = d.get<ControllerSettings>()) {
-    std::erase_if(v.set(*c).overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
+  if (ControllerSettings* c = v.get<ControllerSettings>()) {
+    std::erase_if(c->overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
   }
   return v;
 }
 
 std::string design_hash(const Design& d, const std::vector<std::string>& stations) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "fnv1a64:%016llx",
-                static_cast<unsigned long long>(format::fnv1a64(to_yaml(export_view(d, stations)))));
-  return buffer;
+  return "sha256:" + sha256_hex(to_yaml(export_view(d, stations)));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -501,7 +509,7 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
   Json p = Json::object();
   p["fivebar"] = {{"design", d.name},
                   {"design_hash", design_hash(d, stations)},
-                  {"hash_algorithm", "fnv1a64 of the canonical design text (fivebar/export/export.hpp)"},
+                  {"hash_algorithm", "sha256 of the canonical design text (fivebar/export/export.hpp)"},
                   {"tool_version", std::string(version())},
                   {"format_version", kFormatVersion},
                   {"units", "SI (REP 103): m, rad, s, V, Hz"}};
@@ -548,7 +556,7 @@ Json controller_parameters(const Design& d, const std::vector<std::string>& want
           lim["max_position"] = branch[j - 1].hi();
         }
         lim["has_velocity_limits"] = true;
-        lim["max_velocity"] = c.max_velocity;
+        lim["max_velocity"] = joint_speed_limit(d, s, *m, j);  // the one joint speed (fivebar/export/joint_limits.hpp)
         lim["has_acceleration_limits"] = false;
         lim["has_jerk_limits"] = false;
         lim["has_effort_limits"] = false;
@@ -741,7 +749,7 @@ ExportCheck check_export(const std::string& text, ExportFormat format, const Des
   };
 
   ExportCheck check;
-  check.format = format;
+  check.format = std::string(to_string(format));
   check.file_design = info_string("design");
   check.file_hash = info_string("design_hash");
   check.file_tool_version = info_string("tool_version");
@@ -770,6 +778,12 @@ ExportCheck check_export_file(const std::filesystem::path& file, const Design& d
   text << in.rdbuf();
   if (!in && !in.eof()) throw InputError(file.string() + ": cannot read the file");
   const std::string content = text.str();
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  const auto first = content.find_first_not_of(" \t\r\n");
+  if (ext == ".urdf" || ext == ".xml" || (first != std::string::npos && content[first] == '<')) {
+    return check_robot_export(content, d, file.string());
+  }
   return check_export(content, detect_export_format(file, content), d, file.string());
 }
 

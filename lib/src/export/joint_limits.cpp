@@ -334,3 +334,37 @@ std::vector<GateCheck> hardware_limit_checks(const Design& design, const Station
 }
 
 }  // namespace fivebar
+
+namespace fivebar {
+
+double motor_free_speed(const MotorParams& p) {
+  const double gain = p.gearbox_efficiency * p.gear_ratio * p.torque_constant();  // output torque per ampere
+  const double ke = p.back_emf_constant() * p.gear_ratio;                         // back-emf per output rad/s
+  const double tau_c = p.coulomb_friction(), b = p.viscous_friction();
+  double w = (gain * p.supply_voltage_V / p.resistance() - tau_c) / (gain * ke / p.resistance() + b);
+  if ((p.supply_voltage_V - ke * w) / p.resistance() > p.current_limit_A && b > 0.0) {
+    w = (gain * p.current_limit_A - tau_c) / b;  // the driver's limit binds before the speed settles
+  }
+  return std::max(w, 0.0);
+}
+
+double joint_speed_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint) {
+  const ControllerSettings* controller = design.get<ControllerSettings>();
+  const MotorSettings* motors = design.get<MotorSettings>();
+  double v = controller != nullptr ? controller->max_velocity : 0.0;
+  if (motors != nullptr) {
+    const double motor = motor_free_speed(motors->joint(station.name, mechanism.name, joint));
+    v = controller != nullptr ? std::min(v, motor) : motor;
+  }
+  return v;
+}
+
+double station_joint_speed_limit(const Design& design, const Station& station) {
+  double v = std::numeric_limits<double>::infinity();
+  for (const Mechanism* m : station.mechanisms()) {
+    for (int j = 1; j <= 2; ++j) v = std::min(v, joint_speed_limit(design, station, *m, j));
+  }
+  return std::isfinite(v) ? v : 0.0;
+}
+
+}  // namespace fivebar

@@ -86,15 +86,7 @@ std::string xyz(double x_mm, double y_mm, double z_mm) { return "xyz=\"" + m(x_m
 std::string urdf_file_name(const Design& design, const Station& station) { return design.name + "_" + station.name + ".urdf"; }
 
 double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint) {
-  const ControllerSettings* controller = design.get<ControllerSettings>();
-  const MotorSettings* motors = design.get<MotorSettings>();
-  double v = controller != nullptr ? controller->max_velocity : 0.0;
-  if (motors != nullptr) {
-    const MotorParams p = motors->joint(station.name, mechanism.name, joint);
-    const double no_load = p.supply_voltage_V / (p.back_emf_constant() * p.gear_ratio);
-    v = controller != nullptr ? std::min(v, no_load) : no_load;
-  }
-  return v;
+  return joint_speed_limit(design, station, mechanism, joint);  // the one joint speed (fivebar/export/joint_limits.hpp)
 }
 
 std::string render_urdf(const Design& design, const Station& station, const UrdfOptions& options) {
@@ -197,8 +189,8 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
                        (motors != nullptr ? "; effort: the stall torque at the output, eta N k_t min(V_supply / R, I_limit) "
                                             "(motor: section); damping and friction at the output shaft"
                                           : "; effort 0: the design has no motor: section") +
-                       "; velocity: the smaller of controller.max_velocity_deg_s and the motor's no-load speed at the "
-                       "output, V_supply / (k_e N).");
+                       "; velocity: the smaller of controller.max_velocity_deg_s and the motor's steady speed at the "
+                       "supply voltage less what friction takes (the same value as the controller files and the export gate).");
       w.line(1, "<joint name=\"" + format::xml_escape(r.joint) + "\" type=\"" + (r.limited ? "revolute" : "continuous") + "\">");
       w.line(2, "<parent link=\"" + format::xml_escape(base) + "\"/>");
       w.line(2, "<child link=\"" + format::xml_escape(prefix + "_L" + std::to_string(j)) + "\"/>");

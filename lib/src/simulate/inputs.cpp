@@ -10,6 +10,7 @@
 #include "fivebar/numerics.hpp"
 #include "fivebar/pattern.hpp"
 #include "fivebar/export/export.hpp"
+#include "fivebar/export/joint_limits.hpp"
 #include "fivebar/runtime/json_config.hpp"
 
 namespace fivebar {
@@ -204,7 +205,7 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
   for (PatternSpec spec : specs) {
     if (request.pattern && spec.kind != *request.pattern) continue;
     spec.rate_hz = rate;  // the controller samples the pattern
-    const PatternResult pr = check_pattern(station, g, spec, controller.max_velocity);
+    const PatternResult pr = check_pattern(station, g, spec, station_joint_speed_limit(design, station));
     SimulationInput in = make(std::string(to_string(spec.kind)));
     for (const PatternSample& s : pr.samples) {
       for (const TactorSample* ts : {&s.lower, &s.upper}) {

@@ -47,10 +47,10 @@ Product tolerance_product() {
   };
   p.build = [](Context& ctx) {
     const Design& d = ctx.design;
-    md::Table table({"station", "mechanism", "3σ at centre (mm)", "Monte Carlo (mm)", "worst 3σ (mm)",
-                     "worst case (mm)", "play (mm)", "resolution (µm/count)", "margin (mm)", "robust margin (mm)",
-                     "devices covering (MC)", "MC margin quantile (mm)"},
-                    "llrrrrrrrrrr");
+    md::Table table({"station", "mechanism", "3σ at centre, first order (mm)", "Monte Carlo (mm)", "worst 3σ, first order (mm)",
+                     "worst case, nonlinear corners (mm)", "worst case, first order (mm)", "play (mm)", "resolution (µm/count)",
+                     "margin (mm)", "robust margin, first order (mm)", "devices covering (MC)", "MC margin quantile (mm)"},
+                    "llrrrrrrrrrrr");
     std::string flagged_md, calibrated_md;
     Json stations = Json::array();
     std::vector<std::string> failed, pictures;
@@ -72,7 +72,9 @@ Product tolerance_product() {
         if (!map.robust.covered) failed.push_back(s.name + "/" + map.mechanism);
         table.row({s.name, map.mechanism, md::fixed(map.centre.ellipse_semi_axes.x(), 3),
                    md::fixed(map.centre_monte_carlo_3sigma_mm, 3), md::fixed(map.worst_3sigma_mm, 3),
-                   (map.worst_case_flagged ? "⚠ " : "") + md::fixed(map.worst_case_mm, 3), md::fixed(map.worst_play_mm, 3),
+                   (map.worst_case_flagged ? "⚠ " : "") + md::fixed(map.worst_case_mm, 3),
+                   (map.worst_case_first_order_flagged ? "⚠ " : "") + md::fixed(map.worst_case_first_order_mm, 3),
+                   md::fixed(map.worst_play_mm, 3),
                    md::fixed(map.worst_resolution_um, 2), md::fixed(map.robust.margin_mm, 3),
                    (map.robust.covered ? "" : "✗ ") + md::fixed(map.robust.robust_margin_mm, 3),
                    md::fixed(100.0 * map.robust.fraction_monte_carlo, 2) + " % of " +

@@ -152,8 +152,8 @@ RenderedPlot plot_tolerance(const Station& s, const std::vector<ToleranceMap>& m
       axes(cr, panel, b, 2.0);
       colour_bar(cr, x0, y0 + kPanel + 28.0, top, "mm");
       text(cr, x0 + 40.0, y0 + kPanel + 56.0,
-           "worst over the target " + fixed(map.worst_3sigma_mm, 3) + " mm (red dot); worst case " +
-               fixed(map.worst_case_mm, 3) + " mm",
+           "worst over the target " + fixed(map.worst_3sigma_mm, 3) + " mm first order (red dot); worst case " +
+               fixed(map.worst_case_mm, 3) + " mm nonlinear (first order " + fixed(map.worst_case_first_order_mm, 3) + ")",
            10.5, kInk);
       if (!map.near_singular.empty()) {
         double mc = 0.0;
@@ -165,8 +165,8 @@ RenderedPlot plot_tolerance(const Station& s, const std::vector<ToleranceMap>& m
       }
       text(cr, x0 + 40.0, y0 + kPanel + 72.0,
            "robust margin " + fixed(map.robust.robust_margin_mm, 3) + " mm at " +
-               fixed(100.0 * map.robust.fraction, 1) +
-               " % of printed devices",
+               fixed(100.0 * map.robust.fraction, 1) + " % of printed devices (first order)" +
+               (map.robust.samples > 0 ? "; Monte Carlo " + fixed(100.0 * map.robust.fraction_monte_carlo, 2) + " % cover" : std::string()),
            10.5, kInk);
     }
     // (b) Play set extent.

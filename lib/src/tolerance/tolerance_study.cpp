@@ -471,6 +471,7 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
   map.centre_monte_carlo = tolerance_monte_carlo(m, target.center, spread, src.samples, src.seed);
   map.centre_monte_carlo_3sigma_mm = major_3sigma_mm(map.centre_monte_carlo.covariance);
   map.centre_play = tolerance_play(m, target.center, src.leg_play_mm);
+  map.centre_corners = tolerance_corners(m, target.center, spread);
   map.target_points_mm = ellipse_grid(target);
   for (const Vec2& p : map.target_points_mm) {
     ++map.target_points;
@@ -481,22 +482,30 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
       ++map.target_not_ok;
       continue;
     }
+    const CornerEnumeration corners = tolerance_corners(m, p, spread);
     if (e.near_singular) {
       ToleranceMap::Flagged f;
       f.at = p;
       f.first_order = e;
-      f.corners = tolerance_corners(m, p, spread);
+      f.corners = corners;
       map.near_singular.push_back(f);
+    } else if (corners.worst_mm > 1.1 * e.worst_case_mm) {
+      ++map.first_order_low_by_10_percent;
+    }
+    if (corners.status == Status::ok && corners.worst_mm > map.worst_case_mm) {
+      map.worst_case_mm = corners.worst_mm;
+      map.worst_case_at = p;
+      map.worst_case_flagged = e.near_singular;
     }
     if (e.ellipse_semi_axes.x() > map.worst_3sigma_mm) {
       map.worst_3sigma_mm = e.ellipse_semi_axes.x();
       map.worst_3sigma_at = p;
       map.worst_3sigma_flagged = e.near_singular;
     }
-    if (e.worst_case_mm > map.worst_case_mm) {
-      map.worst_case_mm = e.worst_case_mm;
-      map.worst_case_at = p;
-      map.worst_case_flagged = e.near_singular;
+    if (e.worst_case_mm > map.worst_case_first_order_mm) {
+      map.worst_case_first_order_mm = e.worst_case_mm;
+      map.worst_case_first_order_at = p;
+      map.worst_case_first_order_flagged = e.near_singular;
     }
     if (e.resolution_um > map.worst_resolution_um) {
       map.worst_resolution_um = e.resolution_um;
@@ -530,12 +539,12 @@ Json to_json(const RobustCoverage& r) {
   robust["fraction"] = r.fraction;
   robust["margin_mm"] = r.margin_mm;
   robust["decided"] = r.decided;
-  robust["margin_sigma_mm"] = r.sigma_mm;
+  robust["margin_sigma_first_order_mm"] = r.sigma_mm;
   robust["calibrated"] = r.calibrated;
   robust["z"] = r.z;
-  robust["robust_margin_mm"] = r.robust_margin_mm;
-  robust["robust_margin_lower_mm"] = r.robust_margin_lower_mm;
-  robust["robust_margin_certified"] = r.robust_certified;
+  robust["robust_margin_first_order_mm"] = r.robust_margin_mm;
+  robust["robust_margin_first_order_lower_mm"] = r.robust_margin_lower_mm;
+  robust["robust_margin_first_order_certified"] = r.robust_certified;
   robust["covered"] = r.covered;
   robust["fraction_first_order_at_most"] = r.fraction_first_order;
   robust["robust_point_mm"] = xy(r.robust_point);
@@ -559,11 +568,15 @@ Json to_json(const ToleranceMap& map) {
   j["sigmas_from"] = map.spread_source;
   j["calibrated"] = map.calibrated;
   j["centre_status"] = std::string(to_string(map.centre.status));
-  j["centre_3sigma_mm"] = map.centre.ellipse_semi_axes.x();
-  j["centre_3sigma_minor_mm"] = map.centre.ellipse_semi_axes.y();
-  j["centre_3sigma_angle_deg"] = angle_deg(map.centre.ellipse_angle);
-  j["centre_worst_case_mm"] = map.centre.worst_case_mm;
-  j["centre_sum_of_effects_mm"] = map.centre.sum_of_effects_mm;
+  j["centre_3sigma_first_order_mm"] = map.centre.ellipse_semi_axes.x();
+  j["centre_3sigma_minor_first_order_mm"] = map.centre.ellipse_semi_axes.y();
+  j["centre_3sigma_angle_first_order_deg"] = angle_deg(map.centre.ellipse_angle);
+  // The +-3 sigma corners on the real kinematics; the first-order corner beside it.
+  j["centre_worst_case_mm"] = map.centre_corners.worst_mm;
+  j["centre_worst_case_corners"] = map.centre_corners.corners;
+  j["centre_worst_case_corners_failed"] = map.centre_corners.failed;
+  j["centre_worst_case_first_order_mm"] = map.centre.worst_case_mm;
+  j["centre_sum_of_effects_first_order_mm"] = map.centre.sum_of_effects_mm;
   j["centre_near_singular"] = map.centre.near_singular;
   j["centre_resolution_um"] = map.centre.resolution_um;
   j["centre_monte_carlo_3sigma_mm"] = map.centre_monte_carlo_3sigma_mm;
@@ -574,12 +587,16 @@ Json to_json(const ToleranceMap& map) {
   j["centre_play_first_order_mm"] = map.centre_play.linear_extent_mm;
   j["target_points"] = map.target_points;
   j["target_points_not_ok"] = map.target_not_ok;
-  j["target_worst_3sigma_mm"] = map.worst_3sigma_mm;
-  j["target_worst_3sigma_at_mm"] = xy(map.worst_3sigma_at);
+  j["target_worst_3sigma_first_order_mm"] = map.worst_3sigma_mm;
+  j["target_worst_3sigma_first_order_at_mm"] = xy(map.worst_3sigma_at);
   j["target_worst_case_mm"] = map.worst_case_mm;
   j["target_worst_case_at_mm"] = xy(map.worst_case_at);
-  j["target_worst_3sigma_near_singular"] = map.worst_3sigma_flagged;
+  j["target_worst_case_first_order_mm"] = map.worst_case_first_order_mm;
+  j["target_worst_case_first_order_at_mm"] = xy(map.worst_case_first_order_at);
+  j["target_points_first_order_low_by_10_percent"] = map.first_order_low_by_10_percent;
+  j["target_worst_3sigma_first_order_near_singular"] = map.worst_3sigma_flagged;
   j["target_worst_case_near_singular"] = map.worst_case_flagged;
+  j["target_worst_case_first_order_near_singular"] = map.worst_case_first_order_flagged;
   Json flagged = Json::array();
   for (const auto& f : map.near_singular) {
     flagged.push_back({{"at_mm", xy(f.at)},
@@ -602,15 +619,17 @@ Json to_json(const ToleranceMap& map) {
   // Quantities that do not exist are null, never 0 mm at (0, 0) (docs/conventions.md; docs/reliability.md
   // family 5): no first-order estimate at the centre, no regular point of the target.
   if (map.centre.status != Status::ok) {
-    for (const char* key : {"centre_3sigma_mm", "centre_3sigma_minor_mm", "centre_3sigma_angle_deg", "centre_worst_case_mm",
-                            "centre_resolution_um"}) {
+    for (const char* key : {"centre_3sigma_first_order_mm", "centre_3sigma_minor_first_order_mm", "centre_3sigma_angle_first_order_deg",
+                            "centre_worst_case_first_order_mm", "centre_resolution_um"}) {
       j[key] = nullptr;
     }
   }
+  if (map.centre_corners.status != Status::ok) j["centre_worst_case_mm"] = nullptr;
   if (map.centre_monte_carlo.used == 0) j["centre_monte_carlo_3sigma_mm"] = nullptr;
   if (map.centre_play.status != Status::ok) j["centre_play_mm"] = j["centre_play_first_order_mm"] = nullptr;
   if (map.target_not_ok >= map.target_points) {
-    for (const char* key : {"target_worst_3sigma_mm", "target_worst_3sigma_at_mm", "target_worst_case_mm", "target_worst_case_at_mm",
+    for (const char* key : {"target_worst_3sigma_first_order_mm", "target_worst_3sigma_first_order_at_mm", "target_worst_case_mm",
+                            "target_worst_case_at_mm", "target_worst_case_first_order_mm", "target_worst_case_first_order_at_mm",
                             "target_worst_resolution_um", "target_worst_resolution_at_mm", "target_worst_play_mm",
                             "target_worst_play_at_mm"}) {
       j[key] = nullptr;
@@ -629,8 +648,8 @@ std::vector<std::pair<std::string, std::string>> tolerance_files(const Station& 
     f.spacing = map.spacing_mm;
     f.nx = map.nx;
     f.ny = map.ny;
-    f.arrays.emplace_back("three_sigma_mm", map.field_3sigma_mm);
-    f.arrays.emplace_back("worst_case_mm", map.field_worst_case_mm);
+    f.arrays.emplace_back("three_sigma_first_order_mm", map.field_3sigma_mm);
+    f.arrays.emplace_back("worst_case_first_order_mm", map.field_worst_case_mm);
     f.arrays.emplace_back("resolution_um", map.field_resolution_um);
     f.arrays.emplace_back("play_mm", map.field_play_mm);
     f.arrays.emplace_back("near_singular",

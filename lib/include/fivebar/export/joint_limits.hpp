@@ -52,6 +52,7 @@
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/motor.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
@@ -134,6 +135,24 @@ std::vector<JointMarginCheck> check_joint_margins(const Design& design, const St
 /// The range of one joint in a line: "[19.38, 285.00] deg (hard stop at lower O2 ... potentiometer
 /// travel)", "every angle", or the problem.
 std::string describe(const UsableRange& range);
+
+/// The motor's steady output speed at full duty (rad/s, >= 0): the speed at which the torque it
+/// gives at the supply voltage, eta N k_t min((V - k_e N w) / R, I_limit), equals what friction
+/// takes, b w + tau_c (the motor model of fivebar/dynamics.hpp with the inductance settled):
+///   w = (eta N k_t V / R - tau_c) / (eta N^2 k_t k_e / R + b)   (current below its limit),
+///   w = (eta N k_t I_limit - tau_c) / b                          (current at its limit).
+/// Below the no-load speed V / (k_e N) by what friction takes (343.5 instead of 343.8 deg/s with
+/// the showcase's assumed motor); 0 when friction holds the motor at rest.
+double motor_free_speed(const MotorParams& motor);
+/// The one joint speed limit (rad/s) of joint `joint` (1 or 2) of `mechanism`: in every exported
+/// file (joint_limits.<joint>.max_velocity, the URDF's limit velocity) and in the export gate's
+/// pattern checks: the smaller of controller.max_velocity (a stated limit) and
+/// motor_free_speed() of the joint's motor; either alone when the design has only that section, 0
+/// with neither.
+double joint_speed_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint);
+/// The smallest joint_speed_limit() of the station's motor joints: what a pattern moving all of
+/// them is checked against (check_pattern()'s max_joint_speed).
+double station_joint_speed_limit(const Design& design, const Station& station);
 
 /// The export gate's checks of a station's hardware limits (fivebar/export/export.hpp export_gate()):
 ///   hardware_limits  per mechanism: both joints have a usable range (describe() of each);

@@ -37,7 +37,7 @@
 ///
 /// Limits: motor joints carry the usable range of fivebar/export/joint_limits.hpp (continuous when the
 /// joint has none), velocity motor_velocity_limit() (controller.max_velocity, at most the motor's
-/// no-load speed), effort the stall torque at the output of the motor section,
+/// steady speed at the supply voltage less friction), effort the stall torque at the output of the motor section,
 /// eta N k_t min(supply / R, current limit) (0 without `motor:`: unknown).
 ///
 /// Gearing and rotor inertia (with `motor:`): per motor joint a top-level `<transmission>`
@@ -71,10 +71,8 @@ struct UrdfOptions {
   std::string mesh_prefix = "../parts";
 };
 
-/// The velocity limit of motor joint `joint` (1 or 2) of `mechanism`, rad/s: the smaller of
-/// controller.max_velocity and the motor's no-load speed at the output, V_supply / (k_e N) (344 deg/s
-/// with the assumed motor of `motor:`); either alone when the design has only that section, 0 with
-/// neither.
+/// The velocity limit of motor joint `joint` (1 or 2) of `mechanism`, rad/s: joint_speed_limit()
+/// of fivebar/export/joint_limits.hpp, the one joint speed of every exported file and of the gate.
 double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint);
 
 /// `<design>_<station>.urdf`.
