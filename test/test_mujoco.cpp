@@ -150,7 +150,7 @@ TEST_F(MujocoTest, LoadsEveryExportedUrdfAndMjcfOfTheShowcaseWithoutEdits) {
     (f.extension() == ".urdf" ? urdf : mjcf) += 1;
   }
   EXPECT_EQ(urdf, 2u);  // index and thumb
-  EXPECT_EQ(mjcf, 2u);
+  EXPECT_EQ(mjcf, 8u);  // per station: the model, its position variant and a scene of each
 }
 
 TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf) {
@@ -158,7 +158,7 @@ TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf
   const double reflected = 200.0 * 200.0 * 0.5e-7;
   for (const char* station : {"index", "thumb"}) {
     SCOPED_TRACE(station);
-    Loaded l(*dir_ / "export" / (std::string("iros2022_") + station + ".xml"));
+    Loaded l(*dir_ / "export" / (std::string("iros2022_") + station) / (std::string("iros2022_") + station + ".xml"));
     ASSERT_NE(l.model, nullptr) << l.error;
     ASSERT_EQ(l.model->nu, 4);
     for (const char* mech : {"lower", "upper"}) {
@@ -197,7 +197,7 @@ TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf
 TEST_F(MujocoTest, LoopClosuresSitAtTheTactorInBothBodies) {
   const Design& d = *design_;
   for (const Station& s : d.stations) {
-    Loaded l(*dir_ / "export" / ("iros2022_" + s.name + ".xml"));
+    Loaded l(*dir_ / "export" / ("iros2022_" + s.name) / ("iros2022_" + s.name + ".xml"));
     ASSERT_NE(l.model, nullptr) << l.error;
     mjData* data = mj_makeData(l.model);
     mj_forward(l.model, data);
@@ -257,8 +257,8 @@ void write_box(const fs::path& file, double x0, double y0, double z0, double a, 
   }
 }
 
-TEST(Mujoco, MeshPathsResolveFromTheExportFolderAsTheProductWritesThem) {
-  // The layout of `fivebar run`: <out>/parts/<station>/*.stl and <out>/export/*.urdf|*.xml naming
+TEST(Mujoco, BundleLoadsAloneWithItsMeshesAndTheUrdfFromTheExportFolder) {
+  // The layout of `fivebar run`: <out>/parts/<station>/*.stl, <out>/export/*.urdf naming
   // them "../parts/...". Boxes stand in for the renders.
   const Design d = paper();
   TempDir dir;
@@ -280,17 +280,150 @@ TEST(Mujoco, MeshPathsResolveFromTheExportFolderAsTheProductWritesThem) {
   options.urdf_options.parts_dir = dir.path / "parts";
   const ExportResult r = export_controller(d, {}, dir.path / "export", options);
   ASSERT_TRUE(r.gate.passed());
-  ASSERT_EQ(r.files.size(), 2u);
-  for (const fs::path& f : r.files) {
+  // The URDF names the renders in ../parts; the bundle carries copies in its assets/ folder and loads
+  // from anywhere on its own (the export folder and the parts removed).
+  const fs::path alone = dir.path / "elsewhere" / "copy";
+  fs::create_directories(alone.parent_path());
+  fs::copy(dir.path / "export" / "iros2022_index", alone, fs::copy_options::recursive);
+  EXPECT_TRUE(fs::is_regular_file(alone / "assets/index/link.stl"));
+  for (const fs::path& f : {dir.path / "export/iros2022_index.urdf", alone / "iros2022_index.xml",
+                            alone / "iros2022_index_position.xml", alone / "scene.xml", alone / "scene_position.xml"}) {
     SCOPED_TRACE(f.string());
+    if (f.extension() == ".xml" && fs::exists(dir.path / "export")) {
+      fs::remove_all(dir.path / "export");
+      fs::remove_all(dir.path / "parts");
+    }
+    if (f.extension() == ".urdf") {
+      Loaded l(f);
+      ASSERT_NE(l.model, nullptr) << l.error;
+      EXPECT_EQ(l.model->nmesh, 3);
+      continue;
+    }
     Loaded l(f);
     ASSERT_NE(l.model, nullptr) << l.error;
+    EXPECT_EQ(l.error, "");
     EXPECT_EQ(l.model->nmesh, 3);  // one asset per file: link, tip, base
     // The box link's mass from its STL (1.15 g/cm^3, 8 x 4 x 2 mm).
     const int b = id_of(l.model, mjOBJ_BODY, "index_upper_L1");
     ASSERT_GE(b, 0);
     EXPECT_NEAR(l.model->body_mass[b], 1.15e-6 * 64.0, 1e-12);
+    EXPECT_EQ(l.model->nkey, 1);
+    EXPECT_EQ(l.model->nu, 4);
   }
+  for (const char* f : {"README.md", "LICENSE", "preview.svg"}) EXPECT_TRUE(fs::is_regular_file(alone / f)) << f;
+  EXPECT_NE(read_text(alone / "README.md").find("![The home keyframe, top view](preview.svg)"), std::string::npos);
+}
+
+// --- The bundle: keyframe, contacts, stops, servos ------------------------------------------------
+
+/// The index bundle's scene loaded (closed-form masses, box visuals), data at the keyframe `home`.
+struct Scene {
+  std::unique_ptr<Loaded> l;
+  mjData* d = nullptr;
+  explicit Scene(const fs::path& file) : l(std::make_unique<Loaded>(file)) {
+    if (l->model == nullptr) return;
+    d = mj_makeData(l->model);
+    mj_resetDataKeyframe(l->model, d, mj_name2id(l->model, mjOBJ_KEY, "home"));
+    mj_forward(l->model, d);
+  }
+  ~Scene() {
+    if (d != nullptr) mj_deleteData(d);
+  }
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  mjModel* m() const { return l->model; }
+  Vec2 tactor_mm(const std::string& name) const {
+    const int a = l->model->sensor_adr[id_of(l->model, mjOBJ_SENSOR, name)];
+    return Vec2(d->sensordata[a], d->sensordata[a + 1]) * 1e3;
+  }
+  std::string body_of_geom(int g) const { return mj_id2name(l->model, mjOBJ_BODY, l->model->geom_bodyid[g]); }
+};
+
+TEST_F(MujocoTest, HomeKeyframeHasTheTactorsApartAboutTheCentreAndNoContact) {
+  for (const Station& s : design_->stations) {
+    SCOPED_TRACE(s.name);
+    for (const char* scene : {"scene.xml", "scene_position.xml"}) {
+      Scene sc(*dir_ / "export" / ("iros2022_" + s.name) / scene);
+      ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+      // The stretch pattern's start: 8 mm apart vertically about the target centre (designs/iros2022.yaml).
+      const Vec2 lower = sc.tactor_mm(s.name + "_lower_tactor"), upper = sc.tactor_mm(s.name + "_upper_tactor");
+      EXPECT_NEAR((lower - (s.target.center - Vec2(0.0, 4.0))).norm(), 0.0, 1e-9);
+      EXPECT_NEAR((upper - (s.target.center + Vec2(0.0, 4.0))).norm(), 0.0, 1e-9);
+      EXPECT_EQ(sc.d->ncon, 0) << "first contact: " << (sc.d->ncon > 0 ? sc.body_of_geom(sc.d->contact[0].geom1) + " / " +
+                                                                           sc.body_of_geom(sc.d->contact[0].geom2)
+                                                                     : "");
+      // Held there by the position servos (ctrl = the home angles): still clear after 0.2 s.
+      if (std::string(scene) == "scene_position.xml") {
+        for (int i = 0; i < 2000; ++i) mj_step(sc.m(), sc.d);
+        mj_forward(sc.m(), sc.d);
+        EXPECT_EQ(sc.d->ncon, 0);
+        EXPECT_NEAR((sc.tactor_mm(s.name + "_lower_tactor") - lower).norm(), 0.0, 0.01);
+      }
+    }
+  }
+}
+
+TEST_F(MujocoTest, DrivingTheUpperTactorIntoTheLowerOneMakesContact) {
+  const Station& s = *design_->station("index");
+  Scene sc(*dir_ / "export/iros2022_index/scene_position.xml");
+  ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+  // The upper mechanism's servos commanded to the lower tactor's point (the IK there, on the branch of
+  // their home angles); the lower one holds home.
+  const Vec2 target = sc.tactor_mm("index_lower_tactor");
+  const Mechanism& upper = *s.mechanism("upper");
+  const Pose ik_upper = ik(upper, target);
+  ASSERT_NE(ik_upper.status, Status::unreachable);
+  for (int j = 1; j <= 2; ++j) {
+    const int a = id_of(sc.m(), mjOBJ_ACTUATOR, joint_name("index", "upper", j));
+    const double th = j == 1 ? ik_upper.theta1 : ik_upper.theta2;
+    const double home = sc.d->ctrl[a];
+    sc.d->ctrl[a] = home + std::remainder(th - home, 2.0 * std::numbers::pi);
+  }
+  int contact_steps = 0;
+  double deepest = 0.0;
+  std::string pair;
+  for (int i = 0; i < 5000; ++i) {
+    mj_step(sc.m(), sc.d);
+    bool between = false;
+    for (int c = 0; c < sc.d->ncon; ++c) {
+      const std::string b1 = sc.body_of_geom(sc.d->contact[c].geom1), b2 = sc.body_of_geom(sc.d->contact[c].geom2);
+      if ((b1.rfind("index_upper", 0) == 0) != (b2.rfind("index_upper", 0) == 0)) {
+        between = true;
+        deepest = std::min(deepest, sc.d->contact[c].dist);
+        if (pair.empty()) pair = b1 + " / " + b2;
+      }
+    }
+    contact_steps += between ? 1 : 0;
+  }
+  std::printf("[ MuJoCo ] upper tactor driven into the lower: contact in %d of 5000 steps (first %s), deepest %.3g mm\n",
+              contact_steps, pair.c_str(), -deepest * 1e3);
+  EXPECT_GT(contact_steps, 0);
+  EXPECT_GT(deepest, -0.5e-3);  // stiff contacts: less than half a millimetre of overlap
+  // The contact stops the upper tactor short of its command.
+  EXPECT_GT((sc.tactor_mm("index_upper_tactor") - target).norm(), 1.0);
+}
+
+TEST_F(MujocoTest, HardStopsHoldAtFullDuty) {
+  // index_lower_theta1 runs down into its stop against the boss of lower O2 (19.38 deg, docs/urdf.md)
+  // at full duty: by how much does it pass it?
+  Scene sc(*dir_ / "export/iros2022_index/scene.xml");
+  ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+  const int jid = id_of(sc.m(), mjOBJ_JOINT, "index_lower_theta1");
+  ASSERT_EQ(sc.m()->jnt_limited[jid], 1);
+  const double lo = sc.m()->jnt_range[2 * jid];
+  EXPECT_NEAR(lo, std::acos(212.25 / 225.0), 1e-12);
+  sc.d->ctrl[id_of(sc.m(), mjOBJ_ACTUATOR, "index_lower_theta1")] = -1.0;
+  double past = 0.0, held = 0.0;
+  for (int i = 0; i < 10000; ++i) {
+    mj_step(sc.m(), sc.d);
+    const double q = sc.d->qpos[sc.m()->jnt_qposadr[jid]];
+    past = std::max(past, lo - q);
+    held = lo - q;
+  }
+  std::printf("[ MuJoCo ] full duty into the hard stop: %.3g deg past it at most, %.3g deg after 1 s\n",
+              past * 180.0 / std::numbers::pi, held * 180.0 / std::numbers::pi);
+  EXPECT_LT(past, 0.5 * std::numbers::pi / 180.0);
+  EXPECT_LT(held, 0.1 * std::numbers::pi / 180.0);
 }
 
 // --- The same controller in MuJoCo and in fivebar simulate ------------------------------------------
@@ -409,6 +542,9 @@ Trace run_mujoco(const fs::path& file, const SimulationInput& input, const Json&
         tr.max_loop_gap_m = std::max(tr.max_loop_gap_m, std::sqrt(gap2));
       }
     }
+    // mj_step computes the sensors before it integrates: recompute them at the new state, so the next
+    // sample reads the joints at t_k+1 and not one timestep earlier.
+    mj_forward(m, d);
   }
   mj_deleteData(d);
   return tr;
@@ -484,7 +620,7 @@ TEST_F(MujocoTest, AOneMillimetreStepFollowsFivebarSimulate) {
   std::vector<SimulationInput> inputs = simulation_inputs(d, request, closed_form(d, "index"));
   ASSERT_EQ(inputs.size(), 1u);
   double gap = 0.0;
-  const Agreement a = run_both(d, *dir_ / "export/iros2022_index.xml", result_->parameters, inputs[0], "step", &gap);
+  const Agreement a = run_both(d, *dir_ / "export/iros2022_index/iros2022_index.xml", result_->parameters, inputs[0], "step", &gap);
   EXPECT_GT(a.tracking_mm, 0.5);  // the step is tracked with a transient of most of a millimetre
   EXPECT_LT(a.rad, kAgreementRad);
   EXPECT_LT(a.mm, kAgreementMm);
@@ -506,7 +642,7 @@ TEST_F(MujocoTest, TheStretchPatternFollowsFivebarSimulate) {
       if (!m.target_mm.empty()) m.target_mm.resize(30);  // what the runtime is fed (fivebar/dynamics.hpp)
     }
   }
-  const Agreement a = run_both(d, *dir_ / "export/iros2022_index.xml", result_->parameters, in, "stretch");
+  const Agreement a = run_both(d, *dir_ / "export/iros2022_index/iros2022_index.xml", result_->parameters, in, "stretch");
   EXPECT_GT(a.tracking_mm, 0.0);
   EXPECT_LT(a.rad, kAgreementRad);
   EXPECT_LT(a.mm, kAgreementMm);
@@ -519,7 +655,7 @@ TEST_F(MujocoTest, WhatLimitsTheAgreement) {
   request.step = true;
   if (kSanitized) request.step_hold_s = 0.15;
   const SimulationInput in = simulation_inputs(d, request, closed_form(d, "index")).front();
-  const fs::path f = *dir_ / "export/iros2022_index.xml";
+  const fs::path f = *dir_ / "export/iros2022_index/iros2022_index.xml";
   const Json& p = result_->parameters;
   struct Row {
     const char* label;

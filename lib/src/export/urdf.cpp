@@ -16,6 +16,7 @@
 #include "fivebar/export/export.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/export/joint_limits.hpp"
+#include "fivebar/kinematics.hpp"
 #include "fivebar/parts.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
@@ -81,9 +82,42 @@ class Writer {
 
 std::string xyz(double x_mm, double y_mm, double z_mm) { return "xyz=\"" + m(x_mm) + " " + m(y_mm) + " " + m(z_mm) + "\""; }
 
+struct MotorJoint {
+  std::string name;
+  UsableRange range;
+  std::optional<MotorParams> motor;
+};
+
+void write_transmissions(Writer& w, const std::vector<MotorJoint>& motor_joints);
+void write_ros2_control(Writer& w, const std::string& robot, const std::vector<MotorJoint>& motor_joints);
+
 }  // namespace
 
 std::string urdf_file_name(const Design& design, const Station& station) { return design.name + "_" + station.name + ".urdf"; }
+
+std::vector<std::pair<std::string, double>> initial_pose(const Design& design, const Station& station) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const Mechanism* mech : station.mechanisms()) {
+    const std::array<UsableRange, 2> ranges = usable_ranges(design, station, *mech);
+    for (const UsableRange& r : ranges) {
+      if (!r.usable) throw InputError("joint " + r.joint + " has no usable range: " + r.problem);
+    }
+    const Pose pose = fk(*mech, ranges[0].reference, ranges[1].reference);
+    const Vec2 r3 = pose.P - pose.A1, r4 = pose.P - pose.A2;
+    const std::array<double, 2> phi{std::atan2(r3.y(), r3.x()), std::atan2(r4.y(), r4.x())};
+    const std::string prefix = station.name + "_" + mech->name;
+    for (int j = 0; j < 2; ++j) {
+      const std::size_t i = static_cast<std::size_t>(j);
+      // Elbow in (-pi, pi]: the same angle as the MJCF's ref.
+      double elbow = phi[i] - ranges[i].reference;
+      elbow = std::remainder(elbow, 2.0 * std::numbers::pi);
+      if (elbow <= -std::numbers::pi) elbow += 2.0 * std::numbers::pi;
+      out.emplace_back(ranges[i].joint, ranges[i].reference);
+      out.emplace_back(prefix + "_elbow" + std::to_string(j + 1), elbow);
+    }
+  }
+  return out;
+}
 
 double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint) {
   const ControllerSettings* controller = design.get<ControllerSettings>();
@@ -127,24 +161,35 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
   w.line(2, "<compiler strippath=\"false\" discardvisual=\"false\" fusestatic=\"false\" angle=\"radian\"/>");
   w.line(1, "</mujoco>");
 
-  // Base: the root, no inertia (it is fixed to the gripper).
-  if (!bodies.base_mesh.empty()) {
-    w.line(1, "<link name=\"" + format::xml_escape(base) + "\">");
-    w.line(2, "<visual>");
-    w.line(3, "<origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>");
-    w.line(3, "<geometry><mesh filename=\"" + format::xml_escape(bodies.base_mesh) + "\" scale=\"0.001 0.001 0.001\"/></geometry>");
-    w.line(2, "</visual>");
-    w.line(1, "</link>");
-  } else {
-    w.link_element(base, nullptr, "");
+  // Base: the root (or the child of `world`), with the base plate's inertia: SDFormat drops a root
+  // link without one, and every link under it.
+  if (options.world_link) {
+    w.comment(1, "The device fixed in the world (a bench device; fivebar/export/urdf.hpp UrdfOptions::world_link).");
+    w.line(1, "<link name=\"world\"/>");
+    w.line(1, "<joint name=\"" + format::xml_escape(base + "_to_world") + "\" type=\"fixed\">");
+    w.line(2, "<parent link=\"world\"/>");
+    w.line(2, "<child link=\"" + format::xml_escape(base) + "\"/>");
+    w.line(2, "<origin xyz=\"0 0 0\" rpy=\"0 0 0\"/>");
+    w.line(1, "</joint>");
+  }
+  w.comment(1, base + ": the station frame, z = 0 the base plate's top face. Mass properties: " +
+                   (bodies.base_from_stl ? std::string("the base's STL render")
+                                         : "a plate " + num(bodies.base_plate_size_mm.x()) + " x " +
+                                               num(bodies.base_plate_size_mm.y()) + " x " +
+                                               num(bodies.base_plate_size_mm.z()) +
+                                               " mm under the base joints (the base's outline without the finger "
+                                               "rest and the mounting pads)") +
+                   ", at the printing density; the motors' own mass is not in the design and is left out.");
+  {
+    const Eigen::Vector3d& c = bodies.base_plate_centre_mm;
+    const Eigen::Vector3d& e = bodies.base_plate_size_mm;
+    w.link_element(base, &bodies.base,
+                   "<origin " + xyz(c.x(), c.y(), c.z()) + " rpy=\"0 0 0\"/><geometry><box size=\"" + m(e.x()) + " " +
+                       m(e.y()) + " " + m(e.z()) + "\"/></geometry>");
   }
 
-  struct MotorJoint {
-    std::string name;
-    UsableRange range;
-    std::optional<MotorParams> motor;
-  };
   std::vector<MotorJoint> motor_joints;
+  std::vector<std::string> sdf_frames;  // the cut frames P, for SDFormat (below)
   for (const detail::MechanismBodies& mb : bodies.mechanisms) {
     const Mechanism* mech = mb.mechanism;
     const std::string prefix = station.name + "_" + mech->name;
@@ -237,34 +282,64 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
     w.line(2, "<child link=\"" + format::xml_escape(prefix + "_P") + "\"/>");
     w.line(2, "<origin " + xyz(mech->L[o], 0.0, plane_z(g.layers[c]) - plane_z(g.layers[o])) + " rpy=\"0 0 0\"/>");
     w.line(1, "</joint>");
+    w.comment(1, "SDFormat merges a fixed joint's child into its parent unless told to keep it.");
+    w.line(1, "<gazebo reference=\"" + format::xml_escape(prefix + "_tip_mount") +
+                  "\"><preserveFixedJoint>true</preserveFixedJoint></gazebo>");
+    sdf_frames.push_back("<frame name=\"" + format::xml_escape(prefix + "_P") + "\" attached_to=\"" +
+                         format::xml_escape(prefix + "_L" + std::to_string(other + 1)) + "\"><pose relative_to=\"" +
+                         format::xml_escape(prefix + "_L" + std::to_string(other + 1)) + "\">" + m(mech->L[o]) + " 0 " +
+                         m(plane_z(g.layers[c]) - plane_z(g.layers[o])) + " 0 0 0</pose></frame>");
+  }
+  if (!sdf_frames.empty()) {
+    w.comment(1, "For SDFormat (Gazebo), which drops a massless link: the cut frames P as SDF frames. SDFormat keeps "
+                 "no loop closure here (its joints would close a loop where the links stand at the zero pose, an open "
+                 "pose of this linkage): in Gazebo the mechanisms are open trees; the MJCF is the closed model.");
+    w.line(1, "<gazebo>");
+    for (const std::string& f : sdf_frames) w.line(2, f);
+    w.line(1, "</gazebo>");
+  }
+  {
+    std::string pose;
+    for (const auto& [joint, angle] : initial_pose(design, station)) pose += (pose.empty() ? "" : ", ") + joint + " " + num(angle);
+    w.comment(1, "Initial pose (rad), the device at the target centre; the joints' zero is not a pose of the device "
+                 "(a motor joint's zero may lie outside its limits): " + pose + ".");
   }
 
-  // Transmissions: the gearing and the rotor inertia, as ROS 1 / Gazebo (mechanicalReduction) and
-  // Drake (drake:gear_ratio, drake:rotor_inertia) read them.
-  if (motors != nullptr) {
-    w.comment(1, "Transmissions: each motor drives its joint through a gearbox of ratio N (motor turns per joint "
-                 "turn). The rotor inertia J_r (at the motor shaft) reaches the joint as N^2 J_r, which dominates the "
-                 "links' inertia: a simulator that reads neither the transmission nor drake:rotor_inertia must add N^2 "
-                 "J_r to the joint (MuJoCo: the joint's armature; the MJCF has it). See docs/urdf.md.");
-    for (const MotorJoint& mj : motor_joints) {
-      const MotorParams& p = *mj.motor;
-      w.line(1, "<transmission name=\"" + format::xml_escape(mj.name + "_transmission") + "\">");
-      w.comment(2, "reflected rotor inertia N^2 J_r = " + num(p.gear_ratio * p.gear_ratio * p.rotor_inertia()) + " kg m^2");
-      w.line(2, "<type>transmission_interface/SimpleTransmission</type>");
-      w.line(2, "<joint name=\"" + format::xml_escape(mj.name) + "\">");
-      w.line(3, "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>");
-      w.line(2, "</joint>");
-      w.line(2, "<actuator name=\"" + format::xml_escape(mj.name + "_motor") + "\">");
-      w.line(3, "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface>");
-      w.line(3, "<mechanicalReduction>" + num(p.gear_ratio) + "</mechanicalReduction>");
-      w.line(3, "<drake:gear_ratio value=\"" + num(p.gear_ratio) + "\"/>");
-      w.line(3, "<drake:rotor_inertia value=\"" + num(p.rotor_inertia()) + "\"/>");
-      w.line(2, "</actuator>");
-      w.line(1, "</transmission>");
-    }
-  }
+  if (motors != nullptr) write_transmissions(w, motor_joints);
+  write_ros2_control(w, robot, motor_joints);
+  w.line(0, "</robot>");
+  return w.out.str();
+}
 
-  // ros2_control: the motor joints.
+namespace {
+
+// Transmissions: the gearing and the rotor inertia, as ROS 1 / Gazebo (mechanicalReduction) and
+// Drake (drake:gear_ratio, drake:rotor_inertia) read them. The interface is the one ros2_control
+// commands (position: the device runs its own PID).
+void write_transmissions(Writer& w, const std::vector<MotorJoint>& motor_joints) {
+  w.comment(1, "Transmissions: each motor drives its joint through a gearbox of ratio N (motor turns per joint "
+               "turn). The rotor inertia J_r (at the motor shaft) reaches the joint as N^2 J_r, which dominates the "
+               "links' inertia: a simulator that reads neither the transmission nor drake:rotor_inertia must add N^2 "
+               "J_r to the joint (MuJoCo: the joint's armature; the MJCF has it). See docs/urdf.md.");
+  for (const MotorJoint& mj : motor_joints) {
+    const MotorParams& p = *mj.motor;
+    w.line(1, "<transmission name=\"" + format::xml_escape(mj.name + "_transmission") + "\">");
+    w.comment(2, "reflected rotor inertia N^2 J_r = " + num(p.gear_ratio * p.gear_ratio * p.rotor_inertia()) + " kg m^2");
+    w.line(2, "<type>transmission_interface/SimpleTransmission</type>");
+    w.line(2, "<joint name=\"" + format::xml_escape(mj.name) + "\">");
+    w.line(3, "<hardwareInterface>hardware_interface/PositionJointInterface</hardwareInterface>");
+    w.line(2, "</joint>");
+    w.line(2, "<actuator name=\"" + format::xml_escape(mj.name + "_motor") + "\">");
+    w.line(3, "<hardwareInterface>hardware_interface/PositionJointInterface</hardwareInterface>");
+    w.line(3, "<mechanicalReduction>" + num(p.gear_ratio) + "</mechanicalReduction>");
+    w.line(3, "<drake:gear_ratio value=\"" + num(p.gear_ratio) + "\"/>");
+    w.line(3, "<drake:rotor_inertia value=\"" + num(p.rotor_inertia()) + "\"/>");
+    w.line(2, "</actuator>");
+    w.line(1, "</transmission>");
+  }
+}
+
+void write_ros2_control(Writer& w, const std::string& robot, const std::vector<MotorJoint>& motor_joints) {
   w.comment(1, "ros2_control: the four motor joints, position commands, position and velocity states. The hardware is "
                "ros2_control's mock_components/GenericSystem: replace it with the device's hardware interface "
                "(potentiometers through the ADC, PWM to the motor drivers; the gains and calibration are in the "
@@ -300,8 +375,8 @@ std::string render_urdf(const Design& design, const Station& station, const Urdf
     w.line(2, "</transmission>");
   }
   w.line(1, "</ros2_control>");
-  w.line(0, "</robot>");
-  return w.out.str();
 }
+
+}  // namespace
 
 }  // namespace fivebar
