@@ -154,6 +154,17 @@ TEST_F(MujocoTest, LoadsEveryExportedUrdfAndMjcfOfTheShowcaseWithoutEdits) {
   }
   EXPECT_EQ(urdf, 2u);  // index and thumb
   EXPECT_EQ(mjcf, 8u);  // per station: the model, its position variant and a scene of each
+  // Each bundle copied on its own into a scratch folder loads as it is.
+  for (const Station& s : design_->stations) {
+    const fs::path alone = *dir_ / "alone" / s.name;
+    fs::create_directories(alone.parent_path());
+    fs::copy(*dir_ / "export" / ("iros2022_" + s.name), alone, fs::copy_options::recursive);
+    for (const char* f : {"scene.xml", "scene_position.xml"}) {
+      Loaded l(alone / f);
+      EXPECT_NE(l.model, nullptr) << s.name << "/" << f << ": " << l.error;
+      EXPECT_EQ(l.error, "");
+    }
+  }
 }
 
 TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf) {
@@ -433,17 +444,23 @@ TEST_F(MujocoTest, HardStopsHoldAtFullDuty) {
     }
     return std::array<double, 2>{past * 180.0 / std::numbers::pi, held * 180.0 / std::numbers::pi};
   };
+  // As exported: the proximal link meets the other motor's boss (a contact) where its range ends.
+  const auto file = into_stop();
+  // The joint limit alone (contacts off), as exported and with MuJoCo's default limit softness
+  // (solreflimit 0.02 1, solimplimit 0.9 0.95 0.001).
+  sc.m()->opt.disableflags |= mjDSBL_CONTACT;
   const auto stiff = into_stop();
-  // The same with MuJoCo's default limit softness (solreflimit 0.02 1, solimplimit 0.9 0.95 0.001).
   const mjtNum soft_ref[2] = {0.02, 1.0}, soft_imp[5] = {0.9, 0.95, 0.001, 0.5, 2.0};
   for (int k = 0; k < 2; ++k) sc.m()->jnt_solref[mjNREF * jid + k] = soft_ref[k];
   for (int k = 0; k < 5; ++k) sc.m()->jnt_solimp[mjNIMP * jid + k] = soft_imp[k];
   const auto soft = into_stop();
-  std::printf("[ MuJoCo ] full duty into the hard stop: %.3g deg past it at most, %.3g deg after 1 s (MuJoCo's default "
-              "limit softness: %.3g and %.3g deg)\n",
-              stiff[0], stiff[1], soft[0], soft[1]);
-  EXPECT_LT(stiff[0], 0.5);
-  EXPECT_LT(stiff[1], 0.1);
+  std::printf("[ MuJoCo ] full duty into the hard stop, deg past it at most / after 1 s: as exported %.3g / %.3g; the "
+              "joint limit alone %.3g / %.3g; with MuJoCo's default limit softness %.3g / %.3g\n",
+              file[0], file[1], stiff[0], stiff[1], soft[0], soft[1]);
+  for (const auto& r : {file, stiff}) {
+    EXPECT_LT(r[0], 0.5);
+    EXPECT_LT(r[1], 0.1);
+  }
   EXPECT_GT(soft[0], 5.0 * stiff[0]);
 }
 
