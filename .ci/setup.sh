@@ -39,6 +39,11 @@ FIVEBAR_TEST_PACKAGES=(
   # MuJoCo's library and headers: test_mujoco loads the exported URDF and MJCF and runs them against
   # fivebar simulate.
   libmujoco-dev
+  # Gazebo's SDFormat reader (ign sdf -p; the URDF importer of Gazebo): test_urdf checks that it keeps
+  # every link and joint of the exported URDF and of the ROS 2 description package.
+  libsdformat-dev ignition-tools
+  # catkin_pkg, the reader of ROS package manifests: test_urdf parses the ROS 2 package's package.xml.
+  python3-catkin-pkg
   # PyYAML, a YAML 1.1 reader as ROS 2's parameter parser is: test_export reads the parameters file with it.
   python3-yaml
   # The Python module's tests (pytest, run by ctest).

@@ -23,6 +23,7 @@ struct ExportCliOptions {
   std::string format = "all";
   std::string out;
   std::string check;
+  std::string ros2_package;
   bool json = false;
 };
 
@@ -100,16 +101,24 @@ int run_check(const ExportCliOptions& opt) {
 
 int run_export(const ExportCliOptions& opt) {
   if (!opt.check.empty()) return run_check(opt);
-  const std::vector<ExportFormat> formats = formats_of(opt.format);
+  const bool package = !opt.ros2_package.empty();
+  if (package && (opt.format != "all" || !opt.out.empty())) {
+    throw InputError("--ros2-package DIR writes the package alone into DIR: --format and --out do not apply");
+  }
+  const std::vector<ExportFormat> formats = package ? std::vector<ExportFormat>{} : formats_of(opt.format);
   const Design design = load(opt.design);
+  if (package && !design.has<Geometry>()) {
+    throw InputError("--ros2-package: design " + design.name + " has no geometry: section (the URDF's links)");
+  }
   ExportOptions options;
-  options.urdf = opt.format == "all" || opt.format == "urdf";  // fivebar/export/urdf.hpp: closed-form masses here
-  options.mjcf = opt.format == "all" || opt.format == "mjcf";  // fivebar/export/mjcf.hpp
+  options.urdf = !package && (opt.format == "all" || opt.format == "urdf");  // fivebar/export/urdf.hpp: closed-form masses here
+  options.mjcf = !package && (opt.format == "all" || opt.format == "mjcf");  // fivebar/export/mjcf.hpp: the MuJoCo bundles
+  options.ros2_package = package;                                            // fivebar/export/ros2_package.hpp
   if (!opt.station.empty()) options.stations = {opt.station};
   options.progress = terminal_progress("export");
   // The directory is created only once the gate has passed.
   const std::filesystem::path dir =
-      command_output_dir(opt.out, design.name, "export");
+      package ? std::filesystem::path(opt.ros2_package) : command_output_dir(opt.out, design.name, "export");
   const WriteFence fence(dir);  // nothing of this command lands outside it (fivebar/io.hpp)
   const ExportResult r = export_controller(design, formats, dir, options);
 
@@ -176,10 +185,14 @@ void setup_export(CLI::App& app) {
   sub->add_option("--check", opt->check,
                   "Re-read an exported FILE (any format) and confirm it matches DESIGN: hash and every value")
       ->type_name("FILE");
+  sub->add_option("--ros2-package", opt->ros2_package,
+                  "Write a ROS 2 description package (package.xml, CMakeLists.txt, urdf/, config/, launch/) into DIR "
+                  "instead of the files above")
+      ->type_name("DIR");
   add_json_flag(*sub, opt->json);
   sub->footer(
-      "Files: <design>_controller[_<station>].yaml|.json|.hpp, <design>_<station>.urdf and <design>_<station>.xml\n"
-      "(MJCF; both with geometry:), SI "
+      "Files: <design>_controller[_<station>].yaml|.json|.hpp, <design>_<station>.urdf and the MuJoCo bundle\n"
+      "<design>_<station>/ (MJCF, scene.xml, README.md; both with geometry:), SI "
       "units; joints <station>_<mechanism>_theta<1|2>, their limits the usable range of each joint (potentiometer\n"
       "travel, hard stops, joint_limits).\n" +
       exit_status({.ok = "exported (or --check: the file matches)",

@@ -53,9 +53,13 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
                            HasSubstr("design hash sha256:"), HasSubstr("index/lower"), HasSubstr("thumb pivot")));
   EXPECT_THAT(r.out, Not(HasSubstr("FAILED")));
   EXPECT_EQ(listing(dir_ / "ctl"), (std::vector<std::string>{"iros2022_controller.hpp", "iros2022_controller.json",
-                                                             "iros2022_controller.yaml", "iros2022_index.urdf",
-                                                             "iros2022_index.xml", "iros2022_thumb.urdf",
-                                                             "iros2022_thumb.xml"}));
+                                                             "iros2022_controller.yaml", "iros2022_index",
+                                                             "iros2022_index.urdf", "iros2022_thumb",
+                                                             "iros2022_thumb.urdf"}));
+  // The MuJoCo bundle of a station (fivebar/export/mjcf.hpp), laid out as MuJoCo Menagerie's models.
+  EXPECT_EQ(listing(dir_ / "ctl" / "iros2022_index"),
+            (std::vector<std::string>{"LICENSE", "README.md", "iros2022_index.xml", "iros2022_index_position.xml",
+                                      "preview.svg", "scene.xml", "scene_position.xml"}));
   // The ROS file with yaml-cpp: the paper's numbers in SI units, doubles as doubles.
   const YAML::Node p = YAML::LoadFile((dir_ / "ctl" / "iros2022_controller.yaml").string())["fivebar_controller"]["ros__parameters"];
   EXPECT_EQ(p["loop_rate_hz"].Scalar(), "100.0");
@@ -152,16 +156,36 @@ TEST_F(CliExport, ARefusedExportWritesNothingAndListsEveryReason) {
   const std::string before = slurp(dir_ / "kept" / "iros2022_controller.yaml");
   EXPECT_EQ(run({"export", bad.string(), "--out", "kept"}).code, 1);
   EXPECT_EQ(slurp(dir_ / "kept" / "iros2022_controller.yaml"), before);
-  EXPECT_EQ(listing(dir_ / "kept").size(), 7u);  // three formats, two URDFs and two MJCFs
+  EXPECT_EQ(listing(dir_ / "kept").size(), 7u);  // three formats, two URDFs and two MuJoCo bundles
 }
 
-TEST_F(CliExport, FormatMjcfWritesOnlyTheMjcf) {
+TEST_F(CliExport, FormatMjcfWritesOnlyTheMujocoBundle) {
   const Outcome r = run({"export", kDesign, "--station", "index", "--format", "mjcf", "--out", "m"});
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(listing(dir_ / "m"), (std::vector<std::string>{"iros2022_index.xml"}));
-  EXPECT_THAT(slurp(dir_ / "m" / "iros2022_index.xml"),
+  EXPECT_EQ(listing(dir_ / "m"), (std::vector<std::string>{"iros2022_index"}));
+  EXPECT_THAT(slurp(dir_ / "m" / "iros2022_index" / "iros2022_index.xml"),
               AllOf(HasSubstr("<mujoco model=\"iros2022_index\">"), HasSubstr("<connect name=\"index_lower_loop\""),
                     HasSubstr("armature=\"0.002\""), HasSubstr("<general name=\"index_upper_theta2\"")));
+}
+
+TEST_F(CliExport, Ros2PackageWritesTheDescriptionPackageAlone) {
+  const Outcome r = run({"export", kDesign, "--ros2-package", "pkg"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(listing(dir_ / "pkg"), (std::vector<std::string>{"CMakeLists.txt", "README.md", "config", "launch", "package.xml",
+                                                             "urdf"}));
+  EXPECT_EQ(listing(dir_ / "pkg" / "urdf"), (std::vector<std::string>{"iros2022_index.urdf", "iros2022_thumb.urdf"}));
+  EXPECT_EQ(listing(dir_ / "pkg" / "config"),
+            (std::vector<std::string>{"iros2022_controller.yaml", "ros2_controllers.yaml"}));
+  // Without the parts' renders there are no meshes: CMakeLists installs only the folders there are.
+  EXPECT_THAT(slurp(dir_ / "pkg" / "CMakeLists.txt"), HasSubstr("install(DIRECTORY urdf config launch DESTINATION"));
+  EXPECT_THAT(slurp(dir_ / "pkg" / "urdf" / "iros2022_index.urdf"), HasSubstr("<link name=\"world\"/>"));
+  // The parameters file in it checks against the design as any exported one.
+  EXPECT_EQ(run({"export", "--check", (dir_ / "pkg" / "config" / "iros2022_controller.yaml").string(), kDesign}).code, 0);
+  // It writes the package alone: --out and --format do not apply (usage, exit 2, nothing written).
+  EXPECT_EQ(run({"export", kDesign, "--ros2-package", "p2", "--out", "x"}).code, 2);
+  EXPECT_EQ(run({"export", kDesign, "--ros2-package", "p3", "--format", "urdf"}).code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "p2"));
+  EXPECT_FALSE(fs::exists(dir_ / "x"));
 }
 
 TEST_F(CliExport, BadInputIsExitTwo) {
@@ -222,16 +246,22 @@ TEST_F(CliExport, RunBuildsTheExportProduct) {
   EXPECT_EQ(doc["results"]["export"]["exported"], true);
   EXPECT_EQ(doc["results"]["export"]["files"],
             json({"export/iros2022_controller.yaml", "export/iros2022_controller.json", "export/iros2022_controller.hpp",
-                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf", "export/iros2022_index.xml",
-                  "export/iros2022_thumb.xml"}));
+                  "export/iros2022_index.urdf", "export/iros2022_thumb.urdf", "export/iros2022_index/iros2022_index.xml",
+                  "export/iros2022_index/iros2022_index_position.xml", "export/iros2022_index/scene.xml",
+                  "export/iros2022_index/scene_position.xml", "export/iros2022_index/preview.svg",
+                  "export/iros2022_index/LICENSE", "export/iros2022_index/README.md",
+                  "export/iros2022_thumb/iros2022_thumb.xml", "export/iros2022_thumb/iros2022_thumb_position.xml",
+                  "export/iros2022_thumb/scene.xml", "export/iros2022_thumb/scene_position.xml",
+                  "export/iros2022_thumb/preview.svg", "export/iros2022_thumb/LICENSE", "export/iros2022_thumb/README.md"}));
   EXPECT_EQ(listing(dir_ / "scene" / "iros2022" / "export").size(), 7u);
   EXPECT_EQ(run({"export", "--check", (dir_ / "scene" / "iros2022" / "export" / "iros2022_controller.json").string(), kDesign}).code, 0);
   EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"), AllOf(HasSubstr("## Controller export (`export`)"),
                                                                        HasSubstr("Files:")));
   // The report links the MJCF beside the URDF (summary.md, and the HTML page rendered from it).
   EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "summary.md"),
-              HasSubstr("[`export/iros2022_index.xml`](export/iros2022_index.xml)"));
-  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "index.html"), HasSubstr("href=\"export/iros2022_index.xml\""));
+              HasSubstr("[`export/iros2022_index/iros2022_index.xml`](export/iros2022_index/iros2022_index.xml)"));
+  EXPECT_THAT(slurp(dir_ / "scene" / "iros2022" / "index.html"),
+              HasSubstr("href=\"export/iros2022_index/iros2022_index.xml\""));
 
   // A refused export fails the scene and writes no export/ folder.
   const fs::path bad = design_with("bad.yaml", "  min_lci: 0.05", "  min_lci: 0.5");

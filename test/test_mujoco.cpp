@@ -1,6 +1,9 @@
 // The exported URDF and MJCF (fivebar/export/urdf.hpp, fivebar/export/mjcf.hpp) checked by the client itself:
 // MuJoCo 2.2.2 (Debian libmujoco-dev) loads every file `fivebar export` writes for the showcase
-// (designs/iros2022.yaml) without edits, with closed-form masses and with STL meshes; the MJCF's
+// (designs/iros2022.yaml) without edits, with closed-form masses and with STL meshes, and each
+// station's bundle copied on its own; the keyframe `home` puts the tactors where mjcf_home() says,
+// without contact; the upper tactor driven into the lower one meets it (contacts); a joint driven
+// into its hard stop at full duty stays at it; the MJCF's
 // loop closures sit at P (the anchor MuJoCo computes on the second body is P in that body's frame,
 // known from the link lengths); the rotor inertia is in both files; and the same 100 Hz PID (the
 // exported gains, potentiometers and ADC, zero-order hold, one period of delay) run in MuJoCo on
@@ -143,7 +146,18 @@ TEST_F(MujocoTest, LoadsEveryExportedUrdfAndMjcfOfTheShowcaseWithoutEdits) {
     (f.extension() == ".urdf" ? urdf : mjcf) += 1;
   }
   EXPECT_EQ(urdf, 2u);  // index and thumb
-  EXPECT_EQ(mjcf, 2u);
+  EXPECT_EQ(mjcf, 8u);  // per station: the model, its position variant and a scene of each
+  // Each bundle copied on its own into a scratch folder loads as it is.
+  for (const Station& s : design_->stations) {
+    const fs::path alone = *dir_ / "alone" / s.name;
+    fs::create_directories(alone.parent_path());
+    fs::copy(*dir_ / "export" / ("iros2022_" + s.name), alone, fs::copy_options::recursive);
+    for (const char* f : {"scene.xml", "scene_position.xml"}) {
+      Loaded l(alone / f);
+      EXPECT_NE(l.model, nullptr) << s.name << "/" << f << ": " << l.error;
+      EXPECT_EQ(l.error, "");
+    }
+  }
 }
 
 TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf) {
@@ -151,7 +165,7 @@ TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf
   const double reflected = 200.0 * 200.0 * 0.5e-7;
   for (const char* station : {"index", "thumb"}) {
     SCOPED_TRACE(station);
-    Loaded l(*dir_ / "export" / (std::string("iros2022_") + station + ".xml"));
+    Loaded l(*dir_ / "export" / (std::string("iros2022_") + station) / (std::string("iros2022_") + station + ".xml"));
     ASSERT_NE(l.model, nullptr) << l.error;
     ASSERT_EQ(l.model->nu, 4);
     for (const char* mech : {"lower", "upper"}) {
@@ -190,7 +204,7 @@ TEST_F(MujocoTest, RotorInertiaIsTheArmatureOfTheMjcfAndTheTransmissionOfTheUrdf
 TEST_F(MujocoTest, LoopClosuresSitAtTheTactorInBothBodies) {
   const Design& d = *design_;
   for (const Station& s : d.stations) {
-    Loaded l(*dir_ / "export" / ("iros2022_" + s.name + ".xml"));
+    Loaded l(*dir_ / "export" / ("iros2022_" + s.name) / ("iros2022_" + s.name + ".xml"));
     ASSERT_NE(l.model, nullptr) << l.error;
     mjData* data = mj_makeData(l.model);
     mj_forward(l.model, data);
@@ -250,8 +264,8 @@ void write_box(const fs::path& file, double x0, double y0, double z0, double a, 
   }
 }
 
-TEST(Mujoco, MeshPathsResolveFromTheExportFolderAsTheProductWritesThem) {
-  // The layout of `fivebar run`: <out>/parts/<station>/*.stl and <out>/export/*.urdf|*.xml naming
+TEST(Mujoco, BundleLoadsAloneWithItsMeshesAndTheUrdfFromTheExportFolder) {
+  // The layout of `fivebar run`: <out>/parts/<station>/*.stl, <out>/export/*.urdf naming
   // them "../parts/...". Boxes stand in for the renders.
   const Design d = paper();
   TempDir dir;
@@ -273,17 +287,174 @@ TEST(Mujoco, MeshPathsResolveFromTheExportFolderAsTheProductWritesThem) {
   options.urdf_options.parts_dir = dir.path / "parts";
   const ExportResult r = export_controller(d, {}, dir.path / "export", options);
   ASSERT_TRUE(r.gate.passed());
-  ASSERT_EQ(r.files.size(), 2u);
-  for (const fs::path& f : r.files) {
+  // The URDF names the renders in ../parts; the bundle carries copies in its assets/ folder and loads
+  // from anywhere on its own (the export folder and the parts removed).
+  const fs::path alone = dir.path / "elsewhere" / "copy";
+  fs::create_directories(alone.parent_path());
+  fs::copy(dir.path / "export" / "iros2022_index", alone, fs::copy_options::recursive);
+  EXPECT_TRUE(fs::is_regular_file(alone / "assets/index/link.stl"));
+  for (const fs::path& f : {dir.path / "export/iros2022_index.urdf", alone / "iros2022_index.xml",
+                            alone / "iros2022_index_position.xml", alone / "scene.xml", alone / "scene_position.xml"}) {
     SCOPED_TRACE(f.string());
+    if (f.extension() == ".xml" && fs::exists(dir.path / "export")) {
+      fs::remove_all(dir.path / "export");
+      fs::remove_all(dir.path / "parts");
+    }
+    if (f.extension() == ".urdf") {
+      Loaded l(f);
+      ASSERT_NE(l.model, nullptr) << l.error;
+      EXPECT_EQ(l.model->nmesh, 3);
+      continue;
+    }
     Loaded l(f);
     ASSERT_NE(l.model, nullptr) << l.error;
+    EXPECT_EQ(l.error, "");
     EXPECT_EQ(l.model->nmesh, 3);  // one asset per file: link, tip, base
     // The box link's mass from its STL (1.15 g/cm^3, 8 x 4 x 2 mm).
     const int b = id_of(l.model, mjOBJ_BODY, "index_upper_L1");
     ASSERT_GE(b, 0);
     EXPECT_NEAR(l.model->body_mass[b], 1.15e-6 * 64.0, 1e-12);
+    EXPECT_EQ(l.model->nkey, 1);
+    EXPECT_EQ(l.model->nu, 4);
   }
+  for (const char* f : {"README.md", "LICENSE", "preview.svg"}) EXPECT_TRUE(fs::is_regular_file(alone / f)) << f;
+  EXPECT_NE(read_text(alone / "README.md").find("![The home keyframe, top view](preview.svg)"), std::string::npos);
+}
+
+// --- The bundle: keyframe, contacts, stops, servos ------------------------------------------------
+
+/// The index bundle's scene loaded (closed-form masses, box visuals), data at the keyframe `home`.
+struct Scene {
+  std::unique_ptr<Loaded> l;
+  mjData* d = nullptr;
+  explicit Scene(const fs::path& file) : l(std::make_unique<Loaded>(file)) {
+    if (l->model == nullptr) return;
+    d = mj_makeData(l->model);
+    mj_resetDataKeyframe(l->model, d, mj_name2id(l->model, mjOBJ_KEY, "home"));
+    mj_forward(l->model, d);
+  }
+  ~Scene() {
+    if (d != nullptr) mj_deleteData(d);
+  }
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+  mjModel* m() const { return l->model; }
+  Vec2 tactor_mm(const std::string& name) const {
+    const int a = l->model->sensor_adr[id_of(l->model, mjOBJ_SENSOR, name)];
+    return Vec2(d->sensordata[a], d->sensordata[a + 1]) * 1e3;
+  }
+  std::string body_of_geom(int g) const { return mj_id2name(l->model, mjOBJ_BODY, l->model->geom_bodyid[g]); }
+};
+
+TEST_F(MujocoTest, HomeKeyframeHasTheTactorsApartAboutTheCentreAndNoContact) {
+  for (const Station& s : design_->stations) {
+    SCOPED_TRACE(s.name);
+    for (const char* scene : {"scene.xml", "scene_position.xml"}) {
+      Scene sc(*dir_ / "export" / ("iros2022_" + s.name) / scene);
+      ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+      // The stretch pattern's start: 8 mm apart vertically about the target centre (designs/iros2022.yaml).
+      const Vec2 lower = sc.tactor_mm(s.name + "_lower_tactor"), upper = sc.tactor_mm(s.name + "_upper_tactor");
+      EXPECT_NEAR((lower - (s.target.center - Vec2(0.0, 4.0))).norm(), 0.0, 1e-9);
+      EXPECT_NEAR((upper - (s.target.center + Vec2(0.0, 4.0))).norm(), 0.0, 1e-9);
+      EXPECT_EQ(sc.d->ncon, 0) << "first contact: " << (sc.d->ncon > 0 ? sc.body_of_geom(sc.d->contact[0].geom1) + " / " +
+                                                                           sc.body_of_geom(sc.d->contact[0].geom2)
+                                                                     : "");
+      // Held there by the position servos (ctrl = the home angles): still clear after 0.2 s.
+      if (std::string(scene) == "scene_position.xml") {
+        for (int i = 0; i < 2000; ++i) mj_step(sc.m(), sc.d);
+        mj_forward(sc.m(), sc.d);
+        EXPECT_EQ(sc.d->ncon, 0);
+        EXPECT_NEAR((sc.tactor_mm(s.name + "_lower_tactor") - lower).norm(), 0.0, 0.01);
+      }
+    }
+  }
+}
+
+TEST_F(MujocoTest, DrivingTheUpperTactorIntoTheLowerOneMakesContact) {
+  const Station& s = *design_->station("index");
+  Scene sc(*dir_ / "export/iros2022_index/scene_position.xml");
+  ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+  // The upper mechanism's servos commanded to the lower tactor's point (the IK there, on the branch of
+  // their home angles); the lower one holds home.
+  const Vec2 target = sc.tactor_mm("index_lower_tactor");
+  const Mechanism& upper = *s.mechanism("upper");
+  const Pose ik_upper = ik(upper, target);
+  ASSERT_NE(ik_upper.status, Status::unreachable);
+  for (int j = 1; j <= 2; ++j) {
+    const int a = id_of(sc.m(), mjOBJ_ACTUATOR, joint_name("index", "upper", j));
+    const double th = j == 1 ? ik_upper.theta1 : ik_upper.theta2;
+    const double home = sc.d->ctrl[a];
+    sc.d->ctrl[a] = home + std::remainder(th - home, 2.0 * std::numbers::pi);
+  }
+  int contact_steps = 0;
+  double deepest = 0.0, closest_mm = 1e9;
+  std::string pair;
+  for (int i = 0; i < 5000; ++i) {
+    mj_step(sc.m(), sc.d);
+    mj_forward(sc.m(), sc.d);
+    closest_mm = std::min(closest_mm, (sc.tactor_mm("index_upper_tactor") - sc.tactor_mm("index_lower_tactor")).norm());
+    bool between = false;
+    for (int c = 0; c < sc.d->ncon; ++c) {
+      const std::string b1 = sc.body_of_geom(sc.d->contact[c].geom1), b2 = sc.body_of_geom(sc.d->contact[c].geom2);
+      if ((b1.rfind("index_upper", 0) == 0) != (b2.rfind("index_upper", 0) == 0)) {
+        between = true;
+        deepest = std::min(deepest, sc.d->contact[c].dist);
+        if (pair.empty()) pair = b1 + " / " + b2;
+      }
+    }
+    contact_steps += between ? 1 : 0;
+  }
+  std::printf("[ MuJoCo ] upper tactor driven into the lower: contact in %d of 5000 steps (first %s), deepest %.3g mm, "
+              "tactors %.3g mm apart at the closest\n",
+              contact_steps, pair.c_str(), -deepest * 1e3, closest_mm);
+  EXPECT_GT(contact_steps, 0);
+  EXPECT_GT(deepest, -0.5e-3);  // stiff contacts: less than half a millimetre of overlap
+  // The bodies do not pass through each other: the bosses at the two P (5 mm, in the distal links'
+  // common plane) keep the tactors a boss diameter apart, less the overlap; without contacts the
+  // upper tactor reaches its command, the lower tactor's point.
+  EXPECT_GT(closest_mm, 5.0 - 0.5);
+}
+
+TEST_F(MujocoTest, HardStopsHoldAtFullDuty) {
+  // index_lower_theta1 runs down into its stop against the boss of lower O2 (19.38 deg, docs/urdf.md)
+  // at full duty: by how much does it pass it?
+  Scene sc(*dir_ / "export/iros2022_index/scene.xml");
+  ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+  const int jid = id_of(sc.m(), mjOBJ_JOINT, "index_lower_theta1");
+  ASSERT_EQ(sc.m()->jnt_limited[jid], 1);
+  const double lo = sc.m()->jnt_range[2 * jid];
+  EXPECT_NEAR(lo, std::acos(212.25 / 225.0), 1e-12);
+  // {largest excursion past the stop, excursion after 1 s} in degrees, from home at full duty.
+  const auto into_stop = [&]() {
+    mj_resetDataKeyframe(sc.m(), sc.d, 0);
+    sc.d->ctrl[id_of(sc.m(), mjOBJ_ACTUATOR, "index_lower_theta1")] = -1.0;
+    double past = 0.0, held = 0.0;
+    for (int i = 0; i < 10000; ++i) {
+      mj_step(sc.m(), sc.d);
+      const double q = sc.d->qpos[sc.m()->jnt_qposadr[jid]];
+      past = std::max(past, lo - q);
+      held = lo - q;
+    }
+    return std::array<double, 2>{past * 180.0 / std::numbers::pi, held * 180.0 / std::numbers::pi};
+  };
+  // As exported: the proximal link meets the other motor's boss (a contact) where its range ends.
+  const auto file = into_stop();
+  // The joint limit alone (contacts off), as exported and with MuJoCo's default limit softness
+  // (solreflimit 0.02 1, solimplimit 0.9 0.95 0.001).
+  sc.m()->opt.disableflags |= mjDSBL_CONTACT;
+  const auto stiff = into_stop();
+  const mjtNum soft_ref[2] = {0.02, 1.0}, soft_imp[5] = {0.9, 0.95, 0.001, 0.5, 2.0};
+  for (int k = 0; k < 2; ++k) sc.m()->jnt_solref[mjNREF * jid + k] = soft_ref[k];
+  for (int k = 0; k < 5; ++k) sc.m()->jnt_solimp[mjNIMP * jid + k] = soft_imp[k];
+  const auto soft = into_stop();
+  std::printf("[ MuJoCo ] full duty into the hard stop, deg past it at most / after 1 s: as exported %.3g / %.3g; the "
+              "joint limit alone %.3g / %.3g; with MuJoCo's default limit softness %.3g / %.3g\n",
+              file[0], file[1], stiff[0], stiff[1], soft[0], soft[1]);
+  for (const auto& r : {file, stiff}) {
+    EXPECT_LT(r[0], 0.5);
+    EXPECT_LT(r[1], 0.1);
+  }
+  EXPECT_GT(soft[0], 5.0 * stiff[0]);
 }
 
 // --- The same controller in MuJoCo and in fivebar simulate ------------------------------------------
@@ -293,6 +464,7 @@ struct Trace {
   std::vector<std::vector<std::array<double, 2>>> theta;  ///< [sample][mechanism] rad
   std::vector<std::vector<Vec2>> P_mm;                     ///< [sample][mechanism]
   double max_loop_gap_m = 0.0;                             ///< the connect constraints' largest violation
+  int max_contacts = 0;                                    ///< MuJoCo's contacts (fivebar simulate has none)
 };
 
 /// Departures from the exported model, to measure what limits the agreement.
@@ -402,6 +574,10 @@ Trace run_mujoco(const fs::path& file, const SimulationInput& input, const Json&
         tr.max_loop_gap_m = std::max(tr.max_loop_gap_m, std::sqrt(gap2));
       }
     }
+    // mj_step computes the sensors before it integrates: recompute them at the new state, so the next
+    // sample reads the joints at t_k+1 and not one timestep earlier.
+    mj_forward(m, d);
+    tr.max_contacts = std::max(tr.max_contacts, d->ncon);
   }
   mj_deleteData(d);
   return tr;
@@ -442,6 +618,7 @@ Agreement run_both(const Design& d, const fs::path& mjcf, const Json& parameters
   EXPECT_TRUE(sim.ok()) << sim.reason;
   const Trace mj = run_mujoco(mjcf, input, parameters, sim.samples.size(), v);
   EXPECT_EQ(mj.theta.size(), sim.samples.size());
+  EXPECT_EQ(mj.max_contacts, 0) << "the links touch in MuJoCo: the comparison with fivebar simulate (no contacts) fails";
   const Agreement a = compare(sim, mj);
   std::printf("[ MuJoCo ] %s: %zu samples, MuJoCo vs fivebar simulate: max %.3g rad, %.3g mm (simulate's tracking error "
               "%.3g mm); loop gap %.3g m\n",
@@ -462,8 +639,8 @@ std::map<std::string, MechanismInertia> closed_form(const Design& d, const std::
 }
 
 // The agreement bound asserted below: 10 um at the tactor, 11x under the showcase's 0.11 mm
-// tracking error, and 1e-3 rad (measured 5.9e-4 rad and 5.9 um on the step, 4.3e-4 rad and
-// 5.2 um on the stretch; printed, and quoted in docs/mjcf.md). The inductance the MJCF leaves out
+// tracking error, and 1e-3 rad (measured 6.04e-4 rad and 4.93 um on the step, 3.45e-4 rad and
+// 3.30 um on the stretch; printed, and quoted in docs/mjcf.md). The inductance the MJCF leaves out
 // and MuJoCo's Euler step at 0.1 ms set it (WhatLimitsTheAgreement below).
 constexpr double kAgreementMm = 1e-2;
 constexpr double kAgreementRad = 1e-3;
@@ -477,7 +654,7 @@ TEST_F(MujocoTest, AOneMillimetreStepFollowsFivebarSimulate) {
   std::vector<SimulationInput> inputs = simulation_inputs(d, request, closed_form(d, "index"));
   ASSERT_EQ(inputs.size(), 1u);
   double gap = 0.0;
-  const Agreement a = run_both(d, *dir_ / "export/iros2022_index.xml", result_->parameters, inputs[0], "step", &gap);
+  const Agreement a = run_both(d, *dir_ / "export/iros2022_index/iros2022_index.xml", result_->parameters, inputs[0], "step", &gap);
   EXPECT_GT(a.tracking_mm, 0.5);  // the step is tracked with a transient of most of a millimetre
   EXPECT_LT(a.rad, kAgreementRad);
   EXPECT_LT(a.mm, kAgreementMm);
@@ -499,7 +676,7 @@ TEST_F(MujocoTest, TheStretchPatternFollowsFivebarSimulate) {
       if (!m.target_mm.empty()) m.target_mm.resize(30);  // what the runtime is fed (fivebar/dynamics.hpp)
     }
   }
-  const Agreement a = run_both(d, *dir_ / "export/iros2022_index.xml", result_->parameters, in, "stretch");
+  const Agreement a = run_both(d, *dir_ / "export/iros2022_index/iros2022_index.xml", result_->parameters, in, "stretch");
   EXPECT_GT(a.tracking_mm, 0.0);
   EXPECT_LT(a.rad, kAgreementRad);
   EXPECT_LT(a.mm, kAgreementMm);
@@ -512,7 +689,7 @@ TEST_F(MujocoTest, WhatLimitsTheAgreement) {
   request.step = true;
   if (kSanitized) request.step_hold_s = 0.15;
   const SimulationInput in = simulation_inputs(d, request, closed_form(d, "index")).front();
-  const fs::path f = *dir_ / "export/iros2022_index.xml";
+  const fs::path f = *dir_ / "export/iros2022_index/iros2022_index.xml";
   const Json& p = result_->parameters;
   struct Row {
     const char* label;

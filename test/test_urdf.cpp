@@ -28,6 +28,7 @@
 #include "fivebar/export/export.hpp"
 #include "fivebar/export/joint_limits.hpp"
 #include "fivebar/sections/geometry.hpp"
+#include "fivebar/export/ros2_package.hpp"
 #include "fivebar/export/urdf.hpp"
 
 namespace fivebar {
@@ -319,6 +320,24 @@ TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
     EXPECT_DOUBLE_EQ(number(act->child("drake:rotor_inertia")->at("value")), 0.5e-7);
   }
   EXPECT_THAT(text, HasSubstr("reflected rotor inertia N^2 J_r = 0.002 kg m^2"));
+  // The transmissions declare the interface ros2_control commands: position (the device runs its PID).
+  for (const Element* tr : transmissions) {
+    EXPECT_EQ(tr->child("joint")->child("hardwareInterface")->text, "hardware_interface/PositionJointInterface");
+    EXPECT_EQ(tr->child("actuator")->child("hardwareInterface")->text, "hardware_interface/PositionJointInterface");
+  }
+
+  // The base carries the base plate's inertia (SDFormat drops a root without one): by hand, the base
+  // joints' bounding box 12.5 x 31 mm grown by the motor radius 5 and the margin 2 mm each side,
+  // 3 mm thick, 1.15 g/cm^3, centred under the joints.
+  const Element* base = find_named(*robot, "link", "index_base");
+  ASSERT_NE(base->child("inertial"), nullptr);
+  EXPECT_NEAR(number(base->child("inertial")->child("mass")->at("value")), 1.15e-6 * 26.5 * 45.0 * 3.0, 1e-15);
+  const auto base_com = triple(base->child("inertial")->child("origin")->at("xyz"));
+  EXPECT_NEAR(base_com[0], 0.00625, 1e-15);
+  EXPECT_NEAR(base_com[1], 0.0155, 1e-15);
+  EXPECT_NEAR(base_com[2], -0.0015, 1e-15);
+  EXPECT_NEAR(number(base->child("inertial")->child("inertia")->at("izz")),
+              1.15e-6 * 26.5 * 45.0 * 3.0 * (26.5 * 26.5 + 45.0 * 45.0) / 12.0 * 1e-6, 1e-15);
 
   // Masses: the distal link without the post (L4) is a 15 x 4 x 2.5 mm slab with a half disc of
   // 2.5 mm at each end, less two pin holes of 2 + 2 x 0.15 mm, at 1.15 g/cm^3.
@@ -465,6 +484,213 @@ TEST(Urdf, ExportWritesOneUrdfPerStationAtomicallyAndOnlyWhenAsked) {
   Design bare = d;
   bare.reset<Geometry>();
   EXPECT_THROW(render_urdf(bare, *bare.station("index")), InputError);
+}
+
+// --- SDFormat (Gazebo's reader) --------------------------------------------------------------------
+
+const char* const kIgn = "/usr/bin/ign";
+
+/// `ign sdf -p FILE` (stdout only) parsed; nullptr and the text when it is not XML.
+std::unique_ptr<Element> sdf_of(const fs::path& file, std::string& raw) {
+  raw = run(std::string(kIgn) + " sdf -p '" + file.string() + "' 2>/dev/null");
+  const std::size_t end = raw.rfind("\n[exit ");
+  try {
+    return XmlReader(raw.substr(0, end)).document();
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+/// Every link of the URDF with mass is an SDF link, every joint but the massless cut's mount an SDF
+/// joint of the same type, parent and child, and each cut frame P an SDF frame on its distal link at
+/// the mount's origin.
+void expect_sdformat_keeps(const fs::path& file) {
+  SCOPED_TRACE(file.string());
+  const auto urdf = XmlReader(slurp(file)).document();
+  std::string raw;
+  const auto sdf = sdf_of(file, raw);
+  ASSERT_NE(sdf, nullptr) << raw;
+  const Element* model = sdf->child("model");
+  ASSERT_NE(model, nullptr) << raw;
+  EXPECT_EQ(model->at("name"), urdf->at("name"));
+  std::size_t massive = 0, cut = 0;
+  for (const Element* l : urdf->all("link")) {
+    const std::string name = l->at("name");
+    if (name == "world") continue;
+    if (l->child("inertial") != nullptr) {
+      ++massive;
+      EXPECT_NE(find_named(*model, "link", name), nullptr) << "link " << name << " lost";
+    } else {
+      ++cut;
+      const Element* frame = find_named(*model, "frame", name);
+      ASSERT_NE(frame, nullptr) << "frame " << name << " lost";
+      // At the mount's origin on the mount's parent link.
+      for (const Element* j : urdf->all("joint")) {
+        if (j->child("child")->at("link") != name) continue;
+        EXPECT_EQ(frame->at("attached_to"), j->child("parent")->at("link"));
+        const auto a = triple(j->child("origin")->at("xyz"));
+        std::istringstream pose(frame->child("pose")->text);
+        std::array<double, 3> b{};
+        pose >> b[0] >> b[1] >> b[2];
+        for (std::size_t k = 0; k < 3; ++k) EXPECT_NEAR(a[k], b[k], 1e-12);
+      }
+    }
+  }
+  EXPECT_EQ(model->all("link").size(), massive);
+  EXPECT_GT(cut, 0u);
+  std::size_t kept = 0;
+  for (const Element* j : urdf->all("joint")) {
+    const std::string child = j->child("child")->at("link");
+    if (find_named(*urdf, "link", child)->child("inertial") == nullptr) continue;  // the cut's mount: the frame
+    const Element* sj = find_named(*model, "joint", j->at("name"));
+    ASSERT_NE(sj, nullptr) << "joint " << j->at("name") << " lost";
+    ++kept;
+    const std::string type = j->at("type") == "continuous" ? "revolute" : j->at("type");  // SDF has no continuous
+    EXPECT_EQ(sj->at("type"), type) << j->at("name");
+    EXPECT_EQ(sj->child("parent")->text, j->child("parent")->at("link"));
+    EXPECT_EQ(sj->child("child")->text, child);
+  }
+  EXPECT_EQ(model->all("joint").size(), kept);
+  const std::string check = run(std::string(kIgn) + " sdf -k '" + file.string() + "' 2>&1");
+  EXPECT_THAT(check, HasSubstr("Valid."));
+}
+
+TEST(Urdf, SdformatKeepsEveryLinkAndJoint) {
+  if (!fs::exists(kIgn)) GTEST_SKIP() << "ign not installed (Debian packages ignition-tools, libsdformat-dev): not run";
+  const Design d = paper();
+  TempDir dir;
+  for (const bool world : {false, true}) {
+    for (const Station& s : d.stations) {
+      UrdfOptions options;
+      options.world_link = world;
+      const fs::path file = dir.path / ((world ? "world_" : "") + urdf_file_name(d, s));
+      std::ofstream(file) << render_urdf(d, s, options);
+      expect_sdformat_keeps(file);
+      std::string raw;
+      const auto sdf = sdf_of(file, raw);
+      ASSERT_NE(sdf, nullptr);
+      // With `world`: the base fixed to it (SDFormat's joint to the world); without: the base is the root.
+      const Element* fixed = find_named(*sdf->child("model"), "joint", s.name + "_base_to_world");
+      EXPECT_EQ(fixed != nullptr, world);
+      if (fixed != nullptr) EXPECT_EQ(fixed->child("parent")->text, "world");
+    }
+  }
+}
+
+TEST(Urdf, InitialPoseClosesEveryLoopInsideTheLimits) {
+  // The elbows of initial_pose(), put through the two legs by hand, meet at the target centre.
+  const Design d = paper();
+  for (const Station& s : d.stations) {
+    const auto pose = initial_pose(d, s);
+    ASSERT_EQ(pose.size(), 4 * s.mechanisms().size());
+    std::map<std::string, double> q(pose.begin(), pose.end());
+    for (const Mechanism* m : s.mechanisms()) {
+      const std::string p = s.name + "_" + m->name + "_";
+      const double t1 = q.at(p + "theta1"), t2 = q.at(p + "theta2"), e1 = q.at(p + "elbow1"), e2 = q.at(p + "elbow2");
+      const double x1 = m->O1.x() + m->L[0] * std::cos(t1) + m->L[2] * std::cos(t1 + e1);
+      const double y1 = m->O1.y() + m->L[0] * std::sin(t1) + m->L[2] * std::sin(t1 + e1);
+      const double x2 = m->O2.x() + m->L[1] * std::cos(t2) + m->L[3] * std::cos(t2 + e2);
+      const double y2 = m->O2.y() + m->L[1] * std::sin(t2) + m->L[3] * std::sin(t2 + e2);
+      EXPECT_NEAR(x1, s.target.center.x(), 1e-9);
+      EXPECT_NEAR(y1, s.target.center.y(), 1e-9);
+      EXPECT_NEAR(x2, s.target.center.x(), 1e-9);
+      EXPECT_NEAR(y2, s.target.center.y(), 1e-9);
+      for (const UsableRange& r : usable_ranges(d, s, *m)) EXPECT_GT(range_margin(r, q.at(r.joint)), 0.0) << r.joint;
+    }
+  }
+}
+
+// --- The ROS 2 description package -------------------------------------------------------------
+
+/// A parts report of box STL files for the index station (as FromStlRenders... above).
+Json box_parts(const fs::path& parts_dir) {
+  fs::create_directories(parts_dir / "index");
+  write_box(parts_dir / "index/link.stl", 0.5, -2.0, 0.0, 8.0, 4.0, 2.0);
+  write_box(parts_dir / "index/tip.stl", -1.0, -1.0, 0.0, 2.0, 2.0, 1.0);
+  write_box(parts_dir / "index/base.stl", -5.0, -5.0, -3.0, 25.0, 40.0, 3.0);
+  Json parts = {{"parts", Json::array()}};
+  parts["parts"].push_back({{"station", "index"}, {"uses", {"lower/L1", "lower/L2", "lower/L3", "lower/L4", "upper/L1",
+                                                             "upper/L2", "upper/L3", "upper/L4"}},
+                            {"stl", "index/link.stl"}});
+  parts["parts"].push_back({{"station", "index"}, {"uses", {"lower/tactor", "upper/tactor"}}, {"stl", "index/tip.stl"}});
+  parts["parts"].push_back({{"station", "index"}, {"uses", {"base"}}, {"stl", "index/base.stl"}});
+  return parts;
+}
+
+TEST(Urdf, Ros2PackageParsesAndItsUrdfPassesCheckUrdfAndSdformat) {
+  const Design d = paper();
+  TempDir dir;
+  const Json parts = box_parts(dir.path / "parts");
+  ExportOptions options;
+  options.stations = {"index"};
+  options.ros2_package = true;
+  options.ros2_package_subdir = "iros2022_description";
+  options.urdf_options.parts = &parts;
+  options.urdf_options.parts_dir = dir.path / "parts";
+  const ExportResult r = export_controller(d, {}, dir.path / "out", options);
+  ASSERT_TRUE(r.gate.passed());
+  const fs::path pkg = dir.path / "out" / "iros2022_description";
+  EXPECT_EQ(ros2_package_name(d), "iros2022_description");
+  for (const char* f : {"package.xml", "CMakeLists.txt", "README.md", "urdf/iros2022_index.urdf", "meshes/index/link.stl",
+                        "meshes/index/base.stl", "config/iros2022_controller_index.yaml", "config/ros2_controllers.yaml",
+                        "launch/display.launch.py"}) {
+    EXPECT_TRUE(fs::is_regular_file(pkg / f)) << f;
+  }
+  // CMakeLists installs exactly the folders the package has.
+  const std::string cmake = slurp(pkg / "CMakeLists.txt");
+  EXPECT_THAT(cmake, HasSubstr("install(DIRECTORY urdf meshes config launch DESTINATION share/${PROJECT_NAME})"));
+  EXPECT_THAT(cmake, HasSubstr("find_package(ament_cmake REQUIRED)"));
+  // The parameters file is the one `fivebar export` writes.
+  EXPECT_EQ(slurp(pkg / "config/iros2022_controller_index.yaml"), render_ros2_yaml(r.parameters));
+
+  // package.xml through catkin_pkg, ROS's own manifest reader (format 3, ament_cmake, validated).
+  std::vector<std::string> missing;  // tools not installed: their checks are skipped, and the test says so
+  const std::string probe = run("/usr/bin/python3 -c 'import catkin_pkg' 2>&1");
+  if (probe.find("[exit 0]") == std::string::npos) {
+    missing.push_back("python3-catkin-pkg");
+  } else {
+    const std::string out = run("/usr/bin/python3 -c \"from catkin_pkg.package import parse_package; p = parse_package('" +
+                                pkg.string() + "'); p.validate(); print(p.name, p.package_format, "
+                                "[d.name for d in p.buildtool_depends], p.get_build_type())\" 2>&1");
+    EXPECT_THAT(out, HasSubstr("iros2022_description 3 ['ament_cmake'] ament_cmake"));
+    EXPECT_THAT(out, HasSubstr("[exit 0]"));
+  }
+  // The launch file is Python the interpreter compiles.
+  EXPECT_THAT(run("/usr/bin/python3 -m py_compile '" + (pkg / "launch/display.launch.py").string() + "' 2>&1"),
+              HasSubstr("[exit 0]"));
+  const std::string launch = slurp(pkg / "launch/display.launch.py");
+  for (const auto& [joint, angle] : initial_pose(d, *d.station("index"))) {
+    EXPECT_THAT(launch, HasSubstr("'" + joint + "': " + format_double(angle) + ","));
+  }
+
+  // The URDF names its meshes package://iros2022_description/meshes/...; resolved into the folder,
+  // every one exists, check_urdf reads it and SDFormat keeps it.
+  std::string urdf = slurp(pkg / "urdf/iros2022_index.urdf");
+  const std::string scheme = "package://iros2022_description/";
+  EXPECT_THAT(urdf, HasSubstr("filename=\"package://iros2022_description/meshes/index/link.stl\""));
+  EXPECT_EQ(urdf.find("../parts"), std::string::npos);
+  std::size_t resolved = 0;
+  for (std::size_t at; (at = urdf.find(scheme)) != std::string::npos; ++resolved) {
+    urdf.replace(at, scheme.size(), pkg.string() + "/");
+    const std::size_t end = urdf.find('"', at);
+    EXPECT_TRUE(fs::is_regular_file(urdf.substr(at, end - at))) << urdf.substr(at, end - at);
+  }
+  EXPECT_EQ(resolved, 1u + 2 * 5);  // the base, per mechanism four links and the tip
+  const fs::path local = dir.path / "resolved.urdf";
+  std::ofstream(local) << urdf;
+  if (fs::exists(kCheckUrdf)) {
+    const std::string out = run(std::string(kCheckUrdf) + " '" + local.string() + "' 2>&1");
+    EXPECT_THAT(out, HasSubstr("root Link: world has 1 child(ren)"));
+    EXPECT_THAT(out, HasSubstr("[exit 0]"));
+  } else {
+    missing.push_back("liburdfdom-tools");
+  }
+  if (fs::exists(kIgn)) {
+    expect_sdformat_keeps(local);
+  } else {
+    missing.push_back("ignition-tools");
+  }
+  if (!missing.empty()) GTEST_SKIP() << "not installed, their checks not run: " << ::testing::PrintToString(missing);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "fivebar/export/export.hpp"
 #include "fivebar/provenance.hpp"
 #include "fivebar/export/mjcf.hpp"
+#include "fivebar/export/ros2_package.hpp"
 #include "fivebar/sections/tolerance.hpp"
 #include "fivebar/sections/bench.hpp"
 #include "fivebar/sections/optimize.hpp"
@@ -630,10 +631,17 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
       documents.emplace_back(dir / urdf_file_name(d, s), render_urdf(d, s, options.urdf_options));
     }
   }
-  if (options.mjcf && d.has<Geometry>()) {  // fivebar/export/mjcf.hpp
+  if (options.mjcf && d.has<Geometry>()) {  // the MuJoCo bundle per station (fivebar/export/mjcf.hpp)
     for (const std::string& name : result.gate.stations) {
       const Station& s = *d.station(name);
-      documents.emplace_back(dir / mjcf_file_name(d, s), render_mjcf(d, s, options.urdf_options));
+      for (BundleFile& f : mujoco_bundle(d, s, options.urdf_options)) {
+        documents.emplace_back(dir / mujoco_bundle_name(d, s) / f.path, std::move(f.bytes));
+      }
+    }
+  }
+  if (options.ros2_package && d.has<Geometry>()) {  // fivebar/export/ros2_package.hpp
+    for (BundleFile& f : ros2_package(d, result.gate.stations, result.parameters, options.urdf_options)) {
+      documents.emplace_back(dir / options.ros2_package_subdir / f.path, std::move(f.bytes));
     }
   }
   // A target that cannot be replaced (a directory of that name) fails before anything is written.
@@ -645,6 +653,9 @@ ExportResult export_controller(const Design& d, const std::vector<ExportFormat>&
     }
   }
   make_directories(dir);
+  for (const auto& [path, text] : documents) {
+    if (path.parent_path() != dir) make_directories(path.parent_path());  // a bundle's folders
+  }
   std::vector<AtomicFile> files;
   for (const auto& [path, text] : documents) {
     files.emplace_back(path);

@@ -87,7 +87,11 @@ Product export_product() {
       options.urdf_options.mesh_prefix = "../parts";
     }
     const ExportResult r = export_controller(d, all_export_formats(), ctx.dir / "export", options);
-    for (const auto& f : r.files) ctx.record(std::filesystem::path("export") / f.filename());
+    // Paths inside export/: the MuJoCo bundles are folders (fivebar/export/mjcf.hpp).
+    const auto rel = [&](const std::filesystem::path& f) {
+      return std::filesystem::path("export") / f.lexically_relative(ctx.dir / "export");
+    };
+    for (const auto& f : r.files) ctx.record(rel(f));
 
     Built b;
     std::string markdown = kPreamble;
@@ -112,9 +116,10 @@ Product export_product() {
     if (r.gate.passed()) {
       markdown += "Files:";
       for (const auto& f : r.files) {
-        const std::string rel = "export/" + f.filename().string();
-        markdown += " [" + md::code(rel) + "](" + rel + ")";
-        files.push_back(rel);
+        const std::string path = rel(f).generic_string();
+        files.push_back(path);
+        if (path.find("/assets/") != std::string::npos) continue;  // the bundles' mesh copies: listed in JSON only
+        markdown += " [" + md::code(path) + "](" + path + ")";
       }
       markdown += ".\n";
     } else {

@@ -52,6 +52,27 @@ std::map<std::string, std::string> stl_by_use(const Json& parts, const Station& 
   return out;
 }
 
+/// The base plate's closed form (robot_bodies.hpp): a box of the printing density.
+void plate_base(StationBodies& out, const Station& station, const PartsHardware& hw, double density_g_cm3) {
+  Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
+  for (const Mechanism* m : station.mechanisms()) {
+    for (const Vec2& O : {m->O1, m->O2}) {
+      lo = lo.cwiseMin(Eigen::Vector2d(O.x(), O.y()));
+      hi = hi.cwiseMax(Eigen::Vector2d(O.x(), O.y()));
+    }
+  }
+  const double grow = 0.5 * hw.motor_diameter + hw.base_margin;
+  const Eigen::Vector3d size(hi.x() - lo.x() + 2.0 * grow, hi.y() - lo.y() + 2.0 * grow, hw.base_plate_thickness);
+  out.base_plate_size_mm = size;
+  out.base_plate_centre_mm = Eigen::Vector3d(0.5 * (lo.x() + hi.x()), 0.5 * (lo.y() + hi.y()), -0.5 * size.z());
+  Body& b = out.base;
+  b.mass_kg = density_g_cm3 * 1e-6 * size.x() * size.y() * size.z();  // 1 g/cm^3 = 1e-6 kg/mm^3
+  b.com_mm = out.base_plate_centre_mm;
+  const double m = b.mass_kg;
+  b.inertia_kg_mm2.diagonal() << m * (size.y() * size.y() + size.z() * size.z()) / 12.0,
+      m * (size.x() * size.x() + size.z() * size.z()) / 12.0, m * (size.x() * size.x() + size.y() * size.y()) / 12.0;
+}
+
 }  // namespace
 
 StationBodies station_bodies(const Design& design, const Station& station, const UrdfOptions& options) {
@@ -101,6 +122,7 @@ StationBodies station_bodies(const Design& design, const Station& station, const
     }
     const double tip_height = hw.tip_flange_height + hw.tip_dome_height;
     mb.post_height_mm = std::max(0.0, g.tactor_height - tip_height);
+    mb.tip_height_mm = tip_height;
     if (mb.from_stl && stl.count("tactor") != 0) {
       mb.tip = from_mesh(options.parts_dir / stl.at("tactor"), print.density_g_cm3);
       mb.tip.mesh = options.mesh_prefix + "/" + stl.at("tactor");
@@ -115,6 +137,14 @@ StationBodies station_bodies(const Design& design, const Station& station, const
       mb.tip.inertia_kg_mm2.diagonal() << side, side, in.tip_izz_kg_mm2;
     }
     out.mechanisms.push_back(std::move(mb));
+  }
+  plate_base(out, station, hw, print.density_g_cm3);
+  if (!out.base_mesh_rel.empty()) {
+    const std::string mesh = out.base_mesh, rel = out.base_mesh_rel;
+    out.base = from_mesh(options.parts_dir / rel, print.density_g_cm3);
+    out.base.mesh = mesh;
+    out.base.mesh_rel = rel;
+    out.base_from_stl = true;
   }
   return out;
 }

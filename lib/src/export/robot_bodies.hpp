@@ -33,10 +33,18 @@ struct MechanismBodies {
   Body tip;                   ///< on the carrier's post (inertia.carrier: 2 = L3, 3 = L4)
   bool from_stl = false;
   double post_height_mm = 0.0;  ///< tactor_height less the tip
+  double tip_height_mm = 0.0;   ///< the tip: flange and dome (PartsHardware)
 };
 
 struct StationBodies {
   std::vector<MechanismBodies> mechanisms;  ///< station.mechanisms() order
+  /// The base plate: from its STL render with one, else a plate of PartsHardware::base_plate_thickness
+  /// under z = 0 over the base joints' bounding box grown by the motor's radius and the base margin
+  /// (the base's outline in fivebar/parts.hpp, without the finger rest and the mounting pads).
+  Body base;
+  bool base_from_stl = false;
+  Eigen::Vector3d base_plate_size_mm = Eigen::Vector3d::Zero();  ///< the plate's x, y, z extent
+  Eigen::Vector3d base_plate_centre_mm = Eigen::Vector3d::Zero();
   std::string base_mesh;                    ///< as the file should name it; empty without a render
   std::string base_mesh_rel;
   std::string parts_problem;                ///< why a given parts report could not be used

@@ -93,6 +93,10 @@ struct ExportOptions {
   /// `geometry:`; the same urdf_options (parts and meshes).
   bool mjcf = false;
   UrdfOptions urdf_options;
+  /// Also write the ROS 2 description package of the exported stations (fivebar/export/ros2_package.hpp),
+  /// with `geometry:`, into `dir / ros2_package_subdir` ("" : `dir` itself); the same urdf_options.
+  bool ros2_package = false;
+  std::string ros2_package_subdir;
 };
 
 /// One check of the export gate.

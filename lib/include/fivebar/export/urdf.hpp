@@ -33,7 +33,22 @@
 /// height, from mass_properties() of the same files), else closed_form_inertia(): mass, centre of
 /// mass in the plane and z inertia from it, the other components those of a plate of the link's
 /// width and thickness (ixx = m (w^2 + t^2) / 12, iyy = izz - m w^2 / 12 + m t^2 / 12, centre at
-/// mid-plate). The URDF says which in a comment. The base is the root and carries no inertia.
+/// mid-plate). The URDF says which in a comment. The base (the root, or the child of `world`) carries
+/// the base plate's inertia (from its STL render, else the plate of robot_bodies.hpp): SDFormat drops
+/// a root link without one, and every link under it.
+///
+/// SDFormat (Gazebo's reader, `ign sdf -p`): fixed joints are merged into their parent unless kept, so
+/// each tip mount carries `<gazebo reference><preserveFixedJoint>`; a massless link is dropped, so the
+/// cut frame <..>_P is repeated as an SDF `<frame>` attached to its distal link (a top-level `<gazebo>`
+/// block, which other readers ignore). SDFormat keeps no loop closure: its joints close a loop where the
+/// links stand at the zero pose, an open pose of this linkage; the MJCF is the closed model.
+///
+/// Initial pose: the joints' zero is not the device's pose (the motor joints' zero may lie outside their
+/// limits, as the station-frame angle 0 does); the pose at the target centre is given as the
+/// ros2_control state's initial_value and, for every joint, in a comment (initial_pose()).
+///
+/// Interfaces: the device runs its own PID at the loop rate (the exported gains), so ros2_control
+/// commands positions; the transmissions declare the same (PositionJointInterface).
 ///
 /// Limits: motor joints carry the usable range of fivebar/export/joint_limits.hpp (continuous when the
 /// joint has none), velocity motor_velocity_limit() (controller.max_velocity, at most the motor's
@@ -55,6 +70,8 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "fivebar/design.hpp"
 #include "fivebar/json.hpp"
@@ -67,13 +84,23 @@ struct UrdfOptions {
   const Json* parts = nullptr;
   /// Where the report's "stl" paths are relative to (to read them).
   std::filesystem::path parts_dir;
-  /// The same folder as the URDF should name it (relative to the URDF file, e.g. "../parts").
+  /// The same folder as the URDF should name it (relative to the URDF file, e.g. "../parts"; in a
+  /// ROS package "package://<package>/meshes").
   std::string mesh_prefix = "../parts";
+  /// Add a link `world` and a fixed joint `<station>_base_to_world` above the base: the device fixed
+  /// in the world, as Gazebo and RViz users expect of a bench device (fivebar/export/ros2_package.hpp
+  /// sets it). Without it the base is the root, a free body for Gazebo.
+  bool world_link = false;
 };
 
 /// The velocity limit of motor joint `joint` (1 or 2) of `mechanism`, rad/s: joint_speed_limit()
 /// of fivebar/export/joint_limits.hpp, the one joint speed of every exported file and of the gate.
 double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint);
+
+/// Every joint's angle at the target centre (rad), motor joints and elbows, in the URDF's joint order:
+/// the pose a client starts the device in (the ros2_control initial_value, the ROS package's display
+/// launch). InputError as render_urdf().
+std::vector<std::pair<std::string, double>> initial_pose(const Design& design, const Station& station);
 
 /// `<design>_<station>.urdf`.
 std::string urdf_file_name(const Design& design, const Station& station);
