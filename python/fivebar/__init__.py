@@ -266,10 +266,16 @@ def _angles(theta1: Any, theta2: Any, unit: Optional[str]) -> Any:
     if unit is None:
         for name, value in (("theta1", theta1), ("theta2", theta2)):
             v = np.asarray(value)
-            if v.dtype.kind in "fiu" and v.size and np.any(np.abs(v[np.isfinite(v)]) > 2 * np.pi):
-                worst = float(np.max(np.abs(v[np.isfinite(v)])))
-                raise InputError(f"{name} = {worst:g}: angles are in radians unless unit='deg' is given, and "
-                                 f"{worst:g} rad is more than one turn (pass unit='deg' for degrees, or "
+            if v.dtype.kind not in "fiu" or not v.size:
+                continue
+            # Two reductions that skip NaN and allocate nothing (the batch kernels promise that);
+            # NaN and infinities are left to the kernels, which name their index.
+            hi, lo = float(np.fmax.reduce(v, axis=None)), float(np.fmin.reduce(v, axis=None))
+            worst = max((x for x in (hi, -lo) if np.isfinite(x)), default=0.0)
+            if worst > 2 * np.pi:
+                shown = hi if hi == worst else lo
+                raise InputError(f"{name} = {shown:g}: angles are in radians unless unit='deg' is given, and "
+                                 f"{abs(shown):g} rad is more than one turn (pass unit='deg' for degrees, or "
                                  "unit='rad' to mean radians beyond one turn)")
     return theta1, theta2
 

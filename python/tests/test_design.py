@@ -112,9 +112,9 @@ def test_a_mechanism_with_the_wrong_count_says_what_it_expects():
 
 
 def test_a_mistyped_key_path_names_the_nearest_key(showcase):
-    with pytest.raises(fivebar.InputError, match=r'has no key "linkz" \(did you mean "links"\?\)'):
+    with pytest.raises(fivebar.InputError, match=r"has no key 'linkz' \(did you mean 'links'\?\)"):
         showcase.with_numbers({"stations.index.mechanisms.lower.linkz[2]": 16.0})
-    with pytest.raises(fivebar.InputError, match=r'has no key "indx" \(did you mean "index"\?\)'):
+    with pytest.raises(fivebar.InputError, match=r"has no key 'indx' \(did you mean 'index'\?\)"):
         showcase.number("stations.indx.mechanisms.lower.links[2]")
     # Nothing near: no suggestion.
     with pytest.raises(fivebar.InputError) as e:

@@ -27,10 +27,15 @@ p=$scratch/moved
 for f in bin/fivebar lib/cmake/fivebar/fivebarConfig.cmake lib/cmake/fivebar/fivebarConfigVersion.cmake \
          lib/cmake/fivebar/fivebarTargets.cmake lib/cmake/fivebar/fivebarCoreTargets.cmake \
          include/fivebar/kinematics.hpp share/fivebar/scad/fivebar.scad share/fivebar/schemas/fk.schema.json \
-         share/fivebar/designs/iros2022.yaml share/fivebar/designs/iros2022-index.yaml share/fivebar/docs/install.md \
-         share/bash-completion/completions/fivebar share/zsh/vendor-completions/_fivebar share/man/man1/fivebar.1 \
-         share/doc/fivebar/LICENSE share/doc/fivebar/CITATION.cff share/doc/fivebar/CHANGELOG.md; do
+         share/fivebar/designs/iros2022.yaml share/fivebar/designs/iros2022-index.yaml \
+         share/bash-completion/completions/fivebar share/zsh/vendor-completions/_fivebar share/man/man1/fivebar.1; do
   [[ -e $p/$f ]] || fail "$f is not installed"
+done
+for f in "$src"/docs/*.md; do
+  [[ -e $p/share/fivebar/docs/${f##*/} ]] || fail "share/fivebar/docs/${f##*/} is not installed"
+done
+for f in "$src"/LICENSE "$src"/CITATION.cff "$src"/*.md; do
+  [[ -e $p/share/doc/fivebar/${f##*/} ]] || fail "share/doc/fivebar/${f##*/} is not installed"
 done
 for cmd in $(sed -n 's/^FIVEBAR_COMMAND(\([a-z_]*\)).*/\1/p' "$src/cli/commands.def"); do
   [[ -e $p/share/man/man1/fivebar-$cmd.1 ]] || fail "no man page fivebar-$cmd.1"
