@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The installed package (docs/install.md), from a build tree: usage
 #   check_install.sh BUILD_DIR SOURCE_DIR SCRATCH_DIR VERSION
-# installs the components dev and cli into SCRATCH/stage, moves the tree to SCRATCH/moved (an install
-# must not depend on its prefix), then checks that
+# installs the components dev and cli into SCRATCH/stage, moves the tree to a new temporary folder
+# (an install must not depend on its prefix), then checks that
 #   - the files of docs/install.md are there (config + version file, share/fivebar/{scad,schemas,
 #     designs,docs}, completions, a man page per command, licence and citation);
 #   - the installed binary names no path of the checkout, and finds the OpenSCAD library beside
@@ -21,8 +21,12 @@ fail() { echo "check_install: FAIL: $*" >&2; exit 1; }
 for component in dev cli; do
   cmake --install "$build" --prefix "$scratch/stage" --component "$component" > "$scratch/install-$component.log"
 done
-mv "$scratch/stage" "$scratch/moved"
-p=$scratch/moved
+# Moved out of the build tree too: the data must be found beside the binary, not above it in the
+# build tree (whose share/fivebar/ the build-tree binaries use).
+moved=$(mktemp -d "${TMPDIR:-/tmp}/fivebar-install.XXXXXX")
+trap 'rm -rf "$moved"' EXIT
+mv "$scratch/stage" "$moved/prefix"
+p=$moved/prefix
 
 for f in bin/fivebar lib/cmake/fivebar/fivebarConfig.cmake lib/cmake/fivebar/fivebarConfigVersion.cmake \
          lib/cmake/fivebar/fivebarTargets.cmake lib/cmake/fivebar/fivebarCoreTargets.cmake \
