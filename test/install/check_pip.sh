@@ -1,17 +1,18 @@
 #!/usr/bin/env bash
 # `pip install .` as a user runs it (docs/install.md "Python"): usage
-#   check_pip.sh BUILD_DIR SOURCE_DIR SCRATCH_DIR VERSION
-# makes a fresh venv with --system-site-packages (Debian's NumPy and setuptools), installs the
+#   check_pip.sh BUILD_DIR SOURCE_DIR SCRATCH_DIR VERSION PYTHON
+# makes a fresh venv of PYTHON (the interpreter the module is built for, Debian's /usr/bin/python3)
+# with --system-site-packages (Debian's NumPy, setuptools and wheel), installs the
 # source tree with no index and no build isolation (offline), building in BUILD_DIR
 # (FIVEBAR_CMAKE_BUILD_DIR, setup.py), and checks from an unrelated directory that
 # `import fivebar` loads the venv's copy, `fivebar.__version__` is VERSION, and that the OpenSCAD
 # library shipped beside the extension is where the library looks for it.
 set -euo pipefail
-build=$(cd "$1" && pwd) src=$(cd "$2" && pwd) scratch=$3 version=$4
+build=$(cd "$1" && pwd) src=$(cd "$2" && pwd) scratch=$3 version=$4 python=${5:-/usr/bin/python3}
 rm -rf "$scratch"
 mkdir -p "$scratch"
 scratch=$(cd "$scratch" && pwd)
-python3 -m venv --system-site-packages "$scratch/venv"
+"$python" -m venv --system-site-packages "$scratch/venv"
 FIVEBAR_CMAKE_BUILD_DIR="$build" "$scratch/venv/bin/python" -m pip install --no-build-isolation --no-index -q "$src" \
   > "$scratch/pip.log" 2>&1 || { tail -40 "$scratch/pip.log" >&2; echo "check_pip: FAIL: pip install" >&2; exit 1; }
 cd "$scratch"
