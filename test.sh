@@ -6,12 +6,16 @@
 #
 #   ./test.sh              the test suite through ctest (build/, Release)
 #   ./test.sh --sanitize   the whole suite again under AddressSanitizer + UndefinedBehaviorSanitizer
-#                          (build-sanitize/, Debug at -O1, gcc)
+#                          (build-sanitize/, Debug at -O1, gcc; the long property tests run fewer
+#                          cases there: FIVEBAR_SANITIZE)
 #   ./test.sh --core       fivebar::core alone, configured with only its dependencies (Eigen, yaml-cpp,
 #                          CGAL, GoogleTest), and its suites and layering test (build-core/)
 #   ./test.sh --fuzz       each libFuzzer target for FIVEBAR_FUZZ_SECONDS seconds (default 60)
 #                          (build-fuzz/, clang; test/fuzz/run_fuzzers.sh)
 #   ./test.sh --all        the four in that order; what `./test.sh` does when CI=true (.ci/run)
+#
+# Every build directory shares the machine's compiler cache (.ci/setup.sh). Each stage logs its
+# wall time ("stage NAME: N s"); test/build_cost.py tabulates them.
 #
 # Other arguments go to ctest (e.g. ./test.sh -R hostile).
 set -euo pipefail
@@ -37,27 +41,28 @@ fi
 # The main job's packages and the test tools; the fuzzing toolchain only for --fuzz (and --all).
 packages=("${FIVEBAR_PACKAGES[@]}" "${FIVEBAR_TEST_PACKAGES[@]}")
 if ((fuzz)); then packages+=("${FIVEBAR_HARDENING_PACKAGES[@]}"); fi
-fivebar_install_packages "${packages[@]}"
+fivebar_stage packages fivebar_install_packages "${packages[@]}"
 
 if ((normal)); then
-  fivebar_build_in build "Release" -DFIVEBAR_BUILD_TESTS=ON --
+  fivebar_stage build fivebar_build_in build "Release" -DFIVEBAR_BUILD_TESTS=ON --
   fivebar_log "test suite (build/)"
-  ctest --test-dir build --output-on-failure -j2 "${ctest_args[@]}"
+  fivebar_stage test ctest --test-dir build --output-on-failure -j2 "${ctest_args[@]}"
 fi
 
 if ((core)); then
   # The layers hold (docs/architecture.md "Layers"): the core configures with its own dependencies
   # only, builds and passes its suites and the layering test without anything above it.
-  fivebar_build_in build-core "fivebar::core alone" -DFIVEBAR_CORE_ONLY=ON --
+  fivebar_stage core-build fivebar_build_in build-core "fivebar::core alone" -DFIVEBAR_CORE_ONLY=ON --
   fivebar_log "core suites (build-core/)"
-  ctest --test-dir build-core --output-on-failure -j2 "${ctest_args[@]}"
+  fivebar_stage core-test ctest --test-dir build-core --output-on-failure -j2 "${ctest_args[@]}"
 fi
 
 if ((sanitize)); then
   # Without MPI: OpenMPI's own allocations at MPI_Init read as leaks to LeakSanitizer (the MPI
-  # sweep test skips itself there; the normal suite runs it).
-  fivebar_build_in build-sanitize "ASan + UBSan, Debug -O1" -DCMAKE_BUILD_TYPE=Debug -DFIVEBAR_SANITIZE=ON \
-    -DFIVEBAR_WITH_MPI=OFF --
+  # sweep test skips itself there; the normal suite runs it). Without the benchmarks: their smoke run
+  # takes several minutes under ASan, and what it checks (each benchmark runs) the normal suite checks.
+  fivebar_stage sanitize-build fivebar_build_in build-sanitize "ASan + UBSan, Debug -O1" -DCMAKE_BUILD_TYPE=Debug \
+    -DFIVEBAR_SANITIZE=ON -DFIVEBAR_WITH_MPI=OFF -DFIVEBAR_BUILD_BENCH=OFF --
   # Any sanitizer report fails the test that triggered it, also in a child `fivebar` process: the
   # distinctive exit code 86 never matches an expected one. Leaks are reported too.
   export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:check_initialization_order=1:strict_init_order=1:detect_stack_use_after_return=0:exitcode=86}"
@@ -66,14 +71,14 @@ if ((sanitize)); then
   export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/test/sanitizer/lsan.supp:print_suppressions=0}"
   # A whole `fivebar run` of the showcase takes about 55 s under ASan on this 2-core machine.
   export FIVEBAR_TEST_CHILD_TIMEOUT_S="${FIVEBAR_TEST_CHILD_TIMEOUT_S:-240}"
-  # The whole suite but bench_smoke: the benchmarks' smoke run takes about 30 s in Release and
-  # several minutes under ASan, and what it checks (each benchmark runs) the normal suite checks.
   fivebar_log "test suite under ASan + UBSan (build-sanitize/)"
-  ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 1500 -E '^bench_smoke$' "${ctest_args[@]}"
+  fivebar_stage sanitize-test ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 1500 "${ctest_args[@]}"
 fi
 
 if ((fuzz)); then
-  fivebar_build_in build-fuzz "libFuzzer, clang, ASan + UBSan" -DCMAKE_BUILD_TYPE=Debug -DFIVEBAR_FUZZ=ON -DFIVEBAR_WITH_MPI=OFF \
-    -DFIVEBAR_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_C_COMPILER=clang -- fuzz_design_loader fuzz_cli
-  test/fuzz/run_fuzzers.sh build-fuzz
+  # The fuzzers alone (clang's libFuzzer), without the suites.
+  fivebar_stage fuzz-build fivebar_build_in build-fuzz "libFuzzer, clang, ASan + UBSan" -DCMAKE_BUILD_TYPE=Debug \
+    -DFIVEBAR_FUZZ=ON -DFIVEBAR_WITH_MPI=OFF -DFIVEBAR_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_C_COMPILER=clang -- fuzz_design_loader fuzz_cli
+  fivebar_stage fuzz test/fuzz/run_fuzzers.sh build-fuzz
 fi

@@ -53,6 +53,28 @@ FIVEBAR_HARDENING_PACKAGES=(
 
 fivebar_log() { printf '[fivebar] %s\n' "$*" >&2; }
 
+# The compiler cache (ccache, found by CMakeLists.txt) is shared by every build directory and every
+# checkout of this machine: paths under the checkout are hashed relative to it (base_dir) and the
+# working directory is left out of the hash (hash_dir), so that a second clone, CI's fresh clone
+# included, reuses what an earlier build compiled. Settings the caller made are kept.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$FIVEBAR_ROOT}"
+export CCACHE_NOHASHDIR="${CCACHE_NOHASHDIR:-1}"
+# Four configurations of the whole tree (Release, core, ASan + libFuzzer, Debug objects carry debug
+# information) hold about 6 GB: ccache's default of 5 GB would evict the first by the last.
+export CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-20G}"
+
+# fivebar_stage NAME COMMAND...: runs a command and logs its wall time, for the table of CI stage
+# times (test/build_cost.py reads these lines from a saved log; docs/architecture.md "Build cost").
+fivebar_stage() {
+  local name="$1" start end status=0
+  shift
+  start=$(date +%s)
+  "$@" || status=$?
+  end=$(date +%s)
+  fivebar_log "stage ${name}: $((end - start)) s (exit ${status})"
+  return "$status"
+}
+
 # fivebar_install_packages [PACKAGE...]: installs those of the packages (default: FIVEBAR_PACKAGES)
 # that dpkg does not report as installed.
 fivebar_install_packages() {
@@ -111,7 +133,8 @@ fivebar_build_in() {
     generator=(-G Ninja)
   fi
   fivebar_log "configuring ${dir#"$FIVEBAR_ROOT"/}/ ($description)"
-  cmake -S "$FIVEBAR_ROOT" -B "$dir" "${cmake_args[@]}" "${generator[@]}"
+  # `|| return`: set -e does not hold inside a function called from `... || status=$?` (fivebar_stage).
+  cmake -S "$FIVEBAR_ROOT" -B "$dir" "${cmake_args[@]}" "${generator[@]}" || return
   local targets=()
   local t
   for t in "$@"; do
@@ -123,7 +146,7 @@ fivebar_build_in() {
     targets+=(--target "$t")
   done
   fivebar_log "building with $(nproc) jobs"
-  cmake --build "$dir" -j"$(nproc)" "${targets[@]}"
+  cmake --build "$dir" -j"$(nproc)" "${targets[@]}" || return
 }
 
 # Packages, configure, build.

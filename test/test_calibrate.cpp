@@ -37,7 +37,7 @@ std::uint64_t base_seed() {
   return s != nullptr ? std::strtoull(s, nullptr, 10) : 1;
 }
 
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(FIVEBAR_SANITIZE)
 constexpr int kSeeds = 12;
 #else
 constexpr int kSeeds = 120;
@@ -362,7 +362,7 @@ TEST(CalibratedTolerance, PosteriorCovarianceReplacesTheSigmasAndMatchesAMonteCa
   const ToleranceSettings tol = back.get<ToleranceSettings>() ? *back.get<ToleranceSettings>() : ToleranceSettings{};
   const double a = tol.linearity_percent / 100.0 * tol.pot_travel_deg * std::numbers::pi / 180.0;  // half band, rad
   const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(r.key_covariance).matrixL();
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(FIVEBAR_SANITIZE)
   const int n = 4000;
   const double tol_rel = 0.12;
 #else

@@ -47,14 +47,7 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kSource = FIVEBAR_SOURCE_DIR;
 
-#if defined(__SANITIZE_ADDRESS__)
-#define FIVEBAR_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define FIVEBAR_TEST_ASAN 1
-#endif
-#endif
-#ifdef FIVEBAR_TEST_ASAN
+#ifdef FIVEBAR_SANITIZE
 constexpr bool kSanitized = true;  // the sanitizer build (FIVEBAR_SANITIZE): shorter runs
 #else
 constexpr bool kSanitized = false;

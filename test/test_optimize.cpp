@@ -388,7 +388,7 @@ TEST(RunOptimize, ShardsMergeIntoTheFrontOfTheirUnion) {
 TEST(RunOptimize, FrontNearlyMatchesTheGridParetoSetWithATenthOfItsEvaluations) {
   OptimizeSettings s = two_variable({{"margin", true}, {"footprint", false}});
   constexpr int kA = 57, kB = 49;
-#if defined(__SANITIZE_ADDRESS__)  // the sanitizer build (FIVEBAR_SANITIZE): fewer seeds
+#if defined(FIVEBAR_SANITIZE)  // the sanitizer build (FIVEBAR_SANITIZE): fewer seeds
   constexpr int kSeeds = 2;
 #else
   constexpr int kSeeds = 8;
@@ -468,7 +468,7 @@ TEST(RunOptimize, EightVariablesBeatASobolSweepOfTheSameBudget) {
   s.evaluations = 1000;
   s.polish = false;
   s.atlas = false;
-#if defined(__SANITIZE_ADDRESS__)  // the sanitizer build (FIVEBAR_SANITIZE): one seed
+#if defined(FIVEBAR_SANITIZE)  // the sanitizer build (FIVEBAR_SANITIZE): one seed
   constexpr int kSeeds = 1;
 #else
   constexpr int kSeeds = 3;
