@@ -16,6 +16,7 @@
 
 #include "cli.hpp"
 #include "common.hpp"
+#include "help.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/version.hpp"
@@ -128,9 +129,9 @@ int run(int argc, char** argv) {
           ": design five-bar-linkage cutaneous haptic devices (IROS 2022).\n"
           "Lengths in mm and angles in degrees on the command line, in files and in JSON.",
       "fivebar"};
-  app.set_version_flag("--version", "fivebar " + std::string(fivebar::version()));
+  app.set_version_flag("-V,--version", "fivebar " + std::string(fivebar::version()));
   app.require_subcommand(1);
-  app.footer("Run 'fivebar <subcommand> --help' for its options.\n" +
+  app.footer("Run 'fivebar help <subcommand>' (or 'fivebar <subcommand> --help') for its options.\n" +
              exit_status({.ok = "success",
                           .failed = "a check failed or no solution",
                           .bad_input = "bad input (usage or design file)"}));
@@ -143,6 +144,8 @@ int run(int argc, char** argv) {
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);
+    // `fivebar help [CMD [SUB]]`, `help --completion bash|zsh`, `help --man [CMD]` (cli/help.hpp).
+    if (!args.empty() && args[0] == "help") return run_help(app, std::vector<std::string>(args.begin() + 1, args.end()));
     // CLI11 says only "A subcommand is required" for an unknown word where a subcommand must be
     // (fivebar WORD, fivebar report WORD): name the word and the choices.
     CLI::App* level = &app;
@@ -158,8 +161,11 @@ int run(int argc, char** argv) {
       if (match == nullptr) {
         std::string shown;  // a word from the command line must not bring terminal escapes along
         for (const char c : word) shown += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
+        std::vector<std::string> names;
+        for (CLI::App* sub : level->get_subcommands([](CLI::App*) { return true; })) names.push_back(sub->get_name());
+        const std::string near = did_you_mean(word, names);
         throw fivebar::InputError("unknown subcommand '" + shown + "'" + (path.empty() ? "" : " of '" + path + "'") +
-                                  " (known: " + known + ")");
+                                  (near.empty() ? "" : " (did you mean '" + near + "'?)") + " (known: " + known + ")");
       }
       path += (path.empty() ? "" : " ") + match->get_name();
       level = match;
@@ -172,7 +178,7 @@ int run(int argc, char** argv) {
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    (void)app.exit(e);  // prints the message and a --help hint on stderr
+    print_parse_error(app, e);  // "fivebar CMD: error: ...", with the nearest option for an unknown one
     return kBadInput;
   } catch (const fivebar::InputError& e) {
     std::cerr << "fivebar: error: " << e.what() << "\n";

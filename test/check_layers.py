@@ -25,7 +25,7 @@ from fnmatch import fnmatch
 # Headers of the core's layer (public under lib/include, private under lib/src).
 CORE_HEADERS = [
     "lib/include/fivebar/design.hpp", "lib/include/fivebar/error.hpp", "lib/include/fivebar/format.hpp",
-    "lib/include/fivebar/ranges.hpp", "lib/include/fivebar/version.hpp", "lib/include/fivebar/numerics.hpp",
+    "lib/include/fivebar/ranges.hpp", "lib/include/fivebar/version.hpp", "lib/include/fivebar/numerics.hpp", "lib/include/fivebar/suggest.hpp",
     "lib/include/fivebar/kinematics.hpp", "lib/include/fivebar/detail/*.hpp",
     "lib/include/fivebar/workspace/region.hpp", "lib/include/fivebar/workspace/polyline.hpp",
     "lib/include/fivebar/coverage/coverage.hpp", "lib/include/fivebar/sections/*.hpp",

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <numbers>
 #include <random>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -145,3 +146,113 @@ TEST_F(Cli, MalformedDesignExitsTwoNamingTheKeyAndWritesNothing) {
 }
 
 }  // namespace
+
+// --- help, -V, suggestions, completion and man pages (cli/help.hpp, docs/install.md) ---------------
+
+namespace {
+
+/// The commands of cli/commands.def, read from the file.
+std::vector<std::string> table_commands() {
+  std::vector<std::string> out;
+  std::istringstream in(slurp(fs::path(FIVEBAR_SOURCE_DIR) / "cli" / "commands.def"));
+  const std::regex line(R"(^FIVEBAR_COMMAND\((\w+)\))");
+  for (std::string l; std::getline(in, l);) {
+    std::smatch m;
+    if (std::regex_search(l, m, line)) out.push_back(m[1]);
+  }
+  return out;
+}
+
+/// The long options a help text lists, one per option line ("  -t,--theta FLOAT ..."), in order.
+std::vector<std::string> long_options(const std::string& help) {
+  std::vector<std::string> out;
+  const std::regex option(R"(^\s+(?:-[A-Za-z0-9],)?(--[a-z][a-z0-9-]*))");
+  std::istringstream in(help);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, option)) out.push_back(m[1]);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_F(Cli, HelpCommandEqualsTheHelpFlagOfEveryCommand) {
+  const std::vector<std::string> commands = table_commands();
+  ASSERT_GE(commands.size(), 10u);
+  for (const std::string& cmd : commands) {
+    const Outcome via_help = run({"help", cmd});
+    const Outcome via_flag = run({cmd, "--help"});
+    EXPECT_EQ(via_help.code, 0) << cmd;
+    EXPECT_EQ(via_help.out, via_flag.out) << cmd;
+  }
+  EXPECT_EQ(run({"help", "report", "accuracy"}).out, run({"report", "accuracy", "--help"}).out);
+  EXPECT_EQ(run({"help"}).out, run({"--help"}).out);
+  const Outcome unknown = run({"help", "fkk"});
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_THAT(unknown.err, HasSubstr("fivebar help: error: unknown subcommand 'fkk' (did you mean 'fk'?)"));
+}
+
+TEST_F(Cli, ShortVersionFlagPrintsTheVersionOfCMakeLists) {
+  const std::string cmake = slurp(fs::path(FIVEBAR_SOURCE_DIR) / "CMakeLists.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(cmake, m, std::regex(R"(project\(fivebar VERSION ([0-9.]+))")));
+  const Outcome v = run({"-V"});
+  EXPECT_EQ(v.code, 0);
+  EXPECT_EQ(v.out, "fivebar " + m[1].str() + "\n");
+  EXPECT_EQ(run({"--version"}).out, v.out);
+}
+
+TEST_F(Cli, UnknownOptionsAndSubcommandsNameTheNearestOne) {
+  const Outcome option = run({"fk", kDesign, "--thetta", "100,80"});
+  EXPECT_EQ(option.code, 2);
+  EXPECT_THAT(option.out, IsEmpty());
+  EXPECT_THAT(option.err, HasSubstr("fivebar fk: error: unknown option '--thetta' (did you mean '--theta'?)\n"));
+  EXPECT_THAT(option.err, HasSubstr("'fivebar help fk'"));
+  const Outcome nested = run({"report", "accuracy", kDesign, "--jsn"});
+  EXPECT_EQ(nested.code, 2);
+  EXPECT_THAT(nested.err, HasSubstr("fivebar report accuracy: error: unknown option '--jsn' (did you mean '--json'?)"));
+  const Outcome far = run({"fk", kDesign, "--zzzzzzzzzz"});
+  EXPECT_EQ(far.code, 2);
+  EXPECT_THAT(far.err, HasSubstr("fivebar fk: error: unknown option '--zzzzzzzzzz'\n"));
+  const Outcome sub = run({"simulat", kDesign});
+  EXPECT_EQ(sub.code, 2);
+  EXPECT_THAT(sub.err, HasSubstr("unknown subcommand 'simulat' (did you mean 'simulate'?)"));
+  // Other parse errors carry the same prefix.
+  const Outcome missing = run({"fk"});
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_THAT(missing.err, HasSubstr("fivebar fk: error: "));
+  EXPECT_TRUE(tree(dir_).empty()) << "usage errors write nothing";
+}
+
+TEST_F(Cli, CompletionAndManPagesListEveryOptionTheHelpLists) {
+  const Outcome bash = run({"help", "--completion", "bash"});
+  const Outcome zsh = run({"help", "--completion", "zsh"});
+  ASSERT_EQ(bash.code, 0);
+  ASSERT_EQ(zsh.code, 0);
+  EXPECT_THAT(bash.out, HasSubstr("complete -o default -F _fivebar fivebar"));
+  EXPECT_THAT(zsh.out, ::testing::StartsWith("#compdef fivebar\n"));
+  for (const std::string& cmd : table_commands()) {
+    SCOPED_TRACE(cmd);
+    const std::string help = run({cmd, "--help"}).out;
+    // bash: the command's case line holds each of its options.
+    const std::size_t at = bash.out.find("    \"" + cmd + "\") opts=\"");
+    ASSERT_NE(at, std::string::npos);
+    const std::string line = bash.out.substr(at, bash.out.find('\n', at) - at);
+    const Outcome man = run({"help", "--man", cmd});
+    EXPECT_EQ(man.code, 0);
+    std::string upper = cmd;
+    std::transform(upper.begin(), upper.end(), upper.begin(), [](unsigned char c) { return char(std::toupper(c)); });
+    EXPECT_THAT(man.out, HasSubstr(".TH FIVEBAR\\-" + upper + " 1 "));
+    for (const std::string& option : long_options(help)) {
+      if (option == "--help") continue;
+      EXPECT_THAT(line, HasSubstr(" " + option)) << option;
+      EXPECT_THAT(zsh.out, HasSubstr("'" + option + "[")) << option;
+      std::string escaped;
+      for (const char c : option) escaped += c == '-' ? std::string("\\-") : std::string(1, c);
+      EXPECT_THAT(man.out, HasSubstr(escaped)) << option;
+    }
+  }
+  EXPECT_EQ(run({"help", "--completion", "fish"}).code, 2);
+  EXPECT_EQ(run({"help", "--man", "nope"}).code, 2);
+}

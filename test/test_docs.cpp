@@ -147,7 +147,8 @@ std::vector<fs::path> repository_files() {
     }
   }
   // outputs/ holds generated files besides its README: only the README is the repository's.
-  for (const char* top : {"README.md", "CMakeLists.txt", "run.sh", "test.sh", "outputs/README.md"}) {
+  for (const char* top : {"README.md", "CMakeLists.txt", "run.sh", "test.sh", "outputs/README.md", "CHANGELOG.md",
+                          "CITATION.cff", "setup.py", "pyproject.toml"}) {
     files.push_back(kSource / top);
   }
   return files;
@@ -176,6 +177,35 @@ TEST(RepositoryDocs, EveryCitedDocumentIsInTheRepository) {
       }
     }
   }
+}
+
+TEST(RepositoryDocs, OneVersionForCMakeCitationAndChangelog) {
+  // CMakeLists.txt's project(VERSION) is the version; CITATION.cff repeats it, CHANGELOG.md has a
+  // section for it, and setup.py reads it from CMakeLists.txt rather than writing its own.
+  std::smatch m;
+  const std::string cmake = slurp(kSource / "CMakeLists.txt");
+  ASSERT_TRUE(std::regex_search(cmake, m, std::regex(R"(project\(fivebar VERSION ([0-9]+\.[0-9]+\.[0-9]+))")));
+  const std::string version = m[1];
+  const std::string citation = slurp(kSource / "CITATION.cff");
+  ASSERT_TRUE(std::regex_search(citation, m, std::regex(R"((?:^|\n)version: ([^\n]+))")));
+  EXPECT_EQ(m[1].str(), version) << "CITATION.cff";
+  EXPECT_THAT(slurp(kSource / "CHANGELOG.md"), ::testing::HasSubstr("\n## [" + version + "]")) << "CHANGELOG.md";
+  const std::string setup = slurp(kSource / "setup.py");
+  EXPECT_THAT(setup, ::testing::HasSubstr("version=project_version()"));
+  EXPECT_FALSE(std::regex_search(slurp(kSource / "pyproject.toml"), std::regex(R"((?:^|\n)version\s*=)")))
+      << "pyproject.toml must not state a version of its own";
+}
+
+TEST(RepositoryDocs, LicenceIsNamedWhereUsersLook) {
+  // The licence text, its SPDX name in CITATION.cff, and the README saying which it is.
+  EXPECT_THAT(slurp(kSource / "LICENSE"), ::testing::StartsWith("BSD 3-Clause License"));
+  EXPECT_THAT(slurp(kSource / "CITATION.cff"), ::testing::HasSubstr("license: BSD-3-Clause"));
+  EXPECT_THAT(slurp(kSource / "README.md"), ::testing::HasSubstr("BSD-3-Clause"));
+  // The paper is the preferred citation, with its DOI.
+  EXPECT_THAT(slurp(kSource / "CITATION.cff"),
+              ::testing::AllOf(::testing::HasSubstr("preferred-citation:"),
+                               ::testing::HasSubstr("Cutaneous Feedback Interface for Teleoperated In-Hand Manipulation"),
+                               ::testing::HasSubstr("doi: 10.1109/IROS47612.2022.9982247")));
 }
 
 }  // namespace

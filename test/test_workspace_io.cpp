@@ -26,6 +26,8 @@
 #include <vtkXMLUtilities.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -44,6 +46,7 @@
 #include "fivebar/workspace/files.hpp"
 #include "fivebar/workspace/io.hpp"
 #include "fivebar/workspace/plot.hpp"
+#include "process.hpp"
 
 namespace fs = std::filesystem;
 using namespace fivebar;
@@ -120,7 +123,7 @@ TEST(Discretise, ArcsStepAtMostOneDegreeOnTheCircleFromSourceToTarget) {
   // 90 deg ccw; 90 deg cw (the long way round is 270 deg); 0.5 deg; 100.5 deg.
   for (const Case& c : {Case{0.0, kPi / 2, true, 90}, Case{0.0, kPi / 2, false, 270}, Case{0.2, 0.2 + 0.5 * kDeg, true, 1},
                         Case{1.0, 1.0 - 100.5 * kDeg, false, 101}}) {
-    SCOPED_TRACE(testing::Message() << "a0 " << c.a0 << " a1 " << c.a1 << " ccw " << c.ccw);
+    SCOPED_TRACE(::testing::Message() << "a0 " << c.a0 << " a1 " << c.a1 << " ccw " << c.ccw);
     const Vec2 centre(3.0, -2.0);
     const double r = 7.5;
     const CurvePiece p = arc(centre, r, c.a0, c.a1, c.ccw);
@@ -394,7 +397,7 @@ TEST_F(TempDir, RegionsVtpReadsBackWithVtkAndLiesOnTheAnnuli) {
   int shared = 0, target = 0, assembly = 0;
   for (std::size_t k = 0; k < c.points.size(); ++k) {
     const auto& pts = c.points[k];
-    SCOPED_TRACE(testing::Message() << "cell " << k << " kind " << c.kind[k] << " mechanism " << c.mechanism[k]);
+    SCOPED_TRACE(::testing::Message() << "cell " << k << " kind " << c.kind[k] << " mechanism " << c.mechanism[k]);
     switch (c.kind[k]) {
       case int(CurveKind::region): {
         ASSERT_TRUE(c.mechanism[k] == 0 || c.mechanism[k] == 1);
@@ -583,3 +586,57 @@ TEST(Picture, ViridisIsMatplotlibsMap) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Pixels of a decoded PNG that differ from its corner's colour (the background) in the band of
+/// `band` pixels along its four edges: text or a plot that runs off the canvas leaves ink there.
+std::size_t ink_in_outer_band(cairo_surface_t* s, int band) {
+  cairo_surface_flush(s);
+  const int w = cairo_image_surface_get_width(s), h = cairo_image_surface_get_height(s);
+  const int stride = cairo_image_surface_get_stride(s);
+  const unsigned char* data = cairo_image_surface_get_data(s);
+  const auto pixel = [&](int x, int y) {
+    std::uint32_t p = 0;
+    std::memcpy(&p, data + std::size_t(y) * std::size_t(stride) + std::size_t(x) * 4, 4);
+    return p;
+  };
+  const std::uint32_t background = pixel(0, 0);
+  std::size_t ink = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool in_band = x < band || y < band || x >= w - band || y >= h - band;
+      if (in_band && pixel(x, y) != background) ++ink;
+    }
+  }
+  return ink;
+}
+
+}  // namespace
+
+TEST(Picture, EveryPngOfTheSceneKeepsItsOuterMarginClear) {
+  // The products that draw PNGs with text and fields near their edges (report's work-precision
+  // plots with their footnotes, tolerance and control heat maps, workspace, collision and pattern
+  // pictures), as `fivebar run` writes them; each decoded, and its outer 3-pixel band must be all
+  // background: nothing is cut at the canvas edge.
+  const fs::path dir = fs::temp_directory_path() / ("fivebar_png_margin_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fivebar::testing::Outcome r = fivebar::testing::run(
+      FIVEBAR_BINARY,
+      {"run", (fs::path(FIVEBAR_SOURCE_DIR) / "designs" / "iros2022.yaml").string(), "--products",
+       "workspace,collision,pattern,tolerance,control,report", "--out", (dir / "out").string(), "-q"},
+      dir, dir, 900.0);
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+  std::size_t pngs = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir / "out")) {
+    if (!e.is_regular_file() || e.path().extension() != ".png") continue;
+    ++pngs;
+    Png image;
+    image.surface = cairo_image_surface_create_from_png(e.path().c_str());
+    ASSERT_EQ(cairo_surface_status(image.surface), CAIRO_STATUS_SUCCESS) << e.path();
+    EXPECT_EQ(ink_in_outer_band(image.surface, 3), 0u) << fs::relative(e.path(), dir).string() << " has ink in its outer margin";
+  }
+  EXPECT_GE(pngs, 20u);
+  fs::remove_all(dir);
+}

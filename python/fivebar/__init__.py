@@ -1,12 +1,14 @@
 """fivebar from Python: NumPy-native bindings of the fivebar library (docs/python.md).
 
-Units follow the library: lengths in mm, angles in radians (``numpy.deg2rad`` converts); every
-result's ``to_dict()`` gives the document the CLI prints with ``--json`` (mm and degrees).
+Units follow the library: lengths in mm, angles in radians; ``fk`` and ``jacobian`` take
+``unit="deg"`` for degrees and refuse, without it, an angle beyond one turn (``fk(m, 100, 80)``
+raises instead of meaning 100 rad). Every result's ``to_dict()`` gives the document the CLI prints
+with ``--json`` (mm and degrees). ``fivebar.__version__`` is the library's version.
 
     import fivebar, numpy as np
     design = fivebar.load("designs/iros2022.yaml")
     lower = design.station("index").lower
-    pose = fivebar.fk(lower, np.deg2rad(100), np.deg2rad(80))          # one Pose
+    pose = fivebar.fk(lower, 100, 80, unit="deg")                      # one Pose
     x, y, status = fivebar.fk(lower, theta1_array, theta2_array)       # arrays, GIL released
 
 Batch kernels read C-contiguous float64 arrays in place and write into ``out=`` arrays when given;
@@ -80,10 +82,13 @@ from . import _fivebar as _native  # noqa: E402
 
 _set_exception_types(InputError, IoError)
 
+#: The package's version: the library's, set once by CMakeLists.txt's project(VERSION).
+__version__: str = version()
+
 __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
-    "simulate", "tolerance", "control", "export_gate", "Record",
+    "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]
@@ -232,42 +237,96 @@ def _scalar(*values: Any) -> bool:
     return all(not isinstance(v, np.ndarray) and np.ndim(v) == 0 for v in values)
 
 
-def fk(mechanism: Mechanism, theta1: Any, theta2: Any, *, branch: Optional[str] = None, out: Any = None) -> Any:
-    """Forward kinematics at motor angles (rad). Scalars -> Pose; arrays (float64, same shape) ->
-    (x, y, status) arrays (mm, mm, uint8) from the batch kernel, written into out=(x, y, status)
-    when given. branch ("+", "-", "any") for scalars only (arrays use the design's assembly mode)."""
+def _broadcast(a: Any, an: str, b: Any, bn: str) -> Any:
+    """a and b broadcast to one shape, NumPy's rules (a Python number becomes a float64 array);
+    arrays of one shape already pass through untouched (the kernels read them in place). The
+    dtype stays the caller's: the kernels refuse what is not float64, naming the argument."""
+    a = np.asarray(a, dtype=np.float64) if np.ndim(a) == 0 and not isinstance(a, np.ndarray) else a
+    b = np.asarray(b, dtype=np.float64) if np.ndim(b) == 0 and not isinstance(b, np.ndarray) else b
+    if not isinstance(a, np.ndarray) or not isinstance(b, np.ndarray) or a.shape == b.shape:
+        return a, b
+    try:
+        shape = np.broadcast_shapes(a.shape, b.shape)
+    except ValueError:
+        raise ValueError(f"shape mismatch: {an} has shape {a.shape}, {bn} has {b.shape}, "
+                         "which do not broadcast together") from None
+    return np.ascontiguousarray(np.broadcast_to(a, shape)), np.ascontiguousarray(np.broadcast_to(b, shape))
+
+
+_ANGLE_UNITS = ("rad", "deg")
+
+
+def _angles(theta1: Any, theta2: Any, unit: Optional[str]) -> Any:
+    """Motor angles in radians from the caller's unit. Without unit= they are radians, and a value
+    beyond one turn (|theta| > 2 pi) is refused: fk(m, 100, 80) is degrees given as radians far
+    more often than 16 turns of a motor."""
+    if unit not in (None, *_ANGLE_UNITS):
+        raise ValueError(f"unit = {unit!r}: must be 'rad' or 'deg'")
+    if unit == "deg":
+        return np.deg2rad(theta1), np.deg2rad(theta2)
+    if unit is None:
+        for name, value in (("theta1", theta1), ("theta2", theta2)):
+            v = np.asarray(value)
+            if v.dtype.kind not in "fiu" or not v.size:
+                continue
+            # Two reductions that skip NaN and allocate nothing (the batch kernels promise that);
+            # NaN and infinities are left to the kernels, which name their index.
+            hi, lo = float(np.fmax.reduce(v, axis=None)), float(np.fmin.reduce(v, axis=None))
+            worst = max((x for x in (hi, -lo) if np.isfinite(x)), default=0.0)
+            if worst > 2 * np.pi:
+                shown = hi if hi == worst else lo
+                raise InputError(f"{name} = {shown:g}: angles are in radians unless unit='deg' is given, and "
+                                 f"{abs(shown):g} rad is more than one turn (pass unit='deg' for degrees, or "
+                                 "unit='rad' to mean radians beyond one turn)")
+    return theta1, theta2
+
+
+def fk(mechanism: Mechanism, theta1: Any, theta2: Any, *, unit: Optional[str] = None, branch: Optional[str] = None,
+       out: Any = None) -> Any:
+    """Forward kinematics at motor angles: radians, or degrees with unit="deg" (without unit= a
+    value beyond one turn raises InputError). Scalars -> Pose; arrays (float64, shapes that
+    broadcast) -> (x, y, status) arrays (mm, mm, uint8) from the batch kernel, written into
+    out=(x, y, status) when given. branch ("+", "-", "any") for scalars only (arrays use the
+    design's assembly mode)."""
+    theta1, theta2 = _angles(theta1, theta2, unit)
     if _scalar(theta1, theta2) and out is None:
         return mechanism.fk(float(theta1), float(theta2), branch)
     if branch is not None:
         raise ValueError("branch: only for scalar angles (the batch kernel uses the design's assembly mode)")
+    theta1, theta2 = _broadcast(theta1, "theta1", theta2, "theta2")
     return mechanism.fk_batch(theta1, theta2, out=out)
 
 
 def ik(mechanism: Mechanism, x: Any, y: Any, *, mode: Optional[str] = None, out: Any = None) -> Any:
-    """Inverse kinematics at tactor points (mm). Scalars -> Pose; arrays -> (theta1, theta2, status)
-    (rad, rad, uint8). mode (e.g. "+-") for scalars only."""
+    """Inverse kinematics at tactor points (mm). Scalars -> Pose; arrays (shapes that broadcast) ->
+    (theta1, theta2, status) (rad, rad, uint8). mode (e.g. "+-") for scalars only."""
     if _scalar(x, y) and out is None:
         return mechanism.ik(float(x), float(y), mode)
     if mode is not None:
         raise ValueError("mode: only for scalar points (the batch kernel uses the design's working mode)")
+    x, y = _broadcast(x, "x", y, "y")
     return mechanism.ik_batch(x, y, out=out)
 
 
-def jacobian(mechanism: Mechanism, theta1: Any, theta2: Any) -> Any:
-    """Jacobian dP/dtheta (mm/rad) at motor angles (rad) -> (J, status): a 2x2 array and a Status
-    for scalars, J[..., 2, 2] and a uint8 array for arrays; J is zero where it does not exist."""
+def jacobian(mechanism: Mechanism, theta1: Any, theta2: Any, *, unit: Optional[str] = None) -> Any:
+    """Jacobian dP/dtheta (mm/rad) at motor angles (rad, or deg with unit="deg", as fk) -> (J, status):
+    a 2x2 array and a Status for scalars, J[..., 2, 2] and a uint8 array for arrays (shapes that
+    broadcast); J is zero where it does not exist."""
+    theta1, theta2 = _angles(theta1, theta2, unit)
     if _scalar(theta1, theta2):
         J, status = mechanism.jacobian_batch(np.array([float(theta1)]), np.array([float(theta2)]))
         return J[0], Status(int(status[0]))
+    theta1, theta2 = _broadcast(theta1, "theta1", theta2, "theta2")
     return mechanism.jacobian_batch(theta1, theta2)
 
 
 def lci(mechanism: Mechanism, x: Any, y: Any, *, out: Any = None) -> Any:
     """Local conditioning index 1/cond(J) at tactor points (mm) in the working mode -> (lci, status);
-    lci is 0 where the point is unreachable or singular."""
+    lci is 0 where the point is unreachable or singular. Arrays broadcast as ik's."""
     if _scalar(x, y) and out is None:
         value, status = mechanism.lci_batch(np.array([float(x)]), np.array([float(y)]))
         return float(value[0]), Status(int(status[0]))
+    x, y = _broadcast(x, "x", y, "y")
     return mechanism.lci_batch(x, y, out=out)
 
 

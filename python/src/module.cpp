@@ -57,10 +57,46 @@ py::tuple limits_tuple(const Mechanism& m) {
 
 Vec2 vec2(const std::array<double, 2>& a) { return {a[0], a[1]}; }
 
-Mechanism make_mechanism(const std::string& name, const std::array<std::array<double, 2>, 2>& bases,
-                         const std::array<double, 4>& links, const std::string& working_mode,
-                         const std::string& assembly_mode, const std::optional<std::array<std::array<double, 2>, 2>>& limits,
-                         double min_lci) {
+/// `n` numbers from a Python sequence, or InputError naming the argument, what it holds and the count.
+template <std::size_t n>
+std::array<double, n> numbers_of(const py::handle& given, const std::string& what, const char* holds) {
+  const bool sequence = py::isinstance<py::sequence>(given) && !py::isinstance<py::str>(given);
+  const std::size_t got = sequence ? py::len(given) : 0;
+  if (!sequence || got != n) {
+    throw InputError(what + ": expected " + std::to_string(n) + " " + holds + ", got " +
+                     (sequence ? std::to_string(got) : "a " + std::string(py::str(given.get_type().attr("__name__")))));
+  }
+  std::array<double, n> out{};
+  py::sequence seq = py::reinterpret_borrow<py::sequence>(given);
+  for (std::size_t i = 0; i < n; ++i) {
+    try {
+      out[i] = seq[i].cast<double>();
+    } catch (const py::cast_error&) {
+      throw InputError(what + "[" + std::to_string(i) + "]: expected a number, got a " +
+                       std::string(py::str(py::handle(seq[i]).get_type().attr("__name__"))));
+    }
+  }
+  return out;
+}
+
+/// ((a, b), (c, d)) from Python, each pair checked as numbers_of does.
+std::array<std::array<double, 2>, 2> pairs_of(const py::object& given, const std::string& what, const char* holds) {
+  const bool sequence = py::isinstance<py::sequence>(given) && !py::isinstance<py::str>(given);
+  if (!sequence || py::len(given) != 2) {
+    throw InputError(what + ": expected 2 " + holds + ", got " +
+                     (sequence ? std::to_string(py::len(given)) : "a " + std::string(py::str(given.get_type().attr("__name__")))));
+  }
+  py::sequence seq = py::reinterpret_borrow<py::sequence>(given);
+  return {numbers_of<2>(seq[0], what + "[0]", "numbers"), numbers_of<2>(seq[1], what + "[1]", "numbers")};
+}
+
+Mechanism make_mechanism(const std::string& name, const py::object& bases_given, const py::object& links_given,
+                         const std::string& working_mode, const std::string& assembly_mode,
+                         const py::object& limits_given, double min_lci) {
+  const auto bases = pairs_of(bases_given, "bases", "base joints ((x1, y1), (x2, y2)) in mm");
+  const auto links = numbers_of<4>(links_given, "links", "lengths (L1, L2, L3, L4) in mm");
+  std::optional<std::array<std::array<double, 2>, 2>> limits;
+  if (!limits_given.is_none()) limits = pairs_of(limits_given, "joint_limits", "ranges ((lo1, hi1), (lo2, hi2)) in rad");
   Mechanism m;
   m.name = name;
   m.O1 = vec2(bases[0]);

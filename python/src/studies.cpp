@@ -635,7 +635,7 @@ void register_studies(py::module_& m) {
         for (const auto& x : p.settings().objectives) o.emplace_back(x.figure, x.maximise);
         return o;
       }, "(figure, maximise) per objective.")
-      .def_property_readonly("figures", [] {
+      .def_property_readonly("figures", [](const OptimizeProblem&) {
         std::vector<std::string> names;
         for (const auto& f : optimize_figures()) names.emplace_back(f.name);
         return names;

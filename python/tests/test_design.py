@@ -80,3 +80,43 @@ def test_a_mechanism_built_by_hand_is_validated():
         fivebar.Mechanism(bases=((0, 0), (12.5, 0)), links=(9, -9, 15, 15))
     with pytest.raises(fivebar.InputError, match="working_mode"):
         fivebar.Mechanism(bases=((0, 0), (12.5, 0)), links=(9, 9, 15, 15), working_mode="x")
+
+
+def test_version_is_the_one_of_cmakelists():
+    """One version for the project: CMakeLists.txt's project(VERSION), read here from the file."""
+    import re
+    from conftest import ROOT
+    text = (ROOT / "CMakeLists.txt").read_text()
+    version = re.search(r"project\(fivebar\s+VERSION\s+([0-9.]+)", text).group(1)
+    assert fivebar.__version__ == version == fivebar.version()
+    assert "__version__" in fivebar.__all__
+
+
+def test_a_mechanism_with_the_wrong_count_says_what_it_expects():
+    bases = ((0.0, 0.0), (12.5, 0.0))
+    with pytest.raises(fivebar.InputError, match=r"links: expected 4 lengths \(L1, L2, L3, L4\) in mm, got 3"):
+        fivebar.Mechanism(bases=bases, links=[9, 9, 15])
+    with pytest.raises(fivebar.InputError, match=r"links: expected 4 lengths .* got a float"):
+        fivebar.Mechanism(bases=bases, links=9.0)
+    with pytest.raises(fivebar.InputError, match=r"links\[2\]: expected a number, got a str"):
+        fivebar.Mechanism(bases=bases, links=[9, 9, "15", 15])
+    with pytest.raises(fivebar.InputError, match=r"bases: expected 2 base joints .* got 1"):
+        fivebar.Mechanism(bases=[(0.0, 0.0)], links=[9, 9, 15, 15])
+    with pytest.raises(fivebar.InputError, match=r"bases\[1\]: expected 2 numbers, got 3"):
+        fivebar.Mechanism(bases=[(0.0, 0.0), (12.5, 0.0, 1.0)], links=[9, 9, 15, 15])
+    with pytest.raises(fivebar.InputError, match=r"joint_limits: expected 2 ranges"):
+        fivebar.Mechanism(bases=bases, links=[9, 9, 15, 15], joint_limits=[(0.0, 1.0)])
+    # The same numbers in the right shape build the paper's index mechanism.
+    m = fivebar.Mechanism(bases=bases, links=[9, 9, 15, 15])
+    assert m.links == (9.0, 9.0, 15.0, 15.0)
+
+
+def test_a_mistyped_key_path_names_the_nearest_key(showcase):
+    with pytest.raises(fivebar.InputError, match=r"has no key 'linkz' \(did you mean 'links'\?\)"):
+        showcase.with_numbers({"stations.index.mechanisms.lower.linkz[2]": 16.0})
+    with pytest.raises(fivebar.InputError, match=r"has no key 'indx' \(did you mean 'index'\?\)"):
+        showcase.number("stations.indx.mechanisms.lower.links[2]")
+    # Nothing near: no suggestion.
+    with pytest.raises(fivebar.InputError) as e:
+        showcase.number("stations.index.zzzzzzzz")
+    assert "did you mean" not in str(e.value)

@@ -234,3 +234,54 @@ def test_gil_is_released_during_a_batch(index_lower):
     during = [t for t in ticks if start < t < end]
     assert end - start > 0.05, "the batch was too short to tell"
     assert len(during) >= 10, f"{len(during)} ticks in {end - start:.3f} s"
+
+
+def test_units_are_explicit(index_lower):
+    """Degrees only with unit="deg"; without unit= an angle beyond one turn is refused, so
+    fk(m, 100, 80) cannot mean 100 rad silently. unit="deg" equals the radians given by hand."""
+    with pytest.raises(fivebar.InputError, match=r"theta1 = 100: .*unit='deg'"):
+        fivebar.fk(index_lower, 100, 80)
+    with pytest.raises(fivebar.InputError, match=r"theta2 = 80"):
+        fivebar.fk(index_lower, np.array([0.5, 1.0]), np.array([1.0, 80.0]))
+    with pytest.raises(fivebar.InputError, match=r"theta1"):
+        fivebar.jacobian(index_lower, 100.0, 80.0)
+    with pytest.raises(ValueError, match=r"unit = 'grad'"):
+        fivebar.fk(index_lower, 1.0, 1.0, unit="grad")
+    deg = fivebar.fk(index_lower, 100, 80, unit="deg")
+    rad = fivebar.fk(index_lower, math.radians(100), math.radians(80))
+    assert deg.status == rad.status and deg.P == pytest.approx(rad.P, abs=0.0)
+    # Radians beyond one turn when the caller says so: the same point as the angle less 2 pi.
+    far = fivebar.fk(index_lower, math.radians(100) + 2 * math.pi, math.radians(80), unit="rad")
+    assert far.P == pytest.approx(rad.P, abs=1e-12)
+    t = np.array([100.0, 95.0])
+    xd, yd, sd = fivebar.fk(index_lower, t, t[::-1].copy(), unit="deg")
+    xr, yr, sr = fivebar.fk(index_lower, np.deg2rad(t), np.deg2rad(t[::-1]))
+    assert np.array_equal(xd, xr) and np.array_equal(yd, yr) and np.array_equal(sd, sr)
+    Jd, _ = fivebar.jacobian(index_lower, 100, 80, unit="deg")
+    Jr, _ = fivebar.jacobian(index_lower, math.radians(100), math.radians(80))
+    assert np.array_equal(Jd, Jr)
+
+
+def test_arrays_broadcast_as_numpy_does(index_lower):
+    """A row of x with a column of y is a grid; each cell equals the scalar call at that point.
+    A scalar with an array is the array of that scalar. Shapes that do not broadcast are refused."""
+    xs = np.linspace(0.0, 12.5, 7)
+    ys = np.linspace(14.0, 18.0, 5)
+    t1, t2, st = fivebar.ik(index_lower, xs[None, :], ys[:, None])
+    assert t1.shape == t2.shape == st.shape == (5, 7)
+    for j, y in enumerate(ys):
+        for i, x in enumerate(xs):
+            pose = fivebar.ik(index_lower, float(x), float(y))
+            assert int(st[j, i]) == int(pose.status)
+            if pose.status == fivebar.Status.ok:
+                assert (t1[j, i], t2[j, i]) == pytest.approx((pose.theta1, pose.theta2), abs=1e-12)
+    lg, _ = fivebar.lci(index_lower, xs[None, :], ys[:, None])
+    assert lg[2, 3] == pytest.approx(fivebar.lci(index_lower, float(xs[3]), float(ys[2]))[0], abs=1e-15)
+    a = np.linspace(0.5, 2.5, 9)
+    x1, y1, s1 = fivebar.fk(index_lower, 1.6, a)
+    x2, y2, s2 = fivebar.fk(index_lower, np.full_like(a, 1.6), a)
+    assert np.array_equal(x1, x2) and np.array_equal(y1, y2) and np.array_equal(s1, s2)
+    J, _ = fivebar.jacobian(index_lower, a[:, None], a[None, :])
+    assert J.shape == (9, 9, 2, 2)
+    with pytest.raises(ValueError, match=r"shape mismatch: x has shape \(7,\), y has \(5,\), which do not broadcast"):
+        fivebar.ik(index_lower, xs, ys)

@@ -176,6 +176,17 @@ def test_problem_evaluates_in_process(showcase):
         p.evaluate([float("nan")] * p.dimension)
 
 
+def test_problem_figures_name_every_objective_and_every_evaluated_figure(showcase):
+    """Problem.figures is a property of the instance (it raised TypeError when bound without self):
+    every objective's figure and every figure an evaluation carries is among them."""
+    p = fivebar.Problem(showcase)
+    figures = p.figures
+    assert isinstance(figures, list) and figures and all(isinstance(f, str) for f in figures)
+    assert len(set(figures)) == len(figures)
+    assert {name for name, _ in p.objectives} <= set(figures)
+    assert set(p.evaluate(p.reference_values())["figures"]) <= set(figures)
+
+
 def test_simulated_series_agree_with_the_summary(showcase):
     runs = fivebar.simulate(showcase, station="index", pattern="stretch")
     assert len(runs) == 1

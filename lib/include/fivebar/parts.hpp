@@ -202,7 +202,8 @@ struct PartsOptions {
   std::function<void(std::string_view)> progress;
 };
 
-/// The library folder: FIVEBAR_SCAD_DIR from the environment, else the source tree's scad/.
+/// The library folder: FIVEBAR_SCAD_DIR from the environment, else `share/fivebar/scad` found
+/// above the binary (fivebar/share.hpp find_share_path), else `scad` in the working directory.
 std::filesystem::path default_scad_dir();
 /// Full path of the openscad executable `options.openscad` names (see there), or std::nullopt.
 std::optional<std::filesystem::path> find_openscad(const std::string& name = {});

@@ -33,6 +33,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/numerics.hpp"
+#include "fivebar/share.hpp"
 #include "fivebar/version.hpp"
 #include "yaml/key_lines.hpp"
 
@@ -328,11 +329,8 @@ void PartsHardware::validate() const {
 
 fs::path default_scad_dir() {
   if (const char* env = std::getenv("FIVEBAR_SCAD_DIR"); env != nullptr && *env != '\0') return env;
-#ifdef FIVEBAR_SCAD_DIR
-  return FIVEBAR_SCAD_DIR;
-#else
-  return "scad";
-#endif
+  if (auto found = find_share_path("scad/" + std::string(kLibraryFile), binary_dirs())) return found->parent_path();
+  return "scad";  // not installed and not in a build tree: the working directory's, as a checkout's root has it
 }
 
 std::optional<fs::path> find_openscad(const std::string& name) {

@@ -98,6 +98,55 @@ void text(cairo_t* cr, const std::string& s, double x, double y, double size, do
   cairo_show_text(cr, s.c_str());
 }
 
+/// The footnote inside the canvas: wrapped at spaces to the width between the margins, in at most
+/// two lines below the x-axis label (the font shrinks until it fits; a word longer than a line is
+/// the only thing that can still be cut, by the clip to the canvas less its margin).
+void footnote(cairo_t* cr, const std::string& s) {
+  constexpr double kMargin = 16;
+  const double width = kWidth - 2 * kMargin;
+  cairo_select_font_face(cr, "sans-serif", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
+  std::vector<std::string> lines;
+  double size = 11.5;
+  for (; size >= 7.5; size -= 1.0) {
+    cairo_set_font_size(cr, size);
+    lines.clear();
+    std::string line;
+    std::string word;
+    const auto fits = [&](const std::string& t) {
+      cairo_text_extents_t ext;
+      cairo_text_extents(cr, t.c_str(), &ext);
+      return ext.x_advance <= width;
+    };
+    for (std::size_t i = 0; i <= s.size(); ++i) {
+      if (i < s.size() && s[i] != ' ') {
+        word += s[i];
+        continue;
+      }
+      if (word.empty()) continue;
+      const std::string longer = line.empty() ? word : line + " " + word;
+      if (!line.empty() && !fits(longer)) {
+        lines.push_back(line);
+        line = word;
+      } else {
+        line = longer;
+      }
+      word.clear();
+    }
+    if (!line.empty()) lines.push_back(line);
+    if (lines.size() <= 2) break;
+  }
+  cairo_save(cr);
+  cairo_rectangle(cr, kMargin, kBottom + 50, width, kHeight - kMargin / 2 - (kBottom + 50));
+  cairo_clip(cr);
+  const double step = size * 1.3;
+  double y = kHeight - kMargin / 2 - step * double(lines.size() - 1) - 2;
+  for (const std::string& line : lines) {
+    text(cr, line, kMargin, y, size);
+    y += step;
+  }
+  cairo_restore(cr);
+}
+
 /// Breaks a legend label into lines of at most `width` characters at spaces.
 std::vector<std::string> wrap(const std::string& s, std::size_t width) {
   std::vector<std::string> lines;
@@ -194,7 +243,7 @@ void draw(cairo_t* cr, const PlotSpec& spec) {
   cairo_restore(cr);
   if (!spec.footnote.empty()) {
     cairo_set_source_rgb(cr, 0.3, 0.3, 0.3);
-    text(cr, spec.footnote, kLeft, kHeight - 12, 11.5);
+    footnote(cr, spec.footnote);
   }
 
   // Series, clipped to the plot area.

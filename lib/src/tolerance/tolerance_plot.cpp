@@ -3,7 +3,10 @@
 // extent of the clearance play set.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <numbers>
 
@@ -32,28 +35,56 @@ std::array<double, 4> ellipse_bounds(const Ellipse& e, double pad) {
   return {e.center.x() - r - pad, e.center.y() - r - pad, e.center.x() + r + pad, e.center.y() + r + pad};
 }
 
-/// The map's cells inside `bounds`, coloured by value / top on the ramp (grey where not ok).
+/// The map's cells inside `bounds`, coloured by value / top on the ramp (grey where not ok): one
+/// image pixel per cell, scaled with nearest-neighbour sampling, so that neighbouring cells meet
+/// without seams (in PNG and SVG alike), and clipped to the bounds the axes frame.
 void cells(cairo_t* cr, const Panel& panel, const ToleranceMap& map, const std::vector<double>& values, double top,
            const std::array<double, 4>& b) {
-  const double half = 0.5 * map.spacing_mm;
-  for (int j = 0; j < map.ny; ++j) {
-    const double y = map.y0 + map.spacing_mm * j;
-    if (y < b[1] - map.spacing_mm || y > b[3] + map.spacing_mm) continue;
-    for (int i = 0; i < map.nx; ++i) {
-      const double x = map.x0 + map.spacing_mm * i;
-      if (x < b[0] - map.spacing_mm || x > b[2] + map.spacing_mm) continue;
+  const double sp = map.spacing_mm;
+  const auto index_range = [sp](double lo, double hi, double origin, int n) {
+    const int first = std::max(0, static_cast<int>(std::floor((lo - origin) / sp)) - 1);
+    const int last = std::min(n - 1, static_cast<int>(std::ceil((hi - origin) / sp)) + 1);
+    return std::array<int, 2>{first, last};
+  };
+  const auto [i0, i1] = index_range(b[0], b[2], map.x0, map.nx);
+  const auto [j0, j1] = index_range(b[1], b[3], map.y0, map.ny);
+  if (i1 < i0 || j1 < j0) return;
+  const int w = i1 - i0 + 1, h = j1 - j0 + 1;
+  cairo_surface_t* image = cairo_image_surface_create(CAIRO_FORMAT_RGB24, w, h);
+  if (cairo_surface_status(image) != CAIRO_STATUS_SUCCESS) {
+    cairo_surface_destroy(image);
+    return;
+  }
+  cairo_surface_flush(image);
+  unsigned char* data = cairo_image_surface_get_data(image);
+  const int stride = cairo_image_surface_get_stride(image);
+  const auto byte = [](double v) { return static_cast<std::uint32_t>(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); };
+  for (int j = j0; j <= j1; ++j) {
+    // Image rows run downwards, the station's y upwards.
+    auto* row = reinterpret_cast<std::uint32_t*>(data + static_cast<std::ptrdiff_t>(stride) * (j1 - j));
+    for (int i = i0; i <= i1; ++i) {
       const std::size_t k = static_cast<std::size_t>(j) * static_cast<std::size_t>(map.nx) + static_cast<std::size_t>(i);
-      const auto p0 = panel.px(Vec2(x - half, y - half));
-      const auto p1 = panel.px(Vec2(x + half, y + half));
-      cairo_rectangle(cr, p0[0], p1[1], p1[0] - p0[0] + 0.3, p0[1] - p1[1] + 0.3);
-      if (map.field_status[k] != static_cast<std::uint8_t>(Status::ok)) {
-        set_colour(cr, Rgb{0.88, 0.88, 0.88});
-      } else {
-        set_colour(cr, viridis(top > 0.0 ? values[k] / top : 0.0));
-      }
-      cairo_fill(cr);
+      const Rgb c = map.field_status[k] != static_cast<std::uint8_t>(Status::ok) ? Rgb{0.88, 0.88, 0.88}
+                                                                                 : viridis(top > 0.0 ? values[k] / top : 0.0);
+      row[i - i0] = (byte(c.r) << 16) | (byte(c.g) << 8) | byte(c.b);
     }
   }
+  cairo_surface_mark_dirty(image);
+  const double half = 0.5 * sp;
+  const auto corner_lo = panel.px(Vec2(map.x0 + sp * i0 - half, map.y0 + sp * j0 - half));  // lower left
+  const auto corner_hi = panel.px(Vec2(map.x0 + sp * i1 + half, map.y0 + sp * j1 + half));  // upper right
+  const auto frame_lo = panel.px(Vec2(b[0], b[1]));
+  const auto frame_hi = panel.px(Vec2(b[2], b[3]));
+  cairo_save(cr);
+  cairo_rectangle(cr, frame_lo[0], frame_hi[1], frame_hi[0] - frame_lo[0], frame_lo[1] - frame_hi[1]);
+  cairo_clip(cr);
+  cairo_translate(cr, corner_lo[0], corner_hi[1]);
+  cairo_scale(cr, (corner_hi[0] - corner_lo[0]) / w, (corner_lo[1] - corner_hi[1]) / h);
+  cairo_set_source_surface(cr, image, 0.0, 0.0);
+  cairo_pattern_set_filter(cairo_get_source(cr), CAIRO_FILTER_NEAREST);
+  cairo_paint(cr);
+  cairo_restore(cr);
+  cairo_surface_destroy(image);
 }
 
 void ellipse_outline(cairo_t* cr, const Panel& panel, const Ellipse& e) {

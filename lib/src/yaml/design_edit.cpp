@@ -17,6 +17,7 @@
 #include "design/design_keys.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/sections/geometry.hpp"
+#include "fivebar/suggest.hpp"
 
 namespace fivebar {
 
@@ -114,7 +115,13 @@ std::optional<YAML::Node> follow(const YAML::Node& root, std::string_view key, s
         if ((next == '\0' || next == '.' || next == '[') && (!found || k.size() > best.size())) best = k, found = true;
       }
       if (!found) {
-        why = where() + " has no key " + detail::quoted(rest.substr(0, rest.find_first_of(".[")));
+        const std::string_view wanted = rest.substr(0, rest.find_first_of(".["));
+        std::vector<std::string> keys;
+        for (const auto& entry : node) {
+          if (entry.first.IsScalar()) keys.push_back(entry.first.Scalar());
+        }
+        why = where() + " has no key " + detail::quoted(wanted);
+        if (const std::string near = nearest_name(wanted, keys); !near.empty()) why += " (did you mean " + detail::quoted(near) + "?)";
         return std::nullopt;
       }
       rest.remove_prefix(best.size());
