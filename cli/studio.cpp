@@ -6,7 +6,9 @@
 #include <httplib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -239,9 +241,14 @@ void serve_output(Server& s, const httplib::Request& req, httplib::Response& res
 
 void routes(httplib::Server& http, Server& s) {
   http.set_pre_routing_handler([&s](const httplib::Request& req, httplib::Response& res) { return guard(s, req, res); });
-  http.set_post_routing_handler([&s](const httplib::Request&, httplib::Response& res) {
-    res.set_header("Content-Security-Policy", "default-src 'none'; script-src 'nonce-" + s.nonce + "'; style-src 'nonce-" +
-                                                  s.nonce + "'; connect-src 'self'; img-src 'self' data:; frame-ancestors 'none'");
+  http.set_post_routing_handler([&s](const httplib::Request& req, httplib::Response& res) {
+    // The products page of a run carries its own inline pictures, styles and animation scripts;
+    // it may fetch nothing.
+    res.set_header("Content-Security-Policy",
+                   req.path.rfind("/out/", 0) == 0
+                       ? std::string("default-src 'none'; img-src data: 'self'; style-src 'unsafe-inline'; script-src 'unsafe-inline'; frame-ancestors 'none'")
+                       : "default-src 'none'; script-src 'nonce-" + s.nonce + "'; style-src 'nonce-" + s.nonce +
+                             "'; connect-src 'self'; img-src 'self' data:; frame-ancestors 'none'");
     res.set_header("X-Content-Type-Options", "nosniff");
     res.set_header("Cache-Control", "no-store");
     res.set_header("Referrer-Policy", "no-referrer");
@@ -339,7 +346,7 @@ void setup_studio(CLI::App& app) {
   add_design_argument(*sub, opt->design);
   sub->add_option("--port", opt->port, "Port on 127.0.0.1 (default: a free one)");
   sub->add_flag("--open", opt->open, "Open the page in the desktop's browser (xdg-open); by default only its address is printed");
-  sub->add_flag("--no-open", [o = opt](std::int64_t) { o->open = false; }, "Do not open a browser (the default)");
+  sub->add_flag_function("--no-open", [o = opt](std::int64_t) { o->open = false; }, "Do not open a browser (the default)");
   sub->add_option("--exit-after", opt->exit_after_s, "Stop serving after this many seconds (scripts, tests); default: until interrupted")
       ->type_name("S");
   sub->footer("Prints the page's address (with its token) on stdout. Only files in the design's folder are read or written.\n" +

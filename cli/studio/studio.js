@@ -66,7 +66,7 @@
         st.shownSeq = seq;
         st.figures = fig;
         draw(fig);
-        status('');
+        if ($('status').className === 'bad') status('');
         requestAnimationFrame(() => { if (since !== null) st.latencies.push(performance.now() - since); });
         if (rev === st.rev) st.fullTimer = setTimeout(() => full(rev), 120);
       }
@@ -87,7 +87,8 @@
     return c;
   }
   async function full(rev) {
-    if (rev !== st.rev || st.inflight) return;
+    if (rev !== st.rev) return;
+    if (st.inflight) { st.fullTimer = setTimeout(() => full(rev), 60); return; }
     try {
       const fig = await api('/api/figures', body('full', st.seq));
       if (rev === st.rev) { st.fullRev = rev; st.figures = fig; draw(fig); }
@@ -188,7 +189,7 @@
     else if (shape === 'ring') h = el('circle', { cx: x, cy: y, r: 0.7, fill: 'rgba(255,255,255,0.4)', stroke: colour, 'stroke-width': 0.3, class: 'handle' }, g);
     else h = el('path', { d: `M${x - 0.9},${y}h1.8M${x},${y - 0.9}v1.8`, stroke: colour, 'stroke-width': 0.45, class: 'handle' }, g);
     h.dataset.handle = label;
-    h.addEventListener('pointerdown', (ev) => startDrag(ev, onMove));
+    h.addEventListener('pointerdown', (ev) => startDrag(ev, onMove, shape !== 'ring'));
   }
   function drawHandles(fig, g) {
     const prefix = 'stations.' + fig.station;
@@ -209,20 +210,17 @@
     }, 'target.center');
   }
   function round(v) { return Math.round(v * 1000) / 1000; }  // micrometres: what a file keeps
-  function startDrag(ev, onMove) {
+  function startDrag(ev, onMove, edits) {
     ev.preventDefault();
-    checkpoint();
-    const world = $('world');
-    const target = ev.target;
-    target.setPointerCapture(ev.pointerId);
+    if (edits) checkpoint();  // a tactor point is not an edit of the file: no undo step
+    // Listeners on the window: every redraw replaces the handle that was pressed.
     const move = (e) => {
-      const m = world.getScreenCTM().inverse();
-      const p = new DOMPoint(e.clientX, e.clientY).matrixTransform(m);
+      const p = new DOMPoint(e.clientX, e.clientY).matrixTransform($('world').getScreenCTM().inverse());
       onMove([p.x, p.y], e.timeStamp);
     };
-    const up = () => { target.removeEventListener('pointermove', move); target.removeEventListener('pointerup', up); };
-    target.addEventListener('pointermove', move);
-    target.addEventListener('pointerup', up);
+    const up = () => { window.removeEventListener('pointermove', move); window.removeEventListener('pointerup', up); };
+    window.addEventListener('pointermove', move);
+    window.addEventListener('pointerup', up);
   }
 
   // --- Tables --------------------------------------------------------------------------------------

@@ -41,7 +41,7 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
                     StudioFigures which = StudioFigures::live);
 
 /// The numbers and modes a page can edit, per station: key path, value, unit and a slider range
-/// (for a length: 0.25 to 3 times its value; a coordinate: +- the station's length scale).
+/// (for a length: 0.5 to 1.5 times its value; a coordinate: +- the station's length scale).
 Json studio_controls(const Design& design);
 
 /// The changed lines of `after` against `before` (same line count expected: in-place edits): a

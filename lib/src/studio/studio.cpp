@@ -144,7 +144,7 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
   j["target"]["outline_mm"] = polyline_json(ellipse_polyline(s->target, 120));
   j["mechanisms"] = Json::array();
   for (const Mechanism* m : s->mechanisms()) {
-    j["mechanisms"].push_back(mechanism_json(*m, m == &*s->lower ? lower_at : upper_at, g));
+    j["mechanisms"].push_back(mechanism_json(*m, m->name == "lower" ? lower_at : upper_at, g));
   }
   j["shared_region"] = s->lower && s->upper ? region_json(reachable_region(*s->lower).intersection(reachable_region(*s->upper)))
                                             : Json(nullptr);
@@ -174,7 +174,7 @@ Json studio_controls(const Design& design) {
     for (const Mechanism* m : s.mechanisms()) scale = std::max(scale, m->length_scale());
     const std::string at = "stations." + s.name;  // names are plain words in every shipped design
     Json keys = Json::array();
-    auto length = [&](const std::string& key, double v) { keys.push_back({{"key", key}, {"value", v}, {"unit", "mm"}, {"min", 0.25 * v}, {"max", 3.0 * v}}); };
+    auto length = [&](const std::string& key, double v) { keys.push_back({{"key", key}, {"value", v}, {"unit", "mm"}, {"min", 0.5 * v}, {"max", 1.5 * v}}); };
     auto coord = [&](const std::string& key, double v) { keys.push_back({{"key", key}, {"value", v}, {"unit", "mm"}, {"min", v - scale}, {"max", v + scale}}); };
     coord(at + ".target.center[0]", s.target.center.x());
     coord(at + ".target.center[1]", s.target.center.y());
