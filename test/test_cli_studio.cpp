@@ -82,7 +82,8 @@ TEST_F(StudioCli, TheRegionWithoutJointLimitsHasTheAnnuliClosedFormArea) {
   const json fig = fivebar::studio_figures(d, "index");
   const fivebar::Mechanism& lower = *d.station("index")->lower;
   // Lens sums of the two legs' annuli (region.hpp annuli_intersection_area), not the CGAL arrangement.
-  EXPECT_NEAR(fig["mechanisms"][0]["region"]["area_mm2"].get<double>(), fivebar::annuli_intersection_area(lower), 1e-9);
+  const double annuli = fivebar::annuli_intersection_area(lower);
+  EXPECT_NEAR(fig["mechanisms"][0]["region"]["area_mm2"].get<double>(), annuli, 1e-9 * annuli);
   EXPECT_EQ(fig["collision_map"], "not certified yet");
   EXPECT_EQ(fig["lci_field"], "not certified yet");
   // The pose at the cursor closes the loop: |A1 - P| = L3 and |A2 - P| = L4 of the edited design.
@@ -115,7 +116,7 @@ TEST_F(StudioCli, SavingChangesOnlyTheEditedLinesAndKeepsEveryComment) {
   const int bases = line_of(original, "  index:", "bases: [[0, 0], [12.5, 0]]");
   const int target = line_of(original, "  index:", "target: {center: [6.25, 15.5]");
   EXPECT_EQ(changed, (std::vector<int>{target, bases, links}));
-  EXPECT_EQ(b[std::size_t(links - 1)].substr(0, b[std::size_t(links - 1)].find(" #")), "        links: [9, 9, 15.75, 15]");
+  EXPECT_THAT(b[std::size_t(links - 1)], ::testing::StartsWith("        links: [9, 9, 15.75, 15] "));
   ASSERT_EQ(preview["changes"].size(), 3u);
   EXPECT_EQ(preview["changes"][2]["line"], links);
   EXPECT_EQ(preview["changes"][2]["after"], b[std::size_t(links - 1)]);
@@ -230,6 +231,12 @@ TEST_F(StudioServer, FiguresAndRefusalsOverHttp) {
   EXPECT_EQ(refused->status, 422);
   EXPECT_THAT(json::parse(refused->body)["error"].get<std::string>(), HasSubstr("links[0]"));
   EXPECT_EQ(c.Post("/api/figures", ok_headers(), "not json", "application/json")->status, 400);
+}
+
+TEST_F(StudioCli, PrintsItsAddressAndStops) {
+  const ft::Outcome r = run({"studio", kDesign, "--exit-after", "0"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, ::testing::MatchesRegex("http://127\\.0\\.0\\.1:[0-9]+/\\?token=[0-9a-f]{32}\n"));
 }
 
 TEST_F(StudioCli, BadInputIsExitTwo) {
