@@ -30,6 +30,8 @@ FIVEBAR_PACKAGES=(
   # The Python module fivebar (python/), built by ./run.sh: pybind11 bindings for the system python3
   # with NumPy.
   pybind11-dev python3-dev python3-numpy
+  # fivebar studio's local web server (cli/studio.cpp): cpp-httplib, a header-only HTTP library.
+  libcpp-httplib-dev
 )
 FIVEBAR_TEST_PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
@@ -55,6 +57,8 @@ FIVEBAR_TEST_PACKAGES=(
   # its duties with the x86-64 build's bit for bit.
   g++-aarch64-linux-gnu
   qemu-user
+  # The studio's browser test (test/studio_browser.py) drives Chromium over the DevTools protocol.
+  python3-websocket
 )
 FIVEBAR_HARDENING_PACKAGES=(
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.

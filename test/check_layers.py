@@ -49,6 +49,7 @@ WALLS = {
     "cmark-gfm": (r"cmark-gfm", ["lib/src/products/html.cpp"]),
     "Ceres": (r"ceres/", ["lib/src/calibrate/fit.cpp", "lib/src/identify/ceres_output_error.cpp"]),
     "MuJoCo": (r"mujoco/", []),
+    "cpp-httplib": (r"httplib\.h", ["cli/studio.cpp"]),
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^">]+)[">]', re.M)

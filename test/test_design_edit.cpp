@@ -6,11 +6,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "fivebar/design/edit.hpp"
+#include "fivebar/design/file_edit.hpp"
+#include "fivebar/error.hpp"
 #include "fivebar/optimize.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/optimize.hpp"
@@ -222,6 +225,79 @@ TEST(DesignKeys, LoadingIsLinearInTheKeys) {
   // The library gives the same answer on the same text: every key resolved, none twice.
   const Design d = load_design_from_string(text, "many.yaml");
   EXPECT_EQ(d.get<OptimizeSettings>()->variables[0].keys.size(), 1300u);
+}
+
+// edit_design_text (fivebar/design/file_edit.hpp): the file's own text with one scalar replaced,
+// against set_design_number's round trip through to_yaml and the loader (a second formulation).
+TEST(FileEdit, EditingTheTextEqualsSetDesignNumberAndKeepsEveryOtherByte) {
+  const std::string text =
+      "# a comment that must survive\n"
+      "name: edit   # trailing comment\n"
+      "stations:\n"
+      "  index:\n"
+      "    target: {center: [6.25, 15.5], axes: [15, 12], angle: 0}   # centre\n"
+      "    mechanisms:\n"
+      "      lower:\n"
+      "        bases: [[0, 0], [12.5, 0]]\n"
+      "        links:\n"
+      "          - 9      # L1\n"
+      "          - 9.0\n"
+      "          - 1.5e1  # L3, written with an exponent\n"
+      "          - 15\n"
+      "        working_mode: '-+'   # quoted singly\n"
+      "        assembly_mode: \"+\"\n";
+  const std::vector<FileEdit> edits = {{"stations.index.mechanisms.lower.links[02]", 16.25},
+                                       {"stations.index.mechanisms.lower.links[0]", 9.5},
+                                       {"stations.index.target.center[1]", 16.0},
+                                       {"stations.index.target.angle", 12.5},
+                                       {"stations.index.mechanisms.lower.bases[1][0]", 13.0},
+                                       {"stations.index.mechanisms.lower.working_mode", std::string("+-")}};
+  const std::string edited = edit_design_text(text, "t.yaml", edits);
+  const std::string expected =
+      "# a comment that must survive\n"
+      "name: edit   # trailing comment\n"
+      "stations:\n"
+      "  index:\n"
+      "    target: {center: [6.25, 16], axes: [15, 12], angle: 12.5}   # centre\n"
+      "    mechanisms:\n"
+      "      lower:\n"
+      "        bases: [[0, 0], [13, 0]]\n"
+      "        links:\n"
+      "          - 9.5      # L1\n"
+      "          - 9.0\n"
+      "          - 16.25  # L3, written with an exponent\n"
+      "          - 15\n"
+      "        working_mode: \"+-\"   # quoted singly\n"
+      "        assembly_mode: \"+\"\n";
+  EXPECT_EQ(edited, expected);
+  Design reference = load_design_from_string(text, "t.yaml");
+  for (std::size_t i = 0; i + 1 < edits.size(); ++i) set_design_number(reference, edits[i].key, std::get<double>(edits[i].value));
+  Design loaded = load_design_from_string(edited, "t.yaml");
+  EXPECT_EQ(loaded.stations[0].lower->working_mode, parse_working_mode("+-").value());
+  loaded.stations[0].lower->working_mode = reference.stations[0].lower->working_mode;
+  EXPECT_EQ(to_yaml(loaded), to_yaml(reference));
+  // The last edit of a key wins; an empty list changes nothing.
+  EXPECT_EQ(edit_design_text(text, "t.yaml", {{"stations.index.target.angle", 1.0}, {"stations.index.target.angle", 2.0}}),
+            edit_design_text(text, "t.yaml", {{"stations.index.target.angle", 2.0}}));
+  EXPECT_EQ(edit_design_text(text, "t.yaml", {}), text);
+}
+
+TEST(FileEdit, AKeyThatIsNotAValueOfTheFileIsRefusedNamingIt) {
+  const std::string text = "name: edit\nstations:\n  index:\n    target: {center: [6.25, 15.5], axes: [15, 12], angle: 0}\n";
+  const auto refused = [&](const FileEdit& e, const std::string& words) {
+    SCOPED_TRACE(e.key);
+    try {
+      (void)edit_design_text(text, "t.yaml", {e});
+      ADD_FAILURE() << "accepted";
+    } catch (const InputError& error) {
+      EXPECT_THAT(error.what(), HasSubstr("t.yaml"));
+      EXPECT_THAT(error.what(), HasSubstr(words));
+    }
+  };
+  refused({"stations.index.mechanisms.lower.joint_limits[0][0]", 10.0}, "is not in the file");
+  refused({"stations.index.target", 1.0}, "t.yaml:4: key 'stations.index.target': not a single value");
+  refused({"name", 1.0}, "not a number");
+  refused({"stations.index.target.angle", std::nan("")}, "not a finite number");
 }
 
 }  // namespace

@@ -120,6 +120,24 @@ void limit_control(std::vector<std::string>& args) {
   }
 }
 
+/// `studio` serves for no time (it binds, prints its address and stops) and never opens a browser:
+/// every --exit-after, --open and --port of the input is dropped (a port is bound to a free one).
+void limit_studio(std::vector<std::string>& args) {
+  if (args.empty() || args[0] != "studio") return;
+  std::vector<std::string> kept{args[0]};
+  for (std::size_t i = 1; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--exit-after" || a == "--port") {
+      ++i;  // and its value
+      continue;
+    }
+    if (a == "--open" || a.starts_with("--exit-after=") || a.starts_with("--port=")) continue;
+    kept.push_back(a);
+  }
+  kept.insert(kept.end(), {"--exit-after", "0"});
+  args = std::move(kept);
+}
+
 /// `optimize` runs at most 64 candidates and 2 s of wall time (an evaluation past it abandons its
 /// round), without the re-check (a `fivebar run` of the chosen design) and the polish: a design's
 /// own budget may ask for millions of candidates, each simulating every pattern.
@@ -262,6 +280,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   limit_simulate(args);
   limit_control(args);
   limit_optimize(args);
+  limit_studio(args);
   std::vector<std::string> storage{"fivebar"};
   storage.insert(storage.end(), args.begin(), args.end());
   std::vector<char*> argv;

@@ -1,0 +1,90 @@
+#pragma once
+/// The studio's state (docs/studio.md): a design file held open for editing by hand, its edits as
+/// key paths and values (fivebar/design/file_edit.hpp), and one station's figures computed with
+/// the library calls the command line makes (reachable regions, `fivebar coverage`, the priority
+/// rule and collision map of `fivebar collision`, the LCI field of `fivebar workspace`). Behind
+/// `fivebar studio`; it knows no HTTP.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "fivebar/design.hpp"
+#include "fivebar/design/file_edit.hpp"
+#include "fivebar/json.hpp"
+
+namespace fivebar {
+
+/// Which figures one request computes. `live` is what a drag redraws (regions, coverage, poses,
+/// outlines, the priority rule at the two tactor points); `full` adds the sampled figures (the
+/// collision map over the target and the LCI field), which the page marks "not certified yet"
+/// until their answer for the current edits has arrived.
+enum class StudioFigures : std::uint8_t { live, full };
+
+/// Where the two tactors are held for the poses, outlines and the priority rule (mm, station
+/// frame); unset: the target centre (the paper's worst case, `centre_rule` of the collision map).
+struct StudioCursor {
+  std::optional<Vec2> lower;
+  std::optional<Vec2> upper;
+};
+
+/// One station's figures as JSON (docs/studio.md "Figures"): station, cursor, target, mechanisms
+/// (bases, links, modes, joint limits, exact region loops, pose and outline at the cursor),
+/// shared region, coverage (the record of `fivebar coverage --json`), priority (the record of
+/// `fivebar collision`'s rule), and with StudioFigures::full: collision_map (summary of
+/// `fivebar collision --json`, sampled) and lci_field (sampled); otherwise those two are the
+/// string "not certified yet". InputError when the station does not exist.
+Json studio_figures(const Design& design, std::string_view station, const StudioCursor& cursor = {},
+                    StudioFigures which = StudioFigures::live);
+
+/// The numbers and modes a page can edit, per station: key path, value, unit and a slider range
+/// (for a length: 0.5 to 1.5 times its value; a coordinate: +- the station's length scale).
+Json studio_controls(const Design& design);
+
+/// The changed lines of `after` against `before` (same line count expected: in-place edits): a
+/// list of {line, before, after}; when the counts differ, every line from the first difference.
+Json line_diff(std::string_view before, std::string_view after);
+
+/// A design file open in the studio: the text as read (or as last saved) and its hash.
+class Studio {
+ public:
+  /// Reads and loads `file` with `rule` beside the loader's own (the command line passes
+  /// validate_products of fivebar/scene.hpp, as load_scene does). InputError otherwise.
+  explicit Studio(std::filesystem::path file, DesignRule rule = {});
+
+  const std::filesystem::path& file() const { return file_; }
+  const std::string& text() const { return text_; }
+  /// SHA-256 of text(): what a save checks the file on disk against.
+  const std::string& text_sha256() const { return sha_; }
+
+  /// text() with `edits` applied (edit_design_text). InputError naming the file and key.
+  std::string edited_text(const std::vector<FileEdit>& edits) const;
+  /// The design with `edits` applied, loaded from the edited text: every rule of the loader, with
+  /// its FILE:LINE: key messages (the lines are those of the file). InputError otherwise.
+  Design design(const std::vector<FileEdit>& edits) const;
+
+  /// What a save would write: {file, sha256 (of the file as read), changes: line_diff, valid}.
+  Json preview(const std::vector<FileEdit>& edits) const;
+
+  /// Outcome of save().
+  enum class SaveStatus : std::uint8_t { saved, changed_on_disk };
+  /// Writes the edited text atomically (fivebar/io.hpp) when the file on disk still has the hash
+  /// `expected_sha256` (the text the edits were made against); then text() is the saved text.
+  /// changed_on_disk (nothing written) when it does not. InputError for edits the loader refuses
+  /// (nothing written); IoError when the write fails.
+  SaveStatus save(const std::vector<FileEdit>& edits, std::string_view expected_sha256);
+
+  /// Re-reads the file from disk (after it changed there): InputError when it no longer loads.
+  void reload();
+
+ private:
+  std::filesystem::path file_;
+  std::string text_;
+  std::string sha_;
+  DesignRule rule_;
+};
+
+}  // namespace fivebar

@@ -1,0 +1,250 @@
+// fivebar studio (docs/studio.md): the state module against the command line it must agree with
+// (the margin of `fivebar coverage --json` on the saved file), saves that keep every other byte of
+// the file, a file changed on disk, the loader's FILE:LINE: key messages for an edit it refuses,
+// and the server's refusals (token, Host, Origin, paths outside the design's folder) over HTTP.
+// The page itself is tested in a real browser by test/studio_browser.py.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <signal.h>
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli_test.hpp"
+#include "fivebar/error.hpp"
+#include "fivebar/studio.hpp"
+#include "fivebar/workspace/region.hpp"
+
+namespace fs = std::filesystem;
+namespace ft = fivebar::testing;
+using nlohmann::json;
+using ::testing::HasSubstr;
+
+namespace {
+
+class StudioCli : public ft::CliTest {
+ protected:
+  StudioCli() : CliTest("fivebar-test-studio") {}
+  /// The lines of `text`.
+  static std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::size_t from = 0;
+    while (from < text.size()) {
+      const std::size_t end = std::min(text.find('\n', from), text.size());
+      out.push_back(text.substr(from, end - from));
+      from = end + 1;
+    }
+    return out;
+  }
+};
+
+/// The first line of the paper's design that holds `needle` after the line holding `after` (1-based).
+int line_of(const std::string& text, const std::string& after, const std::string& needle) {
+  const std::size_t a = text.find(after);
+  const std::size_t p = text.find(needle, a);
+  return 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(p), '\n'));
+}
+
+const std::vector<fivebar::FileEdit> kEdits = {
+    {"stations.index.mechanisms.lower.links[2]", 15.75},
+    {"stations.index.mechanisms.lower.bases[1][0]", 12.0},
+    {"stations.index.target.center[1]", 15.25},
+};
+
+TEST_F(StudioCli, TheStudiosMarginIsTheCommandLinesOnTheSavedFile) {
+  const fs::path design = write("d.yaml", slurp(kDesign));
+  fivebar::Studio studio(design);
+  const json fig = fivebar::studio_figures(studio.design(kEdits), "index");
+  ASSERT_EQ(studio.save(kEdits, studio.text_sha256()), fivebar::Studio::SaveStatus::saved);
+  const ft::Outcome r = run({"coverage", design.string(), "--station", "index", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json cli = json::parse(r.out)["stations"][0];
+  ASSERT_EQ(fig["coverage"]["mechanisms"].size(), cli["mechanisms"].size());
+  for (std::size_t i = 0; i < cli["mechanisms"].size(); ++i) {
+    EXPECT_EQ(fig["coverage"]["mechanisms"][i]["margin_mm"], cli["mechanisms"][i]["margin_mm"]);
+    EXPECT_EQ(fig["coverage"]["mechanisms"][i]["worst_point_mm"], cli["mechanisms"][i]["worst_point_mm"]);
+  }
+  EXPECT_EQ(fig["coverage"]["shared"]["margin_mm"], cli["shared"]["margin_mm"]);
+  // The edits moved the margin: the lower mechanism's longer... shorter distal link changes it.
+  const json before = fivebar::studio_figures(fivebar::Studio(write("e.yaml", slurp(kDesign))).design({}), "index");
+  EXPECT_NE(before["coverage"]["mechanisms"][0]["margin_mm"], fig["coverage"]["mechanisms"][0]["margin_mm"]);
+}
+
+TEST_F(StudioCli, TheRegionWithoutJointLimitsHasTheAnnuliClosedFormArea) {
+  fivebar::Studio studio(write("d.yaml", slurp(kDesign)));
+  const fivebar::Design d = studio.design(kEdits);
+  const json fig = fivebar::studio_figures(d, "index");
+  const fivebar::Mechanism& lower = *d.station("index")->lower;
+  // Lens sums of the two legs' annuli (region.hpp annuli_intersection_area), not the CGAL arrangement.
+  const double annuli = fivebar::annuli_intersection_area(lower);
+  EXPECT_NEAR(fig["mechanisms"][0]["region"]["area_mm2"].get<double>(), annuli, 1e-9 * annuli);
+  EXPECT_EQ(fig["collision_map"], "not certified yet");
+  EXPECT_EQ(fig["lci_field"], "not certified yet");
+  // The pose at the cursor closes the loop: |A1 - P| = L3 and |A2 - P| = L4 of the edited design.
+  const json& pts = fig["mechanisms"][0]["pose"]["points_mm"];
+  const auto dist = [&](int a, int b) { return std::hypot(pts[a][0].get<double>() - pts[b][0].get<double>(), pts[a][1].get<double>() - pts[b][1].get<double>()); };
+  EXPECT_NEAR(dist(1, 2), 15.75, 1e-9);
+  EXPECT_NEAR(dist(3, 2), 15.0, 1e-9);
+  EXPECT_NEAR(pts[4][0].get<double>(), 12.0, 0.0);
+}
+
+TEST_F(StudioCli, SavingChangesOnlyTheEditedLinesAndKeepsEveryComment) {
+  const std::string original = slurp(kDesign);
+  const fs::path design = write("d.yaml", original);
+  fivebar::Studio studio(design);
+  const json preview = studio.preview(kEdits);
+  ASSERT_EQ(studio.save(kEdits, studio.text_sha256()), fivebar::Studio::SaveStatus::saved);
+  const std::vector<std::string> a = lines(original), b = lines(slurp(design));
+  ASSERT_EQ(a.size(), b.size());
+  std::vector<int> changed;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i] != b[i]) changed.push_back(int(i) + 1);
+    // A comment is everything from " #" on: it survives on every line.
+    const std::size_t ca = a[i].find(" #"), cb = b[i].find(" #");
+    if (ca != std::string::npos) {
+      ASSERT_NE(cb, std::string::npos) << "line " << i + 1;
+      EXPECT_EQ(a[i].substr(ca), b[i].substr(cb)) << "line " << i + 1;
+    }
+  }
+  const int links = line_of(original, "  index:", "links: [9, 9, 15, 15]");
+  const int bases = line_of(original, "  index:", "bases: [[0, 0], [12.5, 0]]");
+  const int target = line_of(original, "  index:", "target: {center: [6.25, 15.5]");
+  EXPECT_EQ(changed, (std::vector<int>{target, bases, links}));
+  EXPECT_THAT(b[std::size_t(links - 1)], ::testing::StartsWith("        links: [9, 9, 15.75, 15] "));
+  ASSERT_EQ(preview["changes"].size(), 3u);
+  EXPECT_EQ(preview["changes"][2]["line"], links);
+  EXPECT_EQ(preview["changes"][2]["after"], b[std::size_t(links - 1)]);
+}
+
+TEST_F(StudioCli, AFileChangedOnDiskIsNotOverwritten) {
+  const fs::path design = write("d.yaml", slurp(kDesign));
+  fivebar::Studio studio(design);
+  const std::string sha = studio.text_sha256();
+  const std::string theirs = slurp(kDesign) + "# edited elsewhere\n";
+  write("d.yaml", theirs);
+  EXPECT_EQ(studio.save(kEdits, sha), fivebar::Studio::SaveStatus::changed_on_disk);
+  EXPECT_EQ(slurp(design), theirs);
+  studio.reload();
+  EXPECT_EQ(studio.save(kEdits, studio.text_sha256()), fivebar::Studio::SaveStatus::saved);
+  EXPECT_THAT(slurp(design), HasSubstr("# edited elsewhere\n"));
+}
+
+TEST_F(StudioCli, AnEditTheLoaderRefusesNamesTheFileLineAndKeyAndWritesNothing) {
+  const std::string original = slurp(kDesign);
+  const fs::path design = write("d.yaml", original);
+  fivebar::Studio studio(design);
+  const std::vector<fivebar::FileEdit> bad = {{"stations.index.mechanisms.lower.links[0]", -1.0}};
+  const int links = line_of(original, "  index:", "links: [9, 9, 15, 15]");
+  try {
+    (void)studio.design(bad);
+    ADD_FAILURE() << "a negative link was accepted";
+  } catch (const fivebar::InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(design.string() + ":" + std::to_string(links) + ":"));
+    EXPECT_THAT(e.what(), HasSubstr("links[0]"));
+  }
+  EXPECT_THROW((void)studio.save(bad, studio.text_sha256()), fivebar::InputError);
+  EXPECT_EQ(slurp(design), original);
+  EXPECT_THROW((void)studio.design({{"stations.index.mechanisms.lower.joint_limits[0][0]", 10.0}}), fivebar::InputError);
+}
+
+/// `fivebar studio` started in the background; its address read from its first line of stdout.
+class StudioServer : public StudioCli {
+ protected:
+  void SetUp() override {
+    design_ = write("d.yaml", slurp(kDesign));
+    child_ = ft::spawn(FIVEBAR_BINARY, {"studio", design_.string(), "--exit-after", "120"}, dir_, dir_);
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (std::chrono::steady_clock::now() < until) {
+      const std::string out = slurp(child_.out);
+      if (out.find('\n') != std::string::npos) {
+        address_ = out.substr(0, out.find('\n'));
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    ASSERT_THAT(address_, ::testing::MatchesRegex("http://127\\.0\\.0\\.1:[0-9]+/\\?token=[0-9a-f]{32}"));
+    const std::size_t colon = address_.find(':', 7), slash = address_.find('/', colon);
+    port_ = std::stoi(address_.substr(colon + 1, slash - colon - 1));
+    token_ = address_.substr(address_.find("token=") + 6);
+  }
+  void TearDown() override {
+    if (child_.pid > 0) {
+      ::kill(child_.pid, SIGTERM);
+      (void)ft::wait(child_, 30.0);
+    }
+  }
+  httplib::Client client() const {
+    httplib::Client c("127.0.0.1", port_);
+    c.set_read_timeout(60, 0);
+    return c;
+  }
+  httplib::Headers ok_headers() const { return {{"X-Fivebar-Token", token_}}; }
+  fs::path design_;
+  ft::Child child_;
+  std::string address_, token_;
+  int port_ = 0;
+};
+
+TEST_F(StudioServer, ServesThePageWithItsTokenAndRefusesEverythingElse) {
+  httplib::Client c = client();
+  auto page = c.Get("/?token=" + token_);
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_THAT(page->body, HasSubstr("fivebar studio"));
+  EXPECT_THAT(page->get_header_value("Content-Security-Policy"), HasSubstr("default-src 'none'"));
+  EXPECT_EQ(c.Get("/")->status, 403);                                 // no token
+  EXPECT_EQ(c.Get("/?token=" + std::string(32, '0'))->status, 403);   // a wrong one
+  EXPECT_EQ(c.Get("/api/state")->status, 403);
+  // DNS rebinding: a page of another name resolving to 127.0.0.1 sends its own Host.
+  EXPECT_EQ(c.Get("/?token=" + token_, {{"Host", "evil.example:" + std::to_string(port_)}})->status, 403);
+  // Another origin's page, even with the token.
+  httplib::Headers cross = ok_headers();
+  cross.emplace("Origin", "http://evil.example");
+  EXPECT_EQ(c.Post("/api/figures", cross, "{}", "application/json")->status, 403);
+  httplib::Headers same = ok_headers();
+  same.emplace("Origin", "http://127.0.0.1:" + std::to_string(port_));
+  EXPECT_EQ(c.Post("/api/figures", same, "{}", "application/json")->status, 200);
+  // Nothing outside the design's outputs folder: a path that climbs out is not served.
+  auto climb = c.Get("/out/../../d.yaml?token=" + token_);
+  EXPECT_NE(climb->status, 200);
+  auto climb2 = c.Get("/out/%2e%2e/%2e%2e/etc/passwd?token=" + token_);
+  EXPECT_NE(climb2->status, 200);
+}
+
+TEST_F(StudioServer, FiguresAndRefusalsOverHttp) {
+  httplib::Client c = client();
+  const json edits = {{"edits", {{{"key", "stations.index.mechanisms.lower.links[2]"}, {"value", 15.75}}}}, {"station", "index"}};
+  auto r = c.Post("/api/figures", ok_headers(), edits.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  fivebar::Studio studio(design_);
+  const json local = fivebar::studio_figures(studio.design({{"stations.index.mechanisms.lower.links[2]", 15.75}}), "index");
+  EXPECT_EQ(json::parse(r->body)["coverage"], local["coverage"]);
+  const json bad = {{"edits", {{{"key", "stations.index.mechanisms.lower.links[0]"}, {"value", -1}}}}};
+  auto refused = c.Post("/api/figures", ok_headers(), bad.dump(), "application/json");
+  EXPECT_EQ(refused->status, 422);
+  EXPECT_THAT(json::parse(refused->body)["error"].get<std::string>(), HasSubstr("links[0]"));
+  EXPECT_EQ(c.Post("/api/figures", ok_headers(), "not json", "application/json")->status, 400);
+}
+
+TEST_F(StudioCli, PrintsItsAddressAndStops) {
+  const ft::Outcome r = run({"studio", kDesign, "--exit-after", "0"});
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, ::testing::MatchesRegex("http://127\\.0\\.0\\.1:[0-9]+/\\?token=[0-9a-f]{32}\n"));
+}
+
+TEST_F(StudioCli, BadInputIsExitTwo) {
+  EXPECT_EQ(run({"studio", "missing.yaml", "--exit-after", "0"}).code, 2);
+  const ft::Outcome r = run({"studio", design_with("bad.yaml", "links: [9, 9, 15, 15]", "links: [9, 9, -15, 15]").string(), "--exit-after", "0"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.err, HasSubstr("links[2]"));
+  EXPECT_EQ(run({"studio", kDesign, "--port", "70000", "--exit-after", "0"}).code, 2);
+}
+
+}  // namespace
