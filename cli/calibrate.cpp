@@ -18,6 +18,7 @@
 #include "fivebar/calibrate.hpp"
 #include "fivebar/csv_reader.hpp"
 #include "fivebar/provenance.hpp"  // today_utc()
+#include "fivebar/provenance/gate.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
@@ -53,6 +54,14 @@ std::string read_text(const std::string& path, const char* what) {
   return csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, what);
 }
 
+void print_gate(const gate::GateResult& g) {
+  if (g.parameters.empty() && g.passed) return;
+  std::cout << "quality gate: " << (g.passed ? "passed" : "refused") << " (solver " << g.solver.termination << ", "
+            << g.solver.iterations << " iterations)\n";
+  for (const gate::ResidualTest& t : g.tests) std::cout << "  " << t.statement << "\n";
+  for (const std::string& line : g.refusal_lines()) std::cout << "  not measured: " << line << "\n";
+}
+
 void print_result(const calibrate::CalibrationResult& r) {
   std::cout << "station " << r.station << " (" << format::join(r.mechanisms) << "): " << r.poses << " poses fitted";
   if (r.holdout_poses > 0) std::cout << ", " << r.holdout_poses << " held out";
@@ -74,6 +83,11 @@ void print_result(const calibrate::CalibrationResult& r) {
   for (const calibrate::Unidentifiable& u : r.unidentifiable) {
     std::cout << "not identifiable: " << u.parameter << " " << u.combination << "\n";
   }
+  for (const calibrate::ExcludedPose& e : r.skipped) std::cout << "skipped: line " << e.line << " (" << e.mechanism << "): " << e.reason << "\n";
+  for (const calibrate::ExcludedPose& e : r.outliers) {
+    std::cout << "outlier: line " << e.line << " (" << e.mechanism << "): " << e.reason << ": left out of the final fit\n";
+  }
+  print_gate(r.gate);
 }
 
 int run_calibrate(const CalibrateCliOptions& opt) {
@@ -140,7 +154,12 @@ int run_calibrate(const CalibrateCliOptions& opt) {
     source.sha256 = sha256_hex(text);
     doc["hard_stops"] = calibrate::to_json(r);
     if (!opt.json) print_result(r);
-    patched = calibrate::with_provenance(calibrate::patched_design(design, r), r, source);
+    if (!r.gate.passed) {
+      code = kCheckFailed;
+      std::cerr << "fivebar calibrate: the hard-stop calibration did not pass the quality gate (reasons above): nothing written\n";
+    } else {
+      patched = calibrate::with_provenance(calibrate::patched_design(design, r), r, source);
+    }
   }
 
   if (fitting) {
@@ -164,6 +183,10 @@ int run_calibrate(const CalibrateCliOptions& opt) {
     if (r.requested_unidentifiable) {
       code = kCheckFailed;
       std::cerr << "fivebar calibrate: the poses cannot identify parameters asked for with --fit (listed above): nothing written\n";
+    } else if (!r.gate.passed) {
+      code = kCheckFailed;
+      std::cerr << "fivebar calibrate: the fit did not pass the quality gate: nothing written\n";
+      for (const std::string& line : r.gate.refusal_lines()) std::cerr << "  " << line << "\n";
     } else {
       patched = calibrate::with_provenance(calibrate::patched_design(design, r), r, source);
       files.emplace_back("calibration-summary.md", calibrate::report_markdown(r, source));
@@ -235,7 +258,9 @@ void setup_calibrate(CLI::App& app) {
   sub->footer(
       "Model, identifiability and the bench walk-through: docs/calibrate.md.\n" +
       exit_status({.ok = "fitted",
-                   .failed = "a parameter named with --fit is not identifiable or no plan exists (nothing written)"}));
+                   .failed = "the fit did not pass the quality gate (not converged, residuals the noise does not explain, a sigma "
+                             "above its prior: reasons per parameter), a parameter named with --fit is not identifiable or no "
+                             "plan exists (nothing written)"}));
 }
 
 }  // namespace fivebar::cli

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <random>
+#include <set>
 #include <string>
 
 #include "fivebar/calibrate.hpp"
@@ -523,6 +524,175 @@ TEST(CalibrateHardStops, OffsetsFromTwoStopsRecoverTheTruth) {
   EXPECT_TRUE(any);
   EXPECT_THAT([&] { hard_stop_calibration(d, "station,mechanism,joint,stop,volts\nindex,lower,3,lo,1\n", "s.csv"); },
               ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("s.csv:2: column 'joint'")));
+}
+
+
+// The quality gate (fivebar/provenance/gate.hpp) on a fit that cannot determine its parameters:
+// every pose on one horizontal line of the target. Nothing may be written as measured, and each
+// refused value says why.
+TEST(CalibrateGate, PosesOnALineAreRefusedWithReasonsPerParameter) {
+  std::mt19937_64 rng(base_seed() + 3);
+  const Truth t = perturbed("lower", rng);
+  const Design& d = paper();
+  const Mechanism truth = with_geometry(*d.station("index")->lower, t.q);
+  const Ellipse& e = d.station("index")->target;
+  std::normal_distribution<double> noise(0.0, 0.02);
+  std::vector<Measurement> rows;
+  for (int k = 0; k < 30; ++k) {
+    const Vec2 p = e.center + Vec2((k / 29.0 - 0.5) * 0.8 * e.axes.x(), 0.0);
+    const Pose pose = ik(truth, p);
+    ASSERT_EQ(pose.status, Status::ok);
+    Measurement r;
+    r.station = "index";
+    r.mechanism = "lower";
+    r.volts1 = t.q[8] + pose.theta1 / t.q[9];
+    r.volts2 = t.q[10] + pose.theta2 / t.q[11];
+    r.point = p + Vec2(noise(rng), noise(rng));
+    r.line = k + 2;
+    rows.push_back(r);
+  }
+  const CalibrationResult r = calibrate(d, rows, {}, "line.csv");
+  std::printf("[calibrate] poses on a line: solver %s, gate %s\n", r.termination.c_str(), r.gate.passed ? "passed" : "refused");
+  EXPECT_FALSE(r.gate.passed);
+  const auto lines = r.gate.refusal_lines();
+  ASSERT_FALSE(lines.empty());
+  for (const std::string& l : lines) std::printf("  %s\n", l.c_str());
+  // Each refused value names its key and a reason: the solver's verdict or a sigma beyond its prior.
+  for (const std::string& l : lines) {
+    EXPECT_THAT(l, ::testing::AnyOf(::testing::HasSubstr("did not converge"), ::testing::HasSubstr("its prior")));
+    EXPECT_THAT(l, ::testing::HasSubstr("stations.index.mechanisms.lower."));
+  }
+  if (!r.converged) EXPECT_THAT(lines.front(), ::testing::HasSubstr("(" + r.termination + ")"));
+  // The writer refuses a refused fit.
+  EXPECT_THROW(with_provenance(patched_design(d, r), r, {"line.csv", sha256_hex("x"), "2026-11-26"}), std::logic_error);
+}
+
+// A good fit passes: with the sigma stated, by its chi-square test (the unmodelled compliance of the
+// synthetic device is a tenth of the noise), and the patched design's entries record the gate.
+TEST(CalibrateGate, AGoodFitPassesAndItsEntriesRecordTheGate) {
+  std::mt19937_64 rng(base_seed() + 5);
+  const Truth t = perturbed("lower", rng);
+  auto rows = measure("lower", t, 60, rng);
+  for (Measurement& m : rows) m.sigma_mm = 0.02;
+  const CalibrationResult r = calibrate(paper(), rows, {}, "good.csv");
+  ASSERT_TRUE(r.gate.passed) << (r.gate.refusal_lines().empty() ? "" : r.gate.refusal_lines().front());
+  EXPECT_EQ(r.termination, "CONVERGENCE");
+  ASSERT_EQ(r.gate.tests.size(), 1u);
+  EXPECT_EQ(r.gate.tests[0].name, "chi-square");
+  EXPECT_EQ(r.gate.parameters.size(), 12u);
+  const Design back = load_design_from_string(
+      to_yaml(with_provenance(patched_design(paper(), r), r, {"good.csv", sha256_hex("x"), "2026-11-26"})), "patched");
+  const auto* entry = &back.get<ProvenanceSettings>()->entries.at("stations.index.mechanisms.lower.links[2]");
+  ASSERT_TRUE(entry->gate.has_value());
+  EXPECT_TRUE(entry->gate->passed);
+  EXPECT_EQ(entry->gate->solver, "CONVERGENCE");
+  EXPECT_THAT(entry->gate->tests, ::testing::HasSubstr("chi-square"));
+  ASSERT_TRUE(entry->gate->sigma_ratio.has_value());
+  EXPECT_LT(*entry->gate->sigma_ratio, 1.0);
+  EXPECT_TRUE(untrusted_values(back, "kinematics", {"index"}, "lower").empty());
+  // A sigma stated ten times too small: the chi-square test refuses the fit.
+  for (Measurement& m : rows) m.sigma_mm = 0.002;
+  const CalibrationResult small = calibrate(paper(), rows, {}, "good.csv");
+  EXPECT_FALSE(small.gate.passed);
+  EXPECT_THAT(small.gate.reasons.front(), ::testing::HasSubstr("larger than the stated measurement sigma"));
+}
+
+// Honest sigmas under a robust loss: 5 % of the poses carry a 1-mm blunder. The robust fit names
+// them, and the estimate and covariance are least squares over the other poses: the truth lies
+// within 3 sigma in at least 95 % of (parameter, seed) cases, and the blunders are the poses named.
+TEST(CalibrateRobust, SigmasStayHonestWithFivePercentBlunders) {
+  int inside = 0, cases = 0, named = 0, blunders = 0, wrongly = 0;
+  for (const Loss loss : {Loss::huber, Loss::cauchy}) {
+    for (int seed = 0; seed < 20; ++seed) {
+      std::mt19937_64 rng(base_seed() * 7919 + static_cast<std::uint64_t>(seed));
+      const Truth t = perturbed("lower", rng);
+      auto rows = measure("lower", t, 60, rng);
+      std::uniform_real_distribution<double> angle(0.0, 2.0 * std::numbers::pi);
+      std::set<int> bad;
+      for (int k = 0; k < 3; ++k) {  // 5 % of 60
+        Measurement& m = rows[static_cast<std::size_t>(7 + 19 * k)];
+        const double a = angle(rng);
+        m.point += Vec2(std::cos(a), std::sin(a));
+        bad.insert(m.line);
+      }
+      CalibrateOptions o;
+      o.loss = loss;
+      const CalibrationResult r = calibrate(paper(), rows, o, "blunders.csv");
+      for (const ExcludedPose& e : r.outliers) (bad.count(e.line) != 0 ? named : wrongly) += 1;
+      blunders += static_cast<int>(bad.size());
+      for (const Parameter& p : r.parameters) {
+        ++cases;
+        if (std::abs(p.value - true_value(p, t.q)) <= 3.0 * p.sigma) ++inside;
+      }
+      EXPECT_TRUE(r.gate.passed) << "seed " << seed;
+    }
+  }
+  const double coverage = static_cast<double>(inside) / cases;
+  std::printf("[calibrate] robust loss, 5%% 1-mm blunders: 3-sigma coverage %d / %d = %.4f; blunders named %d / %d, "
+              "clean poses named %d\n", inside, cases, coverage, named, blunders, wrongly);
+  EXPECT_GE(coverage, 0.95);
+  EXPECT_EQ(named, blunders);
+  EXPECT_LE(wrongly, blunders / 10);
+}
+
+// A pose the design's nominal model cannot assemble (the device reached it) is skipped and named;
+// the fit goes on. Too few poses left is bad input naming the skipped lines.
+TEST(Calibrate, APoseTheNominalModelCannotAssembleIsSkippedAndNamed) {
+  std::mt19937_64 rng(base_seed() + 9);
+  const Truth t = perturbed("lower", rng);
+  auto rows = measure("lower", t, 40, rng);
+  Measurement odd = rows.front();
+  const MechanismVector q = design_q("lower");
+  odd.volts1 = q[8] + 3.0 / q[9];  // theta1 = 3 rad, theta2 = -2 rad: the distal links cannot meet
+  odd.volts2 = q[10] - 2.0 / q[11];
+  odd.line = 99;
+  ASSERT_NE(predict(*paper().station("index")->lower, q, FrameVector::Zero(), odd.volts1, odd.volts2).status, Status::ok);
+  rows.push_back(odd);
+  const CalibrationResult r = calibrate(paper(), rows, {}, "m.csv");
+  ASSERT_EQ(r.skipped.size(), 1u);
+  EXPECT_EQ(r.skipped[0].line, 99);
+  EXPECT_THAT(r.skipped[0].reason, ::testing::HasSubstr("cannot assemble"));
+  EXPECT_EQ(r.poses, 40);
+  EXPECT_TRUE(r.gate.passed);
+  std::vector<Measurement> few(rows.begin(), rows.begin() + 5);
+  few.push_back(odd);
+  EXPECT_THAT([&] { calibrate(paper(), few, {}, "m.csv"); },
+              ::testing::ThrowsMessage<InputError>(::testing::HasSubstr("skipped: the design's model cannot assemble line 99")));
+}
+
+// Hard stops: one stop per joint holds the slope at the design's value, whose prior (1 % of k)
+// enters V0's sigma (dV0/dk = theta_stop / k^2): with a true slope 1 % off, V0 stays within 3 sigma.
+// One reading per stop gives no sigma: refused.
+TEST(CalibrateHardStops, OneStopCarriesTheSlopePriorAndOneReadingIsRefused) {
+  const Design& d = paper();
+  const Station& st = *d.station("index");
+  const double k_design = d.get<ControllerSettings>()->joint("index", "lower", 1).potentiometer.rad_per_volt;
+  const double k_true = 1.01 * k_design, v0 = 0.31;
+  std::string once = "station,mechanism,joint,stop,volts\n", twice = once;
+  std::vector<double> theta;
+  for (int j = 1; j <= 2; ++j) {
+    const auto range = usable_ranges(d, st, *st.lower)[static_cast<std::size_t>(j - 1)];
+    const bool lo = range.lo_by.rfind("hard stop", 0) == 0;
+    if (!lo && range.hi_by.rfind("hard stop", 0) != 0) continue;
+    const double th = lo ? range.lo : range.hi;
+    const std::string row = "index,lower," + std::to_string(j) + "," + (lo ? "lo," : "hi,");
+    once += row + format::shortest(v0 + th / k_true) + "\n";
+    twice += row + format::shortest(v0 + th / k_true - 1e-4) + "\n" + row + format::shortest(v0 + th / k_true + 1e-4) + "\n";
+    theta.push_back(th);
+  }
+  if (theta.empty()) GTEST_SKIP() << "no hard stop in the paper design";
+  const CalibrationResult one = hard_stop_calibration(d, once, "once.csv");
+  EXPECT_FALSE(one.gate.passed);
+  EXPECT_THAT(one.gate.reasons.front(), ::testing::HasSubstr("read once"));
+  const CalibrationResult two = hard_stop_calibration(d, twice, "twice.csv");
+  std::size_t n = 0;
+  for (const Parameter& p : two.parameters) {
+    if (p.unit != "V") continue;
+    const double th = theta[std::min(n++, theta.size() - 1)];
+    // The slope's share of the sigma (the readings' spread is 1e-4 V / sqrt(2) ... ).
+    EXPECT_GT(p.sigma, 0.9 * std::abs(th) / (k_design * k_design) * 0.01 * k_design) << p.key;
+    EXPECT_LE(std::abs(p.value - v0), 3.0 * p.sigma) << p.key;
+  }
 }
 
 TEST(Sha256, KnownAnswers) {

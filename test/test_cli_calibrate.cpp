@@ -21,6 +21,7 @@
 #include "fivebar/export/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/provenance.hpp"
+#include "fivebar/sections/provenance.hpp"
 #include "fivebar/sections/bench.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sha256.hpp"
@@ -158,6 +159,67 @@ TEST_F(CliCalibrate, RequireMeasuredMakesTheExportGateRefuseAssumedPotentiometer
   EXPECT_THAT(r.out, HasSubstr("controller.require_measured"));
 }
 
+// Poses on one line cannot determine the parameters: the quality gate refuses the fit with the
+// reason per parameter, exit 1, nothing written.
+TEST_F(CliCalibrate, AFitThatFailsTheQualityGateIsRefusedWithReasonsAndNothingWritten) {
+  const fivebar::Design d = fivebar::load_design(kDesign);
+  fivebar::Mechanism truth = *d.station("index")->lower;
+  truth.L[2] = kL3;
+  const auto* c = d.get<fivebar::ControllerSettings>();
+  const auto p1 = c->joint("index", "lower", 1).potentiometer, p2 = c->joint("index", "lower", 2).potentiometer;
+  const auto& t = d.station("index")->target;
+  std::string text = "station,mechanism,volts1,volts2,x_mm,y_mm\n";
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  for (int i = 0; i < 30; ++i) {
+    const fivebar::Vec2 p = t.center + fivebar::Vec2((i / 29.0 - 0.5) * 0.8 * t.axes.x(), 0.0);
+    const fivebar::Pose pose = fivebar::ik(truth, p);
+    ASSERT_EQ(pose.status, fivebar::Status::ok);
+    text += "index,lower," + fivebar::format::shortest(p1.volts_at_zero + pose.theta1 / p1.rad_per_volt) + "," +
+            fivebar::format::shortest(p2.volts_at_zero + pose.theta2 / p2.rad_per_volt) + "," + fivebar::format::shortest(p.x() + noise(rng)) +
+            "," + fivebar::format::shortest(p.y() + noise(rng)) + "\n";
+  }
+  const fs::path meas = write("line.csv", text);
+  const ft::Outcome r = run({"calibrate", kDesign, meas.string(), "--out", "cal"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("did not pass the quality gate: nothing written"));
+  EXPECT_THAT(r.err, HasSubstr("lower.L3 (stations.index.mechanisms.lower.links[2])"));
+  EXPECT_THAT(r.out, HasSubstr("quality gate: refused"));
+  EXPECT_FALSE(fs::exists(dir_ / "cal"));
+  const ft::Outcome j = run({"calibrate", kDesign, meas.string(), "--json"});
+  EXPECT_EQ(j.code, 1);
+  const json doc = parse(j);
+  EXPECT_FALSE(doc["calibration"]["gate"]["passed"].get<bool>());
+  EXPECT_TRUE(doc["files"].empty());
+}
+
+// controller.require_measured follows --station: the index station measured through gated fits is
+// exported although the thumb is still assumed; a hand-written entry (no gate) is not trusted.
+TEST_F(CliCalibrate, RequireMeasuredFollowsTheExportedStationsAndTrustsOnlyGatedEntries) {
+  const fs::path base = design_with("base.yaml", "  joint_margin_deg: 5 ", "  require_measured: [kinematics]\n  joint_margin_deg: 5 ");
+  const fivebar::Design d = fivebar::load_design(base);
+  std::vector<fivebar::MeasuredValue> values;
+  std::vector<fivebar::GateRecord> gates;
+  fivebar::GateRecord ok;
+  ok.passed = true;
+  ok.solver = "CONVERGENCE";
+  for (const char* m : {"lower", "upper"}) {
+    for (const std::string& k : fivebar::calibration_keys(d, "index", m)) values.push_back({k, 0.01}), gates.push_back(ok);
+  }
+  const fivebar::MeasurementSource src{"bench.csv", fivebar::sha256_hex("bench"), "2026-11-26", "test"};
+  const fs::path gated = write("gated.yaml", fivebar::to_yaml(fivebar::with_measured_values(d, values, src, Eigen::MatrixXd(), gates)));
+  const ft::Outcome r = run({"export", gated.string(), "--json", "--out", "exp", "--station", "index"});
+  const json doc = parse(r);
+  for (const json& check : doc["gate"]["checks"]) {
+    if (check["kind"] == "provenance") EXPECT_TRUE(check["passed"].get<bool>()) << check["detail"];
+  }
+  EXPECT_EQ(std::count(doc["gate"]["assumed"].begin(), doc["gate"]["assumed"].end(), "kinematics"), 0);
+  const fs::path hand = write("hand.yaml", fivebar::to_yaml(fivebar::with_measured_values(d, values, src)));
+  const ft::Outcome h = run({"export", hand.string(), "--json", "--out", "exp2", "--station", "index"});
+  EXPECT_EQ(h.code, 1);
+  EXPECT_THAT(h.out, HasSubstr("records no quality gate"));
+}
+
 TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
   const fivebar::Design d = fivebar::load_design(kDesign);
   const fivebar::Station& st = *d.station("index");
@@ -168,7 +230,10 @@ TEST_F(CliCalibrate, HardStopReadingsPatchThePotentiometers) {
     const auto range = fivebar::usable_ranges(d, st, *st.lower)[static_cast<std::size_t>(j - 1)];
     for (const auto& [end, by, theta] : {std::tuple{"lo", range.lo_by, range.lo}, std::tuple{"hi", range.hi_by, range.hi}}) {
       if (by.rfind("hard stop", 0) != 0 || !key.empty()) continue;
-      text += "index,lower," + std::to_string(j) + "," + end + "," + fivebar::format::shortest(0.3 + theta / k) + "\n";
+      // Two readings per stop: one reading has no spread and so no sigma (the quality gate refuses it).
+      for (const double dv : {-2e-4, 2e-4}) {
+        text += "index,lower," + std::to_string(j) + "," + end + "," + fivebar::format::shortest(0.3 + theta / k + dv) + "\n";
+      }
       key = "controller.stations.index.lower.theta" + std::to_string(j) + ".potentiometer.volts_at_zero";
     }
   }

@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -16,6 +18,8 @@
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/provenance.hpp"
+#include "fivebar/provenance/gate.hpp"
+#include "fivebar/io.hpp"
 #include "fivebar/sha256.hpp"
 
 namespace fivebar {
@@ -121,6 +125,155 @@ TEST(FigureBases, TheExportValidationBlockCarriesWhatEachFigureRestsOn) {
     EXPECT_EQ(figures, 8);
   }
   std::filesystem::remove_all(dir);
+}
+
+
+// The chi-square tail against closed forms (an independent reference): for an even number of
+// degrees of freedom 2k, P(X >= x) = exp(-x/2) sum_{i<k} (x/2)^i / i!; for one, erfc(sqrt(x/2)).
+TEST(QualityGate, ChiSquareTailMatchesItsClosedForms) {
+  for (int k : {1, 2, 5, 20, 60}) {
+    for (double x : {0.1, 1.0, 3.0, 10.0, 40.0, 120.0, 200.0}) {
+      double sum = 0.0, term = 1.0;
+      for (int i = 0; i < k; ++i) {
+        sum += term;
+        term *= (x / 2) / (i + 1);
+      }
+      const double exact = std::exp(-x / 2) * sum;
+      EXPECT_NEAR(gate::chi_square_sf(x, 2 * k), exact, 1e-12 + 1e-10 * exact) << "dof " << 2 * k << " x " << x;
+    }
+  }
+  for (double x : {0.01, 0.5, 2.0, 9.0, 30.0}) EXPECT_NEAR(gate::chi_square_sf(x, 1), std::erfc(std::sqrt(x / 2)), 1e-12) << x;
+  EXPECT_EQ(gate::chi_square_sf(0.0, 3), 1.0);
+}
+
+// The test's false-refusal rate under its own noise model is its alpha (Monte Carlo over sums of
+// squared normal draws), and a blunder of 10 sigma in 100 residuals is refused.
+TEST(QualityGate, ChiSquareTestRefusesAtItsStatedRate) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const int dof = 40, trials = 20000;
+  int refused = 0, refused_at_5pc = 0;
+  for (int t = 0; t < trials; ++t) {
+    double s = 0.0;
+    for (int i = 0; i < dof; ++i) s += std::pow(n(rng), 2);
+    refused += gate::chi_square_test(s, dof).passed ? 0 : 1;
+    refused_at_5pc += gate::chi_square_test(s, dof, 0.05).passed ? 0 : 1;
+  }
+  EXPECT_LT(refused, 3 * trials * gate::kAlpha + 5);
+  EXPECT_NEAR(refused_at_5pc / static_cast<double>(trials), 0.05, 0.006);
+  std::vector<double> z(100);
+  for (double& v : z) v = n(rng);
+  EXPECT_TRUE(gate::largest_residual_test(z).passed);
+  z[17] = 10.0;
+  const gate::ResidualTest t = gate::largest_residual_test(z);
+  EXPECT_FALSE(t.passed);
+  EXPECT_THAT(t.statement, HasSubstr("10.00"));
+  EXPECT_FALSE(gate::chi_square_test(0.0, 0).applicable);
+}
+
+TEST(QualityGate, EveryConditionRefusesWithItsReasonPerParameter) {
+  gate::GateInput in;
+  in.fit = "test fit";
+  in.solver = {true, "CONVERGENCE", 5};
+  in.tests.push_back(gate::chi_square_test(38.0, 40));
+  in.parameters.push_back({"a.key", "a", "mm", 1.0, 0.01, 0.1, true, ""});
+  in.parameters.push_back({"b.key", "b", "mm", 2.0, 0.5, 0.1, true, ""});
+  in.parameters.push_back({"c.key", "c", "V", 3.0, 0.001, std::nan(""), true, ""});
+  gate::GateResult g = gate::evaluate(in);
+  EXPECT_FALSE(g.passed);
+  EXPECT_TRUE(g.parameters[0].passed);
+  EXPECT_FALSE(g.parameters[1].passed);
+  EXPECT_TRUE(g.parameters[2].passed);
+  EXPECT_DOUBLE_EQ(g.parameters[1].sigma_ratio, 5.0);
+  ASSERT_EQ(g.refusal_lines().size(), 1u);
+  EXPECT_THAT(g.refusal_lines()[0], HasSubstr("b (b.key)"));
+  EXPECT_THAT(g.refusal_lines()[0], HasSubstr("5x its prior"));
+  // The record of a passed value says so, with its figures; the refused one does not pass.
+  EXPECT_TRUE(g.record("a.key").passed);
+  EXPECT_FALSE(g.record("b.key").passed);
+  EXPECT_EQ(g.record("a.key").solver, "CONVERGENCE");
+  EXPECT_NEAR(*g.record("a.key").sigma_ratio, 0.1, 1e-12);
+  EXPECT_FALSE(g.record("c.key").sigma_ratio.has_value());
+  // A solver that did not converge refuses every value, each with that reason.
+  in.parameters.erase(in.parameters.begin() + 1);
+  in.solver = {false, "NO_CONVERGENCE", 100};
+  g = gate::evaluate(in);
+  EXPECT_FALSE(g.passed);
+  ASSERT_EQ(g.refusal_lines().size(), 2u);
+  for (const std::string& line : g.refusal_lines()) EXPECT_THAT(line, HasSubstr("did not converge (NO_CONVERGENCE)"));
+  // Residuals the noise does not explain, and an unidentifiable value.
+  in.solver = {true, "CONVERGENCE", 5};
+  in.tests = {gate::chi_square_test(400.0, 40)};
+  in.parameters[1].identifiable = false;
+  in.parameters[1].identifiability = "moves the tactor as a";
+  g = gate::evaluate(in);
+  EXPECT_THAT(g.refusal_lines()[0], HasSubstr("larger than the stated measurement sigma"));
+  EXPECT_THAT(g.refusal_lines()[1], HasSubstr("not identifiable: moves the tactor as a"));
+  EXPECT_TRUE(gate::to_json(g).at("parameters").is_array());
+}
+
+/// `design` with `key` measured by an entry of the given sha256 and gate.
+Design with_entry(const Design& d, const std::string& key, const std::string& sha, std::optional<bool> passed,
+                  const std::string& source = "bench.csv") {
+  std::vector<GateRecord> gates;
+  if (passed) {
+    GateRecord r;
+    r.passed = *passed;
+    r.solver = "CONVERGENCE";
+    gates.push_back(r);
+  }
+  return with_measured_values(d, {{key, 0.01}}, {source, sha, "2026-11-26", "test"}, Eigen::MatrixXd(), gates);
+}
+
+TEST(QualityGate, RequireMeasuredTrustsOnlyGatedEntriesWithRealHashesOfUnchangedFiles) {
+  const Design& d = paper();
+  const std::string key = "stations.index.mechanisms.lower.links[2]";
+  const std::string zeros(64, '0');
+  // A hand-written entry with an all-zero hash is not a measurement at all.
+  EXPECT_FALSE(is_measured(with_entry(d, key, zeros, std::nullopt), key));
+  EXPECT_FALSE(is_measured(with_entry(d, key, zeros, true), key));
+  // An entry whose gate failed is not a measurement; one without a gate is, but require_measured refuses it.
+  EXPECT_FALSE(is_measured(with_entry(d, key, sha256_hex("x"), false), key));
+  const Design hand = with_entry(d, key, sha256_hex("x"), std::nullopt);
+  EXPECT_TRUE(is_measured(hand, key));
+  const auto reason = [&](const Design& x) {
+    for (const UntrustedValue& u : untrusted_values(x, "kinematics", {"index"}, "lower")) {
+      if (u.key == key) return u.reason;
+    }
+    return std::string();
+  };
+  EXPECT_THAT(reason(hand), HasSubstr("no quality gate"));
+  EXPECT_THAT(reason(with_entry(d, key, zeros, true)), HasSubstr("all zeros"));
+  EXPECT_THAT(reason(with_entry(d, key, sha256_hex("x"), false)), HasSubstr("did not pass"));
+  EXPECT_EQ(reason(with_entry(d, key, sha256_hex("x"), true)), "");
+  // The source file, when present beside the design, must still have the recorded hash.
+  const auto dir = std::filesystem::temp_directory_path() / ("fivebar_gate_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  write_file_atomic(dir / "bench.csv", "the bench file\n");
+  Design placed = with_entry(d, key, sha256_hex("the bench file\n"), true);
+  placed.source = dir / "d.yaml";
+  EXPECT_EQ(reason(placed), "");
+  write_file_atomic(dir / "bench.csv", "the bench file, edited\n");
+  EXPECT_THAT(reason(placed), HasSubstr("has changed since the fit"));
+  std::filesystem::remove_all(dir);
+  // Scope: the thumb's values do not count for the index station, nor the upper mechanism's for --mechanism lower.
+  std::vector<MeasuredValue> values;
+  std::vector<GateRecord> gates;
+  GateRecord ok;
+  ok.passed = true;
+  ok.solver = "CONVERGENCE";
+  for (const std::string& k : calibration_keys(d, "index", "lower")) values.push_back({k, 0.01}), gates.push_back(ok);
+  const Design lower = with_measured_values(d, values, {"m.csv", sha256_hex("m"), "2026-11-26", "test"}, Eigen::MatrixXd(), gates);
+  EXPECT_TRUE(untrusted_values(lower, "kinematics", {"index"}, "lower").empty());
+  EXPECT_TRUE(untrusted_values(lower, "potentiometer", {"index"}, "lower").empty());
+  EXPECT_FALSE(untrusted_values(lower, "kinematics", {"index"}).empty());
+  EXPECT_FALSE(untrusted_values(lower, "kinematics", {}).empty());
+  const auto groups = assumed_groups(lower, {"index"}, "lower");
+  EXPECT_EQ(std::count(groups.begin(), groups.end(), "kinematics"), 0);
+  EXPECT_EQ(std::count(groups.begin(), groups.end(), "potentiometer"), 0);
+  const auto thumb = assumed_groups(lower, {"thumb"});
+  EXPECT_EQ(std::count(thumb.begin(), thumb.end(), "kinematics"), 1);
 }
 
 }  // namespace

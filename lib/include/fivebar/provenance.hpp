@@ -14,17 +14,21 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "fivebar/design.hpp"
+#include "fivebar/sections/provenance.hpp"
 
 namespace fivebar {
 
 /// The group names above, in that order.
 const std::vector<std::string>& provenance_groups();
-/// True when `key` or a key path above it has a provenance entry.
+/// True when `key` or a key path above it has a provenance entry that counts as a measurement: its
+/// sha256 is not a placeholder (all zeros) and, when it records a quality gate
+/// (fivebar/provenance/gate.hpp), that gate passed.
 bool is_measured(const Design& design, std::string_view key);
 /// The key paths of `group` that the design has and that are assumptions. InputError for an
 /// unknown group.
@@ -70,6 +74,24 @@ std::string rests_on_line(const Design& design, std::string_view key, double val
 /// The figure and its value alone: "max tracking error 0.117 mm".
 std::string figure_text(std::string_view key, double value);
 
+/// A value that `controller.require_measured` does not trust as measured, and why.
+struct UntrustedValue {
+  std::string key;
+  std::string reason;  ///< "no provenance: entry", "written without a quality gate", ...
+};
+/// The values of `group` that the figures of `stations` (every station when empty) rest on and that
+/// the export's `controller.require_measured` does not trust: a value is trusted only when its
+/// provenance entry (its own or a key path's above it) records a quality gate that passed, its
+/// sha256 is not all zeros, and the file it names, when present (resolved against the design
+/// file's folder), still has that sha256. Only these stations' mechanisms count for kinematics,
+/// potentiometer and motor values, and only `mechanism` of them when it is given; contact, density
+/// and tolerance are design-wide.
+std::vector<UntrustedValue> untrusted_values(const Design& design, std::string_view group, const std::vector<std::string>& stations,
+                                             std::string_view mechanism = {});
+/// The groups (provenance_groups() order) with an assumed value that the figures of `stations`
+/// (all when empty; only `mechanism` when given) rest on: the export gate's `assumed` list.
+std::vector<std::string> assumed_groups(const Design& design, const std::vector<std::string>& stations, std::string_view mechanism = {});
+
 /// The key paths of a mechanism's twelve calibration values, in the order of
 /// fivebar/calibrate/model.hpp (links[0..3], bases[0][0], bases[0][1], bases[1][0], bases[1][1]; each
 /// joint's volts_at_zero and rad_per_volt at the narrowest `controller` scope that sets it).
@@ -95,8 +117,10 @@ struct MeasuredValue {
 /// `correlation:` under the key that sorts first. A value's earlier entry is replaced, and the
 /// correlations other entries held with it are dropped (a new measurement supersedes the old one).
 /// The result is validated (ValidationError).
+/// `gates` (empty, or one per value in the values' order) are the quality gates the fit passed
+/// (fivebar/provenance/gate.hpp GateResult::records()), kept in each entry.
 Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,
-                            const Eigen::MatrixXd& covariance = Eigen::MatrixXd());
+                            const Eigen::MatrixXd& covariance = Eigen::MatrixXd(), const std::vector<GateRecord>& gates = {});
 
 /// The covariance that the provenance entries give for `keys` (file units, keys' order): sigma^2 on
 /// the diagonal of each key with an entry and a sigma (its own, or that of a key path above it),

@@ -60,12 +60,80 @@ struct Block {
   std::vector<std::size_t> rows;  ///< indices into the station's measurements
 };
 
+/// Poses the design's nominal model cannot assemble: the device reached them, so they are skipped
+/// and named rather than fatal (docs/calibrate.md); blocks left without poses are dropped.
+void skip_unassemblable(std::vector<Block>& blocks, const std::vector<Measurement>& all, std::vector<ExcludedPose>& skipped) {
+  for (Block& b : blocks) {
+    std::erase_if(b.rows, [&](std::size_t i) {
+      const Prediction p = predict(*b.design, b.q, FrameVector::Zero(), all[i].volts1, all[i].volts2);
+      if (p.status == Status::ok) return false;
+      skipped.push_back({all[i].line, b.name,
+                         "readings " + format::shortest(all[i].volts1) + ", " + format::shortest(all[i].volts2) +
+                             " V: the design's nominal model cannot assemble the pose (" + std::string(to_string(p.status)) + ")",
+                         0.0, 0.0});
+      return true;
+    });
+  }
+  std::erase_if(blocks, [](const Block& b) { return b.rows.empty(); });
+}
+
+std::string skipped_text(const std::vector<ExcludedPose>& skipped) {
+  std::vector<std::string> lines;
+  for (const ExcludedPose& e : skipped) lines.push_back("line " + std::to_string(e.line));
+  return format::join(lines);
+}
+
+/// Marks the poses whose residual at the robust estimate exceeds kOutlierScales robust scales
+/// (the given sigma when every row has one, else 1.4826 times the median absolute residual per
+/// axis); returns how many were marked.
+template <class Weight>
+int flag_outliers(const std::vector<Block>& blocks, const std::vector<Measurement>& all, const std::vector<bool>& held_out,
+                  const FrameVector& frame, const Weight& weight, bool all_sigma, std::vector<bool>& outlier,
+                  std::vector<ExcludedPose>& named) {
+  struct Row {
+    std::size_t index;
+    const Block* block;
+    Vec2 r;  // weighted residual
+    double mm;
+  };
+  std::vector<Row> rows;
+  std::vector<double> axis;
+  for (const Block& b : blocks) {
+    for (std::size_t i : b.rows) {
+      if (held_out[i]) continue;
+      const Prediction p = predict(*b.design, b.q, frame, all[i].volts1, all[i].volts2);
+      if (p.status != Status::ok) continue;
+      const Vec2 e = p.y - all[i].point;
+      rows.push_back({i, &b, weight(all[i]) * e, e.norm()});
+      axis.push_back(std::abs(rows.back().r.x()));
+      axis.push_back(std::abs(rows.back().r.y()));
+    }
+  }
+  if (axis.empty()) return 0;
+  std::nth_element(axis.begin(), axis.begin() + static_cast<std::ptrdiff_t>(axis.size() / 2), axis.end());
+  const double scale = all_sigma ? 1.0 : std::max(1.4826 * axis[axis.size() / 2], 1e-12);
+  int n = 0;
+  for (const Row& row : rows) {
+    const double z = row.r.norm() / scale;
+    if (!(z > kOutlierScales)) continue;
+    outlier[row.index] = true;
+    named.push_back({all[row.index].line, row.block->name,
+                     "outlier: residual " + format::fixed(row.mm, 4) + " mm, " + format::fixed(z, 1) + " robust scales (limit " +
+                         format::fixed(kOutlierScales, 2) + ")",
+                     row.mm, z});
+    ++n;
+  }
+  return n;
+}
+
 std::string unit_of(int i) {
   if (i < 8) return "mm";
   return i % 2 == 0 ? "V" : "rad/V";
 }
 
 }  // namespace
+
+double prior_sigma(int index, const MechanismVector& q) { return parameter_scale(index, q); }
 
 double parameter_scale(int index, const MechanismVector& q) {
   if (index >= kMechanismParameters) return index == kMechanismParameters ? kDeg : 0.1;
@@ -109,6 +177,8 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     if (st.mechanism(name) == nullptr) throw InputError("station " + station + " has no mechanism '" + name + "'");
   }
   if (blocks.empty()) throw InputError(origin + ": no measurements of station " + station + (opt.mechanisms.empty() ? "" : " for the chosen mechanisms"));
+  skip_unassemblable(blocks, all, out.skipped);
+  if (blocks.empty()) throw InputError(origin + ": no pose of station " + station + " can be assembled by the design's model: " + skipped_text(out.skipped));
 
   const int nb = static_cast<int>(blocks.size());
   const int np = nb * kMechanismParameters + kFrameParameters;
@@ -159,6 +229,7 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
   for (std::size_t i : rows) all_sigma = all_sigma && sigma_of(all[i]) > 0.0;
   const auto weight = [&](const Measurement& r) { return all_sigma ? 1.0 / sigma_of(r) : 1.0; };
 
+  std::vector<bool> outlier(all.size(), false);  // named by the robust fit, left out of the final fit
   FrameVector frame = FrameVector::Zero();
   const FrameVector frame_prior = frame;
   int fit_rows = 0;
@@ -170,7 +241,7 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     for (int b = 0; b < nb; ++b) {
       const Block& blk = blocks[static_cast<std::size_t>(b)];
       for (std::size_t i : blk.rows) {
-        if (held_out[i]) continue;
+        if (held_out[i] || outlier[i]) continue;
         const Measurement& m = all[i];
         const Prediction p = predict(*blk.design, blk.q, frame, m.volts1, m.volts2);
         if (p.status != Status::ok) {
@@ -191,7 +262,10 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
   const auto unknowns = static_cast<int>(std::count(requested.begin(), requested.end(), true));
   if (2 * fit_rows < unknowns) {
     throw InputError(origin + ": " + std::to_string(fit_rows) + " poses give " + std::to_string(2 * fit_rows) + " equations for " +
-                     std::to_string(unknowns) + " unknowns: measure at least " + std::to_string((unknowns + 1) / 2) + " poses");
+                     std::to_string(unknowns) + " unknowns: measure at least " + std::to_string((unknowns + 1) / 2) + " poses" +
+                     (out.skipped.empty() ? std::string()
+                                          : " (" + std::to_string(out.skipped.size()) + " skipped: the design's model cannot assemble " +
+                                                skipped_text(out.skipped) + ")"));
   }
 
   // Identifiability at the design values: greedy in the order of preference (fit.hpp).
@@ -285,7 +359,7 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     ceres::Problem problem(po);
     for (Block& blk : blocks) {
       for (std::size_t i : blk.rows) {
-        if (held_out[i]) continue;
+        if (held_out[i] || outlier[i]) continue;
         problem.AddResidualBlock(new PoseCost(*blk.design, all[i], weight(all[i])), loss_for_rows, blk.q.data(), frame.data());
       }
     }
@@ -316,6 +390,7 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     ceres::Solve(so, &problem, &summary);
     out.iterations += static_cast<int>(summary.iterations.size());
     out.converged = summary.termination_type == ceres::CONVERGENCE;
+    out.termination = ceres::TerminationTypeToString(summary.termination_type);
     out.solver_report = summary.BriefReport();
   };
   solve(nullptr);
@@ -338,6 +413,15 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
     if (opt.loss == Loss::huber) loss = std::make_unique<ceres::HuberLoss>(c);
     else loss = std::make_unique<ceres::CauchyLoss>(c);
     solve(loss.get());
+    // Honest sigmas (docs/calibrate.md "Model"): the robust estimate names the outliers, and
+    // the estimate and covariance are those of least squares over the other poses. A covariance
+    // taken over every residual, blunders included, overstates the sigmas many times.
+    fit_rows -= flag_outliers(blocks, all, held_out, frame, weight, all_sigma, outlier, out.outliers);
+    if (2 * fit_rows < unknowns) {
+      throw InputError(origin + ": " + std::to_string(out.outliers.size()) + " outliers leave " + std::to_string(fit_rows) +
+                       " poses for " + std::to_string(unknowns) + " unknowns");
+    }
+    if (!out.outliers.empty()) solve(nullptr);
   }
 
   // Identification figures and covariance at the estimate.
@@ -466,6 +550,29 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
   }
   out.covariance = cov;
   for (int k : kept) out.covariance_names.push_back(full_name(k));
+
+  // The quality gate (fivebar/provenance/gate.hpp): the residual test is chi-square when the rows
+  // state their sigma, else the largest residual against the fit's own scale.
+  gate::GateInput gi;
+  gi.fit = "fivebar calibrate";
+  gi.solver = {out.converged, out.termination, out.iterations};
+  if (all_sigma) {
+    gi.tests.push_back(gate::chi_square_test(r.squaredNorm(), dof));
+  } else {
+    std::vector<double> z(r.data(), r.data() + r.size());
+    for (double& v : z) v = s2 > 0.0 ? v / std::sqrt(s2) : 0.0;
+    gi.tests.push_back(gate::largest_residual_test(z));
+  }
+  for (const Parameter& p : out.parameters) {
+    if (!p.identified || p.mechanism.empty()) continue;
+    const auto b = std::find_if(blocks.begin(), blocks.end(), [&](const Block& x) { return x.name == p.mechanism; });
+    const Potentiometer p1 = controller ? controller->joint(station, b->name, 1).potentiometer : Potentiometer{};
+    const Potentiometer p2 = controller ? controller->joint(station, b->name, 2).potentiometer : Potentiometer{};
+    const MechanismVector prior = mechanism_vector(*b->design, p1.volts_at_zero, p1.rad_per_volt, p2.volts_at_zero, p2.rad_per_volt);
+    const auto i = static_cast<int>(std::find(mnames.begin(), mnames.end(), p.name) - mnames.begin());
+    gi.parameters.push_back({p.key, p.mechanism + "." + p.name, p.unit, p.value, p.sigma, prior_sigma(i, prior), true, ""});
+  }
+  out.gate = gate::evaluate(gi);
   return out;
 }
 

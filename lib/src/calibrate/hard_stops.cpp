@@ -47,6 +47,7 @@ CalibrationResult hard_stop_calibration(const Design& design, const std::string&
   if (readings.empty()) throw InputError(origin + ": no readings (header station,mechanism,joint,stop,volts)");
   CalibrationResult out;
   const ControllerSettings* c = design.get<ControllerSettings>();
+  std::vector<std::string> single;  // stops read once: no spread, no sigma
   std::map<std::tuple<std::string, std::string, int>, bool> done;
   for (const auto& [key, values] : readings) {
     const auto& [station, mechanism, joint, stop] = key;
@@ -82,6 +83,7 @@ CalibrationResult hard_stop_calibration(const Design& design, const std::string&
       for (double v : it->second) ss += (v - s.mean) * (v - s.mean);
       const auto n = static_cast<double>(it->second.size());
       s.sigma = n > 1 ? std::sqrt(ss / (n - 1) / n) : 0.0;
+      if (n < 2) single.push_back(station + "/" + mechanism + "/theta" + std::to_string(joint) + " " + which);
     }
     const std::string base = "controller.stations." + station + "." + mechanism + ".theta" + std::to_string(joint) + ".potentiometer.";
     Parameter v0, k;
@@ -110,13 +112,35 @@ CalibrationResult hard_stop_calibration(const Design& design, const std::string&
       k.value = pot.rad_per_volt;
       k.note = "one stop only: held at the design value";
       v0.value = s.mean - s.theta / k.value;
-      v0.sigma = s.sigma;
+      // The held slope is not exact: its prior (prior_sigma(), 1 % of k) enters V0 = V - theta/k
+      // through dV0/dk = theta / k^2.
+      const double sk = prior_sigma(9, MechanismVector::Constant(k.value));
+      v0.sigma = std::hypot(s.sigma, s.theta / (k.value * k.value) * sk);
     }
     v0.identified = true;
     out.parameters.push_back(v0);
     out.parameters.push_back(k);
     if (std::find(out.mechanisms.begin(), out.mechanisms.end(), mechanism) == out.mechanisms.end()) out.mechanisms.push_back(mechanism);
   }
+  // The quality gate (fivebar/provenance/gate.hpp): a closed form; the readings must repeat (one
+  // reading has no spread and so no sigma); each value's sigma within its prior.
+  gate::GateInput gi;
+  gi.fit = "fivebar calibrate --hard-stops";
+  gi.solver = {true, "closed form", 0};
+  gate::ResidualTest repeat;
+  repeat.name = "repeated readings";
+  repeat.passed = single.empty();
+  repeat.statement = single.empty() ? "repeated readings: every stop read at least twice (the sigma is the spread of the mean)"
+                                    : "repeated readings: " + format::join(single) +
+                                          " read once: no spread to give a sigma (repeat each reading)";
+  gi.tests.push_back(repeat);
+  for (const Parameter& p : out.parameters) {
+    if (!p.identified) continue;
+    const bool volts = p.unit == "V";
+    MechanismVector q = MechanismVector::Constant(volts ? out.parameters[&p - out.parameters.data() + 1].value : p.value);
+    gi.parameters.push_back({p.key, p.mechanism + "." + p.name, p.unit, p.value, p.sigma, prior_sigma(volts ? 8 : 9, q), true, ""});
+  }
+  out.gate = gate::evaluate(gi);
   return out;
 }
 

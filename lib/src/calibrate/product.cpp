@@ -52,10 +52,12 @@ Product calibrate_product() {
     const auto rows = calibrate::parse_measurements(text, name, d);
     const calibrate::CalibrationResult r = calibrate::calibrate(d, rows, {}, name);
     const calibrate::Source source{name, sha256_hex(text), today_utc()};
-    Design patched = calibrate::with_provenance(calibrate::patched_design(d, r), r, source);
-    patched.reset<BenchSettings>();  // the patched design lives in the output folder: no relative bench files
     ctx.write_file("calibrate/calibration-summary.md", calibrate::report_markdown(r, source));
-    ctx.write_file("calibrate/" + d.name + "-calibrated.yaml", to_yaml(patched));
+    if (r.gate.passed) {  // the quality gate refused: nothing patched (docs/calibrate.md "The quality gate")
+      Design patched = calibrate::with_provenance(calibrate::patched_design(d, r), r, source);
+      patched.reset<BenchSettings>();  // the patched design lives in the output folder: no relative bench files
+      ctx.write_file("calibrate/" + d.name + "-calibrated.yaml", to_yaml(patched));
+    }
 
     Built b;
     std::string md = "The bench measurements `" + name + "` (" + std::to_string(r.poses) + " poses of station " + md::code(r.station) +
@@ -70,14 +72,24 @@ Product calibrate_product() {
     }
     md += t.str() + "\n";
     for (const calibrate::Unidentifiable& u : r.unidentifiable) md += "- " + md::code(u.parameter) + " not identifiable: " + u.combination + "\n";
-    md += "Files: [`calibrate/" + d.name + "-calibrated.yaml`](calibrate/" + d.name +
-          "-calibrated.yaml) (the design with the fitted values, a `provenance:` entry per value and the posterior "
-          "correlations), [`calibrate/calibration-summary.md`](calibrate/calibration-summary.md).\n";
+    for (const calibrate::ExcludedPose& e : r.skipped) md += "- line " + std::to_string(e.line) + " (" + e.mechanism + ") skipped: " + e.reason + "\n";
+    for (const calibrate::ExcludedPose& e : r.outliers) md += "- line " + std::to_string(e.line) + " (" + e.mechanism + ") " + e.reason + "\n";
+    md += "\nQuality gate: " + std::string(r.gate.passed ? "passed" : "refused, nothing patched") + " (solver " + r.gate.solver.termination +
+          "; " + (r.gate.tests.empty() ? std::string() : r.gate.tests.front().statement) + ").\n";
+    for (const std::string& line : r.gate.refusal_lines()) md += "- not measured: " + line + "\n";
+    md += "\n";
+    if (r.gate.passed) {
+      md += "Files: [`calibrate/" + d.name + "-calibrated.yaml`](calibrate/" + d.name +
+            "-calibrated.yaml) (the design with the fitted values, a `provenance:` entry per value and the posterior "
+            "correlations), [`calibrate/calibration-summary.md`](calibrate/calibration-summary.md).\n";
+    } else {
+      md += "Files: [`calibrate/calibration-summary.md`](calibrate/calibration-summary.md).\n";
+    }
     b.markdown = md;
     b.result = calibrate::to_json(r);
     b.result["measurements"] = name;
-    b.result["patched_design"] = "calibrate/" + d.name + "-calibrated.yaml";
-    b.passed = !r.requested_unidentifiable;
+    b.result["patched_design"] = r.gate.passed ? Json("calibrate/" + d.name + "-calibrated.yaml") : Json(nullptr);
+    b.passed = !r.requested_unidentifiable && r.gate.passed;
     b.check = std::to_string(r.poses) + " poses, residual RMS " + format::fixed(r.after.rms_mm, 4) + " mm";
     return b;
   };

@@ -8,6 +8,7 @@
 #include "fivebar/sections/provenance.hpp"
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace fivebar::calibrate {
 
@@ -15,6 +16,22 @@ namespace {
 const char* kMethod = "fivebar calibrate: nonlinear least squares (Ceres, Levenberg-Marquardt), posterior sigma";
 Json finite_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json figures(const Figures& f) { return {{"rms_mm", finite_or_null(f.rms_mm)}, {"max_mm", finite_or_null(f.max_mm)}}; }
+Json excluded(const std::vector<ExcludedPose>& poses) {
+  Json out = Json::array();
+  for (const ExcludedPose& e : poses) {
+    out.push_back({{"line", e.line}, {"mechanism", e.mechanism}, {"reason", e.reason}, {"residual_mm", e.residual_mm},
+                   {"standardized", e.standardized}});
+  }
+  return out;
+}
+}  // namespace
+
+namespace {
+std::vector<GateRecord> records(const CalibrationResult& r, const std::vector<MeasuredValue>& values) {
+  std::vector<std::string> keys;
+  for (const MeasuredValue& v : values) keys.push_back(v.key);
+  return r.gate.records(keys);
+}
 }  // namespace
 
 Json to_json(const CalibrationResult& r) {
@@ -50,7 +67,10 @@ Json to_json(const CalibrationResult& r) {
           {"residuals", {{"before", figures(r.before)}, {"after", figures(r.after)}}},
           {"holdout", {{"before", figures(r.holdout_before)}, {"after", figures(r.holdout_after)}}},
           {"per_pose", poses},
-          {"solver", {{"iterations", r.iterations}, {"converged", r.converged}, {"report", r.solver_report}}}};
+          {"solver", {{"iterations", r.iterations}, {"converged", r.converged}, {"termination", r.termination}, {"report", r.solver_report}}},
+          {"skipped", excluded(r.skipped)},
+          {"outliers", excluded(r.outliers)},
+          {"gate", gate::to_json(r.gate)}};
 }
 
 std::string report_markdown(const CalibrationResult& r, const Source& source) {
@@ -72,12 +92,21 @@ std::string report_markdown(const CalibrationResult& r, const Source& source) {
   md += "Identifiability: condition number " + fixed(r.condition_number, 1) + ", observability index O1 " +
         fixed(r.observability_index, 4) + " (a-priori scales, docs/calibrate.md).\n";
   for (const Unidentifiable& u : r.unidentifiable) md += "- `" + u.parameter + "` not identifiable: " + u.combination + "\n";
+  for (const ExcludedPose& e : r.skipped) md += "- line " + std::to_string(e.line) + " (" + e.mechanism + ") skipped: " + e.reason + "\n";
+  for (const ExcludedPose& e : r.outliers) {
+    md += "- line " + std::to_string(e.line) + " (" + e.mechanism + ") " + e.reason + ": left out of the final least squares\n";
+  }
   md += "\nSolver: " + r.solver_report + "\n";
+  md += "\nQuality gate (docs/calibrate.md \"The quality gate\"): " + std::string(r.gate.passed ? "passed" : "refused: nothing patched") +
+        "; solver " + r.gate.solver.termination + ".\n";
+  for (const gate::ResidualTest& t : r.gate.tests) md += "- " + t.statement + "\n";
+  for (const std::string& line : r.gate.refusal_lines()) md += "- not measured: " + line + "\n";
   return md;
 }
 
 Design with_provenance(const Design& patched, const CalibrationResult& r, const Source& source) {
   // Through the one provenance writer (fivebar/provenance.hpp), with the posterior correlations.
+  if (!r.gate.passed) throw std::logic_error("with_provenance: the fit did not pass its quality gate");
   std::vector<MeasuredValue> values;
   for (const std::string& key : r.key_covariance_keys) {
     const auto it = std::find_if(r.parameters.begin(), r.parameters.end(), [&](const Parameter& q) { return q.key == key; });
@@ -87,9 +116,9 @@ Design with_provenance(const Design& patched, const CalibrationResult& r, const 
     for (const Parameter& q : r.parameters) {
       if (q.identified && !q.mechanism.empty()) values.push_back({q.key, q.sigma});
     }
-    return with_measured_values(patched, values, {source.file, source.sha256, source.date, kMethod});
+    return with_measured_values(patched, values, {source.file, source.sha256, source.date, kMethod}, Eigen::MatrixXd(), records(r, values));
   }
-  return with_measured_values(patched, values, {source.file, source.sha256, source.date, kMethod}, r.key_covariance);
+  return with_measured_values(patched, values, {source.file, source.sha256, source.date, kMethod}, r.key_covariance, records(r, values));
 }
 
 Json to_json(const std::vector<MechanismPlan>& plans, const PlanOptions& o) {

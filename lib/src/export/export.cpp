@@ -439,13 +439,14 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
 
   // Measured or assumed (fivebar/provenance.hpp): what the validated figures rest on, and the
   // groups controller.require_measured wants measured.
-  gate.assumed = assumed_groups(d);
+  // Both follow the exported stations: a value of a station not exported is not what they rest on.
+  gate.assumed = assumed_groups(d, gate.stations);
   for (const std::string& group : c.require_measured) {
-    const std::vector<std::string> assumed = assumed_values(d, group);
-    add("provenance", group, assumed.empty(),
-        assumed.empty() ? "every value measured (provenance:)"
-                        : std::to_string(assumed.size()) + " value(s) without a provenance: entry, e.g. " + assumed.front() +
-                              " (controller.require_measured)");
+    const std::vector<UntrustedValue> untrusted = untrusted_values(d, group, gate.stations);
+    add("provenance", group, untrusted.empty(),
+        untrusted.empty() ? "every value measured, each through a fit that passed its quality gate (provenance:)"
+                          : std::to_string(untrusted.size()) + " value(s) not trusted as measured, e.g. " + untrusted.front().key + ": " +
+                                untrusted.front().reason + " (controller.require_measured)");
   }
   return gate;
 }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <ctime>
 #include <array>
 #include <utility>
@@ -11,6 +12,7 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
+#include "fivebar/sha256.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/print.hpp"
@@ -61,17 +63,60 @@ const std::vector<std::string>& provenance_groups() {
   return groups;
 }
 
-bool is_measured(const Design& design, std::string_view key) {
-  const ProvenanceSettings* p = design.get<ProvenanceSettings>();
-  if (p == nullptr) return false;
-  for (const auto& [k, entry] : p->entries) {
-    if (key == k) return true;
-    if (key.size() > k.size() && key.substr(0, k.size()) == k && (key[k.size()] == '.' || key[k.size()] == '[')) return true;
-  }
-  return false;
+namespace {
+
+bool covers(std::string_view k, std::string_view key) {
+  return key == k || (key.size() > k.size() && key.substr(0, k.size()) == k && (key[k.size()] == '.' || key[k.size()] == '['));
 }
 
-std::vector<std::string> assumed_values(const Design& design, std::string_view group) {
+/// The narrowest entry that covers `key` (its own, else the nearest key path above it), or nullptr.
+const std::pair<const std::string, ProvenanceEntry>* covering_entry(const Design& design, std::string_view key) {
+  const ProvenanceSettings* p = design.get<ProvenanceSettings>();
+  if (p == nullptr) return nullptr;
+  const std::pair<const std::string, ProvenanceEntry>* best = nullptr;
+  for (const auto& item : p->entries) {
+    if (covers(item.first, key) && (best == nullptr || item.first.size() > best->first.size())) best = &item;
+  }
+  return best;
+}
+
+/// Why the export's require_measured does not trust `key`, or "" when it does (fivebar/provenance.hpp).
+std::string distrust(const Design& design, const std::string& key) {
+  const auto* item = covering_entry(design, key);
+  if (item == nullptr) return "no provenance: entry (an assumption)";
+  const ProvenanceEntry& e = item->second;
+  const std::string at = item->first == key ? std::string() : " (entry " + item->first + ")";
+  if (e.placeholder_hash()) return "its provenance: entry's sha256 is all zeros, a placeholder rather than a file's hash" + at;
+  if (!e.gate) return "its provenance: entry records no quality gate (written by hand or by an older fivebar)" + at;
+  if (!e.gate->passed) return "its provenance: entry records a quality gate that did not pass" + at;
+  std::filesystem::path file(e.source);
+  if (file.is_relative() && !design.source.empty()) file = design.source.parent_path() / file;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(file, ec)) {
+    std::string now;
+    try {
+      now = sha256_file(file);
+    } catch (const std::exception&) {
+      return "its source " + file.generic_string() + " cannot be read to check its sha256" + at;
+    }
+    if (now != e.sha256) return "its source " + file.generic_string() + " has changed since the fit (sha256 " + now.substr(0, 12) + "... , entry " + e.sha256.substr(0, 12) + "...)" + at;
+  }
+  return {};
+}
+
+}  // namespace
+
+bool is_measured(const Design& design, std::string_view key) {
+  const auto* item = covering_entry(design, key);
+  if (item == nullptr) return false;
+  const ProvenanceEntry& e = item->second;
+  return !e.placeholder_hash() && (!e.gate || e.gate->passed);
+}
+
+namespace {
+
+/// Every key path of `group` the design has (measured or not).
+std::vector<std::string> group_keys(const Design& design, std::string_view group) {
   std::vector<std::string> keys;
   if (group == "kinematics") {
     for (const Station& s : design.stations) {
@@ -102,6 +147,16 @@ std::vector<std::string> assumed_values(const Design& design, std::string_view g
   } else {
     throw InputError("unknown provenance group '" + std::string(group) + "' (known: " + format::join(provenance_groups()) + ")");
   }
+  return keys;
+}
+
+/// The key paths of `group` that one mechanism's figures rest on (measured or not).
+std::vector<std::string> group_keys(const Design& design, std::string_view group, std::string_view station, std::string_view mechanism);
+
+}  // namespace
+
+std::vector<std::string> assumed_values(const Design& design, std::string_view group) {
+  std::vector<std::string> keys = group_keys(design, group);
   std::erase_if(keys, [&](const std::string& k) { return is_measured(design, k); });
   return keys;
 }
@@ -150,8 +205,8 @@ const FigureBasis& figure_basis(std::string_view key) {
   throw InputError("unknown validated figure '" + std::string(key) + "' (known: " + format::join(keys) + ")");
 }
 
-std::vector<std::string> assumed_values(const Design& design, std::string_view group, std::string_view station,
-                                        std::string_view mechanism) {
+namespace {
+std::vector<std::string> group_keys(const Design& design, std::string_view group, std::string_view station, std::string_view mechanism) {
   std::vector<std::string> keys;
   if (group == "kinematics" || group == "potentiometer") {
     const std::array<std::string, 12> all = calibration_keys(design, station, mechanism);
@@ -177,10 +232,55 @@ std::vector<std::string> assumed_values(const Design& design, std::string_view g
       }
     }
   } else {
-    return assumed_values(design, group);
+    return group_keys(design, group);
   }
+  return keys;
+}
+}  // namespace
+
+std::vector<std::string> assumed_values(const Design& design, std::string_view group, std::string_view station,
+                                        std::string_view mechanism) {
+  std::vector<std::string> keys = group_keys(design, group, station, mechanism);
   std::erase_if(keys, [&](const std::string& k) { return is_measured(design, k); });
   return keys;
+}
+
+namespace {
+/// The distinct key paths of `group` that the figures of `stations` (all when empty; only
+/// `mechanism` when given) rest on.
+std::vector<std::string> scoped_keys(const Design& design, std::string_view group, const std::vector<std::string>& stations,
+                                     std::string_view mechanism) {
+  std::vector<std::string> keys;
+  for (const Station& s : design.stations) {
+    if (!stations.empty() && std::find(stations.begin(), stations.end(), s.name) == stations.end()) continue;
+    for (const Mechanism* m : s.mechanisms()) {
+      if (!mechanism.empty() && m->name != mechanism) continue;
+      for (std::string& k : group_keys(design, group, s.name, m->name)) {
+        if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(std::move(k));
+      }
+    }
+  }
+  if (keys.empty() && group != "kinematics" && group != "potentiometer" && group != "motor") keys = group_keys(design, group);
+  return keys;
+}
+}  // namespace
+
+std::vector<UntrustedValue> untrusted_values(const Design& design, std::string_view group, const std::vector<std::string>& stations,
+                                             std::string_view mechanism) {
+  std::vector<UntrustedValue> out;
+  for (const std::string& k : scoped_keys(design, group, stations, mechanism)) {
+    if (std::string why = distrust(design, k); !why.empty()) out.push_back({k, std::move(why)});
+  }
+  return out;
+}
+
+std::vector<std::string> assumed_groups(const Design& design, const std::vector<std::string>& stations, std::string_view mechanism) {
+  std::vector<std::string> out;
+  for (const std::string& g : provenance_groups()) {
+    const std::vector<std::string> keys = scoped_keys(design, g, stations, mechanism);
+    if (std::any_of(keys.begin(), keys.end(), [&](const std::string& k) { return !is_measured(design, k); })) out.push_back(g);
+  }
+  return out;
 }
 
 std::vector<std::string> figure_assumed(const Design& design, std::string_view key, std::string_view station,
@@ -223,7 +323,8 @@ std::string today_utc() {
 }
 
 Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,
-                            const Eigen::MatrixXd& covariance) {
+                            const Eigen::MatrixXd& covariance, const std::vector<GateRecord>& gates) {
+  if (!gates.empty() && gates.size() != values.size()) throw std::invalid_argument("with_measured_values: one gate record per value");
   const auto n = static_cast<Eigen::Index>(values.size());
   if (covariance.size() != 0 && (covariance.rows() != n || covariance.cols() != n)) {
     throw std::invalid_argument("with_measured_values: the covariance must be values.size() square");
@@ -234,13 +335,15 @@ Design with_measured_values(const Design& design, const std::vector<MeasuredValu
     p.entries.erase(v.key);
     for (auto& item : p.entries) item.second.correlation.erase(v.key);
   }
-  for (const MeasuredValue& v : values) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const MeasuredValue& v = values[i];
     ProvenanceEntry e;
     e.source = source.file;
     e.sha256 = source.sha256;
     e.date = source.date;
     e.method = source.method;
     e.sigma = v.sigma;
+    if (!gates.empty()) e.gate = gates[i];
     p.entries[v.key] = std::move(e);
   }
   if (covariance.size() != 0) {

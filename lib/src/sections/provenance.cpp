@@ -55,6 +55,19 @@ void check_correlations_psd(const std::map<std::string, ProvenanceEntry, std::le
 
 }  // namespace
 
+void GateRecord::validate() const {
+  if (solver.empty()) throw ValidationError("solver", "must not be empty");
+  if (p_value && !(*p_value >= 0.0 && *p_value <= 1.0)) throw ValidationError("p_value", "= " + rules::plain_number(*p_value) + ": must be in [0, 1]");
+  if (sigma_ratio && !(*sigma_ratio >= 0.0 && std::isfinite(*sigma_ratio))) {
+    throw ValidationError("sigma_ratio", "= " + rules::plain_number(*sigma_ratio) + ": must be >= 0");
+  }
+  if (prior_sigma && !(*prior_sigma > 0.0 && std::isfinite(*prior_sigma))) {
+    throw ValidationError("prior_sigma", "= " + rules::plain_number(*prior_sigma) + ": must be > 0");
+  }
+}
+
+bool ProvenanceEntry::placeholder_hash() const { return sha256.find_first_not_of('0') == std::string::npos; }
+
 void ProvenanceEntry::validate() const {
   if (source.empty()) throw ValidationError("source", "must not be empty");
   if (method.empty()) throw ValidationError("method", "must not be empty");
@@ -72,6 +85,7 @@ void ProvenanceEntry::validate() const {
     if (!(std::abs(rho) <= 1.0)) throw ValidationError("correlation." + key, "= " + rules::plain_number(rho) + ": must be in [-1, 1]");
     if (!sigma) throw ValidationError("correlation", "needs this entry's sigma");
   }
+  if (gate) rules::validate_nested("gate", [this] { gate->validate(); });
 }
 
 void ProvenanceSettings::validate() const {
@@ -103,8 +117,8 @@ void load(const Value& v, Design& design) {
   ProvenanceSettings& p = design.set(ProvenanceSettings{});
   if (v.is_null()) return;
   for (const Value& e : v.entries({}, "from key paths of the design to {source, sha256, date, method, sigma}", /*any_key=*/true)) {
-    const auto all = e.entries({"source", "sha256", "date", "method", "sigma", "correlation"},
-                               "(source, sha256, date, method, sigma, correlation)");
+    const auto all = e.entries({"source", "sha256", "date", "method", "sigma", "correlation", "gate"},
+                               "(source, sha256, date, method, sigma, correlation, gate)");
     ProvenanceEntry entry;
     entry.source = require(all, "source", e).text("must be text (a file name)");
     entry.sha256 = require(all, "sha256", e).text("must be text (64 hex digits)");
@@ -117,6 +131,21 @@ void load(const Value& v, Design& design) {
           entry.correlation[r.name()] = r.number("");
         }
       }
+    }
+    if (const Value* g = find(all, "gate")) {
+      const auto fields = g->entries({"passed", "solver", "tests", "p_value", "sigma_ratio", "prior_sigma"},
+                                     "(passed, solver, tests, p_value, sigma_ratio, prior_sigma)");
+      GateRecord r;
+      const Value& passed = require(fields, "passed", *g);
+      const std::string word = passed.text("must be true or false");
+      if (word != "true" && word != "false") passed.fail_value("must be true or false");
+      r.passed = word == "true";
+      r.solver = require(fields, "solver", *g).text("must be text (the solver's termination)");
+      if (const Value* t = find(fields, "tests")) r.tests = t->text("must be text");
+      if (const Value* x = find(fields, "p_value")) r.p_value = x->number("");
+      if (const Value* x = find(fields, "sigma_ratio")) r.sigma_ratio = x->number("");
+      if (const Value* x = find(fields, "prior_sigma")) r.prior_sigma = x->number("");
+      entry.gate = std::move(r);
     }
     p.entries[e.name()] = std::move(entry);
   }
@@ -147,6 +176,15 @@ void write(const Design& design, Out& top) {
     if (!e.correlation.empty()) {
       Out& c = m.add("correlation", Out::map(/*flow=*/true));
       for (const auto& [other, rho] : e.correlation) c.add(other, Out::number(rho));
+    }
+    if (e.gate) {
+      Out& g = m.add("gate", Out::map(/*flow=*/true));
+      g.add("passed", Out::plain(e.gate->passed ? "true" : "false"));
+      g.add("solver", Out::quoted(e.gate->solver));
+      if (!e.gate->tests.empty()) g.add("tests", Out::quoted(e.gate->tests));
+      if (e.gate->p_value) g.add("p_value", Out::number(*e.gate->p_value));
+      if (e.gate->sigma_ratio) g.add("sigma_ratio", Out::number(*e.gate->sigma_ratio));
+      if (e.gate->prior_sigma) g.add("prior_sigma", Out::number(*e.gate->prior_sigma));
     }
   }
 }

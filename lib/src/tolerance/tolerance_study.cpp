@@ -133,9 +133,10 @@ ToleranceSources tolerance_sources(const Design& design, const Station& station,
       const auto uj = static_cast<std::size_t>(j);
       cu.rad_per_volt[uj] = controller ? controller->joint(station.name, m.name, j + 1).potentiometer.rad_per_volt
                                        : ControllerSettings{}.potentiometer.rad_per_volt;
-      // A joint whose volts_at_zero is calibrated keeps only the linearity; otherwise the whole
-      // tolerance angle sigma (the calibration offset and the linearity) stays.
-      const bool pot = pc.measured[static_cast<std::size_t>(8 + 2 * j)];
+      // A joint whose volts_at_zero and rad_per_volt are both calibrated keeps only the linearity;
+      // otherwise the whole tolerance angle sigma (the calibration offset and the linearity) stays:
+      // a V0 measured at a held slope (one hard stop) does not replace it.
+      const bool pot = pc.measured[static_cast<std::size_t>(8 + 2 * j)] && pc.measured[static_cast<std::size_t>(9 + 2 * j)];
       cu.angle_variance[uj] = pot ? linearity * linearity / 3.0 : out.sigma[8 + uj] * out.sigma[8 + uj];
       (pot ? covered : rest).emplace_back(names[8 + uj]);
     }

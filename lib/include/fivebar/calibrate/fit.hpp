@@ -34,6 +34,7 @@
 #include "fivebar/calibrate/measurements.hpp"
 #include "fivebar/calibrate/model.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/provenance/gate.hpp"
 
 namespace fivebar::calibrate {
 
@@ -88,6 +89,20 @@ struct PoseResidual {
   double after_mm = 0.0;   ///< at the estimate
 };
 
+/// A pose left out of the fit: one the design's nominal model cannot assemble (skipped before the
+/// fit), or an outlier of the robust fit (named, then left out of the final least squares).
+struct ExcludedPose {
+  int line = 0;
+  std::string mechanism;
+  std::string reason;         ///< "the nominal model cannot assemble it (unreachable)", "outlier: ..."
+  double residual_mm = 0.0;   ///< |measured - model| at the robust estimate (outliers), 0 otherwise
+  double standardized = 0.0;  ///< its residual over the robust scale (outliers), 0 otherwise
+};
+
+/// Pose residuals beyond this many robust scales (per axis, both axes as a chi-square of 2 dof)
+/// make a pose an outlier of a robust fit: sqrt(-2 ln 1e-3) = 3.72, a 0.1 % tail of Gaussian noise.
+inline constexpr double kOutlierScales = 3.7169221888498383;
+
 struct Figures {
   double rms_mm = 0.0;  ///< sqrt(mean |r|^2) per pose
   double max_mm = 0.0;
@@ -117,12 +132,22 @@ struct CalibrationResult {
   std::vector<PoseResidual> residuals;
   int iterations = 0;
   bool converged = false;
+  std::string termination;    ///< Ceres' termination type ("CONVERGENCE", "NO_CONVERGENCE", ...)
   std::string solver_report;  ///< Ceres' one-line summary
+  std::vector<ExcludedPose> skipped;   ///< poses the nominal model cannot assemble (not fitted)
+  std::vector<ExcludedPose> outliers;  ///< outliers of the robust fit (not in the final fit)
+  /// The quality gate (fivebar/provenance/gate.hpp): converged, the residual test (chi-square with a
+  /// known sigma, the largest residual with one estimated), identifiable, sigma within the prior.
+  gate::GateResult gate;
 };
 
 /// The a-priori scale of a parameter (model order; frame after the twelve): 0.1 mm for lengths and
 /// positions, one degree's worth of volts for V0 (|1 deg / k|), 1 % of k, 1 deg of frame rotation.
 double parameter_scale(int index, const MechanismVector& q);
+
+/// The a-priori standard deviation of a patched key's value (its unit): the parameter's a-priori
+/// scale (parameter_scale()), the one the quality gate compares the posterior sigma with.
+double prior_sigma(int index, const MechanismVector& q);
 
 /// Fits the measurements of one station (fivebar/calibrate/measurements.hpp) to the model.
 /// InputError for bad requests (unknown parameter names, fewer equations than unknowns, a pose

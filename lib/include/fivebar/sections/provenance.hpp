@@ -13,6 +13,18 @@
 
 namespace fivebar {
 
+/// The quality gate a fitted value passed (fivebar/provenance/gate.hpp, docs/calibrate.md "The
+/// quality gate"): what the fit that wrote the entry showed. Entries written by hand have none.
+struct GateRecord {
+  bool passed = false;     ///< every condition held (an entry whose gate did not pass is not measured)
+  std::string solver;      ///< the solver's termination ("CONVERGENCE", "closed form")
+  std::string tests;       ///< the residual tests' statements, "; "-separated
+  std::optional<double> p_value;      ///< the smallest p-value of the residual tests
+  std::optional<double> sigma_ratio;  ///< posterior sigma / prior sigma (absent: no prior)
+  std::optional<double> prior_sigma;  ///< the prior sigma it was compared with, the key's file unit
+  void validate() const;
+};
+
 /// One measured value's origin.
 struct ProvenanceEntry {
   std::string source;          ///< the file the value was fitted from (as given on the command line)
@@ -25,6 +37,9 @@ struct ProvenanceEntry {
   /// (fivebar/provenance.hpp provenance_covariance()). A pair is written once, under the key that
   /// sorts first; either side is read.
   std::map<std::string, double, std::less<>> correlation;
+  std::optional<GateRecord> gate;  ///< the fit's quality gate (absent: written by hand)
+  /// True when the sha256 is all zeros: a placeholder, not the hash of a file (not measured).
+  bool placeholder_hash() const;
   void validate() const;
 };
 
