@@ -379,5 +379,34 @@ TEST(HtmlPage, EverySectionShowsThePicturesOfItsProductInline) {
   EXPECT_THAT(page, HasSubstr("<figcaption>collision map</figcaption>"));
 }
 
+TEST(HtmlPage, CaptionsSayWhatThePictureShows) {
+  // Pictures a section does not caption (listed in the products table only, or named by a bare
+  // word) get a caption saying what they show, from their product's folder and name; a caption
+  // the summary wrote in words stays; a name this table does not know keeps "product: file".
+  const std::string markdown =
+      "# scene\n\n## Products\n\n"
+      "| product | state | files |\n|---|---|---|\n"
+      "| `workspace` | built | `workspace/index-workspace.png` |\n"
+      "| `optimize` | built | `optimize/hypervolume.png`, `optimize/x-optimized/collision/index.png`, `optimize/odd.png` |\n"
+      "| `control` | built | `control/thumb-stability.png` |\n"
+      "| `report` | built | `report/accuracy_index_margin.png` |\n\n"
+      "## Workspace (`workspace`)\n\n![Station index workspace](workspace/index-workspace.png)\n\n"
+      "## Optimize (`optimize`)\n\nText.\n\n"
+      "## Control (`control`)\n\n![thumb](control/thumb-stability.png)\n\n"
+      "## Report (`report`)\n\n`report/accuracy_index_margin.png`\n";
+  md::HtmlFiles files;
+  files.exists = [](const std::string&) { return true; };
+  files.read = [](const std::string&) -> std::optional<std::string> { return std::string("<svg></svg>"); };
+  const std::string page = md::to_html_page(markdown, "t", files);
+  EXPECT_THAT(page, HasSubstr("<figcaption>Station index workspace</figcaption>"));
+  EXPECT_THAT(page, HasSubstr("<figcaption>Hypervolume of the front (normalised) against the evaluations spent (hypervolume.png)</figcaption>"));
+  EXPECT_THAT(page, HasSubstr("<figcaption>Station index of the optimised design: which pairs of tactor targets make the two linkages collide (index.png)</figcaption>"));
+  EXPECT_THAT(page, HasSubstr("<figcaption>optimize: odd.png</figcaption>"));
+  EXPECT_THAT(page, HasSubstr("<figcaption>Station thumb: spectral radius of the sampled PID loop over the reachable region, the target and its worst pose</figcaption>"));
+  EXPECT_THAT(page, HasSubstr("<figcaption>Station index, coverage margin: error against run time of each method (accuracy_index_margin.png)</figcaption>"));
+  // No caption is a bare file name any more for the products this table knows.
+  EXPECT_THAT(page, Not(HasSubstr("<figcaption>optimize: index.png</figcaption>")));
+}
+
 }  // namespace
 }  // namespace fivebar

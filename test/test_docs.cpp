@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -194,6 +195,12 @@ TEST(RepositoryDocs, OneVersionForCMakeCitationAndChangelog) {
   EXPECT_THAT(setup, ::testing::HasSubstr("version=project_version()"));
   EXPECT_FALSE(std::regex_search(slurp(kSource / "pyproject.toml"), std::regex(R"((?:^|\n)version\s*=)")))
       << "pyproject.toml must not state a version of its own";
+}
+
+TEST(RepositoryDocs, ReadmeStaysShort) {
+  // A newcomer reads it to the end (the long tour is docs/tour.md, still run by docs_examples).
+  const std::string readme = slurp(kSource / "README.md");
+  EXPECT_LE(std::count(readme.begin(), readme.end(), '\n'), 400);
 }
 
 TEST(RepositoryDocs, LicenceIsNamedWhereUsersLook) {

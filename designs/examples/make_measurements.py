@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How designs/examples/measurements.csv (README "calibrate") was made: a simulated bench.
+"""How designs/examples/measurements.csv (docs/tour.md "calibrate") was made: a simulated bench.
 
 The device differs from designs/iros2022.yaml: index/lower L3 = 15.2 mm, O2 at x = 12.4 mm, and its
 theta1 potentiometer reads 0.27 V at zero (the design says 0.25 V). For each pose of the plan

@@ -13,6 +13,7 @@
 #include <cctype>
 #include <cstdint>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -133,6 +134,65 @@ std::string picture_stem(std::string_view path) {
   return std::string(picture_file(path) ? path.substr(0, path.size() - 4) : path);
 }
 
+/// What a product's picture shows, from its folder and name (the files the products write, see
+/// docs/tour.md); "" for a name this table does not know (the caption is then the file's name).
+std::string describe_picture(std::string_view path) {
+  const std::string stem = picture_stem(path);
+  const std::size_t slash = stem.rfind('/');
+  const std::string name = slash == std::string::npos ? stem : stem.substr(slash + 1);
+  const std::string dir = slash == std::string::npos ? "" : stem.substr(0, slash);
+  const std::string folder = dir.substr(dir.rfind('/') == std::string::npos ? 0 : dir.rfind('/') + 1);
+  const bool optimised = dir.find("-optimized") != std::string::npos;
+  const std::string of = optimised ? " of the optimised design" : "";
+  const auto after = [&](std::string_view prefix) { return name.substr(prefix.size()); };
+  const auto ends = [&](std::string_view suffix) {
+    return name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  const auto station_of = [&](std::string_view suffix) { return name.substr(0, name.size() - suffix.size()); };
+  if (folder == "workspace" && ends("-workspace")) {
+    return "Station " + station_of("-workspace") + ": the lower (red) and upper (blue) mechanisms' reachable regions, "
+           "their shared region, the target ellipse, the linkages at its centre and the LCI where both reach";
+  }
+  if (folder == "patterns") return "Station " + name + of + ": each skin-deformation pattern's tactor paths, the links at its start and end";
+  if (folder == "collision") return "Station " + name + of + ": which pairs of tactor targets make the two linkages collide";
+  if (folder == "control" && ends("-stability")) {
+    return "Station " + station_of("-stability") + ": spectral radius of the sampled PID loop over the reachable region, the target and its worst pose";
+  }
+  if (folder == "tolerance" && ends("-tolerance")) {
+    return "Station " + station_of("-tolerance") + ": 3-sigma tactor error and the joints' clearance play over the target, per mechanism";
+  }
+  if (folder == "simulate") {
+    const std::size_t dash = name.find('-');
+    if (dash != std::string::npos) {
+      return "Station " + name.substr(0, dash) + ", " + name.substr(dash + 1) + ": the simulated tactors against their references over time";
+    }
+  }
+  if (folder == "optimize") {
+    if (name == "front") return "The optimisation's front: the objectives of its non-dominated designs";
+    if (name == "hypervolume") return "Hypervolume of the front (normalised) against the evaluations spent";
+    if (name.rfind("atlas-", 0) == 0) return "Station " + after("atlas-") + " in the performance atlas of the symmetric five-bars";
+  }
+  if (folder == "sweep") {
+    if (name == "sweep_scatter") return "The swept designs' objectives against each other, and how many cover the target";
+    if (name == "sweep_heatmap") return "The sweep's first objective over its grid of the two swept dimensions";
+  }
+  if (folder == "report" && name.rfind("accuracy_", 0) == 0) {
+    static const std::vector<std::pair<std::string, std::string>> quantities = {
+        {"_area", "workspace area"}, {"_margin", "coverage margin"}, {"_min_lci", "minimum LCI over the target"},
+        {"_restricted", "assembly- and LCI-restricted areas"}, {"_tolerance", "3-sigma tactor error"}};
+    const std::string what = after("accuracy_");
+    if (what == "fk" || what == "ik") return (what == "fk" ? "FK" : "IK") + std::string(": error against a __float128 reference by distance to singularity, per arithmetic");
+    if (what == "dynamics") return "Dynamics: each integrator's tracking error against its run time (BDF against explicit Runge-Kutta)";
+    if (what == "dynamics_stiffness") return "Dynamics: integrator steps per simulated second as the motor inductance shrinks";
+    for (const auto& [suffix, quantity] : quantities) {
+      if (what.size() > suffix.size() && what.compare(what.size() - suffix.size(), suffix.size(), suffix) == 0) {
+        return "Station " + what.substr(0, what.size() - suffix.size()) + ", " + quantity + ": error against run time of each method";
+      }
+    }
+  }
+  return "";
+}
+
 /// The parsed Markdown (GitHub-flavoured: CommonMark and pipe tables), freed on scope exit.
 class Document {
  public:
@@ -189,8 +249,13 @@ class Renderer {
   }
 
   /// A picture as a figure with its caption (inline when it is an animation).
-  std::string figure(std::string_view caption, std::string_view src) {
+  std::string figure(std::string_view given, std::string_view src) {
     shown_.push_back(picture_stem(src));
+    // A caption that is only a word (a station's name, a file's stem) says what is shown instead.
+    std::string caption(given);
+    if (caption.find(' ') == std::string::npos) {
+      if (const std::string shows = describe_picture(src); !shows.empty()) caption = shows;
+    }
     std::string body;
     if (auto svg = inline_svg(src)) {
       body = *svg;
@@ -304,7 +369,14 @@ class Renderer {
       std::string src = path;
       if (ends_with(path, ".svg") && files_.exists(stem + ".png")) src = stem + ".png";
       const std::string name = src.substr(src.rfind('/') + 1);
-      const std::string text = caption == path ? section_product_ + ": " + name : caption + " (" + name + ")";
+      // A caption that is only a name (the file's, a station's) says what the picture shows instead.
+      std::string text = caption + " (" + name + ")";
+      const bool only_a_name = caption == path || caption.find(' ') == std::string::npos;
+      if (const std::string shows = describe_picture(path); only_a_name && !shows.empty()) {
+        text = shows + " (" + name + ")";
+      } else if (caption == path) {
+        text = section_product_ + ": " + name;
+      }
       figures += figure(text, src);
     }
     named_.clear();

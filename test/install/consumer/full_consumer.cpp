@@ -1,5 +1,5 @@
 // fivebar::fivebar from an install prefix: the installed showcase design's index station covers its
-// target (the paper's claim, README "coverage"), a file written through the library's atomic
+// target (the paper's claim, docs/tour.md "coverage"), a file written through the library's atomic
 // writer (fivebar/io.hpp) reads back, and the library's version is the package's.
 #include <cstdio>
 #include <filesystem>
