@@ -78,6 +78,7 @@ struct JointIdentification {
   bool linear = false;
   double sample_time = 0.0, cutoff_hz = 0.0;
   int decimation = 1;
+  int edge_samples = 0;       ///< full-rate samples at each end left out of the fit: the filters' settling
   Estimate idim;              ///< mechanical base parameters, IDIM-LS
   std::optional<Estimate> electrical;  ///< R, L, k_e when a voltage drive logs its current
   std::optional<Estimate> output_error;
