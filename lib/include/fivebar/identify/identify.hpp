@@ -22,7 +22,9 @@ struct IdentifyOptions {
   int decimation = 0;            ///< 0: 10, less when the log would keep fewer than 50 rows per unknown
   bool per_direction = false;    ///< viscous friction per direction of motion
   /// The logged drive is a command held over each sample (zero-order hold): the regression pairs the
-  /// acceleration at t_k with (d_k-1 + d_k) / 2. false: the drive is an instantaneous value.
+  /// acceleration at t_k (two central differences) with (d_k-2 + 3 d_k-1 + 3 d_k + d_k+1) / 8, and a
+  /// voltage's current is taken over each sample through the winding's lag. false: the drive is an
+  /// instantaneous value.
   bool zero_order_hold = true;
   bool output_error = true;      ///< refine by simulation (Ceres) after IDIM-LS
   bool use_output_error = false; ///< report the refined values as the parameters (default: IDIM-LS)
