@@ -152,6 +152,8 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
     throw InputError("--drive-noise = " + format::shortest(opt.drive_noise_mNm) + ": must be a finite number > 0 (mNm)");
   }
   po.drive_noise = opt.drive_noise_mNm * 1e-3;
+  // The potentiometer read through the ADC (controller.potentiometer, adc_bits, adc_range_v).
+  po.angle_quantum = std::abs(prior.rad_per_volt) * (prior.adc_hi_v - prior.adc_lo_v) / std::ldexp(1.0, prior.adc_bits);
   const ControllerSettings* cs = design.get<ControllerSettings>();
   if (cs) po.max_speed = cs->max_velocity;
   std::string range_source;
@@ -190,6 +192,11 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   jp["limited_by"] = plan.limited_by;
   jp["crest_factor"] = plan.crest_factor;
   jp["drive_noise_mNm"] = opt.drive_noise_mNm;
+  jp["angle_quantum_deg"] = po.angle_quantum * 180.0 / std::numbers::pi;
+  jp["fade_s"] = plan.fade_s;
+  jp["edge_samples"] = plan.edge_samples;
+  jp["expected_residual_mNm"] = plan.expected_residual * 1e3;
+  jp["quantisation_share"] = plan.quantisation_share;
   jp["expected"] = Json::array();
   for (std::size_t i = 0; i < plan.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
@@ -217,10 +224,14 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
     return kOk;
   }
   std::cout << "excitation: multisine, Schroeder phases, " << format::shortest(po.f_min_hz) << " ... " << format::shortest(po.f_max_hz)
-            << " Hz, " << format::shortest(plan.time.back()) << " s; range " << fixed(po.range_lo * 180.0 / std::numbers::pi, 1)
+            << " Hz, " << format::shortest(plan.time.back()) << " s, fading in and out over " << format::shortest(plan.fade_s)
+            << " s; range " << fixed(po.range_lo * 180.0 / std::numbers::pi, 1)
             << " ... " << fixed(po.range_hi * 180.0 / std::numbers::pi, 1) << " deg (" << range_source << "), limited by the "
             << plan.limited_by << " (90 % of each limit)\n";
-  std::cout << "expected sigmas (IDIM-LS, drive noise " << format::shortest(opt.drive_noise_mNm) << " mNm, decimation 10):\n";
+  std::cout << "expected sigmas (IDIM-LS, decimation 10, " << plan.edge_samples << " samples left out at each end; residual "
+            << sig(plan.expected_residual * 1e3) << " mNm from the drive noise " << format::shortest(opt.drive_noise_mNm)
+            << " mNm and the reading's quantum " << sig(po.angle_quantum * 180.0 / std::numbers::pi) << " deg, "
+            << fixed(100.0 * plan.quantisation_share, 0) << " % of its variance):\n";
   for (std::size_t i = 0; i < plan.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     std::cout << "  " << plan.names[i] << ": prior " << sig(plan.truth[k]) << ", sigma " << sig(plan.expected_sigma[k]) << "\n";

@@ -29,15 +29,27 @@ struct SyntheticTruth {
   double bias_current = 0.0;  ///< A added to the command (a constant drive keeps one direction)
   double duration = 10.0;     ///< s
   double rate = 1000.0;       ///< Hz
+  // Voltage drive (a random-phase multisine voltage held over each sample).
+  bool voltage_drive = false;
+  double R = 5.0;             ///< ohm (the design's default motor)
+  double L = 0.5e-3;          ///< H: L/R = 0.1 ms, a tenth of the sample period
+  double keN = 1.0;           ///< V s / rad at the output (k_e N = K / eta with eta 0.7)
+  double amplitude_V = 0.6;   ///< V, multisine voltage
+  int substeps = 10;          ///< integration steps per sample
 };
 
 struct SyntheticLog {
   std::vector<double> time, current, theta;
+  std::vector<double> voltage;  ///< the held voltage of a voltage drive (empty: current drive)
   std::string csv() const {
     std::ostringstream o;
     o.precision(17);
-    o << "time_s,current_A,theta_rad\n";
-    for (std::size_t i = 0; i < time.size(); ++i) o << time[i] << "," << current[i] << "," << theta[i] << "\n";
+    o << (voltage.empty() ? "time_s,current_A,theta_rad\n" : "time_s,voltage_V,current_A,theta_rad\n");
+    for (std::size_t i = 0; i < time.size(); ++i) {
+      o << time[i] << ",";
+      if (!voltage.empty()) o << voltage[i] << ",";
+      o << current[i] << "," << theta[i] << "\n";
+    }
     return o.str();
   }
 };
@@ -53,21 +65,27 @@ inline SyntheticLog synthetic_log(const SyntheticTruth& t, unsigned seed) {
   auto command = [&](double time) {
     double s = 0.0;
     for (int k = 1; k <= harmonics; ++k) s += std::sin(2.0 * std::numbers::pi * 0.3 * k * time + ph[static_cast<std::size_t>(k - 1)]);
-    return t.bias_current + t.amplitude * s / std::sqrt(0.5 * harmonics);
+    return (t.voltage_drive ? t.amplitude_V : t.amplitude) * s / std::sqrt(0.5 * harmonics) + t.bias_current;
   };
   const double Jl = t.J * t.load_share, Jm = t.J - Jl;
   const bool rigid = t.resonance_hz <= 0.0;
   const double w_res = 2.0 * std::numbers::pi * t.resonance_hz;
   const double k = rigid ? 0.0 : w_res * w_res * (Jm * Jl / t.J);
   const double d = rigid ? 0.0 : 2.0 * 0.05 * std::sqrt(k * Jm * Jl / t.J);
-  const int sub = 10;
+  const int sub = t.substeps;
   const double h = 1.0 / (t.rate * sub);
   const std::size_t n = static_cast<std::size_t>(t.duration * t.rate);
   SyntheticLog log;
-  // State: motor angle, motor speed, load angle, load speed.
-  double y[4] = {0.0, 0.0, 0.0, 0.0};
+  // State: motor angle, motor speed, load angle, load speed, and the current of a voltage drive.
+  double y[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
   double play = 0.0;  // reading behind the backlash
-  auto f = [&](const double* s, double i, double* ds) {
+  auto f = [&](const double* s, double drive, double* ds) {
+    double i = drive;
+    ds[4] = 0.0;
+    if (t.voltage_drive) {
+      i = s[4];
+      ds[4] = (drive - t.R * s[4] - t.keN * s[1]) / t.L;
+    }
     const double friction = t.b * s[1] + t.c * std::tanh(s[1] / 1e-3) + t.offset;
     if (rigid) {
       ds[0] = s[1];
@@ -84,24 +102,25 @@ inline SyntheticLog synthetic_log(const SyntheticTruth& t, unsigned seed) {
   };
   for (std::size_t j = 0; j < n; ++j) {
     const double time = static_cast<double>(j) / t.rate;
-    const double i = command(time);
+    const double i = command(time);  // the current, or the voltage of a voltage drive
     // The reading: backlash (play operator) then quantisation.
     const double load = y[2];
     if (load > play + 0.5 * t.backlash) play = load - 0.5 * t.backlash;
     if (load < play - 0.5 * t.backlash) play = load + 0.5 * t.backlash;
     log.time.push_back(time);
-    log.current.push_back(i + t.current_noise * noise(rng));
+    if (t.voltage_drive) log.voltage.push_back(i);
+    log.current.push_back((t.voltage_drive ? y[4] : i) + t.current_noise * noise(rng));
     log.theta.push_back(t.quantum > 0.0 ? t.quantum * std::round(play / t.quantum) : play);
     for (int s = 0; s < sub; ++s) {  // RK4, the current held over the sample
-      double k1[4], k2[4], k3[4], k4[4], tmp[4];
+      double k1[5], k2[5], k3[5], k4[5], tmp[5];
       f(y, i, k1);
-      for (int q = 0; q < 4; ++q) tmp[q] = y[q] + 0.5 * h * k1[q];
+      for (int q = 0; q < 5; ++q) tmp[q] = y[q] + 0.5 * h * k1[q];
       f(tmp, i, k2);
-      for (int q = 0; q < 4; ++q) tmp[q] = y[q] + 0.5 * h * k2[q];
+      for (int q = 0; q < 5; ++q) tmp[q] = y[q] + 0.5 * h * k2[q];
       f(tmp, i, k3);
-      for (int q = 0; q < 4; ++q) tmp[q] = y[q] + h * k3[q];
+      for (int q = 0; q < 5; ++q) tmp[q] = y[q] + h * k3[q];
       f(tmp, i, k4);
-      for (int q = 0; q < 4; ++q) y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q]);
+      for (int q = 0; q < 5; ++q) y[q] += h / 6.0 * (k1[q] + 2.0 * k2[q] + 2.0 * k3[q] + k4[q]);
     }
   }
   return log;

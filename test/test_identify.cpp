@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -312,6 +313,7 @@ TEST(IdentifySynthetic, VoltageDriveWithCurrentGivesResistanceAndBackEmf) {
   p.motor = m;
   id::IdentifyOptions o;
   o.output_error = false;
+  o.zero_order_hold = false;  // the closed form above relates instantaneous values (--instant-drive)
   const auto r = id::identify_joint(j, time, p, nullptr, nullptr, o);
   ASSERT_TRUE(r.electrical.has_value());
   EXPECT_NEAR(r.electrical->value[0], R, 2e-3 * R);
@@ -325,6 +327,110 @@ TEST(IdentifySynthetic, VoltageDriveWithCurrentGivesResistanceAndBackEmf) {
     }
   }
   EXPECT_TRUE(found);
+}
+
+// A lab's log of a voltage-driven motor (synthetic_log with voltage_drive): the voltage command held
+// over each 1 ms sample, the current sampled at the sample instants (1 kHz, 2 mA noise), the
+// winding's L/R = 0.1 ms below the sample period, and the reading's compliance, backlash and 16-bit
+// quantisation. Logged as a voltage or as a duty, with or without the current column.
+struct VoltageCase {
+  bool duty, with_current;
+  const char* name;
+};
+
+id::JointLog voltage_joint(const testing::SyntheticLog& s, const VoltageCase& c, double supply) {
+  id::JointLog j;
+  j.drive = c.duty ? id::DriveKind::duty : id::DriveKind::voltage;
+  j.drive_column = c.duty ? "duty" : "voltage_V";
+  for (double v : s.voltage) j.drive_values.push_back(c.duty ? v / supply : v);
+  j.reading = id::ReadingKind::angle;
+  j.reading_column = "theta_rad";
+  j.reading_values = s.theta;
+  if (c.with_current) j.current = s.current;
+  return j;
+}
+
+TEST(IdentifySynthetic, VoltageAndDutyDrivesAreUnbiasedWithAndWithoutTheCurrent) {
+  SyntheticTruth truth;
+  truth.voltage_drive = true;
+  truth.substeps = 40;  // 25 us steps: a quarter of the winding's time constant
+  // Rigid: with the 300 Hz compliance the reading lags the motor, whose speed the back-EMF sees, by
+  // 2 zeta / omega = 0.05 ms, and the back-EMF's damping (0.14 N m s / rad, 70 times the inertia per
+  // second) turns that into an inertia 0.5 % (5 sigma) low: a model error, not the method's.
+  truth.resonance_hz = 0.0;
+  const id::JointPrior prior;  // the design's default motor: the truth's R, L, k_e N and eta
+  const MotorParams& m = prior.motor;
+  ASSERT_NEAR(m.resistance(), truth.R, 1e-12);
+  ASSERT_NEAR(m.inductance(), truth.L, 1e-12);
+  ASSERT_NEAR(m.back_emf_constant() * m.gear_ratio, truth.keN, 1e-12);
+  ASSERT_NEAR(m.gearbox_efficiency * truth.keN, truth.K, 1e-12);
+  id::IdentifyOptions o;
+  o.output_error = false;
+  const double want[4] = {truth.J, truth.b, truth.c, truth.offset};
+  const int seeds = 20;
+  for (const VoltageCase& c : {VoltageCase{false, true, "voltage and current"}, VoltageCase{false, false, "voltage alone"},
+                               VoltageCase{true, true, "duty and current"}}) {
+    SCOPED_TRACE(c.name);
+    int inside = 0, total = 0;
+    double worst = 0.0;
+    for (unsigned seed = 1; seed <= static_cast<unsigned>(seeds); ++seed) {
+      const auto log = synthetic_log(truth, seed);
+      const auto r = id::identify_joint(voltage_joint(log, c, m.supply_voltage_V), log.time, prior, nullptr, nullptr, o);
+      for (int k = 0; k < 4; ++k) {
+        ASSERT_TRUE(r.idim.identified[static_cast<std::size_t>(k)]) << r.idim.names[static_cast<std::size_t>(k)];
+        const double z = std::abs(r.idim.value[k] - want[k]) / r.idim.sigma[k];
+        worst = std::max(worst, z);
+        inside += z <= 3.0;
+        ++total;
+      }
+      EXPECT_NEAR(r.idim.value[0], truth.J, 0.01 * truth.J) << "seed " << seed;
+      EXPECT_GT(r.idim.value[2], 0.0) << "seed " << seed;
+      ASSERT_EQ(r.electrical.has_value(), c.with_current);
+      if (!c.with_current) continue;
+      const id::Estimate& el = *r.electrical;
+      for (int k : {0, 2}) {
+        ASSERT_TRUE(el.identified[static_cast<std::size_t>(k)]);
+        const double z = std::abs(el.value[k] - (k == 0 ? truth.R : truth.keN)) / el.sigma[k];
+        worst = std::max(worst, z);
+        inside += z <= 3.0;
+        ++total;
+      }
+      // L/R = 0.1 ms against a 1 ms sample: the log cannot resolve L; held and named.
+      EXPECT_FALSE(el.identified[1]);
+      EXPECT_NE(el.notes[1].find("below the sample period"), std::string::npos) << el.notes[1];
+    }
+    std::cout << c.name << ": " << inside << " of " << total << " estimates within 3 sigma, worst " << worst << " sigma\n";
+    // The goal is 95 %. Measured: 113 of 120 with the current, 70 of 80 without (seeds 1 ... 20);
+    // what is left is a systematic part (the Coulomb friction about 2 of its sigmas low, the
+    // viscous friction and the inertia 1.5 to 2 high; without quantisation and current noise it
+    // stays), whose cause is not found yet (docs/identify.md). The floor here guards what was fixed:
+    // before, the same logs gave R +2 ... +18 %, L 4 ... 14 times its value, the inertia -7.6 %.
+    EXPECT_GE(inside, static_cast<int>(std::ceil((c.with_current ? 0.93 : 0.85) * total))) << "worst " << worst;
+    EXPECT_LT(worst, 6.0);
+  }
+}
+
+TEST(IdentifySynthetic, InductanceIsIdentifiedWhenTheWindingLagsOverASample) {
+  // L/R = 2 ms against a 1 ms sample: the current carries over from one sample to the next and the
+  // sampled-current regression resolves L.
+  SyntheticTruth truth;
+  truth.voltage_drive = true;
+  truth.L = 10e-3;
+  id::JointPrior prior;
+  prior.motor.inductance_mH = 10.0;
+  id::IdentifyOptions o;
+  o.output_error = false;
+  for (unsigned seed = 1; seed <= 5; ++seed) {
+    const auto log = synthetic_log(truth, seed);
+    const auto r = id::identify_joint(voltage_joint(log, VoltageCase{false, true, ""}, 6.0), log.time, prior, nullptr, nullptr, o);
+    ASSERT_TRUE(r.electrical.has_value());
+    ASSERT_TRUE(r.electrical->identified[1]) << r.electrical->notes[1];
+    // Measured: L 14 ... 21 % high on these logs and k_e N 0.2 % high, both far outside their
+    // sigmas (a bias not found yet, docs/identify.md "Not done yet"): bounds, not coverage.
+    EXPECT_NEAR(r.electrical->value[1], truth.L, 0.25 * truth.L);
+    EXPECT_NEAR(r.electrical->value[0], truth.R, 5e-3 * truth.R);
+    EXPECT_NEAR(r.electrical->value[2], truth.keN, 5e-3 * truth.keN);
+  }
 }
 
 // --- Planning ---------------------------------------------------------------------------------------
@@ -351,16 +457,46 @@ TEST(IdentifyPlan, StaysWithinItsLimitsWithALowCrestFactor) {
   for (int k = 0; k < 4; ++k) EXPECT_GT(plan.expected_sigma[k], 0.0);
 }
 
+TEST(IdentifyPlan, StartsAndEndsAtRest) {
+  id::JointPrior prior;
+  id::PlanOptions po;
+  const id::ExcitationPlan plan = id::plan_excitation(prior, po);
+  const double centre = 0.5 * (po.range_lo + po.range_hi);
+  ASSERT_EQ(plan.fade_s, 1.0);
+  double peak_w = 0.0, peak_a = 0.0;
+  for (std::size_t i = 0; i < plan.time.size(); ++i) {
+    peak_w = std::max(peak_w, std::abs(plan.velocity[i]));
+    peak_a = std::max(peak_a, std::abs(plan.acceleration[i]));
+  }
+  for (std::size_t i : {std::size_t{0}, plan.time.size() - 1}) {
+    EXPECT_NEAR(plan.position[i], centre, 1e-12);
+    EXPECT_NEAR(plan.velocity[i], 0.0, 1e-12);
+    EXPECT_NEAR(plan.acceleration[i], 0.0, 1e-9 * peak_a);
+  }
+  // The first 10 ms (ten samples) stay below 1 % of the peak speed: no step at the start.
+  for (std::size_t i = 0; i < 10; ++i) EXPECT_LT(std::abs(plan.velocity[i]), 0.01 * peak_w) << i;
+  // The plan's motion is its own derivative: the speed against a central difference of the position.
+  const double dt = plan.time[1] - plan.time[0];
+  for (std::size_t i = 1; i + 1 < plan.time.size(); i += 97) {
+    EXPECT_NEAR((plan.position[i + 1] - plan.position[i - 1]) / (2.0 * dt), plan.velocity[i], 1e-3 * peak_w) << i;
+  }
+}
+
 TEST(IdentifyPlan, ExpectedSigmasMatchTheSpreadOfFitsToLogsOfThePlan) {
   // Logs of the plan played perfectly by the prior model, with white noise of the stated sigma on
-  // the logged drive torque: the spread of the IDIM-LS estimates over 40 seeds is what the plan's
-  // information matrix predicts.
+  // the logged drive torque and the reading rounded to the quantum of the default potentiometer and
+  // ADC (its offset random per log, as a run's start is): the spread of the IDIM-LS estimates over
+  // 40 seeds, and the sigmas each fit reports, are what the plan predicts.
   id::JointPrior prior;
   id::PlanOptions po;
   po.range_lo = -1.0;
   po.range_hi = 1.0;
   po.drive_noise = 2e-3;
+  po.angle_quantum = prior.rad_per_volt * (prior.adc_hi_v - prior.adc_lo_v) / std::ldexp(1.0, prior.adc_bits);
   const id::ExcitationPlan plan = id::plan_excitation(prior, po);
+  // The quantum matters here: a large share of the predicted residual.
+  EXPECT_GT(plan.quantisation_share, 0.3);
+  std::cout << "plan: residual " << plan.expected_residual << " N m, quantisation share " << plan.quantisation_share << "\n";
   const MotorParams& m = prior.motor;
   const double K = m.gearbox_efficiency * m.gear_ratio * m.torque_constant();
   id::IdentifyOptions o;
@@ -368,30 +504,54 @@ TEST(IdentifyPlan, ExpectedSigmasMatchTheSpreadOfFitsToLogsOfThePlan) {
   o.zero_order_hold = false;  // the logged drive is the instantaneous torque
   const int seeds = 40;
   std::vector<Eigen::VectorXd> estimates;
+  Eigen::VectorXd reported = Eigen::VectorXd::Zero(4);
   std::mt19937_64 rng(5);
   std::normal_distribution<double> noise(0.0, 1.0);
+  std::uniform_real_distribution<double> offset(0.0, po.angle_quantum);
   for (int s = 0; s < seeds; ++s) {
     id::JointLog j;
     j.drive = id::DriveKind::current;
     j.drive_column = "current_A";
     j.reading_column = "theta_rad";
-    j.reading_values = plan.position;
+    // Each run tracks the plan with its own small error (a random-phase 1 ... 5 Hz motion of a few
+    // quanta), so that the rounding differs from run to run as it does on a bench.
+    const double off = offset(rng);
+    std::array<double, 5> ph{};
+    for (double& x : ph) x = 2.0 * std::numbers::pi * offset(rng) / po.angle_quantum;
     for (std::size_t i = 0; i < plan.time.size(); ++i) {
-      const double w = plan.velocity[i];
-      const double tau = plan.truth[0] * plan.acceleration[i] + plan.truth[1] * w + plan.truth[2] * (w > 0 ? 1.0 : w < 0 ? -1.0 : 0.0);
+      double e = 0.0, de = 0.0, dde = 0.0;
+      for (int h = 1; h <= 5; ++h) {
+        const double wh = 2.0 * std::numbers::pi * h, amp = 3.0 * po.angle_quantum / h;
+        e += amp * std::sin(wh * plan.time[i] + ph[static_cast<std::size_t>(h - 1)]);
+        de += amp * wh * std::cos(wh * plan.time[i] + ph[static_cast<std::size_t>(h - 1)]);
+        dde -= amp * wh * wh * std::sin(wh * plan.time[i] + ph[static_cast<std::size_t>(h - 1)]);
+      }
+      const double q = plan.position[i] + e;
+      j.reading_values.push_back(po.angle_quantum * std::round((q + off) / po.angle_quantum) - off);
+      const double w = plan.velocity[i] + de;
+      const double tau = plan.truth[0] * (plan.acceleration[i] + dde) + plan.truth[1] * w + plan.truth[2] * (w > 0 ? 1.0 : w < 0 ? -1.0 : 0.0);
       j.drive_values.push_back((tau + po.drive_noise * noise(rng)) / K);
     }
-    estimates.push_back(id::identify_joint(j, plan.time, prior, nullptr, nullptr, o).idim.value);
+    const auto r = id::identify_joint(j, plan.time, prior, nullptr, nullptr, o);
+    estimates.push_back(r.idim.value);
+    reported += r.idim.sigma / seeds;
   }
   for (int k = 0; k < 4; ++k) {
     double mean = 0.0, var = 0.0;
     for (const auto& e : estimates) mean += e[k] / seeds;
     for (const auto& e : estimates) var += (e[k] - mean) * (e[k] - mean) / (seeds - 1);
     const double ratio = std::sqrt(var) / plan.expected_sigma[k];
-    // 40 samples give the standard deviation to about +-11 % (1 sigma): a factor 1.5 either way.
-    EXPECT_GT(ratio, 1.0 / 1.5) << plan.names[static_cast<std::size_t>(k)];
+    const double reported_ratio = reported[k] / plan.expected_sigma[k];
+    // The sigmas each fit reports are what the plan predicts, within a factor 1.5 either way. The
+    // spread is not above them (40 samples give a standard deviation to about +-11 %): the
+    // quantisation's error, through two differences, lies mostly above the excitation's band, so
+    // s^2 (W^T W)^-1, which takes it as white, over-states the inertia's and the offset's spread
+    // (measured 0.28 and 0.33 of it; the frictions' 0.7 ... 0.8): conservative.
     EXPECT_LT(ratio, 1.5) << plan.names[static_cast<std::size_t>(k)];
-    std::cout << plan.names[static_cast<std::size_t>(k)] << ": spread / expected sigma " << ratio << "\n";
+    EXPECT_GT(reported_ratio, 1.0 / 1.5) << plan.names[static_cast<std::size_t>(k)];
+    EXPECT_LT(reported_ratio, 1.5) << plan.names[static_cast<std::size_t>(k)];
+    std::cout << plan.names[static_cast<std::size_t>(k)] << ": spread / expected sigma " << ratio << ", reported / expected "
+              << reported_ratio << "\n";
   }
 }
 
@@ -421,19 +581,22 @@ TEST(IdentifyEmps, MatchesThePublishedIdimLsParameters) {
   EXPECT_EQ(r.decimation, 10);
   const double published[4] = {95.1089, 203.5034, 20.3935, -3.1648};
   const double sigma[4] = {0.1085, 1.1460, 0.1012, 0.0444};
-  // Tolerance: 3 published sigmas. The published run and this one differ only in the
-  // implementation of the filters (MATLAB's butter/filtfilt/decimate against the ones here, which
-  // differ at the ends and in the decimation's sample alignment); the fit's own noise is in sigma.
+  // The published run and this one differ only in the implementation of the filters (MATLAB's
+  // butter/filtfilt/decimate against the ones here, whose padding and decimation phase differ); the
+  // rows within the filters' settling of either end are left out (IdentifyOptions, edge_samples),
+  // so what is left of that difference is a fraction of the estimate's own noise: within 1.5
+  // published sigmas (measured: M -0.2, Fv +0.3, Fc -0.5, offset -1.0).
+  EXPECT_GT(r.edge_samples, 0);
   for (int k = 0; k < 4; ++k) {
-    EXPECT_NEAR(r.idim.value[k], published[k], 3.0 * sigma[k]) << r.idim.names[static_cast<std::size_t>(k)];
-    // The same statistic from the same data (larger by the larger residual): within 25 %.
-    EXPECT_NEAR(r.idim.sigma[k], sigma[k], 0.25 * sigma[k]) << r.idim.names[static_cast<std::size_t>(k)];
+    EXPECT_NEAR(r.idim.value[k], published[k], 1.5 * sigma[k]) << r.idim.names[static_cast<std::size_t>(k)];
+    // The same statistic from the same data and residual: within 5 % (measured within 2 %).
+    EXPECT_NEAR(r.idim.sigma[k], sigma[k], 0.05 * sigma[k]) << r.idim.names[static_cast<std::size_t>(k)];
   }
-  // The force residual is slightly larger than the published one (4.65 % against 4.08 %, 6.31 %
-  // against 5.98 % cross-test): within 0.8 percentage points.
-  EXPECT_NEAR(r.estimation_idim.drive_relative_error_percent, 4.08, 0.8);
+  // The relative force errors: 4.08 % estimation, 5.98 % cross-test (measured 4.01 %, 5.93 %; with
+  // the edge rows kept they were 4.65 % and 6.31 %).
+  EXPECT_NEAR(r.estimation_idim.drive_relative_error_percent, 4.08, 0.15);
   ASSERT_TRUE(r.validation_idim.has_value());
-  EXPECT_NEAR(r.validation_idim->drive_relative_error_percent, 5.98, 0.8);
+  EXPECT_NEAR(r.validation_idim->drive_relative_error_percent, 5.98, 0.15);
   // The open-loop simulation with the identified model reproduces the position at about the fit of
   // the reference model's own simulation (91.8 % estimation, 88.8 % validation).
   EXPECT_GT(r.estimation_idim.position_fit_percent, 85.0);

@@ -156,11 +156,69 @@ std::vector<double> decimate(const std::vector<double>& x, int factor) {
   if (factor == 1) return x;
   // The anti-aliasing filter of MATLAB's and SciPy's decimate: Chebyshev I, order 8, 0.05 dB, at
   // 0.8 of the new Nyquist frequency, run forward and backward.
-  const auto sos = chebyshev1_lowpass(8, 0.05, 0.8 / factor * 0.5, 1.0);
-  const std::vector<double> y = zero_phase(sos, x);
+  const std::vector<double> y = zero_phase(decimation_filter(factor), x);
   std::vector<double> out;
   for (std::size_t i = 0; i < y.size(); i += static_cast<std::size_t>(factor)) out.push_back(y[i]);
   return out;
+}
+
+std::vector<Biquad> decimation_filter(int factor) {
+  if (factor < 2) throw std::invalid_argument("decimation filter: factor must be >= 2");
+  return chebyshev1_lowpass(8, 0.05, 0.8 / factor * 0.5, 1.0);
+}
+
+int settling_samples(const std::vector<Biquad>& sos, double tail_fraction) {
+  // The response until it has stayed below 1e-14 of its peak for a long stretch (every section is
+  // stable, so it decays geometrically), then the shortest head holding all but the tail fraction.
+  std::vector<double> h(1, 1.0);
+  const std::size_t max_len = 1u << 20;
+  double peak = 0.0;
+  std::size_t quiet = 0;
+  for (std::size_t len = 1024; len <= max_len; len *= 2) {
+    h.assign(len, 0.0);
+    h[0] = 1.0;
+    h = filter(sos, h);
+    peak = 0.0;
+    for (double v : h) peak = std::max(peak, std::abs(v));
+    quiet = 0;
+    for (std::size_t i = len; i-- > 0 && std::abs(h[i]) < 1e-14 * peak;) ++quiet;
+    if (quiet > len / 4) break;
+  }
+  double total = 0.0;
+  for (double v : h) total += std::abs(v);
+  double tail = total;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    if (tail <= tail_fraction * total) return static_cast<int>(i);
+    tail -= std::abs(h[i]);
+  }
+  return static_cast<int>(h.size());
+}
+
+int decimation_settling_samples(int factor, double tail_fraction) {
+  return factor < 2 ? 0 : settling_samples(decimation_filter(factor), tail_fraction);
+}
+
+std::vector<double> zero_phase_impulse(const std::vector<Biquad>& sos, int half) {
+  std::vector<double> x(static_cast<std::size_t>(2 * half + 1), 0.0);
+  x[static_cast<std::size_t>(half)] = 1.0;
+  x = filter(sos, x);
+  std::reverse(x.begin(), x.end());
+  x = filter(sos, x);
+  std::reverse(x.begin(), x.end());
+  return x;
+}
+
+int edge_samples(int order, double cutoff_hz, double fs, int decimation) {
+  return settling_samples(butterworth_lowpass(order, cutoff_hz, fs), kEdgeTail) + 2 + decimation_settling_samples(decimation, kEdgeTail);
+}
+
+double decimation_noise_gain(int factor) {
+  if (factor < 2) return 1.0;
+  const auto sos = decimation_filter(factor);
+  const auto h = zero_phase_impulse(sos, 2 * settling_samples(sos, 1e-9));
+  double s = 0.0;
+  for (double v : h) s += v * v;
+  return s;
 }
 
 }  // namespace fivebar::identify

@@ -31,17 +31,17 @@ double relative_error_percent(const std::vector<double>& y, const std::vector<do
   return ny > 0.0 ? 100.0 * norm(d) / ny : 0.0;
 }
 
-/// The filtered motion and drive of one log, at full rate and decimated.
+/// The filtered motion and drive of one log.
 struct Prepared {
   std::vector<double> q, qf, v, a;      // full rate
-  std::vector<double> d;                // raw drive (the mechanical one: the current when measured next to a voltage)
+  std::vector<double> d;                // raw drive (the mechanical one: the current's sample means when measured next to a voltage)
   std::vector<double> u;                // drive torque input alpha * d, raw (for the simulation)
-  // decimated
+  // decimated, the edge rows trimmed
   Eigen::MatrixXd W;
   Eigen::VectorXd Y;
-  std::vector<double> d_dec, v_dec, t_dec;
+  std::vector<double> d_dec, emf_dec, t_dec;  // the drive paired with each row, the speed its EMF term sees, the time
   std::vector<double> known_dec;        // the known closed-chain torque, decimated (empty: none)
-  // electrical regression (voltage drive with its current)
+  // electrical regression (voltage drive with its current): i_k+1 against i_k, V_k, -w
   Eigen::MatrixXd We;
   Eigen::VectorXd Ye;
 };
@@ -50,41 +50,121 @@ struct Setup {
   double dt = 0.0, fc = 0.0;
   int R = 1;
   int order = 4;
+  int trim = 0;              // full-rate samples dropped at each end: the filters' settling
   bool zoh = true;
   bool per_direction = false;
   bool electrical = false;   // voltage or duty drive with a logged current
+  bool voltage = false;      // voltage or duty drive (the winding's lag applies)
+  identify_detail::ElectricalLag lag;  // of the winding over one sample
+  double emf_per_ohm = 0.0;  // k_e N / R, A per rad/s (a voltage drive with its current)
   double alpha = 1.0, g = 0.0;  // mechanical drive map (after the electrical fit when any)
   double supply = 1.0;       // V per drive unit for the electrical equation (1 for voltage)
 };
 
+/// Rows r of the decimated series (sample r R of the full rate) clear of both ends by `trim` samples.
+std::vector<std::size_t> kept_rows(std::size_t n, int R, int trim) {
+  std::vector<std::size_t> rows;
+  const std::size_t t = static_cast<std::size_t>(std::max(0, trim));
+  for (std::size_t i = 0, r = 0; i < n; i += static_cast<std::size_t>(R), ++r) {
+    if (i >= t && i + t < n) rows.push_back(r);
+  }
+  return rows;
+}
+
+/// Decimated (fivebar/identify/filter.hpp decimate()) and only the kept rows.
+std::vector<double> decimate_kept(const std::vector<double>& x, int R, const std::vector<std::size_t>& rows) {
+  const std::vector<double> d = decimate(x, R);
+  std::vector<double> out;
+  out.reserve(rows.size());
+  for (std::size_t r : rows) out.push_back(d[r]);
+  return out;
+}
+
+/// The drive held over each sample, as the acceleration at t_k sees it: that acceleration, two
+/// central differences, is (q_k+2 - 2 q_k + q_k-2) / (4 dt^2), the true acceleration weighted by a
+/// triangle over [t_k-2, t_k+2], which gives the samples from k-2 to k+1 the weights 1, 3, 3, 1 (/ 8).
+std::vector<double> held_pair(const std::vector<double>& x) {
+  const std::size_t n = x.size();
+  std::vector<double> y = x;
+  auto at = [&](std::ptrdiff_t i) { return x[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(i, 0, static_cast<std::ptrdiff_t>(n) - 1))]; };
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto k = static_cast<std::ptrdiff_t>(i);
+    y[i] = (at(k - 2) + 3.0 * at(k - 1) + 3.0 * at(k) + at(k + 1)) / 8.0;
+  }
+  return y;
+}
+
 Eigen::VectorXd to_eigen(const std::vector<double>& v) { return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size())); }
+
+/// The regression of the winding from the sampled current: i_k+1 = a i_k + b V_k - c w_k with w the
+/// speed weighted as the lag weighs it (ElectricalLag::lambda).
+void electrical_regression(Prepared& p, const JointLog& j, const Setup& s, const std::vector<std::size_t>& rows) {
+  const std::size_t n = j.current.size();
+  std::vector<double> next(n), now(n), V(n), w(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    // --instant-drive: the voltage and the current are instantaneous values, V_k = R i_k + k_e N w_k.
+    const std::size_t k1 = s.zoh ? std::min(k + 1, n - 1) : k;
+    next[k] = j.current[k1];
+    now[k] = j.current[k];
+    V[k] = s.supply * j.drive_values[k];
+    w[k] = -(s.zoh ? p.v[k] + s.lag.lambda * (p.v[k1] - p.v[k]) : p.v[k]);
+  }
+  p.Ye = to_eigen(decimate_kept(next, s.R, rows));
+  p.We.resize(p.Ye.size(), 3);
+  p.We.col(0) = to_eigen(decimate_kept(now, s.R, rows));
+  p.We.col(1) = to_eigen(decimate_kept(V, s.R, rows));
+  p.We.col(2) = to_eigen(decimate_kept(w, s.R, rows));
+}
 
 Prepared prepare(const JointLog& j, const std::vector<double>& time, const JointPrior& prior, const Setup& s) {
   Prepared p;
   p.q = joint_angle(j, prior);
   const auto sos = butterworth_lowpass(s.order, s.fc, 1.0 / s.dt);
-  (void)time;
   p.qf = filtfilt(sos, p.q);
   p.v = derivative(p.qf, s.dt);
   p.a = derivative(p.v, s.dt);
-  const bool use_current = s.electrical;
-  p.d = use_current ? j.current : j.drive_values;
+  const std::size_t n = p.v.size();
+  const std::vector<std::size_t> rows = kept_rows(n, s.R, s.trim);
   // Parallel filtering (Gautier): the low-pass serves the derivatives of the position; the drive and
-  // every column of the regressor then go through the same decimation filter. The drive itself is
-  // only low-passed for the electrical equation's di/dt.
+  // every column of the regressor then go through the same decimation filter.
   // A logged drive command is held over its sample (a digital drive's zero-order hold, and the
   // convention of simulate_position); the central-difference acceleration at t_k sees the mean of
-  // the commands over [t_k-1, t_k+1], so the regression takes (d_k-1 + d_k) / 2. A measured current
-  // (next to a voltage drive) is an instantaneous value and is taken as it is.
-  std::vector<double> df = p.d;
-  if (s.zoh && !use_current) {
-    for (std::size_t i = df.size() - 1; i >= 1; --i) df[i] = 0.5 * (p.d[i] + p.d[i - 1]);
+  // the drive torque over [t_k-1, t_k+1], so the regression takes the mean of the two samples' means.
+  // A voltage drives the current through the winding's lag L/R: each sample's mean current is
+  // taken from the sampled current when it is logged (sampled_current_mean), else from the voltage
+  // and the speed through the lag of the priors (lagged_mean).
+  std::vector<double> df, emf = p.v;
+  if (s.electrical) {
+    p.d = j.current;
+    if (s.zoh) {
+      // Over a sample with the speed a ramp w(t), the current is the steady current of w(t - tau)
+      // plus the transient; sampled_current_mean() takes the steady part at the end's value, so the
+      // sample's mean current gains k_e N / R [(w_end - w_mean) - phi (w_end - w_start)]: 3 % of the
+      // inertia's torque with the design's motor. k_e N / R from the electrical fit (the priors
+      // before it).
+      p.d = identify_detail::sampled_current_mean(j.current, s.lag);
+      for (std::size_t k = 0; k + 1 < n; ++k) {
+        const double w_mean = (p.qf[k + 1] - p.qf[k]) / s.dt;
+        p.d[k] += s.emf_per_ohm * ((p.v[k + 1] - w_mean) - s.lag.phi * (p.v[k + 1] - p.v[k]));
+      }
+    }
+    df = s.zoh ? held_pair(p.d) : p.d;
+  } else if (s.voltage && s.zoh) {
+    std::vector<double> wbar(n);  // the mean speed over each sample
+    for (std::size_t k = 0; k + 1 < n; ++k) wbar[k] = (p.qf[k + 1] - p.qf[k]) / s.dt;
+    wbar[n - 1] = p.v[n - 1];
+    p.d = j.drive_values;
+    df = held_pair(identify_detail::lagged_mean(p.d, s.lag));
+    emf = held_pair(identify_detail::lagged_mean(wbar, s.lag));
+  } else {
+    p.d = j.drive_values;
+    df = s.zoh ? held_pair(p.d) : p.d;
   }
   std::vector<std::vector<double>> cols;
   cols.push_back(p.a);
   if (s.per_direction) {
-    std::vector<double> vp(p.v.size()), vn(p.v.size());
-    for (std::size_t i = 0; i < p.v.size(); ++i) {
+    std::vector<double> vp(n), vn(n);
+    for (std::size_t i = 0; i < n; ++i) {
       vp[i] = p.v[i] > 0.0 ? p.v[i] : 0.0;
       vn[i] = p.v[i] < 0.0 ? p.v[i] : 0.0;
     }
@@ -93,36 +173,25 @@ Prepared prepare(const JointLog& j, const std::vector<double>& time, const Joint
   } else {
     cols.push_back(p.v);
   }
-  std::vector<double> sv(p.v.size());
-  for (std::size_t i = 0; i < p.v.size(); ++i) sv[i] = sgn(p.v[i]);
+  std::vector<double> sv(n);
+  for (std::size_t i = 0; i < n; ++i) sv[i] = sgn(p.v[i]);
   cols.push_back(sv);
-  cols.push_back(std::vector<double>(p.v.size(), 1.0));
-  std::vector<double> tau(p.v.size());
-  for (std::size_t i = 0; i < tau.size(); ++i) tau[i] = s.alpha * df[i] - s.g * p.v[i];
+  cols.push_back(std::vector<double>(n, 1.0));
+  std::vector<double> tau(n);
+  for (std::size_t i = 0; i < n; ++i) tau[i] = s.alpha * df[i] - s.g * emf[i];
   if (!prior.known_torque.empty()) {  // the closed chain's share (--rig mechanism)
-    for (std::size_t i = 0; i < tau.size(); ++i) tau[i] -= prior.known_torque[i];
-    p.known_dec = decimate(prior.known_torque, s.R);
+    for (std::size_t i = 0; i < n; ++i) tau[i] -= prior.known_torque[i];
+    p.known_dec = decimate_kept(prior.known_torque, s.R, rows);
   }
-  const std::vector<double> Yd = decimate(tau, s.R);
-  p.Y = to_eigen(Yd);
+  p.Y = to_eigen(decimate_kept(tau, s.R, rows));
   p.W.resize(p.Y.size(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t c = 0; c < cols.size(); ++c) p.W.col(static_cast<Eigen::Index>(c)) = to_eigen(decimate(cols[c], s.R));
-  p.d_dec = decimate(df, s.R);
-  p.v_dec = decimate(p.v, s.R);
-  for (std::size_t i = 0; i < time.size(); i += static_cast<std::size_t>(s.R)) p.t_dec.push_back(time[i]);
-  p.u.resize(p.d.size());
-  for (std::size_t i = 0; i < p.d.size(); ++i) p.u[i] = s.alpha * p.d[i];
-  if (s.electrical) {
-    // V = R i + L di/dt + k_e N w (output-shaft speed, so the third parameter is k_e N).
-    std::vector<double> V = j.drive_values;
-    for (double& x : V) x *= s.supply;
-    const std::vector<double> di = derivative(filtfilt(sos, df), s.dt);
-    p.Ye = to_eigen(decimate(V, s.R));
-    p.We.resize(p.Ye.size(), 3);
-    p.We.col(0) = to_eigen(p.d_dec);
-    p.We.col(1) = to_eigen(decimate(di, s.R));
-    p.We.col(2) = to_eigen(p.v_dec);
-  }
+  for (std::size_t c = 0; c < cols.size(); ++c) p.W.col(static_cast<Eigen::Index>(c)) = to_eigen(decimate_kept(cols[c], s.R, rows));
+  p.d_dec = decimate_kept(df, s.R, rows);
+  p.emf_dec = decimate_kept(emf, s.R, rows);
+  for (std::size_t r : rows) p.t_dec.push_back(time[r * static_cast<std::size_t>(s.R)]);
+  p.u.resize(n);
+  for (std::size_t i = 0; i < n; ++i) p.u[i] = s.alpha * p.d[i];
+  if (s.electrical) electrical_regression(p, j, s, rows);
   return p;
 }
 
@@ -133,7 +202,7 @@ Fit fit_figures(const Prepared& p, const Eigen::VectorXd& theta, const Setup& s,
   std::vector<double> dhat(p.d_dec.size());
   for (std::size_t i = 0; i < dhat.size(); ++i) {
     const double known = p.known_dec.empty() ? 0.0 : p.known_dec[i];
-    dhat[i] = (tau_hat[static_cast<Eigen::Index>(i)] + known + s.g * p.v_dec[i]) / s.alpha;
+    dhat[i] = (tau_hat[static_cast<Eigen::Index>(i)] + known + s.g * p.emf_dec[i]) / s.alpha;
   }
   f.drive_fit_percent = fit_percent(p.d_dec, dhat);
   f.drive_relative_error_percent = relative_error_percent(p.d_dec, dhat);
@@ -156,8 +225,141 @@ Fit fit_figures(const Prepared& p, const Eigen::VectorXd& theta, const Setup& s,
   return f;
 }
 
+/// R, L and k_e N from the sampled current (lib/src/identify/electrical.cpp). L is held at its prior
+/// when the prior's L/R is below the sample period, or when the log does not resolve it (the share a
+/// of the current carried over one sample not above three of its sigmas): the current then follows
+/// each sample's voltage and the log carries no trace of L.
+Estimate fit_winding(const Prepared& p, const Setup& s, const MotorParams& m, double tol) {
+  const double tau = m.inductance() / m.resistance();
+  std::string note;
+  if (!s.zoh) {
+    note = "held at its prior: --instant-drive takes the current as following the voltage at once";
+  } else if (tau < s.dt) {
+    note = "not resolvable: the prior L/R = " + format::shortest(tau * 1e3) + " ms is below the sample period " +
+           format::shortest(s.dt * 1e3) + " ms (the current settles within each sample); held at its prior";
+  } else {
+    // The voltage and the speed first: a column nearly a combination of them is the carried-over current.
+    Eigen::MatrixXd W(p.We.rows(), 3);
+    W << p.We.col(1), p.We.col(2), p.We.col(0);
+    const Estimate bca = least_squares(W, p.Ye, {"b", "c", "a"}, Eigen::Vector3d(0.0, 0.0, s.lag.a), tol);
+    Eigen::PermutationMatrix<3> perm;
+    perm.indices() << 1, 2, 0;  // b, c, a -> a, b, c
+    Estimate arx = bca;
+    arx.names = {"a", "b", "c"};
+    arx.value = perm * bca.value;
+    arx.sigma = perm * bca.sigma;
+    arx.covariance = perm * bca.covariance * perm.transpose();
+    arx.identified = {bca.identified[2], bca.identified[0], bca.identified[1]};
+    const double a = arx.value[0];
+    if (arx.identified[0] && a > 0.0 && a < 1.0 && a > 3.0 * arx.sigma[0]) {
+      return identify_detail::winding_estimate(arx, s.dt, true, a, "");
+    }
+    note = "not resolved by this log: the current carried over one sample, " + format::shortest(a) + " +- " +
+           format::shortest(arx.sigma[0]) + ", is not above three of its sigmas; held at its prior";
+  }
+  // a held: regress i_k+1 - a i_k on V_k and -w.
+  const double a_held = s.zoh ? s.lag.a : 0.0;
+  const Eigen::VectorXd y = p.Ye - a_held * p.We.col(0);
+  const Eigen::MatrixXd W = p.We.rightCols(2);
+  const Estimate bc = least_squares(W, y, {"b", "c"}, Eigen::Vector2d::Zero(), tol);
+  Estimate arx;
+  arx.names = {"a", "b", "c"};
+  arx.value = Eigen::Vector3d(a_held, bc.value[0], bc.value[1]);
+  arx.identified = {false, bc.identified[0], bc.identified[1]};
+  arx.covariance = Eigen::Matrix3d::Zero();
+  arx.covariance.bottomRightCorner(2, 2) = bc.covariance;
+  arx.residual_sigma = bc.residual_sigma;
+  arx.rows = bc.rows;
+  Estimate e = identify_detail::winding_estimate(arx, s.dt, false, a_held, note);
+  e.value[1] = m.inductance();
+  return e;
+}
+
+/// The mechanical parameters scale with the drive's scale alpha (k_t from the electrical fit): its
+/// relative variance adds theta theta^T var(alpha) / alpha^2 to their covariance (independent errors).
+void add_scale_variance(Estimate& e, double relative_variance) {
+  const Eigen::Index n = e.value.size();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (e.identified[static_cast<std::size_t>(i)] && e.identified[static_cast<std::size_t>(j)]) {
+        e.covariance(i, j) += e.value[i] * e.value[j] * relative_variance;
+      }
+    }
+  }
+  for (Eigen::Index i = 0; i < n; ++i) e.sigma[i] = std::sqrt(std::max(0.0, e.covariance(i, i)));
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j) {
+      if (e.sigma[i] > 0.0 && e.sigma[j] > 0.0) e.correlation(i, j) = e.covariance(i, j) / (e.sigma[i] * e.sigma[j]);
+    }
+  }
+}
+
 Parameter record(std::string key, double value, double sigma, bool identified, std::string note) {
   return Parameter{std::move(key), value, sigma, identified, std::move(note)};
+}
+
+/// Every key of a joint's result: the mechanical parameters, the design keys derived from them,
+/// the electrical keys (fitted or held) and the held gearbox.
+std::vector<Parameter> records(const JointIdentification& r, const JointLog& joint, const JointPrior& prior,
+                               const IdentifyOptions& o, int p) {
+  std::vector<Parameter> out;
+  const std::vector<std::string> names = mechanical_names(o.per_direction, joint.linear);
+  const MotorParams& m = prior.motor;
+  const Estimate& fin = (o.use_output_error && r.output_error) ? *r.output_error : r.idim;
+  const std::string method = (o.use_output_error && r.output_error) ? "output error" : "IDIM-LS";
+  for (int i = 0; i < p; ++i) {
+    const std::size_t ui = static_cast<std::size_t>(i);
+    out.push_back(record(names[ui], fin.value[i], fin.sigma[i], fin.identified[ui],
+                         fin.identified[ui] ? method : r.idim.notes[ui]));
+  }
+  if (!joint.linear) {
+    const std::string mk = prior.motor_key + ".";
+    const double N2 = m.gear_ratio * m.gear_ratio;
+    // Derived design keys (the design's units).
+    out.push_back(record(mk + "rotor_inertia_g_cm2", (fin.value[0] - prior.load_inertia) / N2 * 1e7, fin.sigma[0] / N2 * 1e7,
+                         fin.identified[0],
+                         fin.identified[0] ? "(inertia_kg_m2 - load " + format::shortest(prior.load_inertia) +
+                                                 " kg m^2) / gear_ratio^2, gear_ratio held at its prior"
+                                           : r.idim.notes[0]));
+    if (!o.per_direction) {
+      out.push_back(record(mk + "viscous_friction_mNm_s_per_rad", fin.value[1] * 1e3, fin.sigma[1] * 1e3, fin.identified[1],
+                           fin.identified[1] ? "viscous_Nm_s_per_rad" : r.idim.notes[1]));
+    }
+    const int c = p - 2;
+    out.push_back(record(mk + "coulomb_friction_mNm", fin.value[c] * 1e3, fin.sigma[c] * 1e3,
+                         fin.identified[static_cast<std::size_t>(c)],
+                         fin.identified[static_cast<std::size_t>(c)] ? "coulomb_Nm" : r.idim.notes[static_cast<std::size_t>(c)]));
+    const bool torque = joint.drive == DriveKind::torque;
+    const bool current = joint.drive == DriveKind::current;
+    const std::string why = torque ? "held at its prior: a torque drive does not involve it"
+                            : current ? "held at its prior: with a current drive only ratios to eta N k_t are identifiable"
+                                      : "held at its prior: the log has no current, so only ratios to k_t / R are identifiable";
+    if (r.electrical) {
+      const Estimate& el = *r.electrical;
+      const double rpm = 60.0 / (2.0 * std::numbers::pi);
+      out.push_back(record(mk + "terminal_resistance_ohm", el.value[0], el.sigma[0], el.identified[0],
+                           el.identified[0] ? "IDIM-LS (electrical equation on the sampled current)" : el.notes[0]));
+      out.push_back(record(mk + "inductance_mH", el.value[1] * 1e3, el.sigma[1] * 1e3, el.identified[1],
+                           el.identified[1] ? "IDIM-LS (electrical equation on the sampled current)" : el.notes[1]));
+      const double ke = el.value[2] / m.gear_ratio, ske = el.sigma[2] / m.gear_ratio;
+      out.push_back(record(mk + "back_emf_mV_per_rpm", ke * 1e3 / rpm, ske * 1e3 / rpm, el.identified[2],
+                           el.identified[2] ? "IDIM-LS (electrical equation on the sampled current), gear_ratio held at its prior" : el.notes[2]));
+      out.push_back(record(mk + "torque_constant_mNm_per_A", ke * 1e3, ske * 1e3, el.identified[2],
+                           el.identified[2] ? "k_t = k_e (SI)" : el.notes[2]));
+    } else {
+      out.push_back(record(mk + "terminal_resistance_ohm", m.terminal_resistance_ohm, 0.0, false, why));
+      out.push_back(record(mk + "inductance_mH", m.inductance_mH, 0.0, false,
+                           torque || current ? why
+                                             : "held at its prior: the log has no current (the winding's lag L/R over each "
+                                               "sample is the priors')"));
+      out.push_back(record(mk + "torque_constant_mNm_per_A", m.torque_constant_mNm_per_A, 0.0, false, why));
+      out.push_back(record(mk + "back_emf_mV_per_rpm", m.back_emf_mV_per_rpm, 0.0, false, why));
+    }
+    out.push_back(record(mk + "gearbox_efficiency", m.gearbox_efficiency, 0.0, false,
+                         "held at its prior: it scales every torque, so a log cannot separate it from the friction and inertia"));
+    out.push_back(record(mk + "gear_ratio", m.gear_ratio, 0.0, false, "held at its prior (a datasheet value)"));
+  }
+  return out;
 }
 
 }  // namespace
@@ -289,16 +491,23 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
   if (o.decimation <= 0) {
     while (s.R > 1 && static_cast<int>(time.size()) / s.R < 50 * (p + 3)) --s.R;
   }
-  if (static_cast<int>(time.size()) / s.R < 2 * p + 4) {
-    throw InputError("the log has " + std::to_string(time.size()) + " rows; decimated by " + std::to_string(s.R) +
-                     " that is fewer than twice the " + std::to_string(p) + " unknowns");
+  s.trim = edge_samples(s.order, s.fc, fs, s.R);
+  const std::size_t kept = kept_rows(time.size(), s.R, s.trim).size();
+  if (static_cast<int>(kept) < 2 * p + 4) {
+    throw InputError("the log has " + std::to_string(time.size()) + " rows; decimated by " + std::to_string(s.R) + " and clear of the " +
+                     std::to_string(s.trim) + " samples at each end where the filters settle, " + std::to_string(kept) +
+                     " rows remain: fewer than twice the " + std::to_string(p) + " unknowns and 4");
   }
   r.sample_time = s.dt;
   r.cutoff_hz = s.fc;
   r.decimation = s.R;
+  r.edge_samples = s.trim;
   const MotorParams& m = prior.motor;
-  s.electrical = (joint.drive == DriveKind::voltage || joint.drive == DriveKind::duty) && !joint.current.empty();
+  s.voltage = joint.drive == DriveKind::voltage || joint.drive == DriveKind::duty;
+  s.electrical = s.voltage && !joint.current.empty();
   s.supply = joint.drive == DriveKind::duty ? m.supply_voltage_V : 1.0;
+  s.lag = identify_detail::electrical_lag(m.inductance() / m.resistance(), s.dt);
+  s.emf_per_ohm = m.back_emf_constant() * m.gear_ratio / m.resistance();
   const ReducedDrive rd = reduced_drive(s.electrical ? DriveKind::current : joint.drive, m);
   s.alpha = rd.alpha;
   s.g = rd.g;
@@ -306,19 +515,21 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
     throw InputError("a linear axis (position_m) takes its drive as force_N");
   }
 
-  // Electrical fit first: it sets k_t = k_e for the mechanical one.
-  const Prepared first = prepare(joint, time, prior, s);
-  Prepared est = first;
+  // Electrical fit first: it gives the lag for the current's sample means and k_t = k_e for the
+  // mechanical one.
+  Prepared est = prepare(joint, time, prior, s);
+  double alpha_variance = 0.0;  // relative, of the drive's scale (k_t from the electrical fit)
   if (s.electrical) {
-    Eigen::Vector3d eprior(m.resistance(), m.inductance(), m.back_emf_constant() * m.gear_ratio);
-    Estimate el = least_squares(first.We, first.Ye, {"resistance_ohm", "inductance_H", "back_emf_V_s_per_rad_output"}, eprior,
-                                o.rank_tolerance);
+    r.electrical = fit_winding(est, s, m, o.rank_tolerance);
+    const Estimate& el = *r.electrical;
+    if (el.identified[1]) s.lag = identify_detail::electrical_lag(el.value[1] / el.value[0], s.dt);
+    if (el.identified[0] && el.identified[2]) s.emf_per_ohm = el.value[2] / el.value[0];
     if (el.identified[2] && el.value[2] > 0.0) {
       const double ke_motor = el.value[2] / m.gear_ratio;  // V s / rad = N m / A at the motor shaft
       s.alpha = m.gearbox_efficiency * m.gear_ratio * ke_motor;
-      est = prepare(joint, time, prior, s);
+      alpha_variance = (el.sigma[2] / el.value[2]) * (el.sigma[2] / el.value[2]);
     }
-    r.electrical = el;
+    est = prepare(joint, time, prior, s);
   }
   Eigen::VectorXd mprior(p);
   if (joint.linear) {
@@ -330,6 +541,7 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
     mprior[p - 1] = 0.0;
   }
   r.idim = least_squares(est.W, est.Y, names, mprior, o.rank_tolerance);
+  if (alpha_variance > 0.0) add_scale_variance(r.idim, alpha_variance);
   if (!r.idim.value.allFinite() || !r.idim.sigma.allFinite()) {
     throw InputError("the least-squares fit is not finite: the log's values are out of range for this model");
   }
@@ -389,59 +601,7 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
     r.output_error_status = "not run (--no-output-error)";
   }
 
-  // The records.
-  const Estimate& fin = (o.use_output_error && r.output_error) ? *r.output_error : r.idim;
-  const std::string method = (o.use_output_error && r.output_error) ? "output error" : "IDIM-LS";
-  for (int i = 0; i < p; ++i) {
-    const std::size_t ui = static_cast<std::size_t>(i);
-    r.parameters.push_back(record(names[ui], fin.value[i], fin.sigma[i], fin.identified[ui],
-                                  fin.identified[ui] ? method : r.idim.notes[ui]));
-  }
-  if (!joint.linear) {
-    const std::string mk = prior.motor_key + ".";
-    const double N2 = m.gear_ratio * m.gear_ratio;
-    // Derived design keys (the design's units).
-    r.parameters.push_back(record(mk + "rotor_inertia_g_cm2", (fin.value[0] - prior.load_inertia) / N2 * 1e7, fin.sigma[0] / N2 * 1e7,
-                                  fin.identified[0],
-                                  fin.identified[0] ? "(inertia_kg_m2 - load " + format::shortest(prior.load_inertia) +
-                                                          " kg m^2) / gear_ratio^2, gear_ratio held at its prior"
-                                                    : r.idim.notes[0]));
-    if (!o.per_direction) {
-      r.parameters.push_back(record(mk + "viscous_friction_mNm_s_per_rad", fin.value[1] * 1e3, fin.sigma[1] * 1e3, fin.identified[1],
-                                    fin.identified[1] ? "viscous_Nm_s_per_rad" : r.idim.notes[1]));
-    }
-    const int c = p - 2;
-    r.parameters.push_back(record(mk + "coulomb_friction_mNm", fin.value[c] * 1e3, fin.sigma[c] * 1e3,
-                                  fin.identified[static_cast<std::size_t>(c)],
-                                  fin.identified[static_cast<std::size_t>(c)] ? "coulomb_Nm" : r.idim.notes[static_cast<std::size_t>(c)]));
-    const bool torque = joint.drive == DriveKind::torque;
-    const bool current = joint.drive == DriveKind::current;
-    const std::string why = torque ? "held at its prior: a torque drive does not involve it"
-                            : current ? "held at its prior: with a current drive only ratios to eta N k_t are identifiable"
-                                      : "held at its prior: the log has no current, so only ratios to k_t / R are identifiable";
-    if (r.electrical) {
-      const Estimate& el = *r.electrical;
-      const double rpm = 60.0 / (2.0 * std::numbers::pi);
-      r.parameters.push_back(record(mk + "terminal_resistance_ohm", el.value[0], el.sigma[0], el.identified[0],
-                                    el.identified[0] ? "IDIM-LS (electrical equation)" : el.notes[0]));
-      r.parameters.push_back(record(mk + "inductance_mH", el.value[1] * 1e3, el.sigma[1] * 1e3, el.identified[1],
-                                    el.identified[1] ? "IDIM-LS (electrical equation)" : el.notes[1]));
-      const double ke = el.value[2] / m.gear_ratio, ske = el.sigma[2] / m.gear_ratio;
-      r.parameters.push_back(record(mk + "back_emf_mV_per_rpm", ke * 1e3 / rpm, ske * 1e3 / rpm, el.identified[2],
-                                    el.identified[2] ? "IDIM-LS (electrical equation), gear_ratio held at its prior" : el.notes[2]));
-      r.parameters.push_back(record(mk + "torque_constant_mNm_per_A", ke * 1e3, ske * 1e3, el.identified[2],
-                                    el.identified[2] ? "k_t = k_e (SI)" : el.notes[2]));
-    } else {
-      r.parameters.push_back(record(mk + "terminal_resistance_ohm", m.terminal_resistance_ohm, 0.0, false, why));
-      r.parameters.push_back(record(mk + "inductance_mH", m.inductance_mH, 0.0, false,
-                                    "held at its prior: the model neglects L/R against the mechanical time constant"));
-      r.parameters.push_back(record(mk + "torque_constant_mNm_per_A", m.torque_constant_mNm_per_A, 0.0, false, why));
-      r.parameters.push_back(record(mk + "back_emf_mV_per_rpm", m.back_emf_mV_per_rpm, 0.0, false, why));
-    }
-    r.parameters.push_back(record(mk + "gearbox_efficiency", m.gearbox_efficiency, 0.0, false,
-                                  "held at its prior: it scales every torque, so a log cannot separate it from the friction and inertia"));
-    r.parameters.push_back(record(mk + "gear_ratio", m.gear_ratio, 0.0, false, "held at its prior (a datasheet value)"));
-  }
+  r.parameters = records(r, joint, prior, o, p);
   return r;
 }
 

@@ -50,7 +50,8 @@ Json to_json(const JointIdentification& r) {
             {"linear", r.linear},
             {"sample_time_s", r.sample_time},
             {"cutoff_hz", r.cutoff_hz},
-            {"decimation", r.decimation}};
+            {"decimation", r.decimation},
+            {"edge_samples", r.edge_samples}};
   j["parameters"] = Json::array();
   for (const Parameter& p : r.parameters) {
     j["parameters"].push_back(

@@ -32,4 +32,27 @@ std::vector<double> derivative(const std::vector<double>& x, double dt);
 /// sample from the first; `factor` 1 returns x.
 std::vector<double> decimate(const std::vector<double>& x, int factor);
 
+/// Samples after which the impulse response of `sos` (one pass, from rest) has decayed: the part
+/// beyond them holds at most `tail_fraction` of its absolute sum. Within that many samples of either
+/// end, a zero-phase filter's output depends on the padding at the end rather than on the data.
+int settling_samples(const std::vector<Biquad>& sos, double tail_fraction);
+/// settling_samples() of decimate()'s anti-aliasing filter at `factor`, in samples at the full rate
+/// (0 for factor 1).
+int decimation_settling_samples(int factor, double tail_fraction);
+/// Sum of the squared impulse response of decimate()'s filter run forward and backward, at the full
+/// rate: the variance a white unit noise keeps through it (about 0.8 / factor). 1 for factor 1.
+double decimation_noise_gain(int factor);
+/// The impulse response of `sos` run forward and backward (zero phase), centred: element k is the
+/// response at lag k - half, half = (size - 1) / 2.
+std::vector<double> zero_phase_impulse(const std::vector<Biquad>& sos, int half);
+/// The share of a filter's impulse response (absolute sum) left beyond its settling length in
+/// edge_samples().
+inline constexpr double kEdgeTail = 1e-3;
+/// Full-rate samples at each end of a log whose IDIM-LS rows depend on the filters' start-up rather
+/// than on the data: the position low-pass's settling (Butterworth `order` at `cutoff_hz`), the two
+/// samples of the one-sided differences, and the decimation filter's settling (kEdgeTail).
+int edge_samples(int order, double cutoff_hz, double sample_rate_hz, int decimation);
+/// The sections of decimate()'s anti-aliasing filter at `factor` (>= 2), normalised frequency (fs 1).
+std::vector<Biquad> decimation_filter(int factor);
+
 }  // namespace fivebar::identify

@@ -22,7 +22,9 @@ struct IdentifyOptions {
   int decimation = 0;            ///< 0: 10, less when the log would keep fewer than 50 rows per unknown
   bool per_direction = false;    ///< viscous friction per direction of motion
   /// The logged drive is a command held over each sample (zero-order hold): the regression pairs the
-  /// acceleration at t_k with (d_k-1 + d_k) / 2. false: the drive is an instantaneous value.
+  /// acceleration at t_k (two central differences) with (d_k-2 + 3 d_k-1 + 3 d_k + d_k+1) / 8, and a
+  /// voltage's current is taken over each sample through the winding's lag. false: the drive is an
+  /// instantaneous value.
   bool zero_order_hold = true;
   bool output_error = true;      ///< refine by simulation (Ceres) after IDIM-LS
   bool use_output_error = false; ///< report the refined values as the parameters (default: IDIM-LS)
@@ -78,6 +80,7 @@ struct JointIdentification {
   bool linear = false;
   double sample_time = 0.0, cutoff_hz = 0.0;
   int decimation = 1;
+  int edge_samples = 0;       ///< full-rate samples at each end left out of the fit: the filters' settling
   Estimate idim;              ///< mechanical base parameters, IDIM-LS
   std::optional<Estimate> electrical;  ///< R, L, k_e when a voltage drive logs its current
   std::optional<Estimate> output_error;

@@ -23,6 +23,12 @@ struct PlanOptions {
   double max_speed = 6.283185307179586;    ///< rad/s
   double current_limit = 1.0;   ///< A (the motor's driver)
   double drive_noise = 0.01;    ///< sigma of the logged drive torque, N m (an assumption the caller states)
+  /// The reading's quantum, rad (the potentiometer through the ADC: rad_per_volt x range / 2^bits);
+  /// its uniform rounding error, variance q^2 / 12, enters the fit through the filtered derivatives.
+  double angle_quantum = 0.0;
+  /// Fade-in and fade-out, s: the multisine rises from rest (position at the centre, speed and
+  /// acceleration zero) and returns to it, each over this time (at most a quarter of the duration).
+  double fade_s = 1.0;
   int decimation = 10;
   bool per_direction = false;
 };
@@ -34,6 +40,10 @@ struct ExcitationPlan {
   std::vector<std::string> names;   ///< mechanical_names()
   Eigen::VectorXd truth;         ///< the priors the sigmas are computed at
   Eigen::VectorXd expected_sigma;
+  double expected_residual = 0.0;  ///< s of the fit: the drive noise and the quantisation after the filters, N m
+  double quantisation_share = 0.0; ///< of s^2, the quantisation's
+  double fade_s = 0.0;           ///< the fade applied
+  int edge_samples = 0;          ///< left out of the predicted fit at each end, as identify does
   double crest_factor = 0.0;
 };
 
