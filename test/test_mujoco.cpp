@@ -41,6 +41,7 @@
 #include "fivebar/kinematics.hpp"
 #include "fivebar/export/mjcf.hpp"
 #include "fivebar/sections/geometry.hpp"
+#include "fivebar/sections/patterns.hpp"
 #include "fivebar/sections/print.hpp"
 #include "fivebar/export/urdf.hpp"
 
@@ -368,6 +369,29 @@ TEST_F(MujocoTest, HomeKeyframeHasTheTactorsApartAboutTheCentreAndNoContact) {
       }
     }
   }
+}
+
+TEST(Mujoco, HomeFallsBackToAReachableSeparation) {
+  // A stretch pattern starting 100 mm apart (beyond the linkages' reach, L1 + L3 = 24 mm):
+  // home falls back to the clearance rule, max(tactor 4, boss 5) + 0.3 = 5.3 mm, still without contact.
+  Design d = paper();
+  PatternSettings* p = d.get<PatternSettings>();
+  ASSERT_NE(p, nullptr);
+  for (PatternSpec& spec : p->global) spec.separation_mm = 100.0;
+  p->overrides.clear();
+  const Station& s = *d.station("index");
+  const MjcfHome home = mjcf_home(d, s);
+  EXPECT_DOUBLE_EQ(home.separation_mm, 5.3);
+  EXPECT_EQ(home.separation_from, "max(tactor_diameter, boss_diameter) + min_clearance");
+  TempDir dir;
+  for (const BundleFile& f : mujoco_bundle(d, s)) {
+    fs::create_directories((dir.path / f.path).parent_path());
+    std::ofstream(dir.path / f.path, std::ios::binary) << f.bytes;
+  }
+  Scene sc(dir.path / "scene.xml");
+  ASSERT_NE(sc.m(), nullptr) << sc.l->error;
+  EXPECT_NEAR((sc.tactor_mm("index_upper_tactor") - sc.tactor_mm("index_lower_tactor")).norm(), 5.3, 1e-9);
+  EXPECT_EQ(sc.d->ncon, 0);
 }
 
 TEST_F(MujocoTest, DrivingTheUpperTactorIntoTheLowerOneMakesContact) {

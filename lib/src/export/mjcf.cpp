@@ -344,9 +344,11 @@ void write_keyframe(MjWriter& w, const Design& design, const Station& station, c
     where += (where.empty() ? "" : ", ") + h.name + " tactor at (" + format::fixed(h.P_mm.x(), 3) + ", " +
              format::fixed(h.P_mm.y(), 3) + ") mm";
   }
-  w.comment(1, "home: the tactors about the target centre (" + where + (home.separation_mm > 0.0
-                   ? "; " + format::fixed(home.separation_mm, 3) + " mm apart, " + home.separation_from
-                   : std::string()) + "), every contact clear; ctrl " +
+  const bool apart = home.separation_mm > 0.0 || home.mechanisms.size() < 2;
+  w.comment(1, "home: the tactors about the target centre (" + where +
+                   (home.separation_mm > 0.0 ? "; " + format::fixed(home.separation_mm, 3) + " mm apart, " + home.separation_from
+                                             : home.separation_from.empty() ? std::string() : "; " + home.separation_from) +
+                   ")" + (apart ? ", every contact clear" : ", the tactors overlapping") + "; ctrl " +
                    (actuators == MjcfActuators::position ? "the home angles." : "0 (duty)."));
   w.line(1, "<keyframe>");
   w.line(2, "<key name=\"home\" qpos=\"" + qpos + "\"" + (ctrl.empty() ? std::string() : " ctrl=\"" + ctrl + "\"") + "/>");
@@ -388,56 +390,64 @@ StopRange stop_range(const Design& design, const Station& station, const Mechani
   return r;
 }
 
+namespace {
+
+/// One mechanism's home at the tactor point centre + (0, dy), on the branches of its pose at the
+/// centre; std::nullopt when it cannot reach the point or a joint leaves its usable range there.
+std::optional<MjcfHome::Mechanism> home_of(const Design& design, const Station& station, const Mechanism& mech, double dy) {
+  const std::array<UsableRange, 2> ranges = usable_ranges(design, station, mech);
+  const Pose centre = fk(mech, ranges[0].reference, ranges[1].reference);
+  MjcfHome::Mechanism h;
+  h.name = mech.name;
+  h.P_mm = station.target.center + Vec2(0.0, dy);
+  const Pose pose = ik(mech, h.P_mm);
+  if (pose.status == Status::unreachable) return std::nullopt;
+  const Vec2 r3 = pose.P - pose.A1, r4 = pose.P - pose.A2;
+  const std::array<double, 2> phi{std::atan2(r3.y(), r3.x()), std::atan2(r4.y(), r4.x())};
+  const std::array<double, 2> theta_c{ranges[0].reference, ranges[1].reference};
+  const Vec2 c3 = centre.P - centre.A1, c4 = centre.P - centre.A2;
+  const std::array<double, 2> elbow_c{wrap(std::atan2(c3.y(), c3.x()) - theta_c[0]), wrap(std::atan2(c4.y(), c4.x()) - theta_c[1])};
+  const std::array<double, 2> theta{pose.theta1, pose.theta2};
+  for (std::size_t i = 0; i < 2; ++i) {
+    h.theta[i] = theta_c[i] + wrap(theta[i] - theta_c[i]);
+    h.elbow[i] = elbow_c[i] + wrap(phi[i] - h.theta[i] - elbow_c[i]);
+    if (range_margin(ranges[i], h.theta[i]) < 0.0) return std::nullopt;
+  }
+  return h;
+}
+
+}  // namespace
+
 MjcfHome mjcf_home(const Design& design, const Station& station) {
   const Geometry* g = design.get<Geometry>();
   if (g == nullptr) throw InputError("the MJCF needs the design's `geometry:` section");
-  MjcfHome home;
   const std::vector<const Mechanism*> mechs = station.mechanisms();
+  // Separations to try, in order: the stretch pattern's start, the tactors' disks and the bosses at P
+  // clear of each other by min_clearance, and none (every tactor at the centre: the target's own pose,
+  // always within the usable ranges).
+  std::vector<std::pair<double, std::string>> candidates;
   if (mechs.size() == 2) {
-    // The stretch pattern's start when the design has one; else the tactors' disks and the bosses at P
-    // clear of each other by min_clearance.
-    home.separation_mm = std::max(g->tactor_diameter, g->boss_diameter) + g->min_clearance;
-    home.separation_from = "max(tactor_diameter, boss_diameter) + min_clearance";
     if (const PatternSettings* p = design.get<PatternSettings>()) {
       for (const PatternSpec& spec : p->for_station(station.name)) {
-        if (spec.kind == PatternKind::stretch) {
-          home.separation_mm = spec.separation_mm;
-          home.separation_from = "the stretch pattern's separation_mm";
-        }
+        if (spec.kind == PatternKind::stretch) candidates.emplace_back(spec.separation_mm, "the stretch pattern's separation_mm");
       }
     }
+    candidates.emplace_back(std::max(g->tactor_diameter, g->boss_diameter) + g->min_clearance,
+                            "max(tactor_diameter, boss_diameter) + min_clearance");
   }
-  for (const Mechanism* mech : mechs) {
-    const std::array<UsableRange, 2> ranges = usable_ranges(design, station, *mech);
-    const Pose centre = fk(*mech, ranges[0].reference, ranges[1].reference);
-    // The upper mechanism's tactor above the lower one's (y from the lower base line toward the upper).
-    const double dy = mechs.size() == 2 ? (mech->name == "upper" ? 0.5 : -0.5) * home.separation_mm : 0.0;
-    MjcfHome::Mechanism h;
-    h.name = mech->name;
-    h.P_mm = station.target.center + Vec2(0.0, dy);
-    const Pose pose = ik(*mech, h.P_mm);
-    if (pose.status == Status::unreachable) {
-      throw InputError("the MJCF's home keyframe: " + station.name + "/" + mech->name + " cannot reach (" +
-                       format::fixed(h.P_mm.x(), 3) + ", " + format::fixed(h.P_mm.y(), 3) + ") mm");
+  candidates.emplace_back(0.0, mechs.size() == 2 ? "none reachable apart: both at the target centre" : "");
+  for (const auto& [separation, from] : candidates) {
+    MjcfHome home;
+    home.separation_mm = separation;
+    home.separation_from = from;
+    for (const Mechanism* mech : mechs) {
+      // The upper mechanism's tactor above the lower one's (y from the lower base line toward the upper).
+      const double dy = (mech->name == "upper" ? 0.5 : -0.5) * separation;
+      if (const auto h = home_of(design, station, *mech, dy)) home.mechanisms.push_back(*h);
     }
-    const Vec2 r3 = pose.P - pose.A1, r4 = pose.P - pose.A2;
-    const std::array<double, 2> phi{std::atan2(r3.y(), r3.x()), std::atan2(r4.y(), r4.x())};
-    const std::array<double, 2> theta_c{ranges[0].reference, ranges[1].reference};
-    const Vec2 c3 = centre.P - centre.A1, c4 = centre.P - centre.A2;
-    const std::array<double, 2> elbow_c{wrap(std::atan2(c3.y(), c3.x()) - theta_c[0]), wrap(std::atan2(c4.y(), c4.x()) - theta_c[1])};
-    const std::array<double, 2> theta{pose.theta1, pose.theta2};
-    for (std::size_t i = 0; i < 2; ++i) {
-      h.theta[i] = theta_c[i] + wrap(theta[i] - theta_c[i]);
-      h.elbow[i] = elbow_c[i] + wrap(phi[i] - h.theta[i] - elbow_c[i]);
-      if (range_margin(ranges[i], h.theta[i]) < 0.0) {
-        throw InputError("the MJCF's home keyframe: joint " + ranges[i].joint + " at " +
-                         format::fixed(h.theta[i] * 180.0 / std::numbers::pi, 2) + " deg is outside its usable range " +
-                         describe(ranges[i]));
-      }
-    }
-    home.mechanisms.push_back(h);
+    if (home.mechanisms.size() == mechs.size()) return home;
   }
-  return home;
+  throw InputError("the MJCF's home keyframe: a mechanism of station " + station.name + " has no pose at its target centre");
 }
 
 std::string mjcf_file_name(const Design& design, const Station& station, MjcfActuators actuators) {

@@ -57,8 +57,8 @@
 /// the duty variant and your own controller for the device's figures).
 ///
 /// Keyframe `home` (mjcf_home()): the tactors about the target centre, the upper one above the
-/// lower, separation apart in y (the stretch pattern's start, else clear of each other); ctrl 0 (duty)
-/// or the home angles (position).
+/// lower, separation apart in y (the stretch pattern's start, else clear of each other, else at the
+/// centre when neither is reachable); ctrl 0 (duty) or the home angles (position).
 ///
 /// Left out: the skin's shear contact (fivebar simulate's stick/slip spring anchored where the
 /// tactor touches needs the skin's normal preload and an anchor that MJCF's contacts do not
@@ -117,7 +117,9 @@ struct MjcfHome {
   };
   std::vector<Mechanism> mechanisms;  ///< station.mechanisms() order
 };
-/// InputError when a mechanism's home point is unreachable or outside its usable range.
+/// The first separation both mechanisms reach within their usable ranges: the stretch pattern's, the
+/// clearance rule, else none (both tactors at the centre, overlapping; separation_from says so).
+/// InputError when a mechanism has no pose at its target centre.
 MjcfHome mjcf_home(const Design& design, const Station& station);
 
 /// `<design>_<station>.xml` (duty), `<design>_<station>_position.xml` (position).
