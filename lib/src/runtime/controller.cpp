@@ -227,8 +227,8 @@ bool forbidden(const Plan& plan, std::size_t nf, V2 q) {
 }
 
 /// The rule's second stage, when the rays' march found no free point (links block every exit
-/// within its steps) or a far one: rings about `origin` at radii r_k = kPriorityRingFirstRel * scale *
-/// kPriorityRingGrowth^(k-1) up to `radius` (the search radius, or the rays' point), kPriorityRays fixed
+/// within its steps): rings about `origin` at radii r_k = kPriorityRingFirstRel * scale *
+/// kPriorityRingGrowth^(k-1) up to `radius` (the search radius), kPriorityRays fixed
 /// directions each (a point inside a forbidden capsule of the tactor is blocked without a probe); on
 /// the first ring with a free point every free ray is bisected kPriorityBisections times against the
 /// ring before, and the closest result wins. A ring point that cannot be held is not free, and its
@@ -399,13 +399,6 @@ bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin,
   const double radius = kPrioritySearchRadiusRel * low.mech.scale;
   if (!(best < inf)) return ring_search(plan, low, upper, origin, nf, radius, found);
   found = origin + best * plan.dirs[best_dir];
-  // A far point of the rays (links blocked the nearer exits) can be much farther than the closest
-  // free point between them: the rings up to it look for a closer one.
-  V2 ring;
-  if (best > kPriorityRingFirstRel * low.mech.scale &&
-      ring_search(plan, low, upper, origin, nf, std::min(best, radius), ring) && norm(ring - origin) < best) {
-    found = ring;
-  }
   return true;
 }
 
