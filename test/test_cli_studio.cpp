@@ -25,6 +25,7 @@
 
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
+using ft::slurp;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
