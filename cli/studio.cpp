@@ -3,7 +3,6 @@
 // (fivebar/studio.hpp); this file is the HTTP front of it, with cpp-httplib: loopback only, a
 // per-run token, Host and Origin checked, assets compiled into the binary, no shell.
 
-#include <httplib.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -23,6 +22,9 @@
 #include "fivebar/scene.hpp"
 #include "fivebar/studio.hpp"
 #include "studio_assets.hpp"
+
+// Last: <httplib.h> brings <resolv.h>, whose macro `_res` would rename a parameter of Eigen's headers.
+#include <httplib.h>
 
 namespace fivebar::cli {
 

@@ -5,7 +5,6 @@
 // The page itself is tested in a real browser by test/studio_browser.py.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <httplib.h>
 #include <signal.h>
 
 #include <nlohmann/json.hpp>
@@ -21,8 +20,12 @@
 #include "fivebar/studio.hpp"
 #include "fivebar/workspace/region.hpp"
 
+// Last: <httplib.h> brings <resolv.h>, whose macro `_res` would rename a parameter of Eigen's headers.
+#include <httplib.h>
+
 namespace fs = std::filesystem;
 namespace ft = fivebar::testing;
+using ft::slurp;
 using nlohmann::json;
 using ::testing::HasSubstr;
 
