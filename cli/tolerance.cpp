@@ -88,8 +88,7 @@ void print_mechanism(const ToleranceMap& r) {
   }
   std::cout << "\n";
   if (c.samples > 0) {
-    std::cout << "    Monte Carlo: the " << fixed(100.0 * (1.0 - c.fraction), 1) << " % quantile of the devices' margins "
-              << fixed(c.quantile_margin_mm, 4) << " mm, >= "
+    std::cout << "    Monte Carlo: that quantile is >= "
               << (std::isfinite(c.quantile_lower_mm) ? fixed(c.quantile_lower_mm, 4) + " mm" : std::string("? (too few samples)"))
               << " with " << fixed(100.0 * c.quantile_confidence, 0) << " % confidence (order statistic, binomial)\n";
   }
