@@ -13,6 +13,7 @@
 // loop by a wall timer at loop_rate_hz. Nothing in the loop allocates after the controller is built.
 
 #include <charconv>
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iostream>
@@ -22,6 +23,7 @@
 #include <string>
 #include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "fivebar/runtime.hpp"
@@ -42,7 +44,9 @@ class DeviceIo {
 /// CSV on streams: a recorded or piped log in, duties out.
 class CsvIo : public DeviceIo {
  public:
-  CsvIo(std::istream& in, std::ostream& out, const rt::Config& c) : in_(in), out_(out) {
+  /// Reads the header; a station of `c` with no column in it is left out of `c` (a log of one
+  /// station runs against the export of several, as `fivebar replay` reads it).
+  CsvIo(std::istream& in, std::ostream& out, rt::Config& c) : in_(in), out_(out) {
     std::string line;
     if (!next_line(line)) throw std::runtime_error("input: no header row");
     const std::vector<std::string> header = split(line);
@@ -54,6 +58,14 @@ class CsvIo : public DeviceIo {
       if (it == at.end()) throw std::runtime_error("input: column " + name + " is missing");
       return it->second;
     };
+    const auto has_columns = [&](const rt::StationConfig& st) {
+      for (const auto& [name, index] : at)
+        if (name.rfind(st.name + "_", 0) == 0) return true;
+      return false;
+    };
+    c.stations.erase(std::remove_if(c.stations.begin(), c.stations.end(), [&](const rt::StationConfig& st) { return !has_columns(st); }),
+                     c.stations.end());
+    if (c.stations.empty()) throw std::runtime_error("input: no station of the configuration has columns");
     const std::string first = c.stations.front().mechanisms.front().joints[0].name;
     kind_ = at.count(first + "_counts") ? rt::Reading::counts : at.count(first + "_volts") ? rt::Reading::volts : rt::Reading::radians;
     const char* suffix = kind_ == rt::Reading::counts ? "_counts" : kind_ == rt::Reading::volts ? "_volts" : "_theta_rad";
@@ -141,13 +153,14 @@ int main(int argc, char** argv) {
     else input = argv[i];
   }
   try {
-    rt::Controller controller(rt::load_config_json(argv[1]));  // refuses a bad configuration, naming the key
+    rt::Config config = rt::load_config_json(argv[1]);  // refuses a bad configuration, naming the key
     std::ifstream file;
     if (input != "-") {
       file.open(input);
       if (!file) throw std::runtime_error(input + ": cannot be read");
     }
-    CsvIo io(input == "-" ? std::cin : file, std::cout, controller.config());
+    CsvIo io(input == "-" ? std::cin : file, std::cout, config);  // leaves out the stations the log lacks
+    rt::Controller controller(std::move(config));
     // Buffers sized once: the loop below does not allocate.
     std::vector<double> readings(controller.joint_count()), targets(2 * controller.mechanism_count());
     std::vector<rt::Status> statuses(controller.mechanism_count());

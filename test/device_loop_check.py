@@ -49,6 +49,13 @@ noted.write_text("# a note before the header\n" + text[0] + "\n# a note between 
 again = subprocess.run([LOOP, str(config), str(noted)], check=True, capture_output=True, text=True).stdout
 if again != out:
     failures.append("the log with # notes and a blank line gives other output")
+# The log of one station against the export of both (as `fivebar replay` reads it): the same output.
+subprocess.run([FIVEBAR, "export", DESIGN, "--format", "json", "--out", str(WORK / "export-all")], check=True,
+               stdout=subprocess.DEVNULL)
+both = next((WORK / "export-all").glob("*_controller.json"))
+whole = subprocess.run([LOOP, str(both), str(log)], capture_output=True, text=True)
+if whole.returncode != 0 or whole.stdout != out:
+    failures.append(f"one-station log against the two-station export: exit {whole.returncode}, {whole.stderr.strip()!r}")
 # A cell that is not wholly a number (`41496junk` was read as 41496) stops the loop naming its line
 # and column, exit 2, as does a short row.
 header = text[0].rstrip("\n").split(",")
