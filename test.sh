@@ -17,7 +17,8 @@
 # Every build directory shares the machine's compiler cache (.ci/setup.sh). Each stage logs its
 # wall time ("stage NAME: N s"); test/build_cost.py tabulates them.
 #
-# Other arguments go to ctest (e.g. ./test.sh -R hostile).
+# Other arguments go to ctest (e.g. ./test.sh -R hostile). Tests labelled `long` (many minutes of
+# CPU: the priority rule on 10^4 random pairs per station) are left out: `ctest -L long` runs them.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")"
 source .ci/setup.sh
@@ -46,7 +47,8 @@ fivebar_stage packages fivebar_install_packages "${packages[@]}"
 if ((normal)); then
   fivebar_stage build fivebar_build_in build "Release" -DFIVEBAR_BUILD_TESTS=ON --
   fivebar_log "test suite (build/)"
-  fivebar_stage test ctest --test-dir build --output-on-failure -j2 "${ctest_args[@]}"
+  # Label `long`: runs of many minutes that a change rarely needs (ctest -L long runs them).
+  fivebar_stage test ctest --test-dir build --output-on-failure -j2 -LE long "${ctest_args[@]}"
 fi
 
 if ((core)); then
@@ -72,7 +74,7 @@ if ((sanitize)); then
   # A whole `fivebar run` of the showcase takes about 55 s under ASan on this 2-core machine.
   export FIVEBAR_TEST_CHILD_TIMEOUT_S="${FIVEBAR_TEST_CHILD_TIMEOUT_S:-240}"
   fivebar_log "test suite under ASan + UBSan (build-sanitize/)"
-  fivebar_stage sanitize-test ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 1500 "${ctest_args[@]}"
+  fivebar_stage sanitize-test ctest --test-dir build-sanitize --output-on-failure -j2 --timeout 1500 -LE long "${ctest_args[@]}"
 fi
 
 if ((fuzz)); then
