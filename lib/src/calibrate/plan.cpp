@@ -67,10 +67,11 @@ bool within_margins(const Mechanism& m, const Vec2& P, const Vec2& side, double 
   return s * signed_distance(P) >= base;
 }
 
-/// True when every one of `samples` devices drawn uniformly within 3 prior sigmas of each of the
+/// True when every one of `samples` devices drawn uniformly within 4 prior sigmas (a margin over the
+/// 3-sigma box the plan promises) of each of the
 /// twelve parameters assembles the candidate's readings in the design's working mode.
 bool reachable_by_perturbed(const Mechanism& m, const MechanismVector& q, const PlannedPose& p, int samples, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  std::uniform_real_distribution<double> u(-4.0, 4.0);  // a margin over the 3-sigma box
   for (int k = 0; k < samples; ++k) {
     MechanismVector d = q;
     for (int i = 0; i < kMechanismParameters; ++i) d[i] += u(rng) * prior_sigma(i, q);
