@@ -4,8 +4,8 @@
 /// limits, hard stops against the base, potentiometer travel), away from singularities (LCI at
 /// least `min_lci`), at least `extension_margin_mm` from each leg's full extension and folding
 /// and `base_margin_mm` from the mechanism's base line on the target's side, and reachable by every
-/// one of `reach_samples` devices drawn within 3 prior sigmas of every parameter
-/// (prior_sigma(), fivebar/calibrate/fit.hpp). From a grid of such candidates the poses are chosen
+/// one of `reach_samples` devices drawn within 4 prior sigmas of every parameter (a margin over the
+/// 3-sigma box; prior_sigma(), fivebar/calibrate/fit.hpp). From a grid of such candidates the poses are chosen
 /// greedily, then improved by exchanges, to minimise the predicted tactor error over the target
 /// (I-optimal, the default: the mean over target points t of trace(G_t M^{-1} G_t^T), G_t the
 /// tactor's sensitivity to the parameters where the controller drives it to t, M the information
