@@ -42,6 +42,7 @@ struct CalibrateCliOptions {
   std::vector<std::string> fit;
   std::optional<int> plan;
   double plan_sigma_mm = 0.02;
+  std::string plan_criterion = "i";
   std::uint64_t seed = 1;
   std::string hard_stops;
   bool json = false;
@@ -119,6 +120,8 @@ int run_calibrate(const CalibrateCliOptions& opt) {
     calibrate::PlanOptions po;
     po.poses = *opt.plan;
     po.sigma_mm = opt.plan_sigma_mm;
+    if (opt.plan_criterion != "i" && opt.plan_criterion != "d") throw InputError("--plan-criterion = '" + opt.plan_criterion + "': must be i or d");
+    po.criterion = opt.plan_criterion == "d" ? calibrate::PlanCriterion::d_optimal : calibrate::PlanCriterion::i_optimal;
     po.seed = opt.seed;
     std::string station = opt.station;
     if (station.empty()) {
@@ -139,6 +142,9 @@ int run_calibrate(const CalibrateCliOptions& opt) {
       }
       std::cout << p.poses.size() << " poses of " << p.candidates << " candidates, observability index " << fixed(p.observability_index, 4)
                 << " (median of " << po.random_trials << " random sets of as many: " << fixed(p.random_observability_index, 4) << ")\n"
+                << "  predicted RMS tactor error over the target (" << p.target_points << " points, "
+                << (po.criterion == calibrate::PlanCriterion::i_optimal ? "I-optimal" : "D-optimal") << ", linearised): "
+                << fixed(p.predicted_target_error_mm * 1e3, 2) << " um (random sets: " << fixed(p.random_target_error_mm * 1e3, 2) << " um)\n"
                 << "  expected posterior sigma at " << fixed(po.sigma_mm, 4) << " mm per axis (planned / random median):\n";
       for (std::size_t k = 0; k < p.names.size(); ++k) {
         std::cout << "    " << p.names[k] << ": " << fixed(p.expected_sigma[k], 5) << " / " << fixed(p.random_sigma[k], 5) << "\n";
@@ -244,6 +250,10 @@ void setup_calibrate(CLI::App& app) {
                                              "else estimated from the residuals")
       ->type_name("MM");
   sub->add_option("--plan", opt->plan, "Choose N poses per mechanism to measure (calibration-plan.csv)")->type_name("N");
+  sub->add_option("--plan-criterion", opt->plan_criterion,
+                  "What the plan optimises: i (the predicted tactor error over the target, I-optimal) or d (det of the "
+                  "parameters' information, D-optimal)")
+      ->capture_default_str();
   sub->add_option("--plan-sigma", opt->plan_sigma_mm, "Measurement sigma the plan's expected sigmas assume (mm)")->capture_default_str();
   sub->add_option("--seed", opt->seed, "Seed of the plan's random comparison sets")->capture_default_str();
   sub->add_option("--hard-stops", opt->hard_stops, "Potentiometer calibration from readings at the hard stops (CSV "

@@ -556,6 +556,11 @@ CalibrationResult calibrate(const Design& design, const std::vector<Measurement>
   gate::GateInput gi;
   gi.fit = "fivebar calibrate";
   gi.solver = {out.converged, out.termination, out.iterations};
+  // The priors here are the a-priori scales of the identifiability analysis (0.1 mm, ...), not
+  // measured tolerances: a value is refused when its sigma exceeds three of them (docs/calibrate.md
+  // "The quality gate"; 60 random poses at 0.02 mm leave a link's sigma up to 1.5 scales, poses on
+  // a line hundreds).
+  gi.max_sigma_to_prior = 3.0;
   if (all_sigma) {
     gi.tests.push_back(gate::chi_square_test(r.squaredNorm(), dof));
   } else {

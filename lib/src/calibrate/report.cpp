@@ -131,6 +131,12 @@ Json to_json(const std::vector<MechanismPlan>& plans, const PlanOptions& o) {
     out.push_back({{"station", p.station}, {"mechanism", p.mechanism}, {"poses", p.poses.size()}, {"candidates", p.candidates},
                    {"measurement_sigma_mm", o.sigma_mm}, {"observability_index", p.observability_index},
                    {"random_observability_index", p.random_observability_index}, {"expected_sigma", sig},
+                   {"criterion", o.criterion == PlanCriterion::i_optimal ? "I-optimal" : "D-optimal"},
+                   {"predicted_target_rms_error_mm_linearised", finite_or_null(p.predicted_target_error_mm)},
+                   {"random_target_rms_error_mm_linearised", finite_or_null(p.random_target_error_mm)},
+                   {"target_points", p.target_points},
+                   {"margins_mm", {{"extension", o.extension_margin_mm}, {"base_line", o.base_margin_mm}}},
+                   {"reach_samples", o.reach_samples},
                    {"problem", p.problem}});
   }
   return out;

@@ -154,7 +154,7 @@ GateRecord GateResult::record(std::string_view key) const {
   r.passed = passed;
   for (const ParameterVerdict& v : parameters) {
     if (v.key != key) continue;
-    r.passed = passed && v.passed;
+    r.passed = reasons.empty() && v.passed;  // this value's own verdict (the fit-wide conditions included)
     if (std::isfinite(v.sigma_ratio)) r.sigma_ratio = v.sigma_ratio;
     if (std::isfinite(v.prior_sigma) && v.prior_sigma > 0.0) r.prior_sigma = v.prior_sigma;
   }

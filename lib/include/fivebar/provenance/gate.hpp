@@ -92,7 +92,8 @@ struct GateResult {
   /// One line per refused parameter: "lower.L3 (stations.index.mechanisms.lower.links[2]) = 12.38 +- 90.1 mm:
   /// the solver did not converge (NO_CONVERGENCE); sigma 90.1 mm is 901x its prior 0.1 mm (bound 1x)".
   std::vector<std::string> refusal_lines() const;
-  /// The record of the gate a provenance entry keeps for `key` (one of the parameters).
+  /// The record of the gate a provenance entry keeps for `key` (one of the parameters): passed when
+  /// the fit-wide conditions and this value's own held (a fit is written only when all passed).
   GateRecord record(std::string_view key) const;
   /// record() of each key, in order (fivebar/provenance.hpp with_measured_values()'s `gates`).
   std::vector<GateRecord> records(const std::vector<std::string>& keys) const;
