@@ -51,7 +51,8 @@ int run_log(const ReplayOptions& opt) {
   if (opt.json) {
     // command and design lead, as in every --json document (docs/conventions.md).
     Json j = {{"command", "replay"}, {"design", config.design}, {"mode", "log"}, {"log", opt.input}, {"config", opt.config}};
-    for (const auto& [key, value] : to_json(r).items()) j[key] = value;
+    const Json body = to_json(r);  // named: items() of a temporary would dangle
+    for (const auto& [key, value] : body.items()) j[key] = value;
     print_json(j);
   } else {
     std::cout << opt.input << ": " << r.rows << " cycles through the runtime of " << opt.config << " (design "

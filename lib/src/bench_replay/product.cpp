@@ -49,6 +49,7 @@ Product bench_replay_product() {
     // The header of each log, through the bench's one reader (the rows need the export's configuration).
     const BenchSettings& bench = *d.get<BenchSettings>();
     for (std::size_t k = 0; k < bench.replay_logs.size(); ++k) {
+      BenchSettings::require_inside(d, "replay_logs[" + std::to_string(k) + "]", bench.replay_logs[k]);
       const std::filesystem::path file = BenchSettings::resolve(d, bench.replay_logs[k]);
       std::ifstream in(file, std::ios::binary);
       if (!in) throw InputError(file.generic_string() + ": cannot be read (" + key_of(k) + ")");

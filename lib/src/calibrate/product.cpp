@@ -42,6 +42,7 @@ Product calibrate_product() {
   };
   p.check_inputs = [](const Design& d) {
     const std::string& name = d.get<BenchSettings>()->calibration;
+    BenchSettings::require_inside(d, "calibration", name);  // links followed: not read when it leads out
     (void)calibrate::parse_measurements(read_bench_file(BenchSettings::resolve(d, name), "calibration measurements"), name, d);
   };
   p.build = [](Context& ctx) {

@@ -37,6 +37,7 @@ Product identify_product() {
   };
   p.check_inputs = [](const Design& d) {
     // Readable, with a header, before the output folder exists (the rows are read by build).
+    BenchSettings::require_inside(d, "identification", d.get<BenchSettings>()->identification);
     const std::filesystem::path file = BenchSettings::resolve(d, d.get<BenchSettings>()->identification);
     std::ifstream in(file, std::ios::binary);
     if (!in) throw InputError(file.generic_string() + ": cannot be read (bench.identification)");

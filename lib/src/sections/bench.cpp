@@ -35,6 +35,31 @@ void BenchSettings::validate() const {
   }
 }
 
+void BenchSettings::check_inside(const Design& design, const std::string& key, const std::string& name) {
+  if (name.empty() || design.source.empty()) return;
+  std::error_code ec;
+  const std::filesystem::path file = BenchSettings::resolve(design, name);
+  if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) return;  // missing: the product says so
+  const std::filesystem::path parent = design.source.parent_path().empty() ? std::filesystem::path(".") : design.source.parent_path();
+  const std::filesystem::path root = std::filesystem::weakly_canonical(parent, ec);
+  const std::filesystem::path real = std::filesystem::weakly_canonical(file, ec);
+  if (ec) return;
+  const auto rel = real.lexically_relative(root);
+  if (rel.empty() || *rel.begin() == "..") {
+    // The target is not named: a refused file's place or content is not echoed.
+    throw ValidationError(key, "= " + name + ": a symbolic link that leads out of the design file's folder (bench files stay beside the design)");
+  }
+}
+
+
+void BenchSettings::require_inside(const Design& design, const std::string& key, const std::string& file) {
+  try {
+    check_inside(design, "bench." + key, file);
+  } catch (const ValidationError& e) {
+    throw InputError(design.source.generic_string() + ": " + e.what());
+  }
+}
+
 namespace sections {
 namespace {
 
@@ -75,22 +100,7 @@ void load(const Value& v, Design& design) {
   b.replay_tolerance = number_or(all, "replay_tolerance", b.replay_tolerance, "");
 }
 
-/// A bench file that is there must resolve, links followed, inside the design file's folder.
-void check_links(const Design& design, const char* key, const std::string& name) {
-  if (name.empty() || design.source.empty()) return;
-  std::error_code ec;
-  const std::filesystem::path file = BenchSettings::resolve(design, name);
-  if (!std::filesystem::exists(std::filesystem::symlink_status(file, ec))) return;  // missing: the product says so
-  const std::filesystem::path parent = design.source.parent_path().empty() ? std::filesystem::path(".") : design.source.parent_path();
-  const std::filesystem::path root = std::filesystem::weakly_canonical(parent, ec);
-  const std::filesystem::path real = std::filesystem::weakly_canonical(file, ec);
-  if (ec) return;
-  const auto rel = real.lexically_relative(root);
-  if (rel.empty() || *rel.begin() == "..") {
-    // The target is not named: a refused file's place or content is not echoed.
-    throw ValidationError(key, "= " + name + ": a symbolic link that leads out of the design file's folder (bench files stay beside the design)");
-  }
-}
+void check_links(const Design& design, const char* key, const std::string& name) { BenchSettings::check_inside(design, key, name); }
 
 /// A log that is there but is a directory is a wrong name, not a missing file.
 void check_replay_logs(const Design& design, const BenchSettings& b) {

@@ -29,6 +29,12 @@ struct BenchSettings {
   /// `file` resolved against the design file's folder (as given when absolute or without a source).
   static std::filesystem::path resolve(const Design& design, const std::string& file);
   void validate() const;
+  /// ValidationError on `bench.<key>` when `file`, resolved and its links followed, lies outside
+  /// the design file's folder (docs/bench-files.md); nothing when it is missing. Called when the
+  /// design is loaded and again by each product before it reads the file.
+  static void check_inside(const Design& design, const std::string& key, const std::string& file);
+  /// check_inside() for a product about to read the file: InputError "DESIGN: bench.<key> = ...".
+  static void require_inside(const Design& design, const std::string& key, const std::string& file);
 };
 
 }  // namespace fivebar
