@@ -59,6 +59,8 @@ FIVEBAR_TEST_PACKAGES=(
   qemu-user
   # The studio's browser test (test/studio_browser.py) drives Chromium over the DevTools protocol.
   python3-websocket
+  # `pip install .` into a fresh venv (ctest python_pip_install): venv, pip and the setuptools build.
+  python3-venv python3-pip python3-setuptools python3-wheel
 )
 FIVEBAR_HARDENING_PACKAGES=(
   # Hardening (./test.sh --fuzz): clang with libFuzzer and the sanitizer runtimes, clang's OpenMP.
