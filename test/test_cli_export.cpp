@@ -81,15 +81,20 @@ TEST_F(CliExport, WritesTheThreeFormatsWhichCheckAgainstTheDesign) {
   EXPECT_EQ(j["stations"]["thumb"]["lower"]["link_lengths_m"][3], 0.0175);
   EXPECT_EQ(j["fivebar"]["design_hash"], p["fivebar"]["design_hash"].as<std::string>());
 
-  // Every file export writes reads back through --check (issue 39), the URDF and MJCF included.
+  // Every file export writes reads back through --check (issue 39), the URDF and MJCF included: the
+  // files at the top and each MuJoCo bundle's model (<design>_<station>/<design>_<station>.xml).
+  std::vector<std::string> checked;
   for (const std::string& file : listing(dir_ / "ctl")) {
+    checked.push_back(fs::is_directory(dir_ / "ctl" / file) ? file + "/" + file + ".xml" : file);
+  }
+  for (const std::string& file : checked) {
     const Outcome c = run({"export", "--check", (dir_ / "ctl" / file).string(), kDesign});
     EXPECT_EQ(c.code, 0) << file << "\n" << c.out << c.err;
     EXPECT_THAT(c.out, AllOf(HasSubstr("the file matches the design"), HasSubstr("(same)")));
   }
   // A changed motor value: every file is stale, and the URDF names the gearing's key.
   const fs::path geared = design_with("geared.yaml", "  gear_ratio: 200", "  gear_ratio: 150");
-  for (const std::string& file : listing(dir_ / "ctl")) {
+  for (const std::string& file : checked) {
     const Outcome c = run({"export", "--check", (dir_ / "ctl" / file).string(), geared.string()});
     EXPECT_EQ(c.code, 1) << file << "\n" << c.out << c.err;
     EXPECT_THAT(c.out, HasSubstr("STALE")) << file;
