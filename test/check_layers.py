@@ -26,6 +26,7 @@ from fnmatch import fnmatch
 CORE_HEADERS = [
     "lib/include/fivebar/design.hpp", "lib/include/fivebar/error.hpp", "lib/include/fivebar/format.hpp",
     "lib/include/fivebar/ranges.hpp", "lib/include/fivebar/version.hpp", "lib/include/fivebar/numerics.hpp", "lib/include/fivebar/suggest.hpp",
+    "lib/include/fivebar/csv_reader.hpp",
     "lib/include/fivebar/kinematics.hpp", "lib/include/fivebar/detail/*.hpp",
     "lib/include/fivebar/workspace/region.hpp", "lib/include/fivebar/workspace/polyline.hpp",
     "lib/include/fivebar/coverage/coverage.hpp", "lib/include/fivebar/sections/*.hpp",

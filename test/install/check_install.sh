@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The installed package (docs/install.md), from a build tree: usage
 #   check_install.sh BUILD_DIR SOURCE_DIR SCRATCH_DIR VERSION
-# installs the components dev and cli into SCRATCH/stage, moves the tree to a new temporary folder
+# installs the components dev, cli and the runtime package's (development, runtime) into SCRATCH/stage,
+# moves the tree to a new temporary folder
 # (an install must not depend on its prefix), then checks that
 #   - the files of docs/install.md are there (config + version file, share/fivebar/{scad,schemas,
 #     designs,docs}, completions, a man page per command, licence and citation);
@@ -18,7 +19,7 @@ mkdir -p "$scratch"
 scratch=$(cd "$scratch" && pwd)
 fail() { echo "check_install: FAIL: $*" >&2; exit 1; }
 
-for component in dev cli; do
+for component in dev cli development runtime; do
   cmake --install "$build" --prefix "$scratch/stage" --component "$component" > "$scratch/install-$component.log"
 done
 # Moved out of the build tree too: the data must be found beside the binary, not above it in the
