@@ -225,12 +225,17 @@ bool skipped(const XmlElement& e, bool masses_from_renders) {
 
 void diff_xml(const XmlElement& expected, const XmlElement& found, const std::string& path, bool renders,
               std::vector<ExportDifference>& out) {
-  for (const auto& [key, value] : expected.attributes) {
+  // Named pairs, not structured bindings: clang 14 (the fuzz build) cannot capture a binding.
+  for (const auto& attribute : expected.attributes) {
+    const std::string& key = attribute.first;
+    const std::string& value = attribute.second;
     const auto it = std::find_if(found.attributes.begin(), found.attributes.end(), [&](const auto& a) { return a.first == key; });
     if (it == found.attributes.end()) out.push_back({path + "@" + key, value, "(absent)"});
     else if (!same_value(value, it->second)) out.push_back({path + "@" + key, value, it->second});
   }
-  for (const auto& [key, value] : found.attributes) {
+  for (const auto& attribute : found.attributes) {
+    const std::string& key = attribute.first;
+    const std::string& value = attribute.second;
     const auto it = std::find_if(expected.attributes.begin(), expected.attributes.end(), [&](const auto& a) { return a.first == key; });
     if (it == expected.attributes.end()) out.push_back({path + "@" + key, "(absent)", value});
   }
