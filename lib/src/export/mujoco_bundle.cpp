@@ -227,14 +227,7 @@ std::vector<BundleFile> mujoco_bundle(const Design& design, const Station& stati
   files.push_back({"scene.xml", scene(design, station, bodies, g, MjcfActuators::duty)});
   files.push_back({"scene_position.xml", scene(design, station, bodies, g, MjcfActuators::position)});
   std::vector<std::string> meshes;
-  const auto add = [&](const detail::Body& b) {
-    if (!b.mesh_rel.empty() && std::find(meshes.begin(), meshes.end(), b.mesh_rel) == meshes.end()) meshes.push_back(b.mesh_rel);
-  };
-  add(bodies.base);
-  for (const detail::MechanismBodies& mb : bodies.mechanisms) {
-    for (const detail::Body& b : mb.links) add(b);
-    add(mb.tip);
-  }
+  detail::add_station_meshes(bodies, meshes);
   for (const std::string& rel : meshes) files.push_back({std::filesystem::path("assets") / rel, read_bytes(options.parts_dir / rel)});
   files.push_back({"preview.svg", preview_svg(design, station, bodies, g)});
   files.push_back({"LICENSE", license_note(design, station)});

@@ -149,4 +149,15 @@ StationBodies station_bodies(const Design& design, const Station& station, const
   return out;
 }
 
+void add_station_meshes(const StationBodies& bodies, std::vector<std::string>& meshes) {
+  const auto add = [&](const Body& b) {
+    if (!b.mesh_rel.empty() && std::find(meshes.begin(), meshes.end(), b.mesh_rel) == meshes.end()) meshes.push_back(b.mesh_rel);
+  };
+  add(bodies.base);
+  for (const MechanismBodies& mb : bodies.mechanisms) {
+    for (const Body& b : mb.links) add(b);
+    add(mb.tip);
+  }
+}
+
 }  // namespace fivebar::detail

@@ -57,5 +57,8 @@ struct StationBodies {
 
 /// InputError without `geometry:`.
 StationBodies station_bodies(const Design& design, const Station& station, const UrdfOptions& options);
+/// Appends to `meshes` each mesh (relative to the parts folder) a station's bodies name and `meshes`
+/// does not hold yet: the files a bundle or a package copies beside its model.
+void add_station_meshes(const StationBodies& bodies, std::vector<std::string>& meshes);
 
 }  // namespace fivebar::detail

@@ -193,14 +193,7 @@ std::vector<BundleFile> ros2_package(const Design& design, const std::vector<std
     const Station& station = *design.station(st);
     files.push_back({std::filesystem::path("urdf") / urdf_file_name(design, station), render_urdf(design, station, options)});
     const detail::StationBodies bodies = detail::station_bodies(design, station, options);
-    const auto add = [&](const detail::Body& b) {
-      if (!b.mesh_rel.empty() && std::find(meshes.begin(), meshes.end(), b.mesh_rel) == meshes.end()) meshes.push_back(b.mesh_rel);
-    };
-    add(bodies.base);
-    for (const detail::MechanismBodies& mb : bodies.mechanisms) {
-      for (const detail::Body& b : mb.links) add(b);
-      add(mb.tip);
-    }
+    detail::add_station_meshes(bodies, meshes);
   }
   for (const std::string& rel : meshes) files.push_back({std::filesystem::path("meshes") / rel, read_bytes(parts.parts_dir / rel)});
   files.push_back({"package.xml", package_xml(design, name, stations)});
