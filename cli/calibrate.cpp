@@ -55,14 +55,6 @@ std::string read_text(const std::string& path, const char* what) {
   return csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, what);
 }
 
-void print_gate(const gate::GateResult& g) {
-  if (g.parameters.empty() && g.passed) return;
-  std::cout << "quality gate: " << (g.passed ? "passed" : "refused") << " (solver " << g.solver.termination << ", "
-            << g.solver.iterations << " iterations)\n";
-  for (const gate::ResidualTest& t : g.tests) std::cout << "  " << t.statement << "\n";
-  for (const std::string& line : g.refusal_lines()) std::cout << "  not measured: " << line << "\n";
-}
-
 void print_result(const calibrate::CalibrationResult& r) {
   std::cout << "station " << r.station << " (" << format::join(r.mechanisms) << "): " << r.poses << " poses fitted";
   if (r.holdout_poses > 0) std::cout << ", " << r.holdout_poses << " held out";
@@ -88,7 +80,7 @@ void print_result(const calibrate::CalibrationResult& r) {
   for (const calibrate::ExcludedPose& e : r.outliers) {
     std::cout << "outlier: line " << e.line << " (" << e.mechanism << "): " << e.reason << ": left out of the final fit\n";
   }
-  print_gate(r.gate);
+  std::cout << gate::to_text(r.gate);
 }
 
 int run_calibrate(const CalibrateCliOptions& opt) {

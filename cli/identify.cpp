@@ -21,6 +21,7 @@
 #include "fivebar/identify.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/provenance.hpp"
+#include "fivebar/provenance/gate.hpp"
 #include "fivebar/sha256.hpp"
 #include "fivebar/export/joint_limits.hpp"
 #include "fivebar/sections/bench.hpp"
@@ -255,6 +256,7 @@ int run_identify(const IdentifyCliOptions& opt) {
     rig_mechanism = sm.substr(slash + 1);
     if (opt.plan) throw InputError("--plan: plans one joint (--joint STATION/MECHANISM/thetaJ), not --rig mechanism");
     if (!opt.validation.empty()) throw InputError("--validation: not with --rig mechanism yet");
+    if (opt.method == "oe") throw InputError("--method oe: not with --rig mechanism (a joint of a closed chain is not simulated alone)");
   } else if (rig != "motor" || opt.rig.size() != 1) {
     throw InputError("--rig: motor, or mechanism STATION/MECHANISM");
   }
@@ -331,10 +333,10 @@ int run_identify(const IdentifyCliOptions& opt) {
   doc["joints"] = Json::array();
   for (const auto& r : results) doc["joints"].push_back(id::to_json(r));
   doc["refused"] = refused;
-  // The patched design (docs/identify.md "The patched design"), built before anything is written.
-  std::optional<Design> patched;
-  std::vector<std::string> skipped;
-  if (refused.empty() && !id::patched_keys(results).empty()) {
+  // The patched design (docs/identify.md "The patched design"), built before anything is written,
+  // with the values that passed the quality gate ("The quality gate").
+  std::optional<id::Patch> patch;
+  if (refused.empty()) {
     MeasurementSource source;
     source.file = opt.log;
     source.sha256 = sha256_file(opt.log);
@@ -342,11 +344,14 @@ int run_identify(const IdentifyCliOptions& opt) {
     source.method = std::string(rig_station.empty() ? "fivebar identify --rig motor: " : "fivebar identify --rig mechanism: ") +
                     (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
                     ", standard deviation";
-    patched = id::patched_design(design, results, source, &skipped);
-    patched->reset<BenchSettings>();  // written elsewhere: its bench: files would not resolve
-    doc["patched"] = id::patched_keys(results);
-    doc["not_patched"] = skipped;
+    patch = id::patch_design(design, results, source, opt.method == "oe");
+    if (patch->design) patch->design->reset<BenchSettings>();  // written elsewhere: its bench: files would not resolve
+    doc["gate"] = gate::to_json(patch->gate);
+    doc["patched"] = patch->patched;
+    doc["not_patched"] = patch->not_patched;
   }
+  const bool gate_refused = patch && !patch->gate.reasons.empty();
+  const Design* patched = patch && patch->design ? &*patch->design : nullptr;
   std::vector<std::string> files;
   if (!opt.no_files) {
     const std::filesystem::path dir =
@@ -380,10 +385,20 @@ int run_identify(const IdentifyCliOptions& opt) {
   } else {
     for (const auto& r : results) print_joint(r);
     for (const std::string& s : refused) std::cout << "NOT IDENTIFIABLE (asked by --fit): " << s << "\n";
-    for (const std::string& s : skipped) std::cout << "not patched: " << s << "\n";
+    if (patch) {
+      // The gate's verdict and tests; the values it or the motor: section refused, one line each.
+      std::cout << "quality gate: " << (patch->gate.reasons.empty() ? "passed" : "refused, nothing patched") << " (solver "
+                << patch->gate.solver.termination << ")\n";
+      for (const gate::ResidualTest& t : patch->gate.tests) std::cout << "  " << t.statement << "\n";
+      for (const std::string& s : patch->not_patched) std::cout << "not patched: " << s << "\n";
+    }
     if (!files.empty()) std::cout << "wrote " << files.size() << " files into " << std::filesystem::path(files.front()).parent_path().generic_string() << "\n";
   }
-  return refused.empty() ? kOk : kCheckFailed;
+  if (gate_refused) {
+    std::cerr << "fivebar identify: the fit did not pass the quality gate (docs/identify.md \"The quality gate\"): nothing patched\n";
+    for (const std::string& r : patch->gate.reasons) std::cerr << "  " << r << "\n";
+  }
+  return refused.empty() && !gate_refused ? kOk : kCheckFailed;
 }
 
 }  // namespace
@@ -439,7 +454,7 @@ void setup_identify(CLI::App& app) {
       "viscous_N_s_per_m, coulomb_N, offset_N). docs/identify.md.\nFiles: <joint>-estimation.svg|.png, "
       "<joint>-validation.svg|.png, identify.json, <design>-identified.yaml (the identified motor keys with provenance: "
       "entries); with --plan identify-plan.csv.\n" +
-      exit_status({.ok = "done", .failed = "a parameter named by --fit is not identifiable from the log"}));
+      exit_status({.ok = "done", .failed = "a parameter named by --fit is not identifiable from the log, or the fit did not pass the quality gate (nothing patched)"}));
 }
 
 }  // namespace fivebar::cli

@@ -139,6 +139,38 @@ TEST_F(CliIdentify, AParameterTheLogCannotSeparateIsNamedAndRefusedWhenAskedFor)
   EXPECT_FALSE(fs::exists(dir_ / "o"));
 }
 
+// The quality gate (docs/identify.md): a log whose drive did not move the joint (its current
+// column played backwards) is fitted, but the model explains little of the drive: exit 1, the
+// failed test printed, no design written.
+TEST_F(CliIdentify, ALogTheModelDoesNotDescribeIsRefusedByTheGateAndNothingIsPatched) {
+  ft::SyntheticTruth truth;
+  ft::SyntheticLog log = ft::synthetic_log(truth, 41);
+  const fs::path good = write("good.csv", log.csv());
+  std::reverse(log.current.begin(), log.current.end());
+  const fs::path bad = write("reversed.csv", log.csv());
+  Outcome r = run({"identify", kDesign, bad.string(), "--no-output-error", "--out", "bad"});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("quality gate: refused, nothing patched"));
+  EXPECT_THAT(r.err, HasSubstr("did not pass the quality gate"));
+  EXPECT_THAT(r.err, HasSubstr("joint motor: drive fit"));
+  EXPECT_FALSE(fs::exists(dir_ / "bad" / "iros2022-identified.yaml"));
+  EXPECT_TRUE(fs::exists(dir_ / "bad" / "identify.json"));
+  r = run({"identify", kDesign, bad.string(), "--no-output-error", "--no-files", "--json"});
+  EXPECT_EQ(r.code, 1);
+  const json j = parse(r);
+  EXPECT_FALSE(j["gate"]["passed"].get<bool>());
+  EXPECT_THAT(j["patched"], IsEmpty());
+  // The same log with its current in order passes, and its entries record the gate.
+  r = run({"identify", kDesign, good.string(), "--no-output-error", "--out", "good"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("quality gate: passed"));
+  const fivebar::Design d = fivebar::load_design(dir_ / "good" / "iros2022-identified.yaml");
+  const auto& e = d.get<fivebar::ProvenanceSettings>()->entries.at("motor.coulomb_friction_mNm");
+  ASSERT_TRUE(e.gate.has_value());
+  EXPECT_TRUE(e.gate->passed);
+  EXPECT_THAT(e.gate->tests, HasSubstr("drive fit"));
+}
+
 TEST_F(CliIdentify, BadLogsExitTwoNamingTheLineAndColumnAndWriteNothing) {
   const fs::path bad = write("bad.csv", "time_s,current_A,theta_rad\n0,1,0\n0.001,1,0\n0.001,1,0\n");
   Outcome r = run({"identify", kDesign, bad.string(), "--out", "o"});

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -18,6 +19,8 @@
 #include "fivebar/error.hpp"
 #include "fivebar/dynamics.hpp"
 #include "fivebar/identify.hpp"
+#include "fivebar/provenance.hpp"
+#include "fivebar/sections/provenance.hpp"
 #include "fivebar/sections/motor.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/resources/estimates.hpp"
@@ -760,6 +763,93 @@ TEST(IdentifyBudget, TheLogSizeLimitIsNotAMemoryBoundTheEstimateIs) {
   }
   EXPECT_NO_THROW(check_budget(big, true, ""));
   EXPECT_NO_THROW(check_budget(identify_estimate(100'000, 4), false, ""));
+}
+
+}  // namespace
+}  // namespace fivebar
+
+// --- The quality gate between a fit and the design (fivebar/identify/patch.hpp) -------------------
+
+namespace fivebar {
+namespace {
+
+/// A hand-made identification of the bench motor: each key's value and sigma as given, every drive
+/// fit `fit_percent`.
+id::JointIdentification hand_fit(double fit_percent, const std::vector<std::array<double, 2>>& rotor_viscous_coulomb) {
+  id::JointIdentification r;
+  r.joint = "motor";
+  r.estimation_idim.drive_fit_percent = fit_percent;
+  const char* keys[] = {"motor.rotor_inertia_g_cm2", "motor.viscous_friction_mNm_s_per_rad", "motor.coulomb_friction_mNm"};
+  for (std::size_t i = 0; i < rotor_viscous_coulomb.size(); ++i) {
+    r.parameters.push_back({keys[i], rotor_viscous_coulomb[i][0], rotor_viscous_coulomb[i][1], true, ""});
+  }
+  r.parameters.push_back({"motor.terminal_resistance_ohm", 5.0, 0.0, false, "held at its prior"});
+  return r;
+}
+
+MeasurementSource hand_source() { return {"bench.csv", std::string(64, 'a'), "2026-11-29", "fivebar identify (test)"}; }
+
+TEST(IdentifyGate, AKeyTheLogDoesNotDetermineStaysAnAssumptionAndTheOthersAreTrusted) {
+  const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  // Viscous friction 0.19 +- 0.16 (84 %): above the 50 % bound. The others within it.
+  const id::Patch p = id::patch_design(d, {hand_fit(89.6, {{{0.59, 0.004}}, {{0.19, 0.16}}, {{0.83, 0.10}}})}, hand_source(), false);
+  EXPECT_TRUE(p.gate.reasons.empty());
+  EXPECT_EQ(p.patched, (std::vector<std::string>{"motor.rotor_inertia_g_cm2", "motor.coulomb_friction_mNm"}));
+  ASSERT_EQ(p.not_patched.size(), 1u);
+  EXPECT_NE(p.not_patched[0].find("motor.viscous_friction_mNm_s_per_rad"), std::string::npos) << p.not_patched[0];
+  EXPECT_NE(p.not_patched[0].find("84 % of the value (bound 50 %)"), std::string::npos) << p.not_patched[0];
+  ASSERT_TRUE(p.design.has_value());
+  const MotorParams m = p.design->get<MotorSettings>()->defaults;
+  EXPECT_EQ(m.rotor_inertia_g_cm2, 0.59);
+  EXPECT_EQ(m.coulomb_friction_mNm, 0.83);
+  EXPECT_EQ(m.viscous_friction_mNm_s_per_rad, d.get<MotorSettings>()->defaults.viscous_friction_mNm_s_per_rad);
+  // What export's require_measured reads: the written keys carry a passed gate, the skipped one none.
+  EXPECT_TRUE(is_measured(*p.design, "motor.coulomb_friction_mNm"));
+  EXPECT_FALSE(is_measured(*p.design, "motor.viscous_friction_mNm_s_per_rad"));
+  std::vector<std::string> untrusted;
+  for (const UntrustedValue& u : untrusted_values(*p.design, "motor", {})) untrusted.push_back(u.key);
+  EXPECT_EQ(std::count(untrusted.begin(), untrusted.end(), "motor.coulomb_friction_mNm"), 0);
+  EXPECT_EQ(std::count(untrusted.begin(), untrusted.end(), "motor.rotor_inertia_g_cm2"), 0);
+  const auto& e = p.design->get<ProvenanceSettings>()->entries.at("motor.coulomb_friction_mNm");
+  ASSERT_TRUE(e.gate.has_value());
+  EXPECT_TRUE(e.gate->passed);
+  EXPECT_NE(e.gate->tests.find("drive fit 89.6 %"), std::string::npos) << e.gate->tests;
+}
+
+TEST(IdentifyGate, ADriveFitBelowTheFloorWritesNothing) {
+  const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  // Two joints, one below the floor: the fit is refused as a whole.
+  id::JointIdentification good = hand_fit(95.0, {{{0.59, 0.004}}});
+  id::JointIdentification bad = hand_fit(79.9, {{{0.61, 0.004}}});
+  bad.joint = "other";
+  const id::Patch p = id::patch_design(d, {good, bad}, hand_source(), false);
+  EXPECT_FALSE(p.gate.passed);
+  ASSERT_EQ(p.gate.reasons.size(), 1u);
+  EXPECT_NE(p.gate.reasons[0].find("joint other: drive fit 79.9 %"), std::string::npos) << p.gate.reasons[0];
+  EXPECT_FALSE(p.design.has_value());
+  EXPECT_TRUE(p.patched.empty());
+  EXPECT_EQ(p.not_patched.size(), 2u);
+  // With a validation log the gate reads its fit, not the estimation log's.
+  bad.validation_idim = id::Fit{};
+  bad.validation_idim->drive_fit_percent = 90.0;
+  EXPECT_TRUE(id::patch_design(d, {good, bad}, hand_source(), false).gate.reasons.empty());
+  bad.estimation_idim.drive_fit_percent = 99.0;
+  bad.validation_idim->drive_fit_percent = 50.0;
+  EXPECT_FALSE(id::patch_design(d, {good, bad}, hand_source(), false).gate.reasons.empty());
+}
+
+TEST(IdentifyGate, TheOutputErrorValuesNeedTheirSolverToHaveConverged) {
+  const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
+  id::JointIdentification r = hand_fit(95.0, {{{0.59, 0.004}}});
+  r.estimation_oe.drive_fit_percent = 95.0;
+  r.output_error_status = "NO_CONVERGENCE: maximum number of iterations reached";
+  const id::Patch p = id::patch_design(d, {r}, hand_source(), true);
+  EXPECT_FALSE(p.gate.solver.converged);
+  EXPECT_FALSE(p.design.has_value());
+  // IDIM-LS's values do not rest on that solver.
+  EXPECT_TRUE(id::patch_design(d, {r}, hand_source(), false).design.has_value());
+  r.output_error_status = "converged";
+  EXPECT_TRUE(id::patch_design(d, {r}, hand_source(), true).design.has_value());
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "fivebar/format.hpp"
 #include "fivebar/identify.hpp"
 #include "fivebar/provenance.hpp"
+#include "fivebar/provenance/gate.hpp"
 #include "fivebar/sections/bench.hpp"
 #include "fivebar/sha256.hpp"
 #include "products/markdown.hpp"
@@ -59,18 +60,19 @@ Product identify_product() {
     }
     Json doc = {{"log", name}, {"method", "IDIM-LS"}, {"joints", Json::array()}};
     for (const auto& r : results) doc["joints"].push_back(identify::to_json(r));
-    const std::vector<std::string> keys = identify::patched_keys(results);
+    MeasurementSource source{name, sha256_file(file), today_utc(),
+                             "fivebar identify --rig motor: inverse dynamic model by least squares (IDIM-LS), standard deviation"};
+    // The quality gate decides what is written as measured (docs/identify.md "The quality gate").
+    identify::Patch patch = identify::patch_design(d, results, source, false);
+    doc["gate"] = gate::to_json(patch.gate);
+    doc["patched"] = patch.patched;
+    doc["not_patched"] = patch.not_patched;
+    const std::vector<std::string>& keys = patch.patched;
     std::string patched_file;
-    if (!keys.empty()) {
-      MeasurementSource source{name, sha256_file(file), today_utc(),
-                               "fivebar identify --rig motor: inverse dynamic model by least squares (IDIM-LS), standard deviation"};
-      std::vector<std::string> skipped;
-      Design patched = identify::patched_design(d, results, source, &skipped);
-      doc["not_patched"] = skipped;
-      patched.reset<BenchSettings>();  // the patched design lives in the output folder
+    if (patch.design) {
+      patch.design->reset<BenchSettings>();  // the patched design lives in the output folder
       patched_file = "identify/" + d.name + "-identified.yaml";
-      ctx.write_file(patched_file, to_yaml(patched));
-      doc["patched"] = keys;
+      ctx.write_file(patched_file, to_yaml(*patch.design));
       doc["patched_design"] = patched_file;
     }
     ctx.write_file("identify/identify.json", doc.dump(2) + "\n");
@@ -92,12 +94,18 @@ Product identify_product() {
       if (!r.unidentifiable.empty()) md += "; not identifiable from this log (held at the prior): " + format::join(r.unidentifiable);
       md += "\n";
     }
+    md += "\nQuality gate: " + std::string(patch.gate.reasons.empty() ? "passed" : "refused, nothing patched") + " (" +
+          patch.gate.solver.termination + ").\n";
+    for (const gate::ResidualTest& test : patch.gate.tests) md += "- " + test.statement + "\n";
+    for (const std::string& s : patch.not_patched) md += "- not patched: " + s + "\n";
     md += "\nFiles: [`identify/identify.json`](identify/identify.json)";
     if (!patched_file.empty()) md += ", [`" + patched_file + "`](" + patched_file + ") (the identified motor keys with their `provenance:` entries)";
     md += ".\n";
     b.markdown = md;
     b.result = doc;
-    b.check = std::to_string(results.size()) + " joint(s), " + std::to_string(keys.size()) + " design key(s) identified";
+    b.check = std::to_string(results.size()) + " joint(s), " + std::to_string(keys.size()) + " design key(s) measured" +
+              (patch.gate.reasons.empty() ? "" : " (the quality gate refused the fit)");
+    b.passed = patch.gate.reasons.empty();
     return b;
   };
   return p;

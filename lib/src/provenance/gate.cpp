@@ -122,6 +122,13 @@ GateResult evaluate(const GateInput& in) {
                             format::general(p.prior_sigma, 3) + " " + p.unit + " (bound " + ratio_text(in.max_sigma_to_prior) + ")");
       }
     }
+    if (std::isfinite(p.max_relative_sigma) && std::isfinite(p.sigma) && std::isfinite(p.value) &&
+        p.sigma > p.max_relative_sigma * std::abs(p.value)) {
+      v.reasons.push_back("sigma " + format::general(p.sigma, 3) + " " + p.unit + " is " +
+                          (p.value == 0.0 ? std::string("larger than the value 0")
+                                          : format::fixed(100.0 * p.sigma / std::abs(p.value), 0) + " % of the value") +
+                          " (bound " + format::fixed(100.0 * p.max_relative_sigma, 0) + " %): the data do not determine it");
+    }
     v.passed = g.reasons.empty() && v.reasons.empty();
     g.passed = g.passed && v.passed;
     g.parameters.push_back(std::move(v));
@@ -164,6 +171,15 @@ GateRecord GateResult::record(std::string_view key) const {
 std::vector<GateRecord> GateResult::records(const std::vector<std::string>& keys) const {
   std::vector<GateRecord> out;
   for (const std::string& k : keys) out.push_back(record(k));
+  return out;
+}
+
+std::string to_text(const GateResult& g) {
+  if (g.parameters.empty() && g.passed) return {};
+  std::string out = "quality gate: " + std::string(g.passed ? "passed" : "refused") + " (solver " + g.solver.termination + ", " +
+                    std::to_string(g.solver.iterations) + " iterations)\n";
+  for (const ResidualTest& t : g.tests) out += "  " + t.statement + "\n";
+  for (const std::string& line : g.refusal_lines()) out += "  not measured: " + line + "\n";
   return out;
 }
 

@@ -9,7 +9,9 @@
 ///      ResidualTest with its statement and p-value);
 ///   3. the parameter is identifiable from the data;
 ///   4. its posterior sigma is at most max_sigma_to_prior (kMaxSigmaToPrior) times its prior
-///      sigma (the a-priori uncertainty the fit was meant to reduce).
+///      sigma (the a-priori uncertainty the fit was meant to reduce), and, where a fit states one,
+///      at most max_relative_sigma of its own value (a value without a stated prior sigma, such
+///      as a motor datasheet value or an assumption: the data must at least fix its size).
 /// Otherwise the fit is refused as a whole: nothing is patched and the command exits 1 with the
 /// reasons per parameter (refusal_lines()). A passed gate's figures go into each provenance entry
 /// it writes (GateRecord, fivebar/sections/provenance.hpp), and the export's
@@ -62,6 +64,9 @@ struct ParameterCheck {
   double prior_sigma = std::numeric_limits<double>::quiet_NaN();
   bool identifiable = true;
   std::string identifiability;  ///< why not identifiable (when it is not)
+  /// Largest sigma / |value| accepted (0.5: the value is at least two sigmas from zero); NaN: no
+  /// relative bound.
+  double max_relative_sigma = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct GateInput {
@@ -116,6 +121,10 @@ ResidualTest largest_residual_test(const std::vector<double>& standardized, doub
 /// Upper tail of the chi-square distribution, P(X >= x) for X ~ chi-square(dof) (the regularised
 /// upper incomplete gamma Q(dof/2, x/2); Numerical Recipes' series and continued fraction).
 double chi_square_sf(double x, double dof);
+
+/// The gate as text, one line per test and per refused value ("quality gate: passed (solver ...)",
+/// "  not measured: ..."); empty for a fit without values that passed.
+std::string to_text(const GateResult& gate);
 
 /// The gate as JSON: {passed, fit, solver: {converged, termination, iterations}, tests: [{name,
 /// statement, statistic, p_value, applicable, passed}], reasons, parameters: [{parameter, value,
