@@ -81,6 +81,6 @@ if ((fuzz)); then
   # The fuzzers alone (clang's libFuzzer), without the suites.
   fivebar_stage fuzz-build fivebar_build_in build-fuzz "libFuzzer, clang, ASan + UBSan" -DCMAKE_BUILD_TYPE=Debug \
     -DFIVEBAR_FUZZ=ON -DFIVEBAR_WITH_MPI=OFF -DFIVEBAR_BUILD_TESTS=OFF -DCMAKE_CXX_COMPILER=clang++ \
-    -DCMAKE_C_COMPILER=clang -- fuzz_design_loader fuzz_cli fuzz_bench_csv
+    -DCMAKE_C_COMPILER=clang -- fuzz_design_loader fuzz_cli fuzz_bench_csv fuzz_runtime_json
   fivebar_stage fuzz test/fuzz/run_fuzzers.sh build-fuzz
 fi

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs each libFuzzer target of a FIVEBAR_FUZZ build for a bounded time (README "Hardening").
 #
-#   test/fuzz/run_fuzzers.sh BUILD_DIR [TARGET...]      (default targets: design_loader cli bench_csv)
+#   test/fuzz/run_fuzzers.sh BUILD_DIR [TARGET...]      (default targets: design_loader cli bench_csv runtime_json)
 #
 #   FIVEBAR_FUZZ_SECONDS   time per target, default 60
 #   FIVEBAR_FUZZ_FLAGS     extra libFuzzer flags (e.g. "-jobs=2 -workers=2" or "-seed=1")
@@ -15,7 +15,7 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
 build="$(cd "${1:?usage: run_fuzzers.sh BUILD_DIR [TARGET...]}" && pwd)"
 shift
 targets=("$@")
-((${#targets[@]} > 0)) || targets=(design_loader cli bench_csv)
+((${#targets[@]} > 0)) || targets=(design_loader cli bench_csv runtime_json)
 seconds="${FIVEBAR_FUZZ_SECONDS:-60}"
 read -r -a extra <<<"${FIVEBAR_FUZZ_FLAGS:-}"
 
@@ -36,6 +36,7 @@ for target in "${targets[@]}"; do
     design_loader) seeds=("$root/designs" "$root/test/data/malformed") ;;
     cli) seeds=("$build/test/fuzz/seeds/cli") ;;
     bench_csv) seeds=("$root/test/data/fuzz-seeds/bench_csv") ;;
+    runtime_json) seeds=("$root/test/data/fuzz-seeds/runtime_json") ;;
     *) seeds=() ;;
   esac
   seeds+=("$root/test/data/fuzz-regressions/$target")
