@@ -544,6 +544,15 @@ TEST(ToleranceMaps, TheFieldIsTheFirstOrderAtEachPointAndZeroWithoutTolerances) 
   const ToleranceMap zero = tolerance_map(m, "thumb", e, none, 1.0);
   EXPECT_EQ(zero.worst_3sigma_mm, 0.0);
   EXPECT_EQ(zero.worst_play_mm, 0.0);
+  // Every point is as bad as any other: the worst one named is a point of the target (inside the
+  // ellipse: (x/a)^2 + (y/b)^2 <= 1 in its axes), not the origin outside it.
+  for (const Vec2& at : {zero.worst_3sigma_at, zero.worst_case_at, zero.worst_case_first_order_at, zero.worst_resolution_at,
+                         zero.worst_play_at}) {
+    const Vec2 d = at - e.center;
+    const double c = std::cos(e.angle), s = std::sin(e.angle);
+    const double u = (c * d.x() + s * d.y()) / (0.5 * e.axes.x()), v = (-s * d.x() + c * d.y()) / (0.5 * e.axes.y());
+    EXPECT_LE(u * u + v * v, 1.0) << at.transpose();
+  }
   EXPECT_EQ(zero.robust.robust_margin_mm, zero.robust.margin_mm);
 }
 

@@ -474,6 +474,10 @@ ToleranceMap tolerance_map(const Mechanism& m, const std::string& station, const
   map.centre_play = tolerance_play(m, target.center, src.leg_play_mm);
   map.centre_corners = tolerance_corners(m, target.center, spread);
   map.target_points_mm = ellipse_grid(target);
+  // Where a figure is the same everywhere (every sigma 0: all zero), its worst point is the
+  // target's centre, a point of the target, not the origin (docs/reliability.md "JSON and exported files").
+  map.worst_case_at = map.worst_3sigma_at = map.worst_case_first_order_at = map.worst_resolution_at = map.worst_play_at =
+      target.center;
   for (const Vec2& p : map.target_points_mm) {
     ++map.target_points;
     const ToleranceEstimate e = tolerance_first_order(m, p, spread, per_count);
