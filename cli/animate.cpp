@@ -11,6 +11,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/export/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "tactors.hpp"
 
@@ -70,7 +71,7 @@ int run_animate(const AnimateOptions& opt) {
     options.simulated = read_simulated_tracks(in, opt.simulated);
   }
 
-  const PatternResult r = check_pattern(s, g, *spec, settings->max_joint_speed);
+  const PatternResult r = check_pattern(s, g, *spec, pattern_joint_speed_limit(design, s));
   const std::string svg = animate_pattern_svg(s, r, options);
   const std::size_t frames = animation_frames(s, r, options.max_frames).size();
 

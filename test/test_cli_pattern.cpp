@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -115,6 +116,28 @@ TEST_F(CliTactors, PatternParametersFromTheDesignAndOverrides) {
   EXPECT_EQ(slow.code, 1);
   EXPECT_EQ(parse(slow)["first_failure"]["status"], "too_fast");
 }
+// One joint speed (docs/export.md): a pattern is checked against the speed every exported file
+// writes as each joint's max_velocity, the smaller of controller.max_velocity_deg_s (360 deg/s on the
+// showcase) and the motors' steady speed less friction; the export's smallest per-joint value of the
+// station is the pattern's limit. A design with neither section keeps patterns.max_joint_speed_deg_s.
+TEST_F(CliTactors, PatternsAreCheckedAgainstTheExportsJointSpeed) {
+  const fs::path out = dir_ / "speed";
+  const json pat = parse(run({"pattern", kDesign, "-s", "index", "--pattern", "stretch", "--out", out.string(), "--json"}));
+  ASSERT_EQ(run({"export", kDesign, "-s", "index", "--format", "json", "--out", (dir_ / "x").string()}).code, 0);
+  const json exported = json::parse(slurp(dir_ / "x" / "iros2022_controller_index.json"));
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const auto& [joint, limits] : exported["fivebar_controller"]["ros__parameters"]["joint_limits"].items()) {
+    smallest = std::min(smallest, limits["max_velocity"].get<double>() * 180.0 / std::numbers::pi);
+  }
+  ASSERT_TRUE(std::isfinite(smallest));
+  EXPECT_LT(smallest, 360.0);
+  EXPECT_NEAR(pat["max_joint_speed_deg_s"].get<double>(), smallest, 1e-9);
+  // Without a controller or motor section the patterns' own limit (360 deg/s by default).
+  const json bare = parse(run({"pattern", (kSource / "designs" / "iros2022-index.yaml").string(), "-s", "index", "--pattern",
+                               "stretch", "--out", (dir_ / "bare").string(), "--json"}));
+  EXPECT_NEAR(bare["max_joint_speed_deg_s"].get<double>(), 360.0, 1e-9);
+}
+
 TEST_F(CliTactors, PatternBadInputExitsTwo) {
   const Outcome kind = run({"pattern", kDesign, "-s", "index", "--pattern", "wiggle"});
   EXPECT_EQ(kind.code, 2);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "fivebar/animation.hpp"
+#include "fivebar/export/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
@@ -63,7 +64,7 @@ Product animate_product() {
       for (const PatternSpec& spec : settings.for_station(s.name)) {
         const std::string kind(to_string(spec.kind));
         ctx.say("animate: station " + s.name + ", " + kind);
-        const PatternResult r = check_pattern(s, g, spec, settings.max_joint_speed);
+        const PatternResult r = check_pattern(s, g, spec, pattern_joint_speed_limit(d, s));
         AnimationOptions options;
         options.tactor_diameter_mm = g.tactor_diameter;
         options.simulated = simulated_tracks(ctx, s.name, kind);

@@ -407,7 +407,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
           continue;
         }
         say(options, "export gate: pattern " + subject);
-        const PatternResult r = check_pattern(s, *d.get<Geometry>(), spec, station_joint_speed_limit(d, s));
+        const PatternResult r = check_pattern(s, *d.get<Geometry>(), spec, pattern_joint_speed_limit(d, s));
         if (r.passed) {
           add("pattern", subject, true,
               "renderable: " + std::to_string(r.samples.size()) + " samples, peak motor speed " +

@@ -367,4 +367,11 @@ double station_joint_speed_limit(const Design& design, const Station& station) {
   return std::isfinite(v) ? v : 0.0;
 }
 
+double pattern_joint_speed_limit(const Design& design, const Station& station) {
+  const double v = station_joint_speed_limit(design, station);
+  if (v > 0.0) return v;
+  const PatternSettings* patterns = design.get<PatternSettings>();
+  return patterns != nullptr ? patterns->max_joint_speed : PatternSettings{}.max_joint_speed;
+}
+
 }  // namespace fivebar

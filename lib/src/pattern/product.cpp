@@ -10,6 +10,7 @@
 #include <string>
 
 #include "fivebar/format.hpp"
+#include "fivebar/export/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
@@ -26,7 +27,8 @@ constexpr const char* kPreamble =
     "of both tactors is checked: reachable in the working mode, not singular, on the design's assembly "
     "side, within the joint limits, LCI ≥ min_lci, collision-free (when the lower tactor collides the "
     "priority rule moves it; the pattern then counts as not renderable) and every motor within "
-    "`patterns.max_joint_speed_deg_s`. The CSV files hold the four motors' joint trajectories "
+    "the one joint speed of the export (the smaller of `controller.max_velocity_deg_s` and the motors' "
+    "steady speed less friction). The CSV files hold the four motors' joint trajectories "
     "(`time_s,station,mechanism,theta1_deg,theta2_deg,x_mm,y_mm,status,...`).\n\n";
 
 }  // namespace
@@ -70,7 +72,7 @@ Product pattern_product() {
       js["patterns"] = Json::array();
       for (const PatternSpec& spec : specs) {
         ctx.say("pattern: station " + s.name + ", " + std::string(to_string(spec.kind)));
-        results.push_back(check_pattern(s, g, spec, settings.max_joint_speed));
+        results.push_back(check_pattern(s, g, spec, pattern_joint_speed_limit(d, s)));
         const PatternResult& r = results.back();
         const std::string csv = "patterns/" + s.name + "-" + std::string(to_string(spec.kind)) + ".csv";
         std::ostringstream text;

@@ -205,7 +205,7 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
   for (PatternSpec spec : specs) {
     if (request.pattern && spec.kind != *request.pattern) continue;
     spec.rate_hz = rate;  // the controller samples the pattern
-    const PatternResult pr = check_pattern(station, g, spec, station_joint_speed_limit(design, station));
+    const PatternResult pr = check_pattern(station, g, spec, pattern_joint_speed_limit(design, station));
     SimulationInput in = make(std::string(to_string(spec.kind)));
     for (const PatternSample& s : pr.samples) {
       for (const TactorSample* ts : {&s.lower, &s.upper}) {

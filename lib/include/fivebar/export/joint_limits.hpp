@@ -153,6 +153,11 @@ double joint_speed_limit(const Design& design, const Station& station, const Mec
 /// The smallest joint_speed_limit() of the station's motor joints: what a pattern moving all of
 /// them is checked against (check_pattern()'s max_joint_speed).
 double station_joint_speed_limit(const Design& design, const Station& station);
+/// The joint speed every check of a pattern of `station` uses (`fivebar pattern`, `fivebar
+/// animate`, their products, simulate's references and the export gate): station_joint_speed_limit(),
+/// or `patterns.max_joint_speed_deg_s` (its default without a `patterns:` section) for a design
+/// with neither a `controller:` nor a `motor:` section.
+double pattern_joint_speed_limit(const Design& design, const Station& station);
 
 /// The export gate's checks of a station's hardware limits (fivebar/export/export.hpp export_gate()):
 ///   hardware_limits  per mechanism: both joints have a usable range (describe() of each);
