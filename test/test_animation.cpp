@@ -328,6 +328,19 @@ TEST(HtmlPage, RendersEmphasisCodeTablesAndListsAsCommonMarkDoes) {
   EXPECT_THAT(page, HasSubstr("<td><em>x</em></td><td class=\"r\"><code>y</code></td>"));
 }
 
+// A file of the scene named in code links to itself, once: as a link's text (the products' "Files:"
+// lines, [`a/b.json`](a/b.json)) it is that link's, never an anchor inside an anchor (HTML forbids
+// nested links; browsers split them).
+TEST(HtmlPage, AFileNamedInALinksTextIsOneLink) {
+  md::HtmlFiles files;
+  files.exists = [](const std::string& f) { return f == "export/a.json" || f == "export/b.yaml"; };
+  files.read = [](const std::string&) -> std::optional<std::string> { return std::nullopt; };
+  const std::string page = md::to_html_page("# t\n\nFiles: [`export/a.json`](export/a.json), `export/b.yaml`.\n", "t", files);
+  EXPECT_THAT(page, HasSubstr("Files: <a href=\"export/a.json\"><code>export/a.json</code></a>, "
+                              "<a href=\"export/b.yaml\"><code>export/b.yaml</code></a>."));
+  EXPECT_THAT(page, Not(HasSubstr("<a href=\"export/a.json\"><a href")));
+}
+
 TEST(HtmlPage, EverySectionShowsThePicturesOfItsProductInline) {
   // The products table lists each product's files; a section names some in links or code, shows
   // others as figures already, and names none at all (simulate): each picture is shown once, in

@@ -297,8 +297,10 @@ class Renderer {
         // A file of the scene named in code (the products' file lists) links to it.
         const bool file = code.find('.') != std::string::npos && local_file(code) && files_.exists && files_.exists(code);
         const std::string html = "<code>" + html_escape(code) + "</code>";
-        if (file) named(code, code);
-        return file ? "<a href=\"" + html_escape(code) + "\">" + html + "</a>" : html;
+        // Inside a link's text it is that link's (no anchor inside an anchor).
+        if (!file || in_link_ > 0) return html;
+        named(code, code);
+        return "<a href=\"" + html_escape(code) + "\">" + html + "</a>";
       }
       case CMARK_NODE_EMPH:
         return "<em>" + inlines(node) + "</em>";
@@ -306,7 +308,9 @@ class Renderer {
         return "<strong>" + inlines(node) + "</strong>";
       case CMARK_NODE_LINK: {
         const std::string target = url_of(node);
+        ++in_link_;
         const std::string text = inlines(node);
+        --in_link_;
         if (!safe_href(target)) return text;
         named(target, plain_text(node));
         return "<a href=\"" + html_escape(target) + "\">" + text + "</a>";
@@ -502,6 +506,7 @@ class Renderer {
   std::vector<std::pair<std::string, std::string>> named_;       ///< pictures the section named (path, caption)
   std::string section_product_;                                  ///< the product of the current section
   std::map<std::string, std::vector<std::string>> product_files_;  ///< pictures of each product's row
+  int in_link_ = 0;  ///< depth of the links whose text is being rendered
 };
 
 }  // namespace
