@@ -241,6 +241,26 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   return kOk;
 }
 
+/// Where the identified values come from: the log, its hash, today, the method.
+MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig) {
+  MeasurementSource source;
+  source.file = opt.log;
+  source.sha256 = sha256_file(opt.log);
+  source.date = today_utc();
+  source.method = std::string(mechanism_rig ? "fivebar identify --rig mechanism: " : "fivebar identify --rig motor: ") +
+                  (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
+                  ", standard deviation";
+  return source;
+}
+
+/// The quality gate's verdict and tests, then the values it or the motor: section refused, a line each.
+void print_patch(const id::Patch& patch) {
+  std::cout << "quality gate: " << (patch.gate.reasons.empty() ? "passed" : "refused, nothing patched") << " (solver "
+            << patch.gate.solver.termination << ")\n";
+  for (const gate::ResidualTest& t : patch.gate.tests) std::cout << "  " << t.statement << "\n";
+  for (const std::string& s : patch.not_patched) std::cout << "not patched: " << s << "\n";
+}
+
 int run_identify(const IdentifyCliOptions& opt) {
   const Design design = load(opt.design);
   // --rig motor, or --rig mechanism STATION/MECHANISM (fivebar/identify/mechanism.hpp).
@@ -337,14 +357,7 @@ int run_identify(const IdentifyCliOptions& opt) {
   // with the values that passed the quality gate ("The quality gate").
   std::optional<id::Patch> patch;
   if (refused.empty()) {
-    MeasurementSource source;
-    source.file = opt.log;
-    source.sha256 = sha256_file(opt.log);
-    source.date = today_utc();
-    source.method = std::string(rig_station.empty() ? "fivebar identify --rig motor: " : "fivebar identify --rig mechanism: ") +
-                    (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
-                    ", standard deviation";
-    patch = id::patch_design(design, results, source, opt.method == "oe");
+    patch = id::patch_design(design, results, log_source(opt, !rig_station.empty()), opt.method == "oe");
     if (patch->design) patch->design->reset<BenchSettings>();  // written elsewhere: its bench: files would not resolve
     doc["gate"] = gate::to_json(patch->gate);
     doc["patched"] = patch->patched;
@@ -385,13 +398,7 @@ int run_identify(const IdentifyCliOptions& opt) {
   } else {
     for (const auto& r : results) print_joint(r);
     for (const std::string& s : refused) std::cout << "NOT IDENTIFIABLE (asked by --fit): " << s << "\n";
-    if (patch) {
-      // The gate's verdict and tests; the values it or the motor: section refused, one line each.
-      std::cout << "quality gate: " << (patch->gate.reasons.empty() ? "passed" : "refused, nothing patched") << " (solver "
-                << patch->gate.solver.termination << ")\n";
-      for (const gate::ResidualTest& t : patch->gate.tests) std::cout << "  " << t.statement << "\n";
-      for (const std::string& s : patch->not_patched) std::cout << "not patched: " << s << "\n";
-    }
+    if (patch) print_patch(*patch);
     if (!files.empty()) std::cout << "wrote " << files.size() << " files into " << std::filesystem::path(files.front()).parent_path().generic_string() << "\n";
   }
   if (gate_refused) {

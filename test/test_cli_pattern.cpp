@@ -119,7 +119,7 @@ TEST_F(CliTactors, PatternParametersFromTheDesignAndOverrides) {
 // One joint speed (docs/export.md): a pattern is checked against the speed every exported file
 // writes as each joint's max_velocity, the smaller of controller.max_velocity_deg_s (360 deg/s on the
 // showcase) and the motors' steady speed less friction; the export's smallest per-joint value of the
-// station is the pattern's limit. A design with neither section keeps patterns.max_joint_speed_deg_s.
+// station is the pattern's limit.
 TEST_F(CliTactors, PatternsAreCheckedAgainstTheExportsJointSpeed) {
   const fs::path out = dir_ / "speed";
   const json pat = parse(run({"pattern", kDesign, "-s", "index", "--pattern", "stretch", "--out", out.string(), "--json"}));
@@ -132,10 +132,6 @@ TEST_F(CliTactors, PatternsAreCheckedAgainstTheExportsJointSpeed) {
   ASSERT_TRUE(std::isfinite(smallest));
   EXPECT_LT(smallest, 360.0);
   EXPECT_NEAR(pat["max_joint_speed_deg_s"].get<double>(), smallest, 1e-9);
-  // Without a controller or motor section the patterns' own limit (360 deg/s by default).
-  const json bare = parse(run({"pattern", (kSource / "designs" / "iros2022-index.yaml").string(), "-s", "index", "--pattern",
-                               "stretch", "--out", (dir_ / "bare").string(), "--json"}));
-  EXPECT_NEAR(bare["max_joint_speed_deg_s"].get<double>(), 360.0, 1e-9);
 }
 
 TEST_F(CliTactors, PatternBadInputExitsTwo) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -19,6 +20,9 @@
 #include "fivebar/design.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/pattern.hpp"
+#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/motor.hpp"
 
 namespace fivebar {
 namespace {
@@ -396,6 +400,29 @@ TEST_F(PaperPatterns, JsonSummaryAndPicture) {
   const RenderedPlot pic = plot_patterns(station("index"), geometry(), {r});
   EXPECT_EQ(pic.png.substr(0, 4), std::string("\x89PNG", 4));
   EXPECT_THAT(pic.svg, HasSubstr("<svg"));
+}
+
+// The one joint speed the pattern checks use (fivebar/export/joint_limits.hpp): the smaller of the
+// controller's stated limit and the motors' steady speed; either alone; the patterns' own limit
+// with neither section.
+TEST(PatternSpeed, TheExportsJointSpeedOrThePatternsOwnWithoutAControllerOrMotor) {
+  Design d = load_design(kDesign);
+  const Station& index = d.require_station("index");
+  double motor = std::numeric_limits<double>::infinity();
+  for (const char* m : {"lower", "upper"}) {
+    for (int j : {1, 2}) motor = std::min(motor, motor_free_speed(d.get<MotorSettings>()->joint("index", m, j)));
+  }
+  const double stated = d.get<ControllerSettings>()->max_velocity;
+  ASSERT_LT(motor, stated);  // the showcase: 343.5 < 360 deg/s
+  EXPECT_EQ(pattern_joint_speed_limit(d, index), motor);
+  d.get<ControllerSettings>()->max_velocity = 0.5 * motor;
+  EXPECT_EQ(pattern_joint_speed_limit(d, index), 0.5 * motor);
+  d.reset<MotorSettings>();
+  EXPECT_EQ(pattern_joint_speed_limit(d, index), 0.5 * motor);
+  d.reset<ControllerSettings>();
+  EXPECT_EQ(pattern_joint_speed_limit(d, index), d.get<PatternSettings>()->max_joint_speed);
+  d.reset<PatternSettings>();
+  EXPECT_EQ(pattern_joint_speed_limit(d, index), PatternSettings{}.max_joint_speed);
 }
 
 }  // namespace
