@@ -255,8 +255,13 @@ MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig) 
 
 /// The quality gate's verdict and tests, then the values it or the motor: section refused, a line each.
 void print_patch(const id::Patch& patch) {
-  std::cout << "quality gate: " << (patch.gate.reasons.empty() ? "passed" : "refused, nothing patched") << " (solver "
-            << patch.gate.solver.termination << ")\n";
+  std::size_t passed = 0;
+  for (const gate::ParameterVerdict& v : patch.gate.parameters) passed += v.passed ? 1 : 0;
+  const std::string verdict = !patch.gate.reasons.empty() ? "refused, nothing patched"
+                              : patch.gate.passed         ? "passed"
+                                                          : "passed for " + std::to_string(passed) + " of " +
+                                                                std::to_string(patch.gate.parameters.size()) + " values";
+  std::cout << "quality gate: " << verdict << " (solver " << patch.gate.solver.termination << ")\n";
   for (const gate::ResidualTest& t : patch.gate.tests) std::cout << "  " << t.statement << "\n";
   for (const std::string& s : patch.not_patched) std::cout << "not patched: " << s << "\n";
 }
