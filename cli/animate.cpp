@@ -11,7 +11,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "tactors.hpp"
 

@@ -23,7 +23,7 @@
 #include "fivebar/provenance.hpp"
 #include "fivebar/provenance/gate.hpp"
 #include "fivebar/sha256.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/sections/bench.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"

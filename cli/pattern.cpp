@@ -13,7 +13,7 @@
 #include "common.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "tactors.hpp"
 
@@ -132,7 +132,7 @@ int run_pattern(const PatternOptions& opt) {
   const Station& s = select_pair_station(design, opt.station);
   const Geometry& g = require_geometry(design);
   const PatternSpec spec = spec_for(opt, design, s, *kind);
-  double max_speed = pattern_joint_speed_limit(design, s);  // the one joint speed (fivebar/export/joint_limits.hpp)
+  double max_speed = pattern_joint_speed_limit(design, s);  // the one joint speed (fivebar/device/joint_limits.hpp)
   if (opt.max_speed_deg_s) max_speed = *opt.max_speed_deg_s / kDegPerRad;
 
   const PatternResult r = check_pattern(s, g, spec, max_speed);

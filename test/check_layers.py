@@ -15,6 +15,12 @@ Rules:
   walls      each heavy dependency's headers are included only in the files of its wall;
   runtime    the device's loop (lib/src/runtime/, fivebar/runtime/) includes nothing of the project
              outside itself: it builds and installs alone (docs/runtime.md);
+  device     the chain from a design to the device: device configuration (lib/src/device/,
+             fivebar/device/) < simulate (lib/src/simulate/, fivebar/dynamics.hpp) < control
+             (lib/src/control/, fivebar/control.hpp, fivebar/control/) < export (lib/src/export/,
+             fivebar/export/): no file of a floor includes a file of a floor above it, so the
+             export's gate runs simulate on the configuration it writes without a loop back
+             (product glue, lib/src/<study>/product.cpp, may reach up: it serves the scene);
   cycles     no include cycle among the project's files.
 """
 import os
@@ -52,6 +58,22 @@ WALLS = {
     "MuJoCo": (r"mujoco/", []),
     "cpp-httplib": (r"httplib\.h", ["cli/studio.cpp"]),
 }
+
+# The device chain, bottom floor first: (name, path prefixes).
+DEVICE_FLOORS = [
+    ("device", ("lib/src/device/", "lib/include/fivebar/device/")),
+    ("simulate", ("lib/src/simulate/", "lib/include/fivebar/dynamics.hpp")),
+    ("control", ("lib/src/control/", "lib/include/fivebar/control.hpp", "lib/include/fivebar/control/")),
+    ("export", ("lib/src/export/", "lib/include/fivebar/export/")),
+]
+
+
+def device_floor(p):
+    for i, (_, prefixes) in enumerate(DEVICE_FLOORS):
+        if p.startswith(prefixes):
+            return i
+    return None
+
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*([<"])([^">]+)[">]', re.M)
 
@@ -135,6 +157,19 @@ def main():
                 if not in_runtime(q):
                     errors.append("runtime: " + p + " includes " + q)
 
+    # device
+    for p in files:
+        if re.fullmatch(r"lib/src/[^/]+/product\.cpp", p):
+            continue
+        floor = device_floor(p)
+        if floor is None:
+            continue
+        for q in quoted[p]:
+            above = device_floor(q)
+            if above is not None and above > floor:
+                errors.append("device: " + p + " (" + DEVICE_FLOORS[floor][0] + ") includes " + q + " (" +
+                              DEVICE_FLOORS[above][0] + ", a floor above)")
+
     # walls
     for p, names in system.items():
         for name in names:
@@ -196,6 +231,10 @@ def self_test():
         ("cli", {"lib/src/tolerance/tolerance.cpp": '#include "../../../cli/main.cpp"\n'}, 1, "cli: "),
         ("scene", {"lib/src/tolerance/tolerance.cpp": '#include "fivebar/scene.hpp"\n'}, 1, "scene: "),
         ("walls", {"lib/src/tolerance/tolerance.cpp": "#include <pagmo/pagmo.hpp>\n"}, 1, "walls: "),
+        ("device", {"lib/src/simulate/inputs.cpp": '#include "fivebar/export/export.hpp"\n',
+                    "lib/include/fivebar/export/export.hpp": "#pragma once\n"}, 1, "device: "),
+        ("device glue", {"lib/src/simulate/product.cpp": '#include "fivebar/export/export.hpp"\n',
+                         "lib/include/fivebar/export/export.hpp": "#pragma once\n"}, 0, ""),
         ("cycles", {"lib/src/tolerance/a.hpp": '#include "tolerance/b.hpp"\n',
                     "lib/src/tolerance/b.hpp": '#include "tolerance/a.hpp"\n'}, 1, "cycles: "),
     ]

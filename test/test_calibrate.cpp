@@ -15,7 +15,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/format.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/provenance.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/provenance.hpp"

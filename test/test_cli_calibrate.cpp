@@ -18,7 +18,7 @@
 #include "cli_test.hpp"
 #include "fivebar/design.hpp"
 #include "fivebar/format.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/provenance.hpp"
 #include "fivebar/sections/provenance.hpp"

@@ -36,7 +36,7 @@
 #include "fivebar/sections/contact.hpp"
 #include "fivebar/sections/motor.hpp"
 #include "fivebar/sections/tolerance.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/export/mjcf.hpp"
 #include "fivebar/export/urdf.hpp"
 #include "fivebar/sha256.hpp"

@@ -13,7 +13,7 @@
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/export/export.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/version.hpp"
 #include "header_values.hpp"
 

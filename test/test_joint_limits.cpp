@@ -1,4 +1,4 @@
-// Tests of the joint limits from the hardware (fivebar/export/joint_limits.hpp): the blocked half-angle of
+// Tests of the joint limits from the hardware (fivebar/device/joint_limits.hpp): the blocked half-angle of
 // a hard stop against hand-computed cases and against a bisection on the collision module's exact
 // capsule clearance (a second formulation), the potentiometer window by hand, the usable ranges of
 // the showcase, their intersection with declared limits, the margin check against an independent
@@ -16,7 +16,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"

@@ -20,7 +20,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/pattern.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
 
@@ -402,7 +402,7 @@ TEST_F(PaperPatterns, JsonSummaryAndPicture) {
   EXPECT_THAT(pic.svg, HasSubstr("<svg"));
 }
 
-// The one joint speed the pattern checks use (fivebar/export/joint_limits.hpp): the smaller of the
+// The one joint speed the pattern checks use (fivebar/device/joint_limits.hpp): the smaller of the
 // controller's stated limit and the motors' steady speed; either alone; the patterns' own limit
 // with neither section.
 TEST(PatternSpeed, TheExportsJointSpeedOrThePatternsOwnWithoutAControllerOrMotor) {

@@ -26,7 +26,7 @@
 #include "fivebar/design.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/export/ros2_package.hpp"
 #include "fivebar/export/urdf.hpp"
@@ -282,7 +282,7 @@ TEST(Urdf, TreeLimitsMassesAndRos2ControlMatchTheDesign) {
   const Element* lim = t1->child("limit");
   EXPECT_NEAR(number(lim->at("lower")), stop, 1e-15);
   EXPECT_NEAR(number(lim->at("upper")), deg(285), 1e-15);
-  // The one joint speed (fivebar/export/joint_limits.hpp): the motor's steady speed at the output
+  // The one joint speed (fivebar/device/joint_limits.hpp): the motor's steady speed at the output
   // at 6 V less friction, (eta N k_t V / R - tau_c) / (eta N^2 k_t k_e / R + b) with k_e N =
   // 0.5236 mV/rpm x 200 = 1.0000 V s/rad: (0.84 - 0.0005) / (0.14 + 0.00001) = 5.996 rad/s
   // (343.5 deg/s), below the no-load 6 rad/s and controller.max_velocity_deg_s 360.

@@ -359,9 +359,11 @@ struct SimulationInput {
   std::vector<SimulatedMechanism> mechanisms;
   ControllerSettings controller;
   ContactSettings contact;
-  /// The device's configuration as exported (fivebar/export/export.hpp), read by the runtime's own JSON
-  /// reader; the gains and potentiometers of `mechanisms[k].control` override its joints' (a
-  /// tuner varies them). Null: runtime_config(*this), without collision outlines or joint limits.
+  /// The device's configuration (fivebar/device/config.hpp device_config(): the Config `fivebar
+  /// export` writes); the gains and potentiometers of `mechanisms[k].control` override its joints'
+  /// (a tuner varies them). simulation_inputs() always sets it. Null only for a model built
+  /// without a design (tests of the dynamics): runtime_config(*this), without collision outlines
+  /// or joint limits.
   std::shared_ptr<const runtime::Config> runtime;
   /// False: `runtime` as given, its gains and calibration too (`fivebar replay --sil --config`).
   bool override_runtime_joints = true;

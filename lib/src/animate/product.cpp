@@ -8,7 +8,7 @@
 #include <string>
 
 #include "fivebar/animation.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"

@@ -12,7 +12,7 @@
 #include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/sections/controller.hpp"
 
 namespace fivebar::calibrate {

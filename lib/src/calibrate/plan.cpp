@@ -13,7 +13,7 @@
 
 #include "fivebar/calibrate/fit.hpp"
 #include "fivebar/error.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/sections/controller.hpp"
 
 namespace fivebar::calibrate {

@@ -27,11 +27,13 @@
 #include "fivebar/coverage/coverage.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/config.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/pattern.hpp"
 #include "fivebar/version.hpp"
 #include "export/export_control_gate.hpp"
+#include "export/export_detail.hpp"
 
 namespace fivebar {
 
@@ -57,12 +59,6 @@ double normalized(double a) {
   return r;
 }
 
-double wrap_two_pi(double a) {
-  double r = std::fmod(a, kTwoPi);
-  if (r < 0.0) r += kTwoPi;
-  if (r >= kTwoPi) r = 0.0;
-  return r;
-}
 
 /// Words a name cannot take in the header: C++ keywords and alternative tokens, and the macros GNU
 /// mode predefines (`linux`, `unix`).
@@ -94,57 +90,6 @@ std::optional<std::string> identifier_problem(std::string_view name) {
   return std::nullopt;
 }
 
-std::vector<std::string> chosen_stations(const Design& d, const std::vector<std::string>& wanted) {
-  std::vector<std::string> out;
-  for (const std::string& w : wanted) d.require_station(w);  // throws for an unknown name
-  for (const Station& s : d.stations) {
-    if (wanted.empty() || std::find(wanted.begin(), wanted.end(), s.name) != wanted.end()) out.push_back(s.name);
-  }
-  return out;
-}
-
-const ControllerSettings& require_controller(const Design& d) {
-  if (!d.get<ControllerSettings>()) {
-    throw InputError("design '" + d.name +
-                     "' has no controller: section (loop rate, PWM, PID gains, potentiometer calibration): "
-                     "nothing to export; see designs/iros2022.yaml");
-  }
-  return *d.get<ControllerSettings>();
-}
-
-/// The branch a joint's angles are written on, one for the gate, the limits and the potentiometer
-/// map: the one holding the joint's angle at the target centre normalised to (-pi, pi]
-/// (`reference`). Without limits an angle is represented within pi of the reference; with limits
-/// the arc starts at the representative of lo at most one turn below the reference (so the arc
-/// holds the reference when the centre is within the limits), and an angle outside the arc is put
-/// next to its nearer end.
-struct Branch {
-  std::optional<JointRange> limits;
-  double reference = 0.0;
-  double lo() const { return reference - wrap_two_pi(reference - limits->lo); }
-  double hi() const { return lo() + limits->span(); }
-  double represent(double theta) const {
-    if (!limits) return reference + std::remainder(theta - reference, kTwoPi);
-    const double offset = wrap_two_pi(theta - lo());
-    const double span = limits->span();
-    if (offset <= span) return lo() + offset;
-    return (offset - span) < (kTwoPi - offset) ? lo() + offset : lo() + offset - kTwoPi;
-  }
-};
-
-/// The branches of both joints of `m` for the target `e`.
-std::array<Branch, 2> branches(const Mechanism& m, const Ellipse& e) {
-  std::array<Branch, 2> b;
-  const Pose centre = ik(m, e.center);
-  for (int j = 0; j < 2; ++j) {
-    if (m.joint_limits) b[j].limits = (*m.joint_limits)[j];
-    // An unreachable centre fails the gate anyway; the limits then start at lo in (-pi, pi].
-    b[j].reference = centre.status == Status::unreachable ? (m.joint_limits ? normalized((*m.joint_limits)[j].lo) : 0.0)
-                                                          : normalized(j == 0 ? centre.theta1 : centre.theta2);
-  }
-  return b;
-}
-
 /// Joint angles over the filled ellipse: boundary samples for the ranges, and rings for the limits.
 struct JointSamples {
   std::array<double, 2> lo{0.0, 0.0}, hi{0.0, 0.0};
@@ -154,12 +99,12 @@ struct JointSamples {
   int worst_joint = 0;
   double worst_theta = 0.0;   ///< on the branch
   Vec2 worst_point{0.0, 0.0};
-  std::array<Branch, 2> branch;
+  std::array<JointBranch, 2> branch;
 };
 
 JointSamples sample_joints(const Mechanism& m, const Ellipse& e, const ExportOptions& options) {
   JointSamples out;
-  std::array<Branch, 2> branch = branches(m, e);
+  std::array<JointBranch, 2> branch = joint_branches(m, e);
   bool reference_set = ik(m, e.center).status != Status::unreachable;
   const auto visit = [&](const Vec2& p) {
     ++out.samples;
@@ -237,10 +182,6 @@ std::string_view file_extension(ExportFormat format) {
 
 std::vector<ExportFormat> all_export_formats() { return {ExportFormat::ros2, ExportFormat::json, ExportFormat::header}; }
 
-std::string joint_name(std::string_view station, std::string_view mechanism, int joint) {
-  return std::string(station) + "_" + std::string(mechanism) + "_theta" + std::to_string(joint);
-}
-
 // ---------------------------------------------------------------------------------------------
 // Gate
 
@@ -255,6 +196,30 @@ std::vector<std::string> ExportGate::reasons() const {
   }
   return out;
 }
+
+namespace {
+
+/// The export gate's checks of a station's hardware limits (fivebar/device/joint_limits.hpp):
+///   hardware_limits  per mechanism: both joints have a usable range (describe() of each);
+///   joint_margin     per mechanism and per pattern: check_joint_margins() with the gate's sampling.
+std::vector<GateCheck> hardware_limit_checks(const Design& design, const Station& station, const ExportOptions& options) {
+  std::vector<GateCheck> out;
+  for (const Mechanism* m : station.mechanisms()) {
+    const std::array<UsableRange, 2> r = usable_ranges(design, station, *m);
+    out.push_back(GateCheck{"hardware_limits", station.name + "/" + m->name, r[0].usable && r[1].usable,
+                            "theta1 " + describe(r[0]) + "; theta2 " + describe(r[1])});
+  }
+  JointMarginOptions sampling;
+  sampling.boundary_samples = options.boundary_samples;
+  sampling.rings = options.coverage.rings;
+  sampling.angles = options.coverage.angles;
+  for (const JointMarginCheck& c : check_joint_margins(design, station, sampling)) {
+    out.push_back(GateCheck{"joint_margin", c.subject, c.passed, c.detail});
+  }
+  return out;
+}
+
+}  // namespace
 
 ExportGate export_gate(const Design& d, const ExportOptions& options) {
   const ControllerSettings& c = require_controller(d);
@@ -290,7 +255,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
   }
 
   for (const std::string& name : gate.stations) {
-    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/export/joint_limits.hpp)
+    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/device/joint_limits.hpp)
     say(options, "export gate: coverage of station " + name);
     const StationCoverage sc = station_coverage(s, std::nullopt, options.coverage);
     for (const Mechanism* m : s.mechanisms()) {
@@ -397,7 +362,7 @@ ExportGate export_gate(const Design& d, const ExportOptions& options) {
     add("pattern", "design", true, "no patterns: section: nothing to check");
   } else {
     for (const std::string& name : gate.stations) {
-      const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/export/joint_limits.hpp)
+      const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/device/joint_limits.hpp)
       const std::vector<PatternSpec> specs = d.get<PatternSettings>()->for_station(name);
       if (specs.empty() || !(s.lower && s.upper)) continue;  // patterns move both tactors
       for (const PatternSpec& spec : specs) {
@@ -469,135 +434,10 @@ Json to_json(const ExportGate& gate) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Hash and view
-
-Design export_view(const Design& d, const std::vector<std::string>& wanted) {
-  const std::vector<std::string> stations = chosen_stations(d, wanted);
-  const auto kept = [&](const std::string& s) { return std::find(stations.begin(), stations.end(), s) != stations.end(); };
-  // Every section stays (kinematics, geometry, print, patterns, controller, motor, contact,
-  // tolerance, provenance, ...) but the three no exported byte or gate figure reads: sweep: and
-  // optimize: (studies that propose designs) and bench: (the bench files' names; what was fitted
-  // from them is in the design's values and provenance:). `products:` only chooses what `fivebar
-  // run` builds. test_export's walk over every number of the showcase holds this list.
-  Design v = d;
-  v.source.clear();
-  v.products.reset();
-  v.reset<SweepSettings>();
-  v.reset<OptimizeSettings>();
-  v.reset<BenchSettings>();
-  std::erase_if(v.stations, [&](const Station& s) { return !kept(s.name); });
-  if (PatternSettings* p = v.get<PatternSettings>()) {
-    std::erase_if(p->overrides, [&](const PatternOverride& o) { return !kept(o.station); });
-  }
-  if (ControllerSettings* c = v.get<ControllerSettings>()) {
-    std::erase_if(c->overrides, [&](const ControlOverride& o) { return !o.station.empty() && !kept(o.station); });
-  }
-  return v;
-}
-
-std::string design_hash(const Design& d, const std::vector<std::string>& stations) {
-  return "sha256:" + sha256_hex(to_yaml(export_view(d, stations)));
-}
-
-// ---------------------------------------------------------------------------------------------
 // Parameter tree
 
-Json controller_parameters(const Design& d, const std::vector<std::string>& wanted) {
-  const ControllerSettings& c = require_controller(d);
-  const std::vector<std::string> stations = chosen_stations(d, wanted);
-  const auto metres = [](double mm) { return mm / kMmPerMetre; };
-  const auto pair_m = [&](const Vec2& p) { return Json::array({metres(p.x()), metres(p.y())}); };
-
-  Json p = Json::object();
-  p["fivebar"] = {{"design", d.name},
-                  {"design_hash", design_hash(d, stations)},
-                  {"hash_algorithm", "sha256 of the canonical design text (fivebar/export/export.hpp)"},
-                  {"tool_version", std::string(version())},
-                  {"format_version", kFormatVersion},
-                  {"units", "SI (REP 103): m, rad, s, V, Hz"}};
-  p["loop_rate_hz"] = c.loop_rate_hz;
-  p["pwm_hz"] = c.pwm_hz;
-  p["adc"] = {{"bits", c.adc_bits},
-              {"range_v", Json::array({c.adc_range_v[0], c.adc_range_v[1]})},
-              {"volts_per_count", (c.adc_range_v[1] - c.adc_range_v[0]) / std::ldexp(1.0, c.adc_bits)}};
-  // The runtime keeps commanded joint angles this far inside the usable ranges (fivebar/runtime).
-  p["joint_margin_rad"] = c.joint_margin;
-  p["station_names"] = stations;
-  Json joint_names = Json::array();
-  Json station_tree = Json::object();
-  Json limits = Json::object(), gains = Json::object(), pots = Json::object();
-  for (const std::string& name : stations) {
-    const Station s = with_usable_limits(d, *d.station(name));  // hardware limits (fivebar/export/joint_limits.hpp)
-    Json st = Json::object();
-    st["target"] = {{"center_m", pair_m(s.target.center)},
-                    {"axes_m", pair_m(s.target.axes)},
-                    {"angle_rad", s.target.angle}};
-    Json mechanisms = Json::array();
-    for (const Mechanism* m : s.mechanisms()) mechanisms.push_back(m->name);
-    st["mechanisms"] = mechanisms;
-    for (const Mechanism* m : s.mechanisms()) {
-      const std::array<Branch, 2> branch = branches(*m, s.target);
-      Json names = Json::array();
-      for (int j = 1; j <= 2; ++j) names.push_back(joint_name(name, m->name, j));
-      Json links = Json::array();
-      for (double l : m->L) links.push_back(metres(l));
-      st[m->name] = {{"joint_names", names},
-                     {"o1_m", pair_m(m->O1)},
-                     {"o2_m", pair_m(m->O2)},
-                     {"link_lengths_m", links},
-                     {"working_mode", to_string(m->working_mode)},
-                     {"assembly_mode", to_string(m->assembly_mode)},
-                     {"min_lci", m->min_lci}};
-      for (int j = 1; j <= 2; ++j) {
-        const std::string joint = joint_name(name, m->name, j);
-        joint_names.push_back(joint);
-        Json lim = Json::object();
-        lim["has_position_limits"] = m->joint_limits.has_value();
-        if (m->joint_limits) {
-          lim["min_position"] = branch[j - 1].lo();
-          lim["max_position"] = branch[j - 1].hi();
-        }
-        lim["has_velocity_limits"] = true;
-        lim["max_velocity"] = joint_speed_limit(d, s, *m, j);  // the one joint speed (fivebar/export/joint_limits.hpp)
-        lim["has_acceleration_limits"] = false;
-        lim["has_jerk_limits"] = false;
-        lim["has_effort_limits"] = false;
-        limits[joint] = lim;
-        const JointControl jc = c.joint(name, m->name, j);
-        gains[joint] = {{"p", jc.pid.kp}, {"i", jc.pid.ki}, {"d", jc.pid.kd}, {"i_clamp", jc.pid.i_clamp}};
-        pots[joint] = {{"volts_at_zero", jc.potentiometer.volts_at_zero},
-                       {"rad_per_volt", jc.potentiometer.rad_per_volt}};
-      }
-    }
-    station_tree[name] = st;
-  }
-  p["joint_names"] = joint_names;
-  p["stations"] = station_tree;
-  Json collision = {{"priority", c.collision_priority}, {"checked", d.has<Geometry>()}};
-  if (d.get<Geometry>()) {
-    const Geometry& g = *d.get<Geometry>();
-    Json widths = Json::array(), layers = Json::array();
-    for (double w : g.link_width) widths.push_back(metres(w));
-    for (int l : g.layers) layers.push_back(l);
-    collision["min_clearance_m"] = metres(g.min_clearance);
-    collision["link_widths_m"] = widths;
-    collision["link_thickness_m"] = metres(g.link_thickness);
-    collision["layers"] = layers;
-    collision["layer_gap_m"] = metres(g.layer_gap);
-    collision["pin_diameter_m"] = metres(g.pin_diameter);
-    collision["boss_diameter_m"] = metres(g.boss_diameter);
-    collision["tactor_diameter_m"] = metres(g.tactor_diameter);
-    collision["tactor_height_m"] = metres(g.tactor_height);
-    collision["motor_shaft_diameter_m"] = metres(g.motor_shaft_diameter);
-  }
-  p["collision"] = collision;
-  p["joint_limits"] = limits;
-  p["gains"] = gains;
-  p["potentiometers"] = pots;
-
-  Json root = Json::object();
-  root[c.node] = {{"ros__parameters", p}};
-  return root;
+Json controller_parameters(const Design& d, const std::vector<std::string>& stations) {
+  return configuration_document(device_config(d, stations));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -779,6 +619,14 @@ ExportCheck check_export(const std::string& text, ExportFormat format, const Des
   Json found = tree;
   found.begin().value()["ros__parameters"]["fivebar"].erase("validation");
   diff(expected, found, "", check.differences);
+  if (format == ExportFormat::header) {
+    // The header's second copy, the one the runtime reads (fivebar/runtime/header_config.hpp).
+    Json embedded = detail::header_runtime_json(text, origin);
+    if (embedded.is_object() && embedded.size() == 1 && embedded.begin().value().contains("ros__parameters")) {
+      embedded.begin().value()["ros__parameters"]["fivebar"].erase("validation");
+    }
+    diff(expected, embedded, "runtime_json", check.differences);
+  }
   return check;
 }
 

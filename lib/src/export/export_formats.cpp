@@ -121,6 +121,9 @@ void require_tree(const Json& parameters) {
   }
 }
 
+/// The header's copy of the JSON document (render_header()).
+constexpr const char* kRuntimeJson = "runtime_json";
+
 std::string cpp_string(const std::string& s) {
   std::string out = "\"";
   for (unsigned char c : s) {
@@ -280,6 +283,7 @@ Json parse_header(const std::string& text, const std::string& origin) {
   std::size_t line_no = 0;
   std::size_t begin = 0;
   static const std::string kDecl = "inline constexpr ";
+  std::size_t runtime_json_line = 0;
   while (begin <= text.size()) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
@@ -332,6 +336,11 @@ Json parse_header(const std::string& text, const std::string& origin) {
       name = name.substr(0, name.size() - 2);
       const auto value = cpp_value("const char*", rhs);
       if (!value) bad_line(origin, line_no, name + ": not a string literal");
+      if (names.size() == 1 && name == kRuntimeJson) {  // the document again, checked below
+        if (runtime_json_line != 0) bad_line(origin, line_no, "a second " + name);
+        runtime_json_line = line_no;
+        continue;
+      }
       if (!is_identifier(name) || scope.contains(name)) bad_line(origin, line_no, "bad or repeated name " + name);
       scope[name] = *value;
       continue;
@@ -363,10 +372,38 @@ Json parse_header(const std::string& text, const std::string& origin) {
     scope[name] = *value;
   }
   if (!names.empty()) throw InputError(origin + ": namespace " + names.back() + " is not closed");
+  // The embedded JSON is what the runtime reads (fivebar/runtime/header_config.hpp); check_export()
+  // compares it with the design as it compares the constants (header_runtime_json()).
+  if (runtime_json_line == 0) throw InputError(origin + ": no " + std::string(kRuntimeJson) + " (the values as JSON, which the runtime reads)");
   return root;
 }
 
 }  // namespace
+
+namespace detail {
+
+Json header_runtime_json(const std::string& text, const std::string& origin) {
+  const std::string decl = "inline constexpr char " + std::string(kRuntimeJson) + "[] = ";
+  std::size_t line_no = 0, begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = trim(std::string_view(text).substr(begin, end - begin));
+    begin = end + 1;
+    ++line_no;
+    if (!line.starts_with(decl) || !line.ends_with(";")) continue;
+    const auto value = cpp_value("const char*", line.substr(decl.size(), line.size() - decl.size() - 1));
+    if (!value) bad_line(origin, line_no, std::string(kRuntimeJson) + ": not a string literal");
+    try {
+      return Json::parse(value->get<std::string>());
+    } catch (const Json::parse_error& e) {
+      bad_line(origin, line_no, std::string(kRuntimeJson) + " is not JSON: " + e.what());
+    }
+  }
+  throw InputError(origin + ": no " + std::string(kRuntimeJson) + " (the values as JSON, which the runtime reads)");
+}
+
+}  // namespace detail
 
 std::string render_ros2_yaml(const Json& parameters) {
   require_tree(parameters);
@@ -400,6 +437,10 @@ std::string render_header(const Json& parameters) {
   out += "#pragma once\n\n";
   out += "namespace " + node + " {\n";
   header_namespace(out, parameters.begin().value().at("ros__parameters"), node);
+  // The same document as the JSON export, for the runtime's one reader of the one key list
+  // (fivebar/runtime/header_config.hpp, fivebar/runtime/config_layout.hpp).
+  out += "// " + std::string(kRuntimeJson) + ": the values above as the JSON export writes them (FIVEBAR_RUNTIME_CONFIG reads it).\n";
+  out += "inline constexpr char " + std::string(kRuntimeJson) + "[] = " + cpp_string(render_json(parameters)) + ";\n";
   out += "}  // namespace " + node + "\n";
   return out;
 }

@@ -14,7 +14,7 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/sections/controller.hpp"

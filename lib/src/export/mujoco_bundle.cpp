@@ -9,7 +9,7 @@
 
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/export/mjcf.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"

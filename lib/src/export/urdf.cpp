@@ -15,7 +15,7 @@
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/format.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/parts.hpp"
 #include "fivebar/sections/controller.hpp"
@@ -120,7 +120,7 @@ std::vector<std::pair<std::string, double>> initial_pose(const Design& design, c
 }
 
 double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint) {
-  return joint_speed_limit(design, station, mechanism, joint);  // the one joint speed (fivebar/export/joint_limits.hpp)
+  return joint_speed_limit(design, station, mechanism, joint);  // the one joint speed (fivebar/device/joint_limits.hpp)
 }
 
 namespace {

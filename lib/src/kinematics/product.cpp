@@ -11,7 +11,7 @@
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/numerics.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"
 
@@ -224,7 +224,7 @@ constexpr const char* kPreamble =
 
 }  // namespace
 
-/// The usable range of every joint from the hardware (fivebar/export/joint_limits.hpp), when any joint
+/// The usable range of every joint from the hardware (fivebar/device/joint_limits.hpp), when any joint
 /// of the station has one.
 std::string usable_ranges_markdown(const Design& d, const Station& s) {
   md::Table table({"joint", "usable range", "angle at the target centre (deg)"}, "llr");

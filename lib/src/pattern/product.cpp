@@ -10,7 +10,7 @@
 #include <string>
 
 #include "fivebar/format.hpp"
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/pattern.hpp"
 #include "products/markdown.hpp"
 #include "products/product.hpp"

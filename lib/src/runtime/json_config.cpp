@@ -1,8 +1,10 @@
 // The exported JSON into a runtime Config (fivebar/runtime/json_config.hpp): a small recursive
-// descent JSON reader (RFC 8259; numbers by std::from_chars, so no locale) and the key walk of
-// the export's layout (fivebar/export/export.hpp). Initialisation only: it allocates and throws.
+// descent JSON reader (RFC 8259; numbers by std::from_chars, so no locale) and the reader of the
+// one key list (fivebar/runtime/config_layout.hpp). Initialisation only: it allocates and throws.
 
 #include "fivebar/runtime/json_config.hpp"
+
+#include "fivebar/runtime/config_layout.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -263,16 +265,47 @@ class Reader {
   std::string origin_;
 };
 
-std::array<std::int8_t, 2> parse_mode(const Reader& r, const std::string& text, const std::string& key) {
-  if (text.size() != 2) r.fail(key, "expected two signs (\"-+\"), found \"" + text + "\"");
-  std::array<std::int8_t, 2> out{};
-  for (std::size_t i = 0; i < 2; ++i) {
-    if (text[i] == '+') out[i] = 1;
-    else if (text[i] == '-') out[i] = -1;
-    else r.fail(key, "expected two signs (\"-+\"), found \"" + text + "\"");
+/// The layout's reader (fivebar/runtime/config_layout.hpp) over a parsed document.
+class LayoutReader {
+ public:
+  static constexpr bool reading = true;
+  LayoutReader(const Reader& r, const Value& params, const std::string& path) : r_(r) { stack_.push_back({&params, path}); }
+
+  template <class F>
+  void object(const std::string& key, F&& inside) {
+    const Value& v = r_.member(top(), path(), key);
+    const std::string at = Reader::join(path(), key);
+    if (v.kind != Value::Kind::object) r_.fail(at, std::string("expected an object, found ") + kind_name(v.kind));
+    stack_.push_back({&v, at});
+    inside();
+    stack_.pop_back();
   }
-  return out;
-}
+  void value(const std::string& key, double& x) { x = r_.number(top(), path(), key); }
+  void value(const std::string& key, int& x) { x = r_.integer(top(), path(), key); }
+  void value(const std::string& key, bool& x) { x = r_.boolean(top(), path(), key); }
+  void value(const std::string& key, std::string& x) { x = r_.string(top(), path(), key); }
+  template <std::size_t N>
+  void value(const std::string& key, std::array<double, N>& x) { x = r_.numbers<N>(top(), path(), key); }
+  void value(const std::string& key, std::array<int, 4>& x) {
+    const auto v = r_.numbers<4>(top(), path(), key);
+    for (std::size_t i = 0; i < 4; ++i) {
+      if (v[i] != std::floor(v[i]) || std::fabs(v[i]) > 1e9) r_.fail(Reader::join(path(), key) + "[" + std::to_string(i) + "]", "expected an integer");
+      x[i] = static_cast<int>(v[i]);
+    }
+  }
+  void value(const std::string& key, std::vector<std::string>& x) {
+    const auto& items = r_.array(top(), path(), key, 0);
+    x.clear();
+    for (std::size_t i = 0; i < items.size(); ++i) x.push_back(r_.string(items[i], Reader::join(path(), key) + "[" + std::to_string(i) + "]"));
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const { r_.fail(Reader::join(path(), key), what); }
+
+ private:
+  const Value& top() const { return *stack_.back().first; }
+  const std::string& path() const { return stack_.back().second; }
+  const Reader& r_;
+  std::vector<std::pair<const Value*, std::string>> stack_;
+};
 
 }  // namespace
 
@@ -282,94 +315,12 @@ Config parse_config_json(std::string_view text, const std::string& origin) {
   if (doc.kind != Value::Kind::object || doc.members.size() != 1) {
     r.fail("(document)", "expected one ROS 2 node {<node>: {ros__parameters: {...}}}");
   }
-  const std::string node = doc.members.front().first;
-  const Value& p = r.member(doc.members.front().second, node, "ros__parameters");
-  const std::string root = node + ".ros__parameters";
-  const auto at = [&](const std::string& key) { return Reader::join(root, key); };
-
   Config c;
-  if (const Value* f = r.optional(p, "fivebar")) {
-    if (const Value* d = r.optional(*f, "design")) c.design = r.string(*d, at("fivebar.design"));
-    if (const Value* h = r.optional(*f, "design_hash")) c.design_hash = r.string(*h, at("fivebar.design_hash"));
-  }
-  c.loop_rate_hz = r.number(p, root, "loop_rate_hz");
-  const Value& adc = r.member(p, root, "adc");
-  c.adc_bits = r.integer(adc, at("adc"), "bits");
-  c.adc_range_v = r.numbers<2>(adc, at("adc"), "range_v");
-  c.volts_per_count = r.number(adc, at("adc"), "volts_per_count");
-  c.joint_margin = r.number(p, root, "joint_margin_rad");
-
-  const Value& col = r.member(p, root, "collision");
-  const std::string cp = at("collision");
-  const std::string priority = r.string(col, cp, "priority");
-  if (priority != "upper") r.fail(cp + ".priority", "only \"upper\" (the paper's rule) is implemented, found \"" + priority + "\"");
-  c.collision.checked = r.boolean(col, cp, "checked");
-  if (c.collision.checked) {
-    c.collision.min_clearance = r.number(col, cp, "min_clearance_m");
-    c.collision.link_widths = r.numbers<4>(col, cp, "link_widths_m");
-    const auto layers = r.numbers<4>(col, cp, "layers");
-    for (std::size_t i = 0; i < 4; ++i) {
-      if (layers[i] != std::floor(layers[i])) r.fail(cp + ".layers[" + std::to_string(i) + "]", "expected an integer");
-      c.collision.layers[i] = static_cast<int>(layers[i]);
-    }
-    c.collision.pin_diameter = r.number(col, cp, "pin_diameter_m");
-    c.collision.boss_diameter = r.number(col, cp, "boss_diameter_m");
-    c.collision.tactor_diameter = r.number(col, cp, "tactor_diameter_m");
-    c.collision.motor_shaft_diameter = r.number(col, cp, "motor_shaft_diameter_m");
-  }
-
-  const Value& limits = r.member(p, root, "joint_limits");
-  const Value& gains = r.member(p, root, "gains");
-  const Value& pots = r.member(p, root, "potentiometers");
-  const Value& stations = r.member(p, root, "stations");
-  const auto& station_names = r.array(p, root, "station_names", 0);
-  if (station_names.empty()) r.fail(at("station_names"), "no station");
-  for (std::size_t si = 0; si < station_names.size(); ++si) {
-    StationConfig sc;
-    sc.name = r.string(station_names[si], at("station_names") + "[" + std::to_string(si) + "]");
-    const std::string sp = at("stations." + sc.name);
-    const Value& st = r.member(stations, at("stations"), sc.name);
-    const auto& mnames = r.array(st, sp, "mechanisms", 0);
-    if (mnames.empty() || mnames.size() > 2) r.fail(sp + ".mechanisms", "expected one or two mechanisms");
-    for (std::size_t mi = 0; mi < mnames.size(); ++mi) {
-      MechanismConfig mc;
-      mc.name = r.string(mnames[mi], sp + ".mechanisms[" + std::to_string(mi) + "]");
-      if (mc.name != "lower" && mc.name != "upper") r.fail(sp + ".mechanisms[" + std::to_string(mi) + "]", "expected \"lower\" or \"upper\"");
-      const std::string mp = sp + "." + mc.name;
-      const Value& m = r.member(st, sp, mc.name);
-      mc.o1 = r.numbers<2>(m, mp, "o1_m");
-      mc.o2 = r.numbers<2>(m, mp, "o2_m");
-      mc.L = r.numbers<4>(m, mp, "link_lengths_m");
-      mc.working_mode = parse_mode(r, r.string(m, mp, "working_mode"), mp + ".working_mode");
-      const std::string& asm_text = r.string(m, mp, "assembly_mode");
-      if (asm_text == "+") mc.assembly = Assembly::plus;
-      else if (asm_text == "-") mc.assembly = Assembly::minus;
-      else if (asm_text == "any") mc.assembly = Assembly::any;
-      else r.fail(mp + ".assembly_mode", "expected \"+\", \"-\" or \"any\", found \"" + asm_text + "\"");
-      const auto& jnames = r.array(m, mp, "joint_names", 2);
-      for (std::size_t j = 0; j < 2; ++j) {
-        JointConfig& jc = mc.joints[j];
-        jc.name = r.string(jnames[j], mp + ".joint_names[" + std::to_string(j) + "]");
-        const std::string gp = at("gains");
-        const Value& g = r.member(gains, gp, jc.name);
-        const std::string gj = gp + "." + jc.name;
-        jc.gains = {r.number(g, gj, "p"), r.number(g, gj, "i"), r.number(g, gj, "d"), r.number(g, gj, "i_clamp")};
-        const std::string pp = at("potentiometers");
-        const Value& pot = r.member(pots, pp, jc.name);
-        jc.volts_at_zero = r.number(pot, pp + "." + jc.name, "volts_at_zero");
-        jc.rad_per_volt = r.number(pot, pp + "." + jc.name, "rad_per_volt");
-        const std::string lp = at("joint_limits");
-        const Value& lim = r.member(limits, lp, jc.name);
-        jc.has_position_limits = r.boolean(lim, lp + "." + jc.name, "has_position_limits");
-        if (jc.has_position_limits) {
-          jc.min_position = r.number(lim, lp + "." + jc.name, "min_position");
-          jc.max_position = r.number(lim, lp + "." + jc.name, "max_position");
-        }
-      }
-      sc.mechanisms.push_back(std::move(mc));
-    }
-    c.stations.push_back(std::move(sc));
-  }
+  c.node = doc.members.front().first;
+  const Value& p = r.member(doc.members.front().second, c.node, "ros__parameters");
+  const std::string root = c.node + ".ros__parameters";
+  LayoutReader io(r, p, root);
+  layout(io, c);
   try {
     c.validate();
   } catch (const ConfigError& e) {

@@ -9,9 +9,8 @@
 #include "fivebar/format.hpp"
 #include "fivebar/numerics.hpp"
 #include "fivebar/pattern.hpp"
-#include "fivebar/export/export.hpp"
-#include "fivebar/export/joint_limits.hpp"
-#include "fivebar/runtime/json_config.hpp"
+#include "fivebar/device/config.hpp"
+#include "fivebar/device/joint_limits.hpp"
 
 namespace fivebar {
 
@@ -42,15 +41,17 @@ SimulatedMechanism base_mechanism(const Design& design, const Station& station, 
   return sm;
 }
 
-/// The station's export (fivebar/export/export.hpp controller_parameters), read back by the runtime's
-/// own JSON reader: the configuration the device would receive, bit for bit.
+/// The station's device configuration (fivebar/device/config.hpp device_config()): the Config
+/// `fivebar export` writes for this station, the one the device loads, checked as the runtime
+/// checks what it reads.
 std::shared_ptr<const runtime::Config> exported_config(const Design& design, const std::string& station) {
-  const std::string text = render_json(controller_parameters(design, {station}));
+  runtime::Config config = device_config(design, {station});
   try {
-    return std::make_shared<const runtime::Config>(runtime::parse_config_json(text, "export of station " + station));
+    config.validate();
   } catch (const runtime::ConfigError& e) {
-    throw InputError(std::string("simulate: the runtime refuses the export: ") + e.what());
+    throw InputError(std::string("simulate: the runtime refuses the station's configuration: ") + e.what());
   }
+  return std::make_shared<const runtime::Config>(std::move(config));
 }
 
 }  // namespace

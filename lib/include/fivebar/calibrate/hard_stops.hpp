@@ -1,7 +1,7 @@
 #pragma once
 /// Potentiometer calibration without a camera (docs/calibrate.md "Hard stops"): readings taken
 /// with a proximal link resting on a hard stop whose angle the geometry gives
-/// (fivebar/export/joint_limits.hpp usable_ranges(): an end of the usable range set by a hard stop).
+/// (fivebar/device/joint_limits.hpp usable_ranges(): an end of the usable range set by a hard stop).
 /// CSV `station,mechanism,joint,stop,volts` (joint 1 or 2, stop lo or hi; repeated readings are
 /// averaged). One stop of a joint gives volts_at_zero at the design's rad_per_volt,
 /// V0 = V - theta_stop / k; both stops give both, k = (theta_hi - theta_lo) / (V_hi - V_lo).

@@ -1,6 +1,6 @@
 #pragma once
 /// Calibration poses chosen for the fit (docs/calibrate.md "Planning"): N joint targets per
-/// mechanism within the usable joint ranges (fivebar/export/joint_limits.hpp usable_ranges(): declared
+/// mechanism within the usable joint ranges (fivebar/device/joint_limits.hpp usable_ranges(): declared
 /// limits, hard stops against the base, potentiometer travel), away from singularities (LCI at
 /// least `min_lci`), at least `extension_margin_mm` from each leg's full extension and folding
 /// and `base_margin_mm` from the mechanism's base line on the target's side, and reachable by every

@@ -10,7 +10,8 @@
 ///   header  a C++17 header of `inline constexpr` values for firmware builds (render_header):
 ///           maps become namespaces (the node's name outermost, `ros__parameters` left out).
 ///
-/// Content (controller_parameters()), SI units as ROS expects (REP 103: m, rad, s, V, Hz), unit
+/// Content (controller_parameters(); the keys are listed once, in fivebar/runtime/config_layout.hpp,
+/// and the values come from fivebar/device/config.hpp device_config()), SI units as ROS expects (REP 103: m, rad, s, V, Hz), unit
 /// suffixes on fivebar's own keys:
 ///   fivebar: {design, design_hash, hash_algorithm, tool_version, format_version, units}
 ///   loop_rate_hz, pwm_hz, adc: {bits, range_v [lo, hi], volts_per_count}, joint_margin_rad (the
@@ -23,7 +24,7 @@
 ///     link_thickness_m, layers, layer_gap_m, pin_diameter_m, boss_diameter_m, tactor_diameter_m,
 ///     tactor_height_m, motor_shaft_diameter_m}
 ///   joint_limits.<joint>: ros2_control layout: has_position_limits, min_position, max_position
-///     (only with limits: the joint's usable range of fivebar/export/joint_limits.hpp, i.e. the design's
+///     (only with limits: the joint's usable range of fivebar/device/joint_limits.hpp, i.e. the design's
 ///     ccw arc cut by the potentiometer's travel and the hard stops, max = min + span), has_velocity_limits,
 ///     max_velocity (rad/s), has_acceleration_limits, has_jerk_limits, has_effort_limits (false)
 ///   gains.<joint>: {p, i, d, i_clamp} (duty per rad, see PidGains)
@@ -59,6 +60,7 @@
 
 #include "fivebar/coverage/coverage.hpp"
 #include "fivebar/design.hpp"
+#include "fivebar/device/config.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sections/patterns.hpp"
@@ -141,7 +143,7 @@ struct ExportGate {
 ///   calibration  the joint's range (its limits, else its angles over the ellipse) reads within
 ///                the ADC's input range through its potentiometer;
 ///   hardware_limits, joint_margin  the usable range of every joint from its potentiometer's travel
-///                and the hard stops (fivebar/export/joint_limits.hpp), and the target and every pattern at
+///                and the hard stops (fivebar/device/joint_limits.hpp), and the target and every pattern at
 ///                least controller.joint_margin inside it, the proximal links clear of the other leg's;
 ///   pattern      every pattern of `patterns:` for the station passes check_pattern();
 /// and, for a design with `motor:` (and `geometry:`), the loop (lib/src/export/export_control_gate.cpp):
@@ -159,15 +161,12 @@ struct ExportGate {
 /// Throws InputError for a design without `controller:` or an unknown station in options.
 ExportGate export_gate(const Design& design, const ExportOptions& options = {});
 
-/// `<station>_<mechanism>_theta<joint>`.
-std::string joint_name(std::string_view station, std::string_view mechanism, int joint);
-/// The part of the design the export depends on (see the header comment); `stations` empty = all.
-Design export_view(const Design& design, const std::vector<std::string>& stations);
-/// "sha256:" + 64 lower-case hex digits of sha256_hex(to_yaml(export_view(design, stations))).
-std::string design_hash(const Design& design, const std::vector<std::string>& stations);
+// joint_name(), export_view(), design_hash() and device_config(): fivebar/device/config.hpp.
 
-/// The parameter tree `{<node>: {ros__parameters: {...}}}` (layout above). Needs `controller:`
-/// (InputError otherwise); does not run the gate.
+/// The parameter tree `{<node>: {ros__parameters: {...}}}` (layout above):
+/// configuration_document(device_config(design, stations)), the device's Config written through
+/// the one key list (fivebar/runtime/config_layout.hpp). Needs `controller:` (InputError
+/// otherwise); does not run the gate.
 Json controller_parameters(const Design& design, const std::vector<std::string>& stations);
 
 /// Shortest text that reads back as the same double (std::to_chars), always recognisable as a

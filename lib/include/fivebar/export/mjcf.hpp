@@ -43,7 +43,7 @@
 /// and the distal link without it) from touching; MuJoCo already skips parent and child.
 ///
 /// Joint ranges: the motor joints' `range` is their mechanical range, the arc between the hard stops
-/// (stop_range(): the base obstacles of fivebar/export/joint_limits.hpp; unlimited without one), made
+/// (stop_range(): the base obstacles of fivebar/device/joint_limits.hpp; unlimited without one), made
 /// stiff (solreflimit the connect constraints' time constant). The usable range (the potentiometer's
 /// travel, the stops, the declared joint_limits) is a sensor range, not a stop: it is the position
 /// servo's ctrlrange and a `<custom><numeric name="<joint>_usable_range">` (lo, hi) in the file.

@@ -50,7 +50,7 @@
 /// Interfaces: the device runs its own PID at the loop rate (the exported gains), so ros2_control
 /// commands positions; the transmissions declare the same (PositionJointInterface).
 ///
-/// Limits: motor joints carry the usable range of fivebar/export/joint_limits.hpp (continuous when the
+/// Limits: motor joints carry the usable range of fivebar/device/joint_limits.hpp (continuous when the
 /// joint has none), velocity motor_velocity_limit() (controller.max_velocity, at most the motor's
 /// steady speed at the supply voltage less friction), effort the stall torque at the output of the motor section,
 /// eta N k_t min(supply / R, current limit) (0 without `motor:`: unknown).
@@ -94,7 +94,7 @@ struct UrdfOptions {
 };
 
 /// The velocity limit of motor joint `joint` (1 or 2) of `mechanism`, rad/s: joint_speed_limit()
-/// of fivebar/export/joint_limits.hpp, the one joint speed of every exported file and of the gate.
+/// of fivebar/device/joint_limits.hpp, the one joint speed of every exported file and of the gate.
 double motor_velocity_limit(const Design& design, const Station& station, const Mechanism& mechanism, int joint);
 
 /// Every joint's angle at the target centre (rad), motor joints and elbows, in the URDF's joint order:

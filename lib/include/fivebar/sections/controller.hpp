@@ -36,7 +36,7 @@ struct PidGains {
 /// 0 V at one end of its travel and travel / |rad_per_volt| volts at the other, so the joint reads
 /// only on the arc theta in [rad_per_volt (0 - volts_at_zero), rad_per_volt (travel/|rad_per_volt|
 /// - volts_at_zero)] (ends swapped when wired reversed); potentiometer_window() in
-/// fivebar/export/joint_limits.hpp. Without it the potentiometer is taken to read on every angle.
+/// fivebar/device/joint_limits.hpp. Without it the potentiometer is taken to read on every angle.
 struct Potentiometer {
   double volts_at_zero = 2.5;                   ///< reading at theta = 0, V
   double rad_per_volt = 1.0471975511965976;     ///< 5 V over 300 deg: 60 deg/V; negative when wired reversed
@@ -104,7 +104,7 @@ struct ControllerSettings {
   /// min_lci): the ellipse keeps this far from singularities.
   double min_lci = 0.05;
   /// Export gate: the target ellipse and every pattern keep at least this far (rad) inside each
-  /// joint's usable range (fivebar/export/joint_limits.hpp; file: joint_margin_deg, default 5 deg, an
+  /// joint's usable range (fivebar/device/joint_limits.hpp; file: joint_margin_deg, default 5 deg, an
   /// assumption: room for the PID's overshoot before a hard stop or the end of a potentiometer).
   double joint_margin = 0.08726646259971647;
   /// Export gate (with `motor:`): the tactor's tracking error |P - P_ref| in every simulated

@@ -53,7 +53,6 @@
 
 #include "fivebar/design.hpp"
 #include "fivebar/sections/motor.hpp"
-#include "fivebar/export/export.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/geometry.hpp"
 
@@ -158,10 +157,5 @@ double station_joint_speed_limit(const Design& design, const Station& station);
 /// or `patterns.max_joint_speed_deg_s` (its default without a `patterns:` section) for a design
 /// with neither a `controller:` nor a `motor:` section.
 double pattern_joint_speed_limit(const Design& design, const Station& station);
-
-/// The export gate's checks of a station's hardware limits (fivebar/export/export.hpp export_gate()):
-///   hardware_limits  per mechanism: both joints have a usable range (describe() of each);
-///   joint_margin     per mechanism and per pattern: check_joint_margins() with the gate's sampling.
-std::vector<GateCheck> hardware_limit_checks(const Design& design, const Station& station, const ExportOptions& options);
 
 }  // namespace fivebar

@@ -1,8 +1,8 @@
-// Joint limits from the hardware (fivebar/export/joint_limits.hpp, where the model is stated): the
+// Joint limits from the hardware (fivebar/device/joint_limits.hpp, where the model is stated): the
 // potentiometer window, the base hard stops of the proximal links, the usable range per joint and
 // the margin check over the target and the patterns.
 
-#include "fivebar/export/joint_limits.hpp"
+#include "fivebar/device/joint_limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +10,7 @@
 #include <numbers>
 
 #include "fivebar/collision.hpp"
-#include "fivebar/export/export.hpp"
+#include "fivebar/device/config.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
 #include "fivebar/pattern.hpp"
@@ -314,23 +314,6 @@ std::string describe(const UsableRange& r) {
   if (!r.limited) return "every angle";
   const auto end = [](const std::string& by) { return by.empty() ? std::string("-") : by; };
   return "[" + deg(r.lo) + ", " + deg(r.hi) + "] deg (" + end(r.lo_by) + " ... " + end(r.hi_by) + ")";
-}
-
-std::vector<GateCheck> hardware_limit_checks(const Design& design, const Station& station, const ExportOptions& options) {
-  std::vector<GateCheck> out;
-  for (const Mechanism* m : station.mechanisms()) {
-    const std::array<UsableRange, 2> r = usable_ranges(design, station, *m);
-    out.push_back(GateCheck{"hardware_limits", station.name + "/" + m->name, r[0].usable && r[1].usable,
-                            "theta1 " + describe(r[0]) + "; theta2 " + describe(r[1])});
-  }
-  JointMarginOptions sampling;
-  sampling.boundary_samples = options.boundary_samples;
-  sampling.rings = options.coverage.rings;
-  sampling.angles = options.coverage.angles;
-  for (const JointMarginCheck& c : check_joint_margins(design, station, sampling)) {
-    out.push_back(GateCheck{"joint_margin", c.subject, c.passed, c.detail});
-  }
-  return out;
 }
 
 }  // namespace fivebar
