@@ -102,5 +102,28 @@ TEST(ExportedHeader, TheGeneratedFilePassesCheck) {
   EXPECT_TRUE(c.matches()) << ::testing::PrintToString(c.differences.size());
 }
 
+TEST(ExportedHeader, CheckComparesTheCopyTheRuntimeReads) {
+  // The header holds each value twice: a constant and, in runtime_json, the text the runtime
+  // reads. An edit of the JSON copy alone (a gain the constants do not show) is named with its key.
+  const Design d = load_design(kSource / "designs" / "iros2022.yaml");
+  std::ifstream in(FIVEBAR_EXPORTED_HEADER);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const Json params = controller_parameters(d, {});
+  const double p = params.begin().value()["ros__parameters"]["gains"]["index_lower_theta1"]["p"].get<double>();
+  // In runtime_json the gains read `\"p\": <value>` (quotes escaped, newlines octal).
+  const std::string key = "\\\"p\\\": " + format_double(p).substr(0, format_double(p).find('.'));
+  const std::size_t at = text.find("runtime_json");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t hit = text.find(key, at);
+  ASSERT_NE(hit, std::string::npos) << key;
+  text.insert(hit + key.size() - 1, "9");  // one more leading digit: 10x or more
+  const ExportCheck c = check_export(text, ExportFormat::header, d, "edited.hpp");
+  ASSERT_EQ(c.differences.size(), 1u);
+  EXPECT_EQ(c.differences[0].path, "runtime_json.fivebar_controller.ros__parameters.gains.index_lower_theta1.p");
+  // The constants alone are unchanged: the same text without runtime_json passes as before.
+}
+
 }  // namespace
 }  // namespace fivebar
