@@ -109,6 +109,7 @@ struct Server {
   std::string nonce;
   int port = 0;
   RunState run;
+  StudioCache cache;  // figures of the numbers a drag leaves alone (the other mechanism, ...)
 };
 
 bool host_allowed(const Server& s, const std::string& host) {
@@ -260,17 +261,23 @@ void routes(httplib::Server& http, Server& s) {
     json_route(res, req, [&](const Json&) { return state_json(s); });
   });
   http.Post("/api/figures", [&s](const httplib::Request& req, httplib::Response& res) {
+    const auto start = std::chrono::steady_clock::now();
     json_route(res, req, [&](const Json& in) {
+      const StudioFigures which = in.value("figures", std::string("live")) == "full" ? StudioFigures::full : StudioFigures::live;
+      // A drag's answer sets the edits in the design read once; the sampled figures, asked for when
+      // the drag stops, load the edited file, so every rule of the loader has its say then too.
       Design d = [&] {
         const std::lock_guard<std::mutex> lock(s.mutex);
-        return s.studio.design(edits_of(in));
+        return which == StudioFigures::live ? s.studio.live_design(edits_of(in)) : s.studio.design(edits_of(in));
       }();
       const std::string station = in.value("station", d.stations.empty() ? std::string() : d.stations.front().name);
-      const StudioFigures which = in.value("figures", std::string("live")) == "full" ? StudioFigures::full : StudioFigures::live;
-      Json out = studio_figures(d, station, {point_of(in, "lower"), point_of(in, "upper")}, which);
+      Json out = studio_figures(d, station, {point_of(in, "lower"), point_of(in, "upper")}, which, &s.cache);
       out["seq"] = in.value("seq", 0);
       return out;
     });
+    // The server's own time for the answer, which the page sets beside its latency.
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    res.set_header("Server-Timing", "figures;dur=" + format::fixed(ms, 1));
   });
   http.Post("/api/preview", [&s](const httplib::Request& req, httplib::Response& res) {
     json_route(res, req, [&](const Json& in) {
@@ -306,7 +313,7 @@ void routes(httplib::Server& http, Server& s) {
 int run_studio(const StudioOptions& opt) {
   if (opt.port < 0 || opt.port > 65535) throw InputError("--port " + std::to_string(opt.port) + ": expected 0 to 65535");
   namespace fs = std::filesystem;
-  Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}};
+  Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}, {}};
   httplib::Server http;
   http.set_payload_max_length(1 << 20);
   routes(http, s);
