@@ -89,7 +89,10 @@ std::optional<Vec2> point_of(const Json& body, const char* key) {
 
 void reply(httplib::Response& res, int status, const Json& doc) {
   res.status = status;
-  res.set_content(doc.dump(), "application/json");
+  // With the charset, cpp-httplib leaves the answer uncompressed: it would otherwise compress it
+  // with brotli at its slowest setting for a browser (measured: 0.27 s for the 99 kB of a drag's
+  // figures, 7 times what computing them takes; on the loopback the bytes cost nothing).
+  res.set_content(doc.dump(), "application/json; charset=utf-8");
 }
 
 /// A scene run started from the page: one at a time, its progress lines and outcome.
@@ -316,6 +319,9 @@ int run_studio(const StudioOptions& opt) {
   Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}, {}};
   httplib::Server http;
   http.set_payload_max_length(1 << 20);
+  // An answer is written in pieces (headers, then the body): without this, Nagle's algorithm holds
+  // each piece until the page acknowledges the last, which it delays (measured: 0.3 s per answer).
+  http.set_tcp_nodelay(true);
   routes(http, s);
   s.port = opt.port == 0 ? http.bind_to_any_port("127.0.0.1") : (http.bind_to_port("127.0.0.1", opt.port) ? opt.port : -1);
   if (s.port <= 0) throw InputError("--port " + std::to_string(opt.port) + ": cannot listen on 127.0.0.1 there");
