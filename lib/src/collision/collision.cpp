@@ -202,7 +202,21 @@ bool parts_collide(const OutlinePart& a, const OutlinePart& b, double threshold)
     const double gap = std::hypot(gx, gy);
     if (gap >= threshold) return false;  // disjoint boxes: clearance >= gap
   }
-  return part_clearance(a, b, nullptr, nullptr) < threshold;
+  // part_clearance(a, b) < threshold: some capsule pair closer than it, each pair's box tested first.
+  for (int i = 0; i < a.count; ++i) {
+    const Capsule& ca = a.shapes[i];
+    for (int j = 0; j < b.count; ++j) {
+      const Capsule& cb = b.shapes[j];
+      const double r = ca.radius + cb.radius;
+      const double cx = std::max({0.0, std::min(ca.a.x(), ca.b.x()) - std::max(cb.a.x(), cb.b.x()) - r,
+                                  std::min(cb.a.x(), cb.b.x()) - std::max(ca.a.x(), ca.b.x()) - r});
+      const double cy = std::max({0.0, std::min(ca.a.y(), ca.b.y()) - std::max(cb.a.y(), cb.b.y()) - r,
+                                  std::min(cb.a.y(), cb.b.y()) - std::max(ca.a.y(), ca.b.y()) - r});
+      if ((cx > 0.0 || cy > 0.0) && std::hypot(cx, cy) >= threshold) continue;  // clearance >= that gap
+      if (capsule_clearance(ca, cb, nullptr, nullptr) < threshold) return true;
+    }
+  }
+  return false;
 }
 
 /// outlines_collide(), trying first the pair (upper index, lower index) in `hint` and leaving
