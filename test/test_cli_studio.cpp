@@ -260,6 +260,32 @@ TEST_F(StudioCli, TheCacheGivesTheFiguresComputedAfresh) {
   EXPECT_FALSE(fivebar::station_coverage(*last.station("index")).lower->inside);
 }
 
+TEST_F(StudioCli, TheToleranceBandAtTheTargetCentreIsTheCommandLines) {
+  const fs::path design = write("d.yaml", slurp(kDesign));
+  const json fig = fivebar::studio_figures(fivebar::Studio(design).design({}), "index");
+  const ft::Outcome r = run({"tolerance", design.string(), "--station", "index", "--json", "--no-files"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json cli = json::parse(r.out)["stations"][0]["mechanisms"];
+  ASSERT_EQ(cli.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& t = fig["mechanisms"][i]["tolerance"];
+    ASSERT_EQ(fig["mechanisms"][i]["mechanism"], cli[i]["mechanism"]);
+    EXPECT_EQ(t["status"], cli[i]["centre_status"]);
+    EXPECT_EQ(t["at_mm"], fig["target"]["center_mm"]);
+    EXPECT_EQ(t["three_sigma_first_order_mm"], cli[i]["centre_3sigma_first_order_mm"]);
+    EXPECT_EQ(t["three_sigma_minor_first_order_mm"], cli[i]["centre_3sigma_minor_first_order_mm"]);
+    EXPECT_NEAR(t["three_sigma_angle_first_order_deg"].get<double>(), cli[i]["centre_3sigma_angle_first_order_deg"].get<double>(), 1e-9);
+    EXPECT_EQ(t["worst_case_first_order_mm"], cli[i]["centre_worst_case_first_order_mm"]);
+    // The Monte Carlo of the command line agrees with the linearisation to a few per cent.
+    EXPECT_NEAR(t["three_sigma_first_order_mm"].get<double>(), cli[i]["centre_monte_carlo_3sigma_mm"].get<double>(),
+                0.05 * cli[i]["centre_monte_carlo_3sigma_mm"].get<double>());
+  }
+  // Elsewhere: the band moves with the cursor (it is not the centre's).
+  const json moved = fivebar::studio_figures(fivebar::Studio(design).design({}), "index", {fivebar::Vec2(6.25, 11.0), std::nullopt});
+  EXPECT_NE(moved["mechanisms"][0]["tolerance"]["three_sigma_first_order_mm"], fig["mechanisms"][0]["tolerance"]["three_sigma_first_order_mm"]);
+  EXPECT_EQ(moved["mechanisms"][1]["tolerance"], fig["mechanisms"][1]["tolerance"]);
+}
+
 /// `fivebar studio` started in the background; its address read from its first line of stdout.
 class StudioServer : public StudioCli {
  protected:

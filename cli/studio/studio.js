@@ -185,6 +185,12 @@
           'stroke-width': 2 * cap.radius_mm, 'stroke-linecap': 'round' }, g);
       }
     }
+    const t = m.tolerance;
+    if (t && t.status === 'ok') {  // the 3-sigma ellipse (first order) around the tactor point
+      el('ellipse', { cx: t.at_mm[0], cy: t.at_mm[1], rx: t.three_sigma_first_order_mm, ry: t.three_sigma_minor_first_order_mm,
+        transform: `rotate(${t.three_sigma_angle_first_order_deg} ${t.at_mm[0]} ${t.at_mm[1]})`, fill: `rgba(${c},0.25)`,
+        stroke: `rgb(${c})`, 'stroke-width': 0.05 }, g);
+    }
     if (m.pose.points_mm) {
       el('polyline', { points: m.pose.points_mm.map((p) => p.join(',')).join(' '), fill: 'none', stroke: `rgb(${c})`, 'stroke-width': 0.35,
         'stroke-linejoin': 'round' }, g);
@@ -274,6 +280,10 @@
       : 'LCI field (sampled): shaded where conditioning is poor; LCI at the tactor points: ' +
         fig.mechanisms.map((m) => `${m.mechanism} ${fmt(m.pose.lci, 4)}`).join(', ');
     $('lci').className = typeof lci === 'string' ? 'pending' : '';
+    $('tolerance').textContent = '3-sigma tactor error at the tactor points (first order, as fivebar tolerance): ' +
+      fig.mechanisms.map((m) => m.tolerance.status !== 'ok' ? `${m.mechanism} ${m.tolerance.status}`
+        : `${m.mechanism} ${fmt(m.tolerance.three_sigma_first_order_mm, 4)} mm (worst case ${fmt(m.tolerance.worst_case_first_order_mm, 4)} mm)` +
+          (m.tolerance.near_singular ? ' [near singular]' : '')).join(', ');
   }
 
   // --- Controls ------------------------------------------------------------------------------------

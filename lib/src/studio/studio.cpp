@@ -23,6 +23,7 @@
 #include "fivebar/kinematics.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sha256.hpp"
+#include "fivebar/tolerance.hpp"
 #include "fivebar/workspace/polyline.hpp"
 #include "fivebar/workspace/region.hpp"
 
@@ -234,9 +235,24 @@ std::vector<std::string> split_lines(std::string_view text) {
 
 namespace {
 
+/// The 3-sigma ellipse and worst case of `fivebar tolerance` (first order, its `centre_*` figures)
+/// at the tactor point `at`.
+Json tolerance_json(const Design& design, const Station& s, const Mechanism& m, const Vec2& at) {
+  const ToleranceSources src = tolerance_sources(design, s, m);
+  const ToleranceEstimate e = tolerance_first_order(m, at, src.spread(), std::max(src.rad_per_count[0], src.rad_per_count[1]));
+  Json j = {{"at_mm", xy(at)}, {"status", std::string(to_string(e.status))}};
+  if (e.status != Status::ok) return j;
+  j["three_sigma_first_order_mm"] = e.ellipse_semi_axes.x();
+  j["three_sigma_minor_first_order_mm"] = e.ellipse_semi_axes.y();
+  j["three_sigma_angle_first_order_deg"] = e.ellipse_angle * 180.0 / M_PI;
+  j["worst_case_first_order_mm"] = e.worst_case_mm;
+  j["near_singular"] = e.near_singular;
+  return j;
+}
+
 /// The station's regions, coverage and priority rule (studio_figures()'s live part), each computed
-/// once per request and through the cache when there is one.
-void live_figures(Json& j, const Station& s, const Geometry* g, const Vec2& lower_at, const Vec2& upper_at,
+/// once per request and through the cache when there is one; the tolerance band at each cursor.
+void live_figures(Json& j, const Design& design, const Station& s, const Geometry* g, const Vec2& lower_at, const Vec2& upper_at,
                   StudioCache::Impl* cache) {
   std::vector<std::shared_ptr<const RegionFigure>> regions;
   std::vector<CoverageResult> coverages;
@@ -246,7 +262,9 @@ void live_figures(Json& j, const Station& s, const Geometry* g, const Vec2& lowe
     regions.push_back(cached(cache ? &cache->regions : nullptr, mk, [&] { return region_figure(reachable_region(*m)); }));
     coverages.push_back(*cached(cache ? &cache->coverages : nullptr, mk + key_of(s.target),
                                 [&] { return coverage(*m, regions.back()->region, s.target); }));
-    j["mechanisms"].push_back(mechanism_json(*m, regions.back()->json, m->name == "lower" ? lower_at : upper_at, g));
+    const Vec2& at = m->name == "lower" ? lower_at : upper_at;
+    j["mechanisms"].push_back(mechanism_json(*m, regions.back()->json, at, g));
+    j["mechanisms"].back()["tolerance"] = tolerance_json(design, s, *m, at);
   }
   // `fivebar coverage`'s record (station_coverage()), from the regions above.
   StationCoverage sc;
@@ -286,7 +304,7 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
   Json j = {{"design", design.name}, {"station", s->name}, {"stations", names}};
   j["target"] = to_json(s->target);
   j["target"]["outline_mm"] = polyline_json(ellipse_polyline(s->target, 120));
-  live_figures(j, *s, g, lower_at, upper_at, cache ? &cache->impl() : nullptr);
+  live_figures(j, design, *s, g, lower_at, upper_at, cache ? &cache->impl() : nullptr);
   const bool full = which == StudioFigures::full;
   j["collision_map"] = !full ? Json(kNotCertified) : g != nullptr && s->lower && s->upper ? collision_map_json(*s, *g) : Json(nullptr);
   if (full) {
