@@ -89,7 +89,10 @@ std::optional<Vec2> point_of(const Json& body, const char* key) {
 
 void reply(httplib::Response& res, int status, const Json& doc) {
   res.status = status;
-  res.set_content(doc.dump(), "application/json");
+  // With the charset, cpp-httplib leaves the answer uncompressed: it would otherwise compress it
+  // with brotli at its slowest setting for a browser (measured: 0.27 s for the 99 kB of a drag's
+  // figures, 7 times what computing them takes; on the loopback the bytes cost nothing).
+  res.set_content(doc.dump(), "application/json; charset=utf-8");
 }
 
 /// A scene run started from the page: one at a time, its progress lines and outcome.
@@ -109,6 +112,7 @@ struct Server {
   std::string nonce;
   int port = 0;
   RunState run;
+  StudioCache cache;  // figures of the numbers a drag leaves alone (the other mechanism, ...)
 };
 
 bool host_allowed(const Server& s, const std::string& host) {
@@ -260,17 +264,23 @@ void routes(httplib::Server& http, Server& s) {
     json_route(res, req, [&](const Json&) { return state_json(s); });
   });
   http.Post("/api/figures", [&s](const httplib::Request& req, httplib::Response& res) {
+    const auto start = std::chrono::steady_clock::now();
     json_route(res, req, [&](const Json& in) {
+      const StudioFigures which = in.value("figures", std::string("live")) == "full" ? StudioFigures::full : StudioFigures::live;
+      // A drag's answer sets the edits in the design read once; the sampled figures, asked for when
+      // the drag stops, load the edited file, so every rule of the loader has its say then too.
       Design d = [&] {
         const std::lock_guard<std::mutex> lock(s.mutex);
-        return s.studio.design(edits_of(in));
+        return which == StudioFigures::live ? s.studio.live_design(edits_of(in)) : s.studio.design(edits_of(in));
       }();
       const std::string station = in.value("station", d.stations.empty() ? std::string() : d.stations.front().name);
-      const StudioFigures which = in.value("figures", std::string("live")) == "full" ? StudioFigures::full : StudioFigures::live;
-      Json out = studio_figures(d, station, {point_of(in, "lower"), point_of(in, "upper")}, which);
+      Json out = studio_figures(d, station, {point_of(in, "lower"), point_of(in, "upper")}, which, &s.cache);
       out["seq"] = in.value("seq", 0);
       return out;
     });
+    // The server's own time for the answer, which the page sets beside its latency.
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    res.set_header("Server-Timing", "figures;dur=" + format::fixed(ms, 1));
   });
   http.Post("/api/preview", [&s](const httplib::Request& req, httplib::Response& res) {
     json_route(res, req, [&](const Json& in) {
@@ -306,9 +316,12 @@ void routes(httplib::Server& http, Server& s) {
 int run_studio(const StudioOptions& opt) {
   if (opt.port < 0 || opt.port > 65535) throw InputError("--port " + std::to_string(opt.port) + ": expected 0 to 65535");
   namespace fs = std::filesystem;
-  Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}};
+  Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}, {}};
   httplib::Server http;
   http.set_payload_max_length(1 << 20);
+  // An answer is written in pieces (headers, then the body): without this, Nagle's algorithm holds
+  // each piece until the page acknowledges the last, which it delays (measured: 0.3 s per answer).
+  http.set_tcp_nodelay(true);
   routes(http, s);
   s.port = opt.port == 0 ? http.bind_to_any_port("127.0.0.1") : (http.bind_to_port("127.0.0.1", opt.port) ? opt.port : -1);
   if (s.port <= 0) throw InputError("--port " + std::to_string(opt.port) + ": cannot listen on 127.0.0.1 there");

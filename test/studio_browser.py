@@ -255,6 +255,11 @@ def main():
         p95 = lat[min(len(lat) - 1, int(0.95 * len(lat)))] if lat else float("inf")
         print(f"latency from a drag event to the redrawn figures: {len(lat)} redraws, median {lat[len(lat) // 2]:.1f} ms, p95 {p95:.1f} ms")
         print(f"  (goal: p95 <= {P95_GOAL_MS:.0f} ms; {'met' if p95 <= P95_GOAL_MS else 'not met'} on this run)")
+        split = cdp.js("window.studio.split")
+        if split:
+            med = {k: sorted(s[k] for s in split)[len(split) // 2] for k in split[0]}
+            print("  medians: " + ", ".join(f"{k} {v:.1f} ms" for k, v in med.items()) +
+                  " (queued: waiting for the answer before; request: the server's answer as the page sees it)")
         check(len(lat) >= 3, f"the figures redrew during the drags ({len(lat)} redraws)", failures)
         errors = console_errors(cdp)
         check(not errors, f"no console error ({errors})", failures)

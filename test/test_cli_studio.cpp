@@ -17,6 +17,8 @@
 
 #include "cli_test.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/coverage/coverage.hpp"
+#include "fivebar/coverage/report.hpp"
 #include "fivebar/studio.hpp"
 #include "fivebar/workspace/region.hpp"
 
@@ -154,6 +156,134 @@ TEST_F(StudioCli, AnEditTheLoaderRefusesNamesTheFileLineAndKeyAndWritesNothing) 
   EXPECT_THROW((void)studio.save(bad, studio.text_sha256()), fivebar::InputError);
   EXPECT_EQ(slurp(design), original);
   EXPECT_THROW((void)studio.design({{"stations.index.mechanisms.lower.joint_limits[0][0]", 10.0}}), fivebar::InputError);
+}
+
+/// A changed value for each control of a station: a number moved by 3 % (and 0.01), a mode to
+/// another of its choices.
+std::vector<fivebar::FileEdit> changed_controls(const json& controls, const std::string& station) {
+  std::vector<fivebar::FileEdit> edits;
+  for (const json& st : controls["stations"]) {
+    if (st["station"] != station) continue;
+    for (const json& k : st["keys"]) {
+      if (k.contains("choices")) {
+        const std::string now = k["value"];
+        for (const json& c : k["choices"]) {
+          if (c != now) {
+            edits.push_back({k["key"], c.get<std::string>()});
+            break;
+          }
+        }
+      } else {
+        edits.push_back({k["key"], k["value"].get<double>() * 1.03 + 0.01});
+      }
+    }
+  }
+  return edits;
+}
+
+TEST_F(StudioCli, AnEditSetInMemoryGivesTheDesignTheLoaderReadsFromTheEditedFile) {
+  // The paper's file, and one whose index lower mechanism has joint limits (their four numbers).
+  const fs::path limited = design_with("limited.yaml", "links: [9, 9, 15, 15]",
+                                       "links: [9, 9, 15, 15]\n        joint_limits: [[-30, 210], [-30, 210]]");
+  for (const fs::path& file : {write("d.yaml", slurp(kDesign)), limited}) {
+    fivebar::Studio s(file);
+    ASSERT_TRUE(s.live_edits()) << file;
+    const fivebar::Design base = s.design({});
+    for (const std::string station : {"index", "thumb"}) {
+      const std::vector<fivebar::FileEdit> all = changed_controls(fivebar::studio_controls(base), station);
+      ASSERT_GE(all.size(), 20u);
+      // Every key alone (a number, a mode), then all of them at once: the same design, every
+      // number to the bit (to_yaml writes the shortest text that reads back as the same double).
+      for (const fivebar::FileEdit& e : all) {
+        const fivebar::Design live = s.live_design({e}), loaded = s.design({e});
+        EXPECT_EQ(fivebar::to_yaml(live), fivebar::to_yaml(loaded)) << file << " " << e.key;
+        EXPECT_NE(fivebar::to_yaml(live), fivebar::to_yaml(base)) << e.key << ": the edit changed nothing";
+      }
+      EXPECT_EQ(fivebar::to_yaml(s.live_design(all)), fivebar::to_yaml(s.design(all))) << file << " " << station;
+    }
+  }
+  EXPECT_THAT(fivebar::studio_controls(fivebar::Studio(limited).design({})).dump(), HasSubstr("joint_limits[1][1]"));
+  fivebar::Studio studio(write("d.yaml", slurp(kDesign)));
+  // A value the rules refuse gets the loader's message, with the file's line.
+  const std::string original = slurp(kDesign);
+  const int links = line_of(original, "  index:", "links: [9, 9, 15, 15]");
+  for (const double bad : {-1.0, 1.0}) {  // not > 0; shorter than geometry.boss_diameter
+    try {
+      (void)studio.live_design({{"stations.index.mechanisms.lower.links[0]", bad}});
+      ADD_FAILURE() << "links[0] = " << bad << " was accepted";
+    } catch (const fivebar::InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr(":" + std::to_string(links) + ":"));
+      EXPECT_THAT(e.what(), HasSubstr("links[0]"));
+    }
+  }
+  EXPECT_THROW((void)studio.live_design({{"stations.index.mechanisms.lower.working_mode", std::string("+")}}), fivebar::InputError);
+  EXPECT_THROW((void)studio.live_design({{"stations.index.mechanisms.lower.joint_limits[0][0]", 10.0}}), fivebar::InputError);
+}
+
+TEST_F(StudioCli, AFileWhoseAnchorTiesTwoNumbersIsLoadedForEveryEdit) {
+  // One anchor for both mechanisms' links: an edit of the lower's changes the upper's in the file.
+  const fs::path file = design_with("tied.yaml", "links: [9, 9, 15, 15]", "links: &L [9, 9, 15, 15]");
+  std::string text = slurp(file);
+  const std::size_t second = text.find("links: [9, 9, 15, 15]");
+  ASSERT_NE(second, std::string::npos);
+  text.replace(second, std::string("links: [9, 9, 15, 15]").size(), "links: *L");
+  fivebar::Studio studio(write("tied.yaml", text));
+  EXPECT_FALSE(studio.live_edits());
+  const std::vector<fivebar::FileEdit> e = {{"stations.index.mechanisms.lower.links[2]", 16.0}};
+  const fivebar::Design d = studio.live_design(e);
+  EXPECT_EQ(d.station("index")->upper->L[2], 16.0);
+  EXPECT_EQ(fivebar::to_yaml(d), fivebar::to_yaml(studio.design(e)));
+}
+
+TEST_F(StudioCli, TheCacheGivesTheFiguresComputedAfresh) {
+  fivebar::Studio studio(write("d.yaml", slurp(kDesign)));
+  fivebar::StudioCache cache;
+  const std::vector<std::vector<fivebar::FileEdit>> states = {
+      {{"stations.index.mechanisms.lower.links[2]", 15.5}},
+      {{"stations.index.mechanisms.lower.links[2]", 15.5}, {"stations.index.mechanisms.upper.bases[0][1]", 0.5}},
+      {{"stations.index.mechanisms.lower.links[2]", 15.5}},  // back: every entry from the cache
+      {{"stations.index.target.axes[0]", 14.0}},             // the regions kept, the coverage not
+      {{"stations.index.mechanisms.lower.bases[1][0]", 20.0}},  // the target not inside: the fraction
+  };
+  const fivebar::StudioCursor at{fivebar::Vec2(6.0, 14.0), fivebar::Vec2(6.5, 17.0)};
+  for (std::size_t i = 0; i < states.size(); ++i) {
+    for (const fivebar::StudioCursor& c : {fivebar::StudioCursor{}, at}) {
+      const fivebar::Design d = studio.live_design(states[i]);
+      const json warm = fivebar::studio_figures(d, "index", c, fivebar::StudioFigures::live, &cache);
+      const json fresh = fivebar::studio_figures(studio.design(states[i]), "index", c);
+      EXPECT_EQ(warm.dump(), fresh.dump()) << "state " << i;
+      // The coverage record is `fivebar coverage --json`'s (station_coverage of the station).
+      EXPECT_EQ(warm["coverage"], fivebar::to_json(fivebar::station_coverage(*d.station("index")), "index")) << "state " << i;
+    }
+  }
+  const fivebar::Design last = studio.design(states.back());
+  EXPECT_FALSE(fivebar::station_coverage(*last.station("index")).lower->inside);
+}
+
+TEST_F(StudioCli, TheToleranceBandAtTheTargetCentreIsTheCommandLines) {
+  const fs::path design = write("d.yaml", slurp(kDesign));
+  const json fig = fivebar::studio_figures(fivebar::Studio(design).design({}), "index");
+  const ft::Outcome r = run({"tolerance", design.string(), "--station", "index", "--json", "--no-files"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json cli = json::parse(r.out)["stations"][0]["mechanisms"];
+  ASSERT_EQ(cli.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& t = fig["mechanisms"][i]["tolerance"];
+    ASSERT_EQ(fig["mechanisms"][i]["mechanism"], cli[i]["mechanism"]);
+    EXPECT_EQ(t["status"], cli[i]["centre_status"]);
+    EXPECT_EQ(t["at_mm"], fig["target"]["center_mm"]);
+    EXPECT_EQ(t["three_sigma_first_order_mm"], cli[i]["centre_3sigma_first_order_mm"]);
+    EXPECT_EQ(t["three_sigma_minor_first_order_mm"], cli[i]["centre_3sigma_minor_first_order_mm"]);
+    EXPECT_NEAR(t["three_sigma_angle_first_order_deg"].get<double>(), cli[i]["centre_3sigma_angle_first_order_deg"].get<double>(), 1e-9);
+    EXPECT_EQ(t["worst_case_first_order_mm"], cli[i]["centre_worst_case_first_order_mm"]);
+    // The Monte Carlo of the command line agrees with the linearisation to a few per cent.
+    EXPECT_NEAR(t["three_sigma_first_order_mm"].get<double>(), cli[i]["centre_monte_carlo_3sigma_mm"].get<double>(),
+                0.05 * cli[i]["centre_monte_carlo_3sigma_mm"].get<double>());
+  }
+  // Elsewhere: the band moves with the cursor (it is not the centre's).
+  const json moved = fivebar::studio_figures(fivebar::Studio(design).design({}), "index", {fivebar::Vec2(6.25, 11.0), std::nullopt});
+  EXPECT_NE(moved["mechanisms"][0]["tolerance"]["three_sigma_first_order_mm"], fig["mechanisms"][0]["tolerance"]["three_sigma_first_order_mm"]);
+  EXPECT_EQ(moved["mechanisms"][1]["tolerance"], fig["mechanisms"][1]["tolerance"]);
 }
 
 /// `fivebar studio` started in the background; its address read from its first line of stdout.

@@ -13,12 +13,12 @@
     edits: new Map(), undo: [], redo: [],
     cursor: { lower: null, upper: null },
     seq: 0, shownSeq: 0, rev: 0, inflight: false, queued: false, oldestEvent: null,
-    fullTimer: null, fullRev: -1, figures: null, latencies: [], errors: 0, view: null,
+    fullTimer: null, fullAbort: null, fullRev: -1, figures: null, latencies: [], split: [], errors: 0, view: null,
   };
   window.studio = st;  // for the browser test (test/studio_browser.py) and the curious
 
-  async function api(path, body) {
-    const init = { method: body === undefined ? 'GET' : 'POST', headers: { 'X-Fivebar-Token': token } };
+  async function api(path, body, signal) {
+    const init = { method: body === undefined ? 'GET' : 'POST', headers: { 'X-Fivebar-Token': token }, signal };
     if (body !== undefined) { init.body = JSON.stringify(body); init.headers['Content-Type'] = 'application/json'; }
     const res = await fetch(path, init);
     const doc = await res.json().catch(() => ({ error: 'HTTP ' + res.status }));
@@ -52,22 +52,31 @@
   // --- Requests: one in flight, the newest state queued, stale answers dropped ----------------------
   function request(eventTime) {
     if (st.oldestEvent === null) st.oldestEvent = eventTime;
+    if (st.fullAbort) { st.fullAbort.abort(); st.fullAbort = null; }  // its answer would be stale
     if (st.inflight) { st.queued = true; return; }
     send();
   }
   async function send() {
     st.inflight = true; st.queued = false;
-    const seq = ++st.seq, rev = st.rev, since = st.oldestEvent;
+    const seq = ++st.seq, rev = st.rev, since = st.oldestEvent, sent = performance.now();
     st.oldestEvent = null;
     clearTimeout(st.fullTimer);
     try {
       const fig = await api('/api/figures', body('live', seq));
       if (seq > st.shownSeq) {  // a newer answer than the one shown: drawn even mid-drag
+        const answered = performance.now();
         st.shownSeq = seq;
         st.figures = fig;
         draw(fig);
+        const drawn = performance.now();
         if ($('status').className === 'bad') status('');
-        requestAnimationFrame(() => { if (since !== null) st.latencies.push(performance.now() - since); });
+        requestAnimationFrame(() => {
+          if (since === null) return;
+          const now = performance.now();
+          st.latencies.push(now - since);
+          // Where the time went: waiting to be sent, the request, drawing, the frame.
+          st.split.push({ queued: sent - since, request: answered - sent, draw: drawn - answered, frame: now - drawn });
+        });
         if (rev === st.rev) st.fullTimer = setTimeout(() => full(rev), 120);
       }
     } catch (e) {
@@ -89,10 +98,16 @@
   async function full(rev) {
     if (rev !== st.rev) return;
     if (st.inflight) { st.fullTimer = setTimeout(() => full(rev), 60); return; }
+    const abort = new AbortController();
+    st.fullAbort = abort;
     try {
-      const fig = await api('/api/figures', body('full', st.seq));
+      const fig = await api('/api/figures', body('full', st.seq), abort.signal);
       if (rev === st.rev) { st.fullRev = rev; st.figures = fig; draw(fig); }
-    } catch (e) { /* the live answer already reported it */ }
+    } catch (e) {
+      // Aborted by a newer edit, or refused: the live answer already reported that.
+    } finally {
+      if (st.fullAbort === abort) st.fullAbort = null;
+    }
   }
   function markInvalid() {
     for (const td of document.querySelectorAll('#coverage td')) td.classList.add('pending');
@@ -169,6 +184,12 @@
         el('line', { x1: cap.a_mm[0], y1: cap.a_mm[1], x2: cap.b_mm[0], y2: cap.b_mm[1], stroke: `rgba(${c},0.18)`,
           'stroke-width': 2 * cap.radius_mm, 'stroke-linecap': 'round' }, g);
       }
+    }
+    const t = m.tolerance;
+    if (t && t.status === 'ok') {  // the 3-sigma ellipse (first order) around the tactor point
+      el('ellipse', { cx: t.at_mm[0], cy: t.at_mm[1], rx: t.three_sigma_first_order_mm, ry: t.three_sigma_minor_first_order_mm,
+        transform: `rotate(${t.three_sigma_angle_first_order_deg} ${t.at_mm[0]} ${t.at_mm[1]})`, fill: `rgba(${c},0.25)`,
+        stroke: `rgb(${c})`, 'stroke-width': 0.05 }, g);
     }
     if (m.pose.points_mm) {
       el('polyline', { points: m.pose.points_mm.map((p) => p.join(',')).join(' '), fill: 'none', stroke: `rgb(${c})`, 'stroke-width': 0.35,
@@ -259,6 +280,10 @@
       : 'LCI field (sampled): shaded where conditioning is poor; LCI at the tactor points: ' +
         fig.mechanisms.map((m) => `${m.mechanism} ${fmt(m.pose.lci, 4)}`).join(', ');
     $('lci').className = typeof lci === 'string' ? 'pending' : '';
+    $('tolerance').textContent = '3-sigma tactor error at the tactor points (first order, as fivebar tolerance): ' +
+      fig.mechanisms.map((m) => m.tolerance.status !== 'ok' ? `${m.mechanism} ${m.tolerance.status}`
+        : `${m.mechanism} ${fmt(m.tolerance.three_sigma_first_order_mm, 4)} mm (worst case ${fmt(m.tolerance.worst_case_first_order_mm, 4)} mm)` +
+          (m.tolerance.near_singular ? ' [near singular]' : '')).join(', ');
   }
 
   // --- Controls ------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -31,14 +32,33 @@ struct StudioCursor {
   std::optional<Vec2> upper;
 };
 
+/// What studio_figures() keeps between calls (docs/studio.md "Speed"): each mechanism's exact
+/// region and its coverage of a target, the shared region of a pair and the priority rule at a
+/// pair of points, each keyed by every number it is computed from, so that a drag of one
+/// mechanism recomputes nothing of the other and a figure is never one of another state. A few
+/// entries of each kind (the newest); safe to share between threads.
+class StudioCache {
+ public:
+  StudioCache();
+  ~StudioCache();
+  StudioCache(const StudioCache&) = delete;
+  StudioCache& operator=(const StudioCache&) = delete;
+  struct Impl;
+  Impl& impl() const { return *impl_; }  ///< for studio_figures()
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 /// One station's figures as JSON (docs/studio.md "Figures"): station, cursor, target, mechanisms
 /// (bases, links, modes, joint limits, exact region loops, pose and outline at the cursor),
 /// shared region, coverage (the record of `fivebar coverage --json`), priority (the record of
 /// `fivebar collision`'s rule), and with StudioFigures::full: collision_map (summary of
 /// `fivebar collision --json`, sampled) and lci_field (sampled); otherwise those two are the
-/// string "not certified yet". InputError when the station does not exist.
+/// string "not certified yet". InputError when the station does not exist. With a `cache`, what
+/// it holds for the same numbers is reused (the same figures, sooner).
 Json studio_figures(const Design& design, std::string_view station, const StudioCursor& cursor = {},
-                    StudioFigures which = StudioFigures::live);
+                    StudioFigures which = StudioFigures::live, StudioCache* cache = nullptr);
 
 /// The numbers and modes a page can edit, per station: key path, value, unit and a slider range
 /// (for a length: 0.5 to 1.5 times its value; a coordinate: +- the station's length scale).
@@ -65,6 +85,16 @@ class Studio {
   /// The design with `edits` applied, loaded from the edited text: every rule of the loader, with
   /// its FILE:LINE: key messages (the lines are those of the file). InputError otherwise.
   Design design(const std::vector<FileEdit>& edits) const;
+  /// The same design, sooner (what a drag asks for): the file as read is parsed once, and an edit
+  /// of a number or mode that studio_controls() lists is set in a copy of that design with the
+  /// design-edit API (fivebar/design/edit.hpp set_station_number) and the edited station checked
+  /// with its rules (check_station_edit). Anything else (another key, a value of the wrong kind,
+  /// a refused value) goes through design(), so a refusal gets the loader's FILE:LINE: key
+  /// message. Used only when, on reading the file, setting every listed key both ways gave the
+  /// same design (a file whose anchors tie two numbers together does not).
+  Design live_design(const std::vector<FileEdit>& edits) const;
+  /// True when live_design() sets edits in memory (see there); false: it loads every time.
+  bool live_edits() const { return live_ != nullptr; }
 
   /// What a save would write: {file, sha256 (of the file as read), changes: line_diff, valid}.
   Json preview(const std::vector<FileEdit>& edits) const;
@@ -81,10 +111,14 @@ class Studio {
   void reload();
 
  private:
+  struct Live;  // the design as read and the keys live_design() sets in memory
+  void prepare_live(Design base);
+
   std::filesystem::path file_;
   std::string text_;
   std::string sha_;
   DesignRule rule_;
+  std::shared_ptr<const Live> live_;
 };
 
 }  // namespace fivebar

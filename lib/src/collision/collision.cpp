@@ -191,18 +191,58 @@ double min_clearance(const std::vector<OutlinePart>& upper, const std::vector<Ou
   return best;
 }
 
-bool outlines_collide(const std::vector<OutlinePart>& upper, const std::vector<OutlinePart>& lower, double threshold) {
-  for (const OutlinePart& a : upper) {
-    for (const OutlinePart& b : lower) {
-      if (a.plane != b.plane) continue;
-      const double gx = std::max({0.0, a.box_lo.x() - b.box_hi.x(), b.box_lo.x() - a.box_hi.x()});
-      const double gy = std::max({0.0, a.box_lo.y() - b.box_hi.y(), b.box_lo.y() - a.box_hi.y()});
-      const double gap = std::hypot(gx, gy);
-      if (gap > 0.0 && gap >= threshold) continue;  // disjoint boxes: clearance >= gap
-      if (part_clearance(a, b, nullptr, nullptr) < threshold) return true;
+namespace {
+
+/// Are two parts closer than `threshold`? Same plane assumed. Parts whose bounding boxes are
+/// disjoint and at least `threshold` apart are not compared (their clearance is at least that).
+bool parts_collide(const OutlinePart& a, const OutlinePart& b, double threshold) {
+  const double gx = std::max({0.0, a.box_lo.x() - b.box_hi.x(), b.box_lo.x() - a.box_hi.x()});
+  const double gy = std::max({0.0, a.box_lo.y() - b.box_hi.y(), b.box_lo.y() - a.box_hi.y()});
+  if (gx > 0.0 || gy > 0.0) {
+    const double gap = std::hypot(gx, gy);
+    if (gap >= threshold) return false;  // disjoint boxes: clearance >= gap
+  }
+  // part_clearance(a, b) < threshold: some capsule pair closer than it, each pair's box tested first.
+  for (int i = 0; i < a.count; ++i) {
+    const Capsule& ca = a.shapes[i];
+    for (int j = 0; j < b.count; ++j) {
+      const Capsule& cb = b.shapes[j];
+      const double r = ca.radius + cb.radius;
+      const double cx = std::max({0.0, std::min(ca.a.x(), ca.b.x()) - std::max(cb.a.x(), cb.b.x()) - r,
+                                  std::min(cb.a.x(), cb.b.x()) - std::max(ca.a.x(), ca.b.x()) - r});
+      const double cy = std::max({0.0, std::min(ca.a.y(), ca.b.y()) - std::max(cb.a.y(), cb.b.y()) - r,
+                                  std::min(cb.a.y(), cb.b.y()) - std::max(ca.a.y(), ca.b.y()) - r});
+      if ((cx > 0.0 || cy > 0.0) && std::hypot(cx, cy) >= threshold) continue;  // clearance >= that gap
+      if (capsule_clearance(ca, cb, nullptr, nullptr) < threshold) return true;
     }
   }
   return false;
+}
+
+/// outlines_collide(), trying first the pair (upper index, lower index) in `hint` and leaving
+/// there the pair found colliding: the verdict is whether any pair collides, so the order only
+/// changes how soon a search over nearby poses (the priority rule's) finds it.
+bool outlines_collide_from(const std::vector<OutlinePart>& upper, const std::vector<OutlinePart>& lower, double threshold,
+                           std::pair<std::size_t, std::size_t>& hint) {
+  if (hint.first < upper.size() && hint.second < lower.size() && upper[hint.first].plane == lower[hint.second].plane &&
+      parts_collide(upper[hint.first], lower[hint.second], threshold)) {
+    return true;
+  }
+  for (std::size_t i = 0; i < upper.size(); ++i) {
+    for (std::size_t j = 0; j < lower.size(); ++j) {
+      if (upper[i].plane != lower[j].plane || !parts_collide(upper[i], lower[j], threshold)) continue;
+      hint = {i, j};
+      return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+bool outlines_collide(const std::vector<OutlinePart>& upper, const std::vector<OutlinePart>& lower, double threshold) {
+  std::pair<std::size_t, std::size_t> hint{upper.size(), lower.size()};
+  return outlines_collide_from(upper, lower, threshold, hint);
 }
 
 Interference interference(const Mechanism& upper, const Pose& upper_pose, const Mechanism& lower,
@@ -281,13 +321,17 @@ class LowerProbe {
   bool free(const Vec2& q) const {
     const Pose pose = ik(lower_, q);
     if (!usable(lower_, pose)) return false;
-    return min_clearance(upper_, link_outline(lower_, pose, g_), g_.min_clearance) >= g_.min_clearance;
+    // The verdict of min_clearance(...) >= g.min_clearance, with part pairs whose boxes are
+    // farther apart than the threshold skipped (as the collision map does) and the pair that
+    // collided at the last point tried first.
+    return !outlines_collide_from(upper_, link_outline(lower_, pose, g_), g_.min_clearance, hint_);
   }
 
  private:
   const Mechanism& lower_;
   const Geometry& g_;
   const std::vector<OutlinePart>& upper_;
+  mutable std::pair<std::size_t, std::size_t> hint_{~std::size_t(0), ~std::size_t(0)};  ///< the last colliding pair
 };
 
 struct RayHit {

@@ -853,10 +853,13 @@ CoverageResult coverage(const Mechanism& m, const Ellipse& target, const Coverag
   return coverage_impl(m, nullptr, target, options);
 }
 
-CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, const Ellipse& target,
-                               const CoverageOptions& options) {
-  const CoverageResult cl = coverage_impl(lower, nullptr, target, options);
-  const CoverageResult cu = coverage_impl(upper, nullptr, target, options);
+namespace {
+
+/// The shared record from the two mechanisms' own (coverage() of each on `target`); the exact
+/// shared region is asked for only when the fraction needs it.
+template <class SharedRegion>
+CoverageResult combine_shared(const CoverageResult& cl, const CoverageResult& cu, SharedRegion&& shared_region,
+                              const Ellipse& target) {
   CoverageResult out;
   // Distance to the complement of an intersection is the smaller of the two distances.
   const bool lower_worse = cl.margin_mm <= cu.margin_mm;
@@ -870,7 +873,7 @@ CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, c
   if (out.inside) {
     out.covered_fraction = 1.0;
   } else {
-    const Region shared = reachable_region(lower).intersection(reachable_region(upper));
+    const Region& shared = shared_region();
     const auto poly = ellipse_polygon(target, kFractionPolygon, 1.0);
     out.covered_fraction = std::clamp(shared.polygon_overlap_area(poly) / polygon_area(poly), 0.0, 1.0);
   }
@@ -888,6 +891,24 @@ CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, c
                                                                   : "lower: " + cl.reason + "; upper: " + cu.reason;
   }
   return out;
+}
+
+}  // namespace
+
+CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, const Ellipse& target,
+                               const CoverageOptions& options) {
+  std::optional<Region> shared;
+  return combine_shared(coverage_impl(lower, nullptr, target, options), coverage_impl(upper, nullptr, target, options),
+                        [&]() -> const Region& {
+                          if (!shared) shared = reachable_region(lower).intersection(reachable_region(upper));
+                          return *shared;
+                        },
+                        target);
+}
+
+CoverageResult coverage_shared(const CoverageResult& lower, const CoverageResult& upper, const Region& shared,
+                               const Ellipse& target) {
+  return combine_shared(lower, upper, [&]() -> const Region& { return shared; }, target);
 }
 
 bool StationCoverage::covered() const {

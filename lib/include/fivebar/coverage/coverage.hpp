@@ -57,6 +57,11 @@ CoverageResult coverage(const Mechanism& m, const Region& region, const Ellipse&
 /// the two, the fraction is measured on the exact intersection.
 CoverageResult coverage_shared(const Mechanism& lower, const Mechanism& upper, const Ellipse& target,
                                const CoverageOptions& options = {});
+/// The same record from what a caller already has: `lower` and `upper` are coverage() of each
+/// mechanism on `target` (default options), `shared` the intersection of their exact regions
+/// (read only for the covered fraction when the ellipse is not inside both).
+CoverageResult coverage_shared(const CoverageResult& lower, const CoverageResult& upper, const Region& shared,
+                               const Ellipse& target);
 
 /// Results of a station: per mechanism present and shared when both are.
 struct StationCoverage {
