@@ -2,7 +2,7 @@
 // point of the device's ROS 2 node. It reads the exported configuration, then every period reads the
 // joints and the reference points from an I/O backend, runs one cycle, and writes the duties.
 //
-//   device_loop CONFIG.json [IN.csv|-] [--realtime]
+//   device_loop CONFIG.json [IN.csv|-] [--realtime] [--watchdog N]
 //
 // The backend here is a CSV stream standing in for the DAQ and the motor drivers: each input row
 // holds time_s, per joint <joint>_counts (or _volts, _theta_rad), per mechanism
@@ -11,13 +11,27 @@
 // <joint>_duty and the statuses <station>_<mechanism>_status. A ROS node replaces CsvIo by an
 // implementation of DeviceIo over its DAQ driver, its PWM outputs and its reference topic, and the
 // loop by a wall timer at loop_rate_hz. Nothing in the loop allocates after the controller is built.
+//
+// Watchdog on stale references: a row whose reference cells are all empty (or cut off) brings no new reference
+// points (the last ones stay, as a ROS node keeps the last message); after more than N such cycles in
+// a row (--watchdog, default 10: 0.1 s at the showcase's 100 Hz, an assumption, not a measured
+// figure) every duty is 0, the statuses read `stale` and the controller is reset, until a row brings
+// references again.
+//
+// Whenever the loop ends (the end of the input, SIGINT or SIGTERM, an input error) the last thing it
+// writes is zero duty to every motor (DeviceIo::stop(); CsvIo: a row of zero duties whose statuses
+// read `stopped`); exit 0 at the end of the input, 128 + the signal's number, 2 on an error.
+
+#include <signal.h>
 
 #include <charconv>
+#include <csignal>
 #include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -34,11 +48,14 @@ namespace rt = fivebar::runtime;
 class DeviceIo {
  public:
   virtual ~DeviceIo() = default;
-  /// The next sample: readings (joint order) and reference points (m, 2 per mechanism); false at the end.
-  virtual bool read(double& t_s, double* readings, double* targets_m) = 0;
+  /// The next sample: readings (joint order) and reference points (m, 2 per mechanism; `fresh`
+  /// false when none came this cycle: `targets_m` is left as it was); false at the end.
+  virtual bool read(double& t_s, double* readings, double* targets_m, bool& fresh) = 0;
   /// The duties (joint order) and statuses (mechanism order) of this cycle.
   virtual void write(double t_s, const double* duties, const rt::Status* statuses) = 0;
   virtual rt::Reading kind() const = 0;
+  /// Zero duty to every motor: the loop's last output, whatever ends it (`why`: what did).
+  virtual void stop(double t_s, const char* why) = 0;
 };
 
 /// CSV on streams: a recorded or piped log in, duties out.
@@ -85,7 +102,7 @@ class CsvIo : public DeviceIo {
     out_ << "\n";
     out_.precision(17);
   }
-  bool read(double& t, double* readings, double* targets) override {
+  bool read(double& t, double* readings, double* targets, bool& fresh) override {
     std::string line;
     if (!next_line(line)) return false;
     const std::vector<std::string> cells = split(line);
@@ -104,7 +121,11 @@ class CsvIo : public DeviceIo {
     };
     t = cell(time_);
     for (std::size_t i = 0; i < reading_.size(); ++i) readings[i] = cell(reading_[i]);
-    for (std::size_t i = 0; i < target_.size(); ++i) targets[i] = cell(target_[i]) / 1000.0;
+    // Every reference cell empty: no new reference this cycle (else each must be a number).
+    fresh = false;
+    for (std::size_t i : target_) fresh = fresh || (i < cells.size() && !cells[i].empty());
+    if (fresh)
+      for (std::size_t i = 0; i < target_.size(); ++i) targets[i] = cell(target_[i]) / 1000.0;
     return true;
   }
   void write(double t, const double* duties, const rt::Status* statuses) override {
@@ -112,8 +133,23 @@ class CsvIo : public DeviceIo {
     for (std::size_t i = 0; i < reading_.size(); ++i) out_ << "," << duties[i];
     for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << "," << rt::to_string(statuses[k]);
     out_ << "\n";
+    out_.flush();  // a pipe's reader (the motor driver's stand-in) sees every cycle at once
   }
   rt::Reading kind() const override { return kind_; }
+  /// Zero duties with every status `stale` (the watchdog).
+  void write_stale(double t) {
+    out_ << t;
+    for (std::size_t i = 0; i < reading_.size(); ++i) out_ << ",0";
+    for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << ",stale";
+    out_ << "\n";
+    out_.flush();
+  }
+  void stop(double t, const char* why) override {
+    out_ << "# stopped: " << why << "\n" << t;
+    for (std::size_t i = 0; i < reading_.size(); ++i) out_ << ",0";
+    for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << ",stopped";
+    out_ << std::endl;
+  }
 
  private:
   /// The next line that is neither blank nor a `#` comment (the logs' notes, as `fivebar replay` reads them).
@@ -141,17 +177,43 @@ class CsvIo : public DeviceIo {
   std::vector<std::size_t> reading_, target_;
 };
 
+namespace {
+volatile std::sig_atomic_t g_signal = 0;
+extern "C" void on_signal(int signal_number) { g_signal = signal_number; }
+}  // namespace
+
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::cerr << "usage: device_loop CONFIG.json [IN.csv|-] [--realtime]\n";
+    std::cerr << "usage: device_loop CONFIG.json [IN.csv|-] [--realtime] [--watchdog N]\n";
     return 2;
   }
   bool realtime = false;
   std::string input = "-";
+  long watchdog = 10;
   for (int i = 2; i < argc; ++i) {
-    if (std::string(argv[i]) == "--realtime") realtime = true;
-    else input = argv[i];
+    const std::string arg = argv[i];
+    if (arg == "--realtime") {
+      realtime = true;
+    } else if (arg == "--watchdog") {
+      const std::string value = i + 1 < argc ? argv[++i] : "";
+      const auto r = std::from_chars(value.data(), value.data() + value.size(), watchdog);
+      if (value.empty() || r.ec != std::errc() || r.ptr != value.data() + value.size() || watchdog < 0) {
+        std::cerr << "device_loop: --watchdog " << value << ": expected a whole number of cycles >= 0\n";
+        return 2;
+      }
+    } else {
+      input = arg;
+    }
   }
+  // SIGINT and SIGTERM end the loop after the cycle under way (no SA_RESTART: a read waiting for
+  // input returns at once), and the motors get zero duty.
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  std::unique_ptr<CsvIo> io_owner;
+  double t = 0.0;
   try {
     rt::Config config = rt::load_config_json(argv[1]);  // refuses a bad configuration, naming the key
     std::ifstream file;
@@ -159,18 +221,28 @@ int main(int argc, char** argv) {
       file.open(input);
       if (!file) throw std::runtime_error(input + ": cannot be read");
     }
-    CsvIo io(input == "-" ? std::cin : file, std::cout, config);  // leaves out the stations the log lacks
+    io_owner = std::make_unique<CsvIo>(input == "-" ? std::cin : file, std::cout, config);  // leaves out the stations the log lacks
+    CsvIo& io = *io_owner;
     rt::Controller controller(std::move(config));
     // Buffers sized once: the loop below does not allocate.
     std::vector<double> readings(controller.joint_count()), targets(2 * controller.mechanism_count());
     std::vector<rt::Status> statuses(controller.mechanism_count());
     const auto period = std::chrono::duration<double>(1.0 / controller.config().loop_rate_hz);
     auto next = std::chrono::steady_clock::now();
-    double t = 0.0;
-    while (io.read(t, readings.data(), targets.data())) {
-      controller.cycle(readings.data(), io.kind(), targets.data());
-      for (std::size_t k = 0; k < statuses.size(); ++k) statuses[k] = controller.mechanism(k).status;
-      io.write(t, controller.duties(), statuses.data());
+    long stale = 0;  // cycles in a row without new references
+    bool fresh = false, any_fresh = false;
+    while (g_signal == 0 && io.read(t, readings.data(), targets.data(), fresh)) {
+      if (!fresh && !any_fresh) throw std::runtime_error("input: the first row brings no reference points");
+      any_fresh = true;
+      stale = fresh ? 0 : stale + 1;
+      if (stale > watchdog) {
+        controller.reset();  // no held command, no integral carried over the gap
+        io.write_stale(t);
+      } else {
+        controller.cycle(readings.data(), io.kind(), targets.data());
+        for (std::size_t k = 0; k < statuses.size(); ++k) statuses[k] = controller.mechanism(k).status;
+        io.write(t, controller.duties(), statuses.data());
+      }
       if (realtime) {
         next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
         std::this_thread::sleep_until(next);
@@ -178,7 +250,10 @@ int main(int argc, char** argv) {
     }
   } catch (const std::exception& e) {
     std::cerr << "device_loop: " << e.what() << "\n";
+    if (io_owner) io_owner->stop(t, "error");
     return 2;
   }
-  return 0;
+  const int signal_number = g_signal;
+  io_owner->stop(t, signal_number == SIGINT ? "SIGINT" : signal_number == SIGTERM ? "SIGTERM" : "end of input");
+  return signal_number != 0 ? 128 + signal_number : 0;
 }
