@@ -127,7 +127,7 @@ TEST_F(CliReplay, AChangedDutyOrGainIsAMismatchNamedByRowAndJoint) {
 }
 
 TEST_F(CliReplay, BadLogsAndConfigurationsAreExitTwoNamingTheColumnOrKey) {
-  const fs::path cfg = write("bad.json", "{\"n\": {\"ros__parameters\": {\"loop_rate_hz\": 100.0}}}");
+  const fs::path cfg = write("bad.json", "{\"n\": {\"ros__parameters\": {\"fivebar\": {\"design\": \"d\", \"design_hash\": \"h\", \"hash_algorithm\": \"a\", \"tool_version\": \"v\", \"format_version\": 1, \"units\": \"SI\"}, \"loop_rate_hz\": 100.0, \"pwm_hz\": 1000.0}}}");
   const fs::path log = write("log.csv", "time_s,index_lower_theta1_counts\n0,1\n");
   Outcome r = run({"replay", log.string(), "--config", cfg.string()});
   EXPECT_EQ(r.code, 2);

@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
 
   /* A refused configuration names its key. */
   {
-    const char* bad = "{\"n\": {\"ros__parameters\": {\"adc\": {}}}}";
+    const char* bad = "{\"n\": {\"ros__parameters\": {\"fivebar\": {\"design\": \"d\", \"design_hash\": \"h\", \"hash_algorithm\": \"a\", \"tool_version\": \"v\", \"format_version\": 1, \"units\": \"SI\"}, \"adc\": {}}}}";
     rt = fivebar_runtime_create_from_json(bad, strlen(bad), error, sizeof error);
     CHECK(rt == NULL);
     CHECK(strstr(error, "loop_rate_hz: missing key") != NULL);

@@ -95,15 +95,17 @@ complete_words() {
   bash -c 'source "$1"; shift; COMP_WORDS=("$@"); COMP_CWORD=$(($# - 1)); _fivebar; printf "%s\n" "${COMPREPLY[@]}"' \
     _ "$p/share/bash-completion/completions/fivebar" "$@"
 }
-complete_words fivebar rep | grep -qx report || fail "bash: 'fivebar rep' does not complete to report"
-complete_words fivebar report acc | grep -qx accuracy || fail "bash: 'fivebar report acc' does not complete to accuracy"
-complete_words fivebar fk designs/x.yaml --the | grep -qx -- --theta-file || fail "bash: 'fivebar fk --the' lacks --theta-file"
-complete_words fivebar help ik | grep -qx ik || fail "bash: 'fivebar help ik' does not complete"
+# (grep reads to the end: with -q it would stop at the first match and, under pipefail, the
+# writer killed by SIGPIPE would fail the pipeline whenever it had more lines to write.)
+complete_words fivebar rep | grep -x report > /dev/null || fail "bash: 'fivebar rep' does not complete to report"
+complete_words fivebar report acc | grep -x accuracy > /dev/null || fail "bash: 'fivebar report acc' does not complete to accuracy"
+complete_words fivebar fk designs/x.yaml --the | grep -x -- --theta-file > /dev/null || fail "bash: 'fivebar fk --the' lacks --theta-file"
+complete_words fivebar help ik | grep -x ik > /dev/null || fail "bash: 'fivebar help ik' does not complete"
 if command -v zsh > /dev/null; then
   zsh -n "$p/share/zsh/vendor-completions/_fivebar" || fail "zsh completion does not parse"
 fi
 if command -v man > /dev/null; then
-  MANWIDTH=100 man -l "$p/share/man/man1/fivebar-fk.1" 2> "$scratch/man.err" | grep -q -- "--theta-file" \
+  MANWIDTH=100 man -l "$p/share/man/man1/fivebar-fk.1" 2> "$scratch/man.err" | grep -- "--theta-file" > /dev/null \
     || { cat "$scratch/man.err" >&2; fail "man page fivebar-fk.1 does not render --theta-file"; }
 fi
 echo "completion and man pages: ok"
