@@ -41,8 +41,10 @@ std::string sig(double value) {
 
 struct IdentifyCliOptions {
   std::string design;
-  std::string log;
+  std::vector<std::string> logs;  ///< estimation logs, fitted together
+  std::string log;                ///< the first
   std::string validation;
+  bool closed_loop = false;
   std::vector<std::string> rig{"motor"};  ///< motor, or mechanism STATION/MECHANISM
   std::string joint;
   std::string out;
@@ -72,7 +74,7 @@ id::JointPrior prior_of(const Design& design, const std::string& station, const 
 }
 
 void print_estimate_table(const id::JointIdentification& r) {
-  std::cout << "  parameters (" << (r.output_error && false ? "output error" : "IDIM-LS unless noted") << "):\n";
+  std::cout << "  parameters (" << r.method << " unless noted):\n";
   for (const id::Parameter& p : r.parameters) {
     std::cout << "    " << p.key << " = " << sig(p.value);
     if (p.identified) {
@@ -81,7 +83,7 @@ void print_estimate_table(const id::JointIdentification& r) {
     } else {
       std::cout << " HELD";
     }
-    if (!p.note.empty() && !(p.identified && (p.note == "IDIM-LS" || p.note == "output error"))) std::cout << "  [" << p.note << "]";
+    if (!p.note.empty() && !(p.identified && p.note == r.method)) std::cout << "  [" << p.note << "]";
     std::cout << "\n";
   }
 }
@@ -103,10 +105,19 @@ void print_joint(const id::JointIdentification& r) {
   if (!r.unidentifiable.empty()) {
     std::cout << "  not identifiable from this log (held at the prior): " << format::join(r.unidentifiable) << "\n";
   }
-  std::cout << "  correlation (IDIM-LS):\n";
-  for (Eigen::Index a = 0; a < r.idim.correlation.rows(); ++a) {
-    std::cout << "    " << r.idim.names[static_cast<std::size_t>(a)] << ":";
-    for (Eigen::Index b = 0; b < r.idim.correlation.cols(); ++b) std::cout << " " << fixed(r.idim.correlation(a, b), 3);
+  const id::Estimate& inv = r.iv ? *r.iv : r.idim;
+  std::cout << "  correlation (" << (r.iv ? "IDIM-IV" : "IDIM-LS") << "):\n";
+  for (Eigen::Index a = 0; a < inv.correlation.rows(); ++a) {
+    std::cout << "    " << inv.names[static_cast<std::size_t>(a)] << ":";
+    for (Eigen::Index b = 0; b < inv.correlation.cols(); ++b) std::cout << " " << fixed(inv.correlation(a, b), 3);
+    std::cout << "\n";
+  }
+  if (r.method == "IDIM-IV") {
+    std::cout << "  closed loop: IDIM-IV " << r.iv_status << "; IDIM-LS (biased under feedback) gave";
+    for (std::size_t i = 0; i < r.idim.names.size(); ++i) {
+      const auto k = static_cast<Eigen::Index>(i);
+      if (r.idim.identified[i]) std::cout << " " << r.idim.names[i] << " = " << sig(r.idim.value[k]) << " +- " << sig(r.idim.sigma[k]);
+    }
     std::cout << "\n";
   }
   std::cout << "  output error: " << r.output_error_status;
@@ -120,10 +131,12 @@ void print_joint(const id::JointIdentification& r) {
   }
   std::cout << "\n";
   const bool chain = r.output_error_status.find("closed chain") != std::string::npos;
-  std::cout << "  estimation log: IDIM-LS " << fit_text(r.estimation_idim, chain) << "\n";
+  const std::string inverse = r.method == "IDIM-IV" ? "IDIM-IV" : "IDIM-LS";
+  std::cout << "  estimation log" << (r.logs > 1 ? "s (" + std::to_string(r.logs) + ")" : std::string()) << ": " << inverse << " "
+            << fit_text(r.estimation_idim, chain) << "\n";
   if (r.output_error) std::cout << "                  output error " << fit_text(r.estimation_oe) << "\n";
   if (r.validation_idim) {
-    std::cout << "  validation log: IDIM-LS " << fit_text(*r.validation_idim) << "\n";
+    std::cout << "  validation log: " << inverse << " " << fit_text(*r.validation_idim) << "\n";
     if (r.validation_oe) std::cout << "                  output error " << fit_text(*r.validation_oe) << "\n";
   }
 }
@@ -248,9 +261,38 @@ MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig) 
   source.sha256 = sha256_file(opt.log);
   source.date = today_utc();
   source.method = std::string(mechanism_rig ? "fivebar identify --rig mechanism: " : "fivebar identify --rig motor: ") +
-                  (opt.method == "oe" ? "output-error refinement (Ceres)" : "inverse dynamic model by least squares (IDIM-LS)") +
+                  (opt.method == "oe"    ? "output-error refinement (Ceres)"
+                   : opt.closed_loop    ? "inverse dynamic model by instrumental variables under the design's PID (IDIM-IV)"
+                                        : "inverse dynamic model by least squares (IDIM-LS)") +
                   ", standard deviation";
+  // Several logs: the entry's source is the first (its hash is checked); the others are named with theirs.
+  for (std::size_t i = 1; i < opt.logs.size(); ++i) source.method += "; with " + opt.logs[i] + " (sha256 " + sha256_file(opt.logs[i]) + ")";
   return source;
+}
+
+/// The device's PID a closed-loop log was taken under: the design's gains for the log's joint (a
+/// bench motor: `controller.pid`), at the log's rate, commanding the log's drive column.
+std::unique_ptr<id::LoopController> closed_loop_controller(const Design& design, const id::JointLog& j, const id::IdentifyLog& l,
+                                                           const std::string& file) {
+  const std::string who = j.prefix.empty() ? "motor" : j.prefix;
+  if (j.reference.empty()) {
+    throw InputError(file + ": --closed-loop: joint '" + who + "' has no reference column (" + (j.prefix.empty() ? "" : j.prefix + "_") +
+                     (j.linear ? "position_ref_m" : "theta_ref_rad") + ")");
+  }
+  if (j.drive != id::DriveKind::duty && j.drive != id::DriveKind::voltage) {
+    throw InputError(file + ": --closed-loop: joint '" + who + "' is driven by '" + j.drive_column +
+                     "'; the device's PID commands a duty (a duty or voltage_V column)");
+  }
+  const auto* controller = design.get<ControllerSettings>();
+  if (controller == nullptr) throw InputError(design.name + ": --closed-loop needs the design's controller: section (the PID the log ran)");
+  const PidGains pid = j.prefix.empty() ? controller->pid : controller->joint(j.station, j.mechanism, j.joint).pid;
+  double scale = 1.0;
+  if (j.drive == id::DriveKind::voltage) {
+    const auto* motor = design.get<MotorSettings>();
+    if (motor == nullptr) throw InputError(design.name + ": --closed-loop with voltage_V needs the motor: section's supply_voltage_V");
+    scale = j.prefix.empty() ? motor->defaults.supply_voltage_V : motor->joint(j.station, j.mechanism, j.joint).supply_voltage_V;
+  }
+  return id::device_pid(j.reference, runtime::Gains{pid.kp, pid.ki, pid.kd, pid.i_clamp}, l.sample_time(), scale);
 }
 
 /// The quality gate's verdict and tests, then the values it or the motor: section refused, a line each.
@@ -266,7 +308,9 @@ void print_patch(const id::Patch& patch) {
   for (const std::string& s : patch.not_patched) std::cout << "not patched: " << s << "\n";
 }
 
-int run_identify(const IdentifyCliOptions& opt) {
+int run_identify(const IdentifyCliOptions& given) {
+  IdentifyCliOptions opt = given;
+  if (!opt.logs.empty()) opt.log = opt.logs.front();
   const Design design = load(opt.design);
   // --rig motor, or --rig mechanism STATION/MECHANISM (fivebar/identify/mechanism.hpp).
   std::string rig_station, rig_mechanism;
@@ -294,14 +338,22 @@ int run_identify(const IdentifyCliOptions& opt) {
   }
   if (opt.plan) return run_plan(opt, design);
   if (opt.log.empty()) throw InputError("LOG: an identification log is required (or --plan)");
-  const id::IdentifyLog est = id::read_identify_log(std::filesystem::path(opt.log));
+  std::vector<id::IdentifyLog> logs;
+  for (const std::string& f : opt.logs) logs.push_back(id::read_identify_log(std::filesystem::path(f)));
+  const id::IdentifyLog& est = logs.front();
   std::optional<id::IdentifyLog> val;
   if (!opt.validation.empty()) val = id::read_identify_log(std::filesystem::path(opt.validation));
   // The study's memory and time from the logs' size, before the work (docs/reliability.md).
-  check_budget(identify_estimate(est.time.size() + (val ? val->time.size() : 0), est.joints.size()), opt.yes,
-               "confirm with fivebar identify --yes");
+  std::size_t rows = val ? val->time.size() : 0;
+  for (const id::IdentifyLog& l : logs) rows += l.time.size();
+  check_budget(identify_estimate(rows, est.joints.size()), opt.yes, "confirm with fivebar identify --yes");
   if (!(opt.load_inertia >= 0.0) || !std::isfinite(opt.load_inertia)) throw InputError("--load-inertia: must be >= 0 kg m^2");
   if (opt.method != "idim" && opt.method != "oe") throw InputError("--method: idim or oe");
+  if (opt.closed_loop && opt.method == "oe") {
+    throw InputError("--method oe: not with --closed-loop (an open-loop simulation of a log taken under feedback drifts; IDIM-IV is reported)");
+  }
+  if (opt.closed_loop && !rig_station.empty()) throw InputError("--closed-loop: with --rig motor only");
+  if (logs.size() > 1 && !rig_station.empty()) throw InputError("LOG: --rig mechanism takes one log");
   id::IdentifyOptions o;
   o.cutoff_hz = opt.cutoff_hz.value_or(0.0);  // 0: the library's default
   o.filter_order = opt.filter_order;
@@ -319,20 +371,30 @@ int run_identify(const IdentifyCliOptions& opt) {
   for (const id::JointLog& j : est.joints) {
     if (!rig_station.empty()) break;
     if (!opt.joint.empty() && j.prefix != opt.joint && !(opt.joint == "motor" && j.prefix.empty())) continue;
-    const id::JointLog* vj = nullptr;
-    if (val) {
-      for (const id::JointLog& x : val->joints) {
-        if (x.prefix == j.prefix) vj = &x;
-      }
-      if (vj == nullptr) throw InputError(opt.validation + ": no columns for joint '" + (j.prefix.empty() ? "motor" : j.prefix) + "'");
-      if (vj->drive != j.drive || vj->linear != j.linear) {
-        throw InputError(opt.validation + ": joint '" + (j.prefix.empty() ? "motor" : j.prefix) + "' is driven by '" + vj->drive_column +
-                         "', the estimation log by '" + j.drive_column + "'");
-      }
-    }
+    const std::string who = j.prefix.empty() ? "motor" : j.prefix;
     const bool need_motor = !j.linear && j.drive != id::DriveKind::torque;
     const id::JointPrior prior = prior_of(design, j.station, j.mechanism, j.joint, opt.load_inertia, need_motor);
-    results.push_back(id::identify_joint(j, est.time, prior, vj, val ? &val->time : nullptr, o));
+    std::vector<std::unique_ptr<id::LoopController>> loops;
+    auto segment = [&](const id::IdentifyLog& l, const std::string& file) {
+      const id::JointLog* x = nullptr;
+      for (const id::JointLog& c : l.joints) {
+        if (c.prefix == j.prefix) x = &c;
+      }
+      if (x == nullptr) throw InputError(file + ": no columns for joint '" + who + "'");
+      if (x->drive != j.drive || x->linear != j.linear) {
+        throw InputError(file + ": joint '" + who + "' is driven by '" + x->drive_column + "', the first log by '" + j.drive_column + "'");
+      }
+      id::LogSegment g{x, &l.time, nullptr};
+      if (opt.closed_loop) {
+        loops.push_back(closed_loop_controller(design, *x, l, file));
+        g.controller = loops.back().get();
+      }
+      return g;
+    };
+    std::vector<id::LogSegment> segs, vsegs;
+    for (std::size_t i = 0; i < logs.size(); ++i) segs.push_back(segment(logs[i], opt.logs[i]));
+    if (val) vsegs.push_back(segment(*val, opt.validation));
+    results.push_back(id::identify_joint(segs, prior, vsegs, o));
   }
   if (results.empty()) throw InputError("--joint '" + opt.joint + "': the log has no such joint");
   // Requested parameters that the logs cannot give.
@@ -352,9 +414,10 @@ int run_identify(const IdentifyCliOptions& opt) {
       throw InputError("--fit " + key + ": not a parameter of this rig (parameters: " + format::join(keys) + ")");
     }
   }
-  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", rig}, {"log", opt.log}};
+  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", rig}, {"log", opt.log}, {"logs", opt.logs},
+              {"closed_loop", opt.closed_loop}};
   if (val) doc["validation"] = opt.validation;
-  doc["method"] = opt.method == "oe" ? "output error" : "IDIM-LS";
+  doc["method"] = opt.method == "oe" ? "output error" : opt.closed_loop ? "IDIM-IV" : "IDIM-LS";
   doc["joints"] = Json::array();
   for (const auto& r : results) doc["joints"].push_back(id::to_json(r));
   doc["refused"] = refused;
@@ -402,6 +465,12 @@ int run_identify(const IdentifyCliOptions& opt) {
     print_json(doc);
   } else {
     for (const auto& r : results) print_joint(r);
+    bool referenced = false;
+    for (const id::JointLog& j : est.joints) referenced = referenced || !j.reference.empty();
+    if (referenced && !opt.closed_loop) {
+      std::cout << "note: the log has a reference column; if it was taken while the PID ran, add --closed-loop "
+                   "(IDIM-LS is biased under feedback, docs/identify.md \"Closed loop\")\n";
+    }
     for (const std::string& s : refused) std::cout << "NOT IDENTIFIABLE (asked by --fit): " << s << "\n";
     if (patch) print_patch(*patch);
     if (!files.empty()) std::cout << "wrote " << files.size() << " files into " << std::filesystem::path(files.front()).parent_path().generic_string() << "\n";
@@ -423,9 +492,13 @@ void setup_identify(CLI::App& app) {
       "refinement by simulation, fit percentages on the estimation and a validation log; or (--plan) the excitation to log",
       run_identify);
   add_design_argument(*sub, opt->design);
-  sub->add_option("log", opt->log, "Estimation log: CSV with time_s and per joint a drive (duty, voltage_V, current_A, "
-                                   "torque_Nm or force_N), a reading (volts, counts, theta_rad or position_m) and optionally current_A")
-      ->type_name("LOG.csv");
+  sub->add_option("log", opt->logs, "Estimation logs, fitted together: CSV with time_s and per joint a drive (duty, voltage_V, "
+                                    "current_A, torque_Nm or force_N), a reading (volts, counts, theta_rad or position_m), optionally "
+                                    "current_A and (--closed-loop) the reference theta_ref_rad")
+      ->type_name("LOG.csv ...");
+  sub->add_flag("--closed-loop", opt->closed_loop,
+                "The logs were taken while the design's PID ran at the log's rate, following the reference column: "
+                "instrumental variables (IDIM-IV), unbiased under feedback");
   sub->add_option("--validation", opt->validation, "A second log of the same joints: fit figures only")->type_name("LOG.csv");
   sub->add_option("--rig", opt->rig,
                   "What the log was taken on: motor (one motor on the bench, optional known load), or mechanism "

@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "fivebar/runtime/controller.hpp"
+
 namespace fivebar::testing {
 
 struct SyntheticTruth {
@@ -36,14 +38,31 @@ struct SyntheticTruth {
   double keN = 1.0;           ///< V s / rad at the output (k_e N = K / eta with eta 0.7)
   double amplitude_V = 0.6;   ///< V, multisine voltage
   int substeps = 10;          ///< integration steps per sample
+  // Closed loop: the device's PID (runtime::pid_update at the log's rate) follows a multisine
+  // reference from the logged (noisy, quantised) reading; the duty x supply_V drives the winding.
+  bool closed_loop = false;
+  double supply_V = 6.0;
+  double kp = 5.0, ki = 1.0, kd = 0.05, i_clamp = 0.2;  ///< duty per rad, per rad s, per rad/s
+  double reference_amplitude = 0.4;  ///< rad, multisine reference
+  double reading_noise = 0.0;        ///< rad, white noise on the reading before quantisation
 };
 
 struct SyntheticLog {
   std::vector<double> time, current, theta;
   std::vector<double> voltage;  ///< the held voltage of a voltage drive (empty: current drive)
-  std::string csv() const {
+  std::vector<double> duty, reference;  ///< closed loop: the PID's duty and its reference
+  std::string csv(bool with_current = true) const {
     std::ostringstream o;
     o.precision(17);
+    if (!duty.empty()) {
+      o << (with_current ? "time_s,duty,current_A,theta_rad,theta_ref_rad\n" : "time_s,duty,theta_rad,theta_ref_rad\n");
+      for (std::size_t i = 0; i < time.size(); ++i) {
+        o << time[i] << "," << duty[i] << ",";
+        if (with_current) o << current[i] << ",";
+        o << theta[i] << "," << reference[i] << "\n";
+      }
+      return o.str();
+    }
     o << (voltage.empty() ? "time_s,current_A,theta_rad\n" : "time_s,voltage_V,current_A,theta_rad\n");
     for (std::size_t i = 0; i < time.size(); ++i) {
       o << time[i] << ",";
@@ -62,11 +81,14 @@ inline SyntheticLog synthetic_log(const SyntheticTruth& t, unsigned seed) {
   const int harmonics = 20;
   std::vector<double> ph(harmonics);
   for (double& p : ph) p = phase(rng);
-  auto command = [&](double time) {
+  auto multisine = [&](double time) {
     double s = 0.0;
     for (int k = 1; k <= harmonics; ++k) s += std::sin(2.0 * std::numbers::pi * 0.3 * k * time + ph[static_cast<std::size_t>(k - 1)]);
-    return (t.voltage_drive ? t.amplitude_V : t.amplitude) * s / std::sqrt(0.5 * harmonics) + t.bias_current;
+    return s / std::sqrt(0.5 * harmonics);
   };
+  auto command = [&](double time) { return (t.voltage_drive ? t.amplitude_V : t.amplitude) * multisine(time) + t.bias_current; };
+  runtime::Gains gains{t.kp, t.ki, t.kd, t.i_clamp};
+  runtime::PidState pid;
   const double Jl = t.J * t.load_share, Jm = t.J - Jl;
   const bool rigid = t.resonance_hz <= 0.0;
   const double w_res = 2.0 * std::numbers::pi * t.resonance_hz;
@@ -102,15 +124,26 @@ inline SyntheticLog synthetic_log(const SyntheticTruth& t, unsigned seed) {
   };
   for (std::size_t j = 0; j < n; ++j) {
     const double time = static_cast<double>(j) / t.rate;
-    const double i = command(time);  // the current, or the voltage of a voltage drive
-    // The reading: backlash (play operator) then quantisation.
+    double i = command(time);  // the current, or the voltage of a voltage drive
+    // The reading: backlash (play operator), noise, then quantisation.
     const double load = y[2];
     if (load > play + 0.5 * t.backlash) play = load - 0.5 * t.backlash;
     if (load < play - 0.5 * t.backlash) play = load + 0.5 * t.backlash;
+    const double read = play + (t.reading_noise > 0.0 ? t.reading_noise * noise(rng) : 0.0);
+    const double reading = t.quantum > 0.0 ? t.quantum * std::round(read / t.quantum) : read;
+    if (t.closed_loop) {  // the device's PID on the reading it gets; the duty drives the winding
+      // The reference fades in over its first second (a device starts from rest).
+      const double fade = std::min(1.0, time);
+      const double ref = t.reference_amplitude * fade * multisine(time);
+      const double duty = runtime::pid_update(gains, 1.0 / t.rate, pid, ref - reading);
+      log.duty.push_back(duty);
+      log.reference.push_back(ref);
+      i = duty * t.supply_V;
+    }
     log.time.push_back(time);
     if (t.voltage_drive) log.voltage.push_back(i);
     log.current.push_back((t.voltage_drive ? y[4] : i) + t.current_noise * noise(rng));
-    log.theta.push_back(t.quantum > 0.0 ? t.quantum * std::round(play / t.quantum) : play);
+    log.theta.push_back(reading);
     for (int s = 0; s < sub; ++s) {  // RK4, the current held over the sample
       double k1[5], k2[5], k3[5], k4[5], tmp[5];
       f(y, i, k1);

@@ -49,18 +49,19 @@ struct PositionResiduals {
 
 }  // namespace
 
-identify::Estimate output_error(const std::vector<double>& time, const std::vector<double>& u, double g,
-                                const std::vector<double>& q, const identify::Estimate& start, bool per_direction,
-                                double q0, double w0, double ws, std::string& status) {
+identify::Estimate output_error(const std::vector<Series>& logs, double g, const identify::Estimate& start, bool per_direction,
+                                double ws, std::string& status) {
   const int p = static_cast<int>(start.value.size());
   identify::Estimate e = start;
   std::vector<double> theta(start.value.data(), start.value.data() + p);
-  auto* functor = new PositionResiduals{&time, &u, &q, g, q0, w0, ws, per_direction, p};
-  auto* cost = new ceres::DynamicAutoDiffCostFunction<PositionResiduals, 8>(functor);
-  cost->AddParameterBlock(p);
-  cost->SetNumResiduals(static_cast<int>(time.size()));
   ceres::Problem problem;
-  problem.AddResidualBlock(cost, nullptr, theta.data());
+  for (const Series& s : logs) {
+    auto* functor = new PositionResiduals{s.time, s.u, s.q, g, s.q0, s.w0, ws, per_direction, p};
+    auto* cost = new ceres::DynamicAutoDiffCostFunction<PositionResiduals, 8>(functor);
+    cost->AddParameterBlock(p);
+    cost->SetNumResiduals(static_cast<int>(s.time->size()));
+    problem.AddResidualBlock(cost, nullptr, theta.data());
+  }
   std::vector<int> held;
   for (int i = 0; i < p; ++i) {
     if (!start.identified[static_cast<std::size_t>(i)]) held.push_back(i);

@@ -8,12 +8,19 @@
 
 namespace fivebar::identify_detail {
 
-/// Minimises sum (q_k - qhat_k)^2 over the identified mechanical parameters, qhat from
+/// One open-loop log for the refinement: its time, drive torque input, logged position and start.
+struct Series {
+  const std::vector<double>* time;
+  const std::vector<double>* u;
+  const std::vector<double>* q;
+  double q0, w0;
+};
+
+/// Minimises sum (q_k - qhat_k)^2 over every log and the identified mechanical parameters, qhat from
 /// identify::simulate_position; held parameters stay at `start`. Returns the estimate (sigma from
 /// the Jacobian at the optimum, s^2 (J^T J)^-1) and sets `status`.
-identify::Estimate output_error(const std::vector<double>& time, const std::vector<double>& u, double g,
-                                const std::vector<double>& q, const identify::Estimate& start, bool per_direction,
-                                double q0, double w0, double coulomb_smoothing, std::string& status);
+identify::Estimate output_error(const std::vector<Series>& logs, double g, const identify::Estimate& start, bool per_direction,
+                                double coulomb_smoothing, std::string& status);
 
 }  // namespace fivebar::identify_detail
 

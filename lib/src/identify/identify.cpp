@@ -4,12 +4,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <numbers>
 #include <numeric>
 
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/identify/filter.hpp"
+#include "fivebar/runtime/controller.hpp"
 #include "identify/detail.hpp"
 
 namespace fivebar::identify {
@@ -116,6 +119,41 @@ void electrical_regression(Prepared& p, const JointLog& j, const Setup& s, const
   p.We.col(2) = to_eigen(decimate_kept(w, s.R, rows));
 }
 
+/// The mechanical regressor at the kept decimated rows: acceleration, speed (or its positive and
+/// negative parts), sgn(speed), 1, each through the decimation filter (parallel filtering).
+Eigen::MatrixXd regressor(const std::vector<double>& v, const std::vector<double>& a, const Setup& s,
+                          const std::vector<std::size_t>& rows) {
+  const std::size_t n = v.size();
+  std::vector<std::vector<double>> cols;
+  cols.push_back(a);
+  if (s.per_direction) {
+    std::vector<double> vp(n), vn(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      vp[i] = v[i] > 0.0 ? v[i] : 0.0;
+      vn[i] = v[i] < 0.0 ? v[i] : 0.0;
+    }
+    cols.push_back(vp);
+    cols.push_back(vn);
+  } else {
+    cols.push_back(v);
+  }
+  std::vector<double> sv(n);
+  for (std::size_t i = 0; i < n; ++i) sv[i] = sgn(v[i]);
+  cols.push_back(sv);
+  cols.push_back(std::vector<double>(n, 1.0));
+  Eigen::MatrixXd W(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t c = 0; c < cols.size(); ++c) W.col(static_cast<Eigen::Index>(c)) = to_eigen(decimate_kept(cols[c], s.R, rows));
+  return W;
+}
+
+/// The regressor of a position at the log's rate, through the same filters as the log's own.
+Eigen::MatrixXd regressor_of(const std::vector<double>& q, const Setup& s) {
+  const auto sos = butterworth_lowpass(s.order, s.fc, 1.0 / s.dt);
+  const std::vector<double> v = derivative(filtfilt(sos, q), s.dt);
+  const std::vector<double> a = derivative(v, s.dt);
+  return regressor(v, a, s, kept_rows(q.size(), s.R, s.trim));
+}
+
 Prepared prepare(const JointLog& j, const std::vector<double>& time, const JointPrior& prior, const Setup& s) {
   Prepared p;
   p.q = joint_angle(j, prior);
@@ -160,23 +198,6 @@ Prepared prepare(const JointLog& j, const std::vector<double>& time, const Joint
     p.d = j.drive_values;
     df = s.zoh ? held_pair(p.d) : p.d;
   }
-  std::vector<std::vector<double>> cols;
-  cols.push_back(p.a);
-  if (s.per_direction) {
-    std::vector<double> vp(n), vn(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      vp[i] = p.v[i] > 0.0 ? p.v[i] : 0.0;
-      vn[i] = p.v[i] < 0.0 ? p.v[i] : 0.0;
-    }
-    cols.push_back(vp);
-    cols.push_back(vn);
-  } else {
-    cols.push_back(p.v);
-  }
-  std::vector<double> sv(n);
-  for (std::size_t i = 0; i < n; ++i) sv[i] = sgn(p.v[i]);
-  cols.push_back(sv);
-  cols.push_back(std::vector<double>(n, 1.0));
   std::vector<double> tau(n);
   for (std::size_t i = 0; i < n; ++i) tau[i] = s.alpha * df[i] - s.g * emf[i];
   if (!prior.known_torque.empty()) {  // the closed chain's share (--rig mechanism)
@@ -184,8 +205,7 @@ Prepared prepare(const JointLog& j, const std::vector<double>& time, const Joint
     p.known_dec = decimate_kept(prior.known_torque, s.R, rows);
   }
   p.Y = to_eigen(decimate_kept(tau, s.R, rows));
-  p.W.resize(p.Y.size(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t c = 0; c < cols.size(); ++c) p.W.col(static_cast<Eigen::Index>(c)) = to_eigen(decimate_kept(cols[c], s.R, rows));
+  p.W = regressor(p.v, p.a, s, rows);
   p.d_dec = decimate_kept(df, s.R, rows);
   p.emf_dec = decimate_kept(emf, s.R, rows);
   for (std::size_t r : rows) p.t_dec.push_back(time[r * static_cast<std::size_t>(s.R)]);
@@ -193,36 +213,6 @@ Prepared prepare(const JointLog& j, const std::vector<double>& time, const Joint
   for (std::size_t i = 0; i < n; ++i) p.u[i] = s.alpha * p.d[i];
   if (s.electrical) electrical_regression(p, j, s, rows);
   return p;
-}
-
-Fit fit_figures(const Prepared& p, const Eigen::VectorXd& theta, const Setup& s, const std::vector<double>& time,
-                const IdentifyOptions& o, std::vector<double>* sim_out, std::vector<double>* drive_hat_out) {
-  Fit f;
-  const Eigen::VectorXd tau_hat = p.W * theta;
-  std::vector<double> dhat(p.d_dec.size());
-  for (std::size_t i = 0; i < dhat.size(); ++i) {
-    const double known = p.known_dec.empty() ? 0.0 : p.known_dec[i];
-    dhat[i] = (tau_hat[static_cast<Eigen::Index>(i)] + known + s.g * p.emf_dec[i]) / s.alpha;
-  }
-  f.drive_fit_percent = fit_percent(p.d_dec, dhat);
-  f.drive_relative_error_percent = relative_error_percent(p.d_dec, dhat);
-  if (!p.known_dec.empty()) {  // one joint of a closed chain: its open-loop simulation alone means nothing
-    if (sim_out) sim_out->clear();
-    if (drive_hat_out) *drive_hat_out = dhat;
-    return f;
-  }
-  const std::vector<double> sim =
-      simulate_position(time, p.u, s.g, theta, s.per_direction, p.qf.front(), p.v.front(), o.coulomb_smoothing);
-  bool finite = true;
-  for (double x : sim) finite = finite && std::isfinite(x);
-  if (finite) {
-    f.simulated = true;
-    f.position_fit_percent = fit_percent(p.q, sim);
-    f.position_relative_error_percent = relative_error_percent(p.q, sim);
-  }
-  if (sim_out) *sim_out = finite ? sim : std::vector<double>();
-  if (drive_hat_out) *drive_hat_out = dhat;
-  return f;
 }
 
 /// R, L and k_e N from the sampled current (lib/src/identify/electrical.cpp). L is held at its prior
@@ -305,8 +295,8 @@ std::vector<Parameter> records(const JointIdentification& r, const JointLog& joi
   std::vector<Parameter> out;
   const std::vector<std::string> names = mechanical_names(o.per_direction, joint.linear);
   const MotorParams& m = prior.motor;
-  const Estimate& fin = (o.use_output_error && r.output_error) ? *r.output_error : r.idim;
-  const std::string method = (o.use_output_error && r.output_error) ? "output error" : "IDIM-LS";
+  const Estimate& fin = r.iv ? *r.iv : (o.use_output_error && r.output_error) ? *r.output_error : r.idim;
+  const std::string method = r.iv ? "IDIM-IV" : (o.use_output_error && r.output_error) ? "output error" : "IDIM-LS";
   for (int i = 0; i < p; ++i) {
     const std::size_t ui = static_cast<std::size_t>(i);
     out.push_back(record(names[ui], fin.value[i], fin.sigma[i], fin.identified[ui],
@@ -466,14 +456,225 @@ std::vector<double> simulate_position(const std::vector<double>& time, const std
   return out;
 }
 
-JointIdentification identify_joint(const JointLog& joint, const std::vector<double>& time, const JointPrior& prior,
-                                   const JointLog* validation, const std::vector<double>* validation_time,
-                                   const IdentifyOptions& o) {
-  JointIdentification r;
-  r.joint = joint.prefix.empty() ? "motor" : joint.prefix;
-  r.drive_column = joint.drive_column;
-  r.reading_column = joint.reading_column;
-  r.linear = joint.linear;
+namespace {
+
+/// The device's PID as a LoopController.
+class DevicePid final : public LoopController {
+ public:
+  DevicePid(std::vector<double> reference, const runtime::Gains& gains, double period, double scale)
+      : reference_(std::move(reference)), gains_(gains), period_(period), scale_(scale) {}
+  void reset() override { state_ = runtime::PidState{}; }
+  double drive(std::size_t row, double angle) override {
+    const double e = reference_[std::min(row, reference_.size() - 1)] - angle;
+    return scale_ * runtime::pid_update(gains_, period_, state_, e);
+  }
+
+ private:
+  std::vector<double> reference_;
+  runtime::Gains gains_;
+  double period_, scale_;
+  runtime::PidState state_;
+};
+
+/// Rows of several prepared logs, one below the other.
+Prepared stack(const std::vector<Prepared>& ps) {
+  if (ps.size() == 1) return ps.front();
+  Prepared out;
+  Eigen::Index rows = 0, erows = 0;
+  for (const Prepared& p : ps) {
+    rows += p.W.rows();
+    erows += p.We.rows();
+  }
+  out.W.resize(rows, ps.front().W.cols());
+  out.Y.resize(rows);
+  out.We.resize(erows, ps.front().We.cols());
+  out.Ye.resize(erows);
+  Eigen::Index r = 0, e = 0;
+  for (const Prepared& p : ps) {
+    out.W.middleRows(r, p.W.rows()) = p.W;
+    out.Y.segment(r, p.Y.size()) = p.Y;
+    r += p.W.rows();
+    if (p.We.rows() > 0) {
+      out.We.middleRows(e, p.We.rows()) = p.We;
+      out.Ye.segment(e, p.Ye.size()) = p.Ye;
+      e += p.We.rows();
+    }
+    out.d_dec.insert(out.d_dec.end(), p.d_dec.begin(), p.d_dec.end());
+    out.emf_dec.insert(out.emf_dec.end(), p.emf_dec.begin(), p.emf_dec.end());
+    out.known_dec.insert(out.known_dec.end(), p.known_dec.begin(), p.known_dec.end());
+  }
+  return out;
+}
+
+/// The logs of one fit, prepared.
+struct Prepped {
+  std::vector<Setup> setups;
+  std::vector<Prepared> logs;
+  Prepared all;  ///< stacked
+};
+
+Prepped prepare_all(const std::vector<LogSegment>& segs, const JointPrior& prior, const Setup& s) {
+  Prepped out;
+  for (const LogSegment& g : segs) {
+    Setup sg = s;
+    sg.dt = (g.time->back() - g.time->front()) / static_cast<double>(g.time->size() - 1);
+    out.setups.push_back(sg);
+    out.logs.push_back(prepare(*g.joint, *g.time, prior, sg));
+  }
+  out.all = stack(out.logs);
+  return out;
+}
+
+/// The drive-to-torque map of the simulated loop: the controller commands the log's drive column
+/// (duty or voltage when the current is only measured), not the current the mechanical regression reads.
+struct LoopDrive {
+  double alpha = 1.0, g = 0.0;
+};
+
+/// Fit figures over every log of a fit (the percentages over the logs' rows together); the series
+/// of the first log for the plot. A closed-loop log's position is simulated in its loop.
+Fit fit_logs(const Prepped& pp, const std::vector<LogSegment>& segs, const Eigen::VectorXd& theta, const LoopDrive& loop,
+             const IdentifyOptions& o, std::vector<double>* sim_first, std::vector<double>* dhat_first) {
+  Fit f;
+  std::vector<double> d, dh, q, qs;
+  bool simulated = pp.all.known_dec.empty();
+  const Eigen::VectorXd tau_hat = pp.all.W * theta;
+  for (std::size_t i = 0; i < pp.all.d_dec.size(); ++i) {
+    const double known = pp.all.known_dec.empty() ? 0.0 : pp.all.known_dec[i];
+    const Setup& s = pp.setups.front();
+    dh.push_back((tau_hat[static_cast<Eigen::Index>(i)] + known + s.g * pp.all.emf_dec[i]) / s.alpha);
+  }
+  d = pp.all.d_dec;
+  if (dhat_first) dhat_first->assign(dh.begin(), dh.begin() + static_cast<std::ptrdiff_t>(pp.logs.front().d_dec.size()));
+  f.drive_fit_percent = fit_percent(d, dh);
+  f.drive_relative_error_percent = relative_error_percent(d, dh);
+  if (sim_first) sim_first->clear();
+  if (!simulated) return f;  // one joint of a closed chain: its simulation alone means nothing
+  for (std::size_t k = 0; k < segs.size(); ++k) {
+    const Prepared& p = pp.logs[k];
+    const Setup& s = pp.setups[k];
+    std::vector<double> sim;
+    if (segs[k].controller != nullptr) {
+      sim = simulate_closed_loop(*segs[k].time, *segs[k].controller, loop.alpha, loop.g, theta, s.per_direction, p.qf.front(),
+                                 p.v.front(), o.coulomb_smoothing);
+    } else {
+      sim = simulate_position(*segs[k].time, p.u, s.g, theta, s.per_direction, p.qf.front(), p.v.front(), o.coulomb_smoothing);
+    }
+    bool finite = sim.size() == p.q.size();
+    for (double x : sim) finite = finite && std::isfinite(x);
+    if (!finite) {
+      simulated = false;
+      break;
+    }
+    if (k == 0 && sim_first) *sim_first = sim;
+    q.insert(q.end(), p.q.begin(), p.q.end());
+    qs.insert(qs.end(), sim.begin(), sim.end());
+  }
+  if (simulated) {
+    f.simulated = true;
+    f.position_fit_percent = fit_percent(q, qs);
+    f.position_relative_error_percent = relative_error_percent(q, qs);
+  } else if (sim_first) {
+    sim_first->clear();
+  }
+  return f;
+}
+
+/// One instrumental-variable solve: theta = (Z^T W)^-1 Z^T Y over the columns `ls` identified (the
+/// others held at its values), covariance s^2 (Z^T W)^-1 Z^T Z (W^T Z)^-1 (Janot, Vandanjon, Gautier 2014).
+Estimate iv_solve(const Eigen::MatrixXd& W, const Eigen::VectorXd& Y, const Eigen::MatrixXd& Z, const Estimate& ls) {
+  Estimate e = ls;
+  const Eigen::Index p = W.cols();
+  std::vector<Eigen::Index> kept;
+  Eigen::VectorXd y = Y;
+  for (Eigen::Index c = 0; c < p; ++c) {
+    if (ls.identified[static_cast<std::size_t>(c)]) {
+      kept.push_back(c);
+    } else {
+      y -= W.col(c) * ls.value[c];
+    }
+  }
+  const Eigen::Index m = static_cast<Eigen::Index>(kept.size());
+  if (m == 0) return e;
+  Eigen::MatrixXd A(W.rows(), m), B(W.rows(), m);
+  for (Eigen::Index k = 0; k < m; ++k) {
+    A.col(k) = W.col(kept[static_cast<std::size_t>(k)]);
+    B.col(k) = Z.col(kept[static_cast<std::size_t>(k)]);
+  }
+  const Eigen::MatrixXd BtA = B.transpose() * A;
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(BtA);
+  const Eigen::VectorXd x = lu.solve(B.transpose() * y);
+  const Eigen::MatrixXd inv = lu.inverse();
+  const double dof = static_cast<double>(W.rows() - m);
+  const double s2 = dof > 0 ? (y - A * x).squaredNorm() / dof : 0.0;
+  const Eigen::MatrixXd cov = s2 * inv * (B.transpose() * B) * inv.transpose();
+  e.residual_sigma = std::sqrt(s2);
+  e.covariance.setZero();
+  e.correlation.setIdentity();
+  for (Eigen::Index a = 0; a < m; ++a) {
+    e.value[kept[static_cast<std::size_t>(a)]] = x[a];
+    for (Eigen::Index b = 0; b < m; ++b) e.covariance(kept[static_cast<std::size_t>(a)], kept[static_cast<std::size_t>(b)]) = cov(a, b);
+  }
+  for (Eigen::Index i = 0; i < p; ++i) e.sigma[i] = std::sqrt(std::max(0.0, e.covariance(i, i)));
+  for (Eigen::Index a : kept) {
+    for (Eigen::Index b : kept) {
+      if (e.sigma[a] > 0.0 && e.sigma[b] > 0.0) e.correlation(a, b) = e.covariance(a, b) / (e.sigma[a] * e.sigma[b]);
+    }
+  }
+  return e;
+}
+
+/// IDIM-IV from IDIM-LS: the loop simulated with the last estimate gives the instruments (the
+/// regressor of the simulated, noise-free position), until no parameter moves by more than
+/// iv_tolerance of its sigma.
+void closed_loop_iv(JointIdentification& r, const Prepped& pp, const std::vector<LogSegment>& segs, const LoopDrive& loop,
+                    const IdentifyOptions& o) {
+  Estimate cur = r.idim;
+  for (int it = 1; it <= o.iv_max_iterations; ++it) {
+    if (!(cur.value[0] > 0.0)) {
+      r.iv_status = "stopped at iteration " + std::to_string(it) + ": the inertia is not positive, the loop cannot be simulated";
+      return;
+    }
+    Eigen::MatrixXd Z(pp.all.W.rows(), pp.all.W.cols());
+    Eigen::Index row = 0;
+    for (std::size_t k = 0; k < segs.size(); ++k) {
+      const Prepared& p = pp.logs[k];
+      const std::vector<double> qs = simulate_closed_loop(*segs[k].time, *segs[k].controller, loop.alpha, loop.g, cur.value,
+                                                          o.per_direction, p.qf.front(), p.v.front(), o.coulomb_smoothing);
+      bool finite = qs.size() == p.q.size();
+      for (double x : qs) finite = finite && std::isfinite(x);
+      if (!finite) {
+        r.iv_status = "stopped at iteration " + std::to_string(it) + ": the simulated loop diverged";
+        return;
+      }
+      Z.middleRows(row, p.W.rows()) = regressor_of(qs, pp.setups[k]);
+      row += p.W.rows();
+    }
+    const Estimate next = iv_solve(pp.all.W, pp.all.Y, Z, r.idim);
+    if (!next.value.allFinite() || !next.sigma.allFinite()) {
+      r.iv_status = "stopped at iteration " + std::to_string(it) + ": the instruments are not independent (Z^T W singular)";
+      return;
+    }
+    double step = 0.0;
+    for (Eigen::Index i = 0; i < next.value.size(); ++i) {
+      if (next.identified[static_cast<std::size_t>(i)] && next.sigma[i] > 0.0) step = std::max(step, std::abs(next.value[i] - cur.value[i]) / next.sigma[i]);
+    }
+    cur = next;
+    r.iv_iterations = it;
+    if (step <= o.iv_tolerance) {
+      r.iv = cur;
+      r.iv_converged = true;
+      r.iv_status = "converged in " + std::to_string(it) + " iterations";
+      return;
+    }
+  }
+  r.iv = cur;
+  r.iv_status = "not converged after " + std::to_string(o.iv_max_iterations) + " iterations";
+}
+
+/// The checks on the logs of a fit and the setup they share.
+Setup setup_for(const std::vector<LogSegment>& logs, const IdentifyOptions& o, int p) {
+  const std::vector<double>& time = *logs.front().time;
   Setup s;
   s.dt = (time.back() - time.front()) / static_cast<double>(time.size() - 1);
   const double fs = 1.0 / s.dt;
@@ -485,19 +686,181 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
   s.zoh = o.zero_order_hold;
   if (o.filter_order < 1 || o.filter_order > 16) throw InputError("--filter-order: must be 1 ... 16");
   s.order = o.filter_order;
-  const std::vector<std::string> names = mechanical_names(o.per_direction, joint.linear);
-  const int p = static_cast<int>(names.size());
+  std::size_t shortest = time.size();
+  for (const LogSegment& g : logs) shortest = std::min(shortest, g.time->size());
   s.R = o.decimation > 0 ? o.decimation : 10;
   if (o.decimation <= 0) {
-    while (s.R > 1 && static_cast<int>(time.size()) / s.R < 50 * (p + 3)) --s.R;
+    while (s.R > 1 && static_cast<int>(shortest) / s.R < 50 * (p + 3)) --s.R;
   }
   s.trim = edge_samples(s.order, s.fc, fs, s.R);
-  const std::size_t kept = kept_rows(time.size(), s.R, s.trim).size();
-  if (static_cast<int>(kept) < 2 * p + 4) {
-    throw InputError("the log has " + std::to_string(time.size()) + " rows; decimated by " + std::to_string(s.R) + " and clear of the " +
-                     std::to_string(s.trim) + " samples at each end where the filters settle, " + std::to_string(kept) +
-                     " rows remain: fewer than twice the " + std::to_string(p) + " unknowns and 4");
+  for (std::size_t k = 0; k < logs.size(); ++k) {
+    const std::vector<double>& t = *logs[k].time;
+    const double dt = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
+    const std::string which = logs.size() > 1 ? "log " + std::to_string(k + 1) + ": " : "";
+    if (std::abs(dt - s.dt) > 0.05 * s.dt) {
+      throw InputError(which + "sample time " + format::shortest(dt) + " s differs from the first log's " + format::shortest(s.dt) + " s");
+    }
+    const std::size_t kept = kept_rows(t.size(), s.R, s.trim).size();
+    if (static_cast<int>(kept) < 2 * p + 4) {
+      throw InputError(which + "the log has " + std::to_string(t.size()) + " rows; decimated by " + std::to_string(s.R) +
+                       " and clear of the " + std::to_string(s.trim) + " samples at each end where the filters settle, " +
+                       std::to_string(kept) + " rows remain: fewer than twice the " + std::to_string(p) + " unknowns and 4");
+    }
+    const JointLog& j = *logs[k].joint;
+    const JointLog& j0 = *logs.front().joint;
+    if (j.drive != j0.drive || j.reading != j0.reading || j.current.empty() != j0.current.empty() || j.linear != j0.linear) {
+      throw InputError(which + "joint '" + (j.prefix.empty() ? std::string("motor") : j.prefix) + "' is logged with '" + j.drive_column +
+                       "' and '" + j.reading_column + "'" + (j.current.empty() ? "" : " and its current") + ", the first log with '" +
+                       j0.drive_column + "' and '" + j0.reading_column + "'" + (j0.current.empty() ? "" : " and its current") +
+                       ": the logs of one fit record the same columns");
+    }
   }
+  return s;
+}
+
+/// The electrical fit (a voltage or duty drive with its current) and the mechanical drive map it
+/// gives; the logs prepared again with it.
+void fit_electrical(JointIdentification& r, Prepped& pp, Setup& s, const std::vector<LogSegment>& logs, const JointPrior& prior,
+                    const IdentifyOptions& o, double& alpha_variance, MotorParams& fitted) {
+  r.electrical = fit_winding(pp.all, s, prior.motor, o.rank_tolerance);
+  const Estimate& el = *r.electrical;
+  const MotorParams& m = prior.motor;
+  if (el.identified[1]) s.lag = identify_detail::electrical_lag(el.value[1] / el.value[0], s.dt);
+  if (el.identified[0] && el.identified[2]) s.emf_per_ohm = el.value[2] / el.value[0];
+  if (el.identified[0] && el.value[0] > 0.0) fitted.terminal_resistance_ohm = el.value[0];
+  if (el.identified[2] && el.value[2] > 0.0) {
+    const double ke_motor = el.value[2] / m.gear_ratio;  // V s / rad = N m / A at the motor shaft
+    s.alpha = m.gearbox_efficiency * m.gear_ratio * ke_motor;
+    alpha_variance = (el.sigma[2] / el.value[2]) * (el.sigma[2] / el.value[2]);
+    fitted.torque_constant_mNm_per_A = ke_motor * 1e3;
+    fitted.back_emf_mV_per_rpm = ke_motor * 1e3 * 2.0 * std::numbers::pi / 60.0;
+  }
+  pp = prepare_all(logs, prior, s);
+}
+
+Eigen::VectorXd mechanical_prior(const JointPrior& prior, bool linear, int p) {
+  Eigen::VectorXd mprior(p);
+  const MotorParams& m = prior.motor;
+  if (linear) {
+    mprior.setZero();
+  } else {
+    mprior[0] = m.gear_ratio * m.gear_ratio * m.rotor_inertia() + prior.load_inertia;
+    for (int k = 1; k < p - 2; ++k) mprior[k] = m.viscous_friction();
+    mprior[p - 2] = m.coulomb_friction();
+    mprior[p - 1] = 0.0;
+  }
+  return mprior;
+}
+
+/// The output-error refinement over the open-loop logs (the closed-loop ones are not simulated open loop).
+void refine_output_error(JointIdentification& r, const Prepped& est, const std::optional<Prepped>& val,
+                         const std::vector<LogSegment>& logs, const std::vector<LogSegment>& validation, const LoopDrive& loop,
+                         const JointPrior& prior, const IdentifyOptions& o, bool closed) {
+  if (!o.output_error) {
+    r.output_error_status = "not run (--no-output-error)";
+    return;
+  }
+  if (!prior.known_torque.empty()) {
+    r.output_error_status = "not run: one joint of a closed chain (--rig mechanism) is not simulated alone";
+    return;
+  }
+  if (closed) {
+    r.output_error_status = "not run: a closed-loop log (an open-loop simulation of it drifts; IDIM-IV is the estimate under feedback)";
+    return;
+  }
+  if (!(r.idim.identified[0] && r.idim.value[0] > 0.0)) {
+    r.output_error_status = "not run: the inertia is not identified or not positive";
+    return;
+  }
+  std::vector<identify_detail::Series> series;
+  for (std::size_t k = 0; k < logs.size(); ++k) {
+    const Prepared& p = est.logs[k];
+    series.push_back({logs[k].time, &p.u, &p.q, p.qf.front(), p.v.front()});
+  }
+  const Setup& s = est.setups.front();
+  Estimate oe = identify_detail::output_error(series, s.g, r.idim, s.per_direction, o.coulomb_smoothing, r.output_error_status);
+  r.output_error = oe;
+  std::vector<double> osim;
+  r.estimation_oe = fit_logs(est, logs, oe.value, loop, o, &osim, nullptr);
+  r.series.position_oe = osim;
+  if (val) {
+    std::vector<double> vo;
+    r.validation_oe = fit_logs(*val, validation, oe.value, loop, o, &vo, nullptr);
+    r.validation_series.position_oe = vo;
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<LoopController> device_pid(std::vector<double> reference, const runtime::Gains& gains, double period_s, double scale) {
+  if (reference.empty()) throw InputError("a closed-loop log needs its reference column");
+  return std::make_unique<DevicePid>(std::move(reference), gains, period_s, scale);
+}
+
+std::vector<double> simulate_closed_loop(const std::vector<double>& time, LoopController& c, double alpha, double g,
+                                         const Eigen::VectorXd& theta, bool per_direction, double q0, double w0, double ws,
+                                         std::vector<double>* drive_out) {
+  c.reset();
+  std::vector<double> out(time.size(), std::numeric_limits<double>::quiet_NaN());
+  if (drive_out) drive_out->assign(time.size(), 0.0);
+  double x = q0, w = w0;
+  const double* th = theta.data();
+  // The smoothed Coulomb term's slope tau_c / (J w_s) makes the speed equation stiff: sub-steps keep
+  // RK4 within its stability bound (h lambda <= 2).
+  const std::size_t k_coulomb = per_direction ? 3 : 2;
+  const double J = theta[0];
+  double lambda = (std::abs(theta[static_cast<Eigen::Index>(k_coulomb)]) / ws + std::abs(g) + std::abs(theta[1])) / J;
+  if (per_direction) lambda += std::abs(theta[2]) / J;
+  for (std::size_t k = 0; k < time.size(); ++k) {
+    out[k] = x;
+    if (!std::isfinite(x) || !std::isfinite(w)) break;
+    const double d = c.drive(k, x);
+    if (drive_out) (*drive_out)[k] = d;
+    if (k + 1 == time.size()) break;
+    const double step = time[k + 1] - time[k];
+    const int sub = static_cast<int>(std::clamp(std::ceil(step * lambda / 2.0), 1.0, 1000.0));
+    const double h = step / sub;
+    const double u = alpha * d;
+    auto f = [&](double ww) { return acceleration(th, per_direction, g, u, ww, ws); };
+    for (int i = 0; i < sub; ++i) {
+      const double a1 = f(w);
+      const double a2 = f(w + 0.5 * h * a1);
+      const double a3 = f(w + 0.5 * h * a2);
+      const double a4 = f(w + h * a3);
+      x += h / 6.0 * (w + 2.0 * (w + 0.5 * h * a1) + 2.0 * (w + 0.5 * h * a2) + (w + h * a3));
+      w += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+    }
+  }
+  return out;
+}
+
+JointIdentification identify_joint(const JointLog& joint, const std::vector<double>& time, const JointPrior& prior,
+                                   const JointLog* validation, const std::vector<double>* validation_time,
+                                   const IdentifyOptions& o) {
+  std::vector<LogSegment> val;
+  if (validation != nullptr) val.push_back({validation, validation_time, nullptr});
+  return identify_joint(std::vector<LogSegment>{{&joint, &time, nullptr}}, prior, val, o);
+}
+
+JointIdentification identify_joint(const std::vector<LogSegment>& logs, const JointPrior& prior,
+                                   const std::vector<LogSegment>& validation, const IdentifyOptions& o) {
+  if (logs.empty()) throw InputError("no log to identify");
+  const JointLog& joint = *logs.front().joint;
+  const bool closed = logs.front().controller != nullptr;
+  for (const LogSegment& g : logs) {
+    if ((g.controller != nullptr) != closed) throw InputError("the logs of one fit are all closed loop (with a reference) or all open loop");
+  }
+  if (logs.size() > 1 && !prior.known_torque.empty()) throw InputError("--rig mechanism: one log per fit");
+  if (joint.linear && joint.drive != DriveKind::torque) throw InputError("a linear axis (position_m) takes its drive as force_N");
+  JointIdentification r;
+  r.joint = joint.prefix.empty() ? "motor" : joint.prefix;
+  r.drive_column = joint.drive_column;
+  r.reading_column = joint.reading_column;
+  r.linear = joint.linear;
+  r.logs = static_cast<int>(logs.size());
+  const std::vector<std::string> names = mechanical_names(o.per_direction, joint.linear);
+  const int p = static_cast<int>(names.size());
+  Setup s = setup_for(logs, o, p);
   r.sample_time = s.dt;
   r.cutoff_hz = s.fc;
   r.decimation = s.R;
@@ -511,96 +874,62 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
   const ReducedDrive rd = reduced_drive(s.electrical ? DriveKind::current : joint.drive, m);
   s.alpha = rd.alpha;
   s.g = rd.g;
-  if (joint.linear && joint.drive != DriveKind::torque) {
-    throw InputError("a linear axis (position_m) takes its drive as force_N");
-  }
 
   // Electrical fit first: it gives the lag for the current's sample means and k_t = k_e for the
   // mechanical one.
-  Prepared est = prepare(joint, time, prior, s);
+  Prepped est = prepare_all(logs, prior, s);
   double alpha_variance = 0.0;  // relative, of the drive's scale (k_t from the electrical fit)
+  MotorParams fitted = m;
+  if (s.electrical) fit_electrical(r, est, s, logs, prior, o, alpha_variance, fitted);
+  LoopDrive loop{s.alpha, s.g};
   if (s.electrical) {
-    r.electrical = fit_winding(est, s, m, o.rank_tolerance);
-    const Estimate& el = *r.electrical;
-    if (el.identified[1]) s.lag = identify_detail::electrical_lag(el.value[1] / el.value[0], s.dt);
-    if (el.identified[0] && el.identified[2]) s.emf_per_ohm = el.value[2] / el.value[0];
-    if (el.identified[2] && el.value[2] > 0.0) {
-      const double ke_motor = el.value[2] / m.gear_ratio;  // V s / rad = N m / A at the motor shaft
-      s.alpha = m.gearbox_efficiency * m.gear_ratio * ke_motor;
-      alpha_variance = (el.sigma[2] / el.value[2]) * (el.sigma[2] / el.value[2]);
-    }
-    est = prepare(joint, time, prior, s);
+    const ReducedDrive ld = reduced_drive(joint.drive, fitted);
+    loop = {ld.alpha, ld.g};
   }
-  Eigen::VectorXd mprior(p);
-  if (joint.linear) {
-    mprior.setZero();
-  } else {
-    mprior[0] = m.gear_ratio * m.gear_ratio * m.rotor_inertia() + prior.load_inertia;
-    for (int k = 1; k < p - 2; ++k) mprior[k] = m.viscous_friction();
-    mprior[p - 2] = m.coulomb_friction();
-    mprior[p - 1] = 0.0;
-  }
-  r.idim = least_squares(est.W, est.Y, names, mprior, o.rank_tolerance);
-  if (alpha_variance > 0.0) add_scale_variance(r.idim, alpha_variance);
+  r.idim = least_squares(est.all.W, est.all.Y, names, mechanical_prior(prior, joint.linear, p), o.rank_tolerance);
   if (!r.idim.value.allFinite() || !r.idim.sigma.allFinite()) {
     throw InputError("the least-squares fit is not finite: the log's values are out of range for this model");
   }
   for (std::size_t i = 0; i < names.size(); ++i) {
     if (!r.idim.identified[i]) r.unidentifiable.push_back(names[i]);
   }
+  if (closed) {
+    closed_loop_iv(r, est, logs, loop, o);
+    if (r.iv && alpha_variance > 0.0) add_scale_variance(*r.iv, alpha_variance);
+  }
+  if (alpha_variance > 0.0) add_scale_variance(r.idim, alpha_variance);
+  const Estimate& reported = r.iv ? *r.iv : r.idim;
   std::vector<double> sim, dhat;
-  r.estimation_idim = fit_figures(est, r.idim.value, s, time, o, &sim, &dhat);
-  r.series.time = time;
-  r.series.position = est.q;
+  r.estimation_idim = fit_logs(est, logs, reported.value, loop, o, &sim, &dhat);
+  r.series.time = *logs.front().time;
+  r.series.position = est.logs.front().q;
   r.series.position_idim = sim;
-  r.series.drive_time = est.t_dec;
-  r.series.drive = est.d_dec;
+  r.series.drive_time = est.logs.front().t_dec;
+  r.series.drive = est.logs.front().d_dec;
   r.series.drive_idim = dhat;
 
-  std::optional<Prepared> val;
-  if (validation != nullptr) {
-    Setup sv = s;
-    sv.dt = ((*validation_time).back() - (*validation_time).front()) / static_cast<double>(validation_time->size() - 1);
-    if (std::abs(sv.dt - s.dt) > 0.05 * s.dt) {
-      throw InputError("--validation: sample time " + format::shortest(sv.dt) + " s differs from the estimation log's " +
-                       format::shortest(s.dt) + " s");
+  std::optional<Prepped> val;
+  if (!validation.empty()) {
+    for (const LogSegment& g : validation) {
+      const double dt = (g.time->back() - g.time->front()) / static_cast<double>(g.time->size() - 1);
+      if (std::abs(dt - s.dt) > 0.05 * s.dt) {
+        throw InputError("--validation: sample time " + format::shortest(dt) + " s differs from the estimation log's " +
+                         format::shortest(s.dt) + " s");
+      }
+      if (static_cast<int>(g.time->size()) / s.R < 2 * p + 4) throw InputError("--validation: the log is too short");
     }
-    if (static_cast<int>(validation_time->size()) / s.R < 2 * p + 4) throw InputError("--validation: the log is too short");
-    val = prepare(*validation, *validation_time, prior, sv);
+    val = prepare_all(validation, prior, s);
     std::vector<double> vsim, vdhat;
-    r.validation_idim = fit_figures(*val, r.idim.value, sv, *validation_time, o, &vsim, &vdhat);
-    r.validation_series.time = *validation_time;
-    r.validation_series.position = val->q;
+    r.validation_idim = fit_logs(*val, validation, reported.value, loop, o, &vsim, &vdhat);
+    r.validation_series.time = *validation.front().time;
+    r.validation_series.position = val->logs.front().q;
     r.validation_series.position_idim = vsim;
-    r.validation_series.drive_time = val->t_dec;
-    r.validation_series.drive = val->d_dec;
+    r.validation_series.drive_time = val->logs.front().t_dec;
+    r.validation_series.drive = val->logs.front().d_dec;
     r.validation_series.drive_idim = vdhat;
   }
-
-  if (o.output_error && !prior.known_torque.empty()) {
-    r.output_error_status = "not run: one joint of a closed chain (--rig mechanism) is not simulated alone";
-  } else if (o.output_error) {
-    bool ok = r.idim.identified[0] && r.idim.value[0] > 0.0;
-    if (!ok) {
-      r.output_error_status = "not run: the inertia is not identified or not positive";
-    } else {
-      Estimate oe = identify_detail::output_error(time, est.u, s.g, est.q, r.idim, s.per_direction, est.qf.front(),
-                                                  est.v.front(), o.coulomb_smoothing, r.output_error_status);
-      r.output_error = oe;
-      std::vector<double> osim;
-      r.estimation_oe = fit_figures(est, oe.value, s, time, o, &osim, nullptr);
-      r.series.position_oe = osim;
-      if (val) {
-        Setup sv = s;
-        std::vector<double> vo;
-        r.validation_oe = fit_figures(*val, oe.value, sv, *validation_time, o, &vo, nullptr);
-        r.validation_series.position_oe = vo;
-      }
-    }
-  } else {
-    r.output_error_status = "not run (--no-output-error)";
-  }
-
+  refine_output_error(r, est, val, logs, validation, loop, prior, o, closed);
+  r.method = closed ? "IDIM-IV" : (o.use_output_error && r.output_error) ? "output error" : "IDIM-LS";
   r.parameters = records(r, joint, prior, o, p);
   return r;
 }

@@ -51,7 +51,9 @@ Json to_json(const JointIdentification& r) {
             {"sample_time_s", r.sample_time},
             {"cutoff_hz", r.cutoff_hz},
             {"decimation", r.decimation},
-            {"edge_samples", r.edge_samples}};
+            {"edge_samples", r.edge_samples},
+            {"method", r.method},
+            {"logs", r.logs}};
   j["parameters"] = Json::array();
   for (const Parameter& p : r.parameters) {
     j["parameters"].push_back(
@@ -60,12 +62,17 @@ Json to_json(const JointIdentification& r) {
   j["unidentifiable"] = r.unidentifiable;
   j["idim_ls"] = estimate_json(r.idim);
   if (r.electrical) j["electrical"] = estimate_json(*r.electrical);
+  if (r.method == "IDIM-IV") {
+    j["idim_iv"] = {{"status", r.iv_status}, {"converged", r.iv_converged}, {"iterations", r.iv_iterations}};
+    if (r.iv) j["idim_iv"]["estimate"] = estimate_json(*r.iv);
+  }
+  const char* inverse = r.method == "IDIM-IV" ? "idim_iv" : "idim_ls";
   j["output_error"] = {{"status", r.output_error_status}};
   if (r.output_error) j["output_error"]["estimate"] = estimate_json(*r.output_error);
-  j["fit"] = {{"estimation", {{"idim_ls", fit_json(r.estimation_idim)}}}};
+  j["fit"] = {{"estimation", {{inverse, fit_json(r.estimation_idim)}}}};
   if (r.output_error) j["fit"]["estimation"]["output_error"] = fit_json(r.estimation_oe);
   if (r.validation_idim) {
-    j["fit"]["validation"] = {{"idim_ls", fit_json(*r.validation_idim)}};
+    j["fit"]["validation"] = {{inverse, fit_json(*r.validation_idim)}};
     if (r.validation_oe) j["fit"]["validation"]["output_error"] = fit_json(*r.validation_oe);
   }
   return j;

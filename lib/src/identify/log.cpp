@@ -20,7 +20,7 @@ namespace {
 
 struct ColumnKind {
   const char* suffix;
-  enum Role { drive, reading, current } role;
+  enum Role { drive, reading, current, reference } role;
   DriveKind drive_kind;
   ReadingKind reading_kind;
   int linear;  ///< 1 linear, 0 rotary, -1 either
@@ -36,6 +36,8 @@ constexpr ColumnKind kColumns[] = {
     {"counts", ColumnKind::reading, DriveKind::torque, ReadingKind::counts, -1},
     {"theta_rad", ColumnKind::reading, DriveKind::torque, ReadingKind::angle, 0},
     {"position_m", ColumnKind::reading, DriveKind::torque, ReadingKind::angle, 1},
+    {"theta_ref_rad", ColumnKind::reference, DriveKind::torque, ReadingKind::angle, 0},
+    {"position_ref_m", ColumnKind::reference, DriveKind::torque, ReadingKind::angle, 1},
 };
 
 std::string where(const std::string& path, std::size_t line) { return path + ":" + std::to_string(line) + ": "; }
@@ -114,7 +116,8 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     if (kind == nullptr || !parse_prefix(prefix, probe)) {
       throw InputError(at +
                        "unknown column (expected time_s and, per joint, [<station>_<mechanism>_theta<1|2>_] followed by "
-                       "duty, voltage_V, current_A, torque_Nm or force_N, and volts, counts, theta_rad or position_m; "
+                       "duty, voltage_V, current_A, torque_Nm or force_N, and volts, counts, theta_rad or position_m, and "
+                       "optionally theta_ref_rad or position_ref_m (the controller's reference); "
                        "[<station>_<mechanism>_]x_ref_mm and y_ref_mm are the device log's targets)");
     }
     auto [it, added] = joint_index.emplace(prefix, log.joints.size());
@@ -128,7 +131,7 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
   if (log.joints.empty()) throw InputError(where(path, header_line) + "no joint columns (a drive and a reading per joint)");
   // Roles per joint.
   struct Roles {
-    int drive = -1, reading = -1, current = -1;
+    int drive = -1, reading = -1, current = -1, reference = -1;
   };
   std::vector<Roles> roles(log.joints.size());
   for (std::size_t c = 0; c < header.size(); ++c) {
@@ -136,9 +139,13 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     Roles& r = roles[bind[c]->joint];
     const ColumnKind& k = *bind[c]->kind;
     const std::string at = where(path, header_line) + "column '" + header[c] + "': ";
-    int& slot = k.role == ColumnKind::drive ? r.drive : k.role == ColumnKind::reading ? r.reading : r.current;
+    int& slot = k.role == ColumnKind::drive     ? r.drive
+                : k.role == ColumnKind::reading ? r.reading
+                : k.role == ColumnKind::current ? r.current
+                                                : r.reference;
     if (slot >= 0) {
-      throw InputError(at + "a second " + (k.role == ColumnKind::reading ? "reading" : "drive") + " column for the joint (already '" +
+      const char* what = k.role == ColumnKind::reading ? "reading" : k.role == ColumnKind::reference ? "reference" : "drive";
+      throw InputError(at + "a second " + what + " column for the joint (already '" +
                        header[static_cast<std::size_t>(slot)] + "')");
     }
     slot = static_cast<int>(c);
@@ -175,6 +182,15 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     jl.drive_column = header[static_cast<std::size_t>(r.drive)];
     jl.reading = rk.reading_kind;
     jl.reading_column = header[static_cast<std::size_t>(r.reading)];
+    if (r.reference >= 0) {
+      const ColumnKind& fk = *bind[static_cast<std::size_t>(r.reference)]->kind;
+      if (fk.linear != (jl.linear ? 1 : 0)) {
+        throw InputError(where(path, header_line) + "column '" + header[static_cast<std::size_t>(r.reference)] +
+                         "': units do not match the joint's reading '" + jl.reading_column +
+                         "' (theta_ref_rad for a rotary joint, position_ref_m for a linear axis)");
+      }
+      jl.reference_column = header[static_cast<std::size_t>(r.reference)];
+    }
   }
   // Rows.
   std::vector<std::size_t> row_lines;
@@ -193,6 +209,7 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
       log.joints[j].drive_values.push_back(v[static_cast<std::size_t>(roles[j].drive)]);
       log.joints[j].reading_values.push_back(v[static_cast<std::size_t>(roles[j].reading)]);
       if (roles[j].current >= 0) log.joints[j].current.push_back(v[static_cast<std::size_t>(roles[j].current)]);
+      if (roles[j].reference >= 0) log.joints[j].reference.push_back(v[static_cast<std::size_t>(roles[j].reference)]);
     }
   }
   if (log.time.size() < 16) {

@@ -39,8 +39,9 @@ DriveFit gated_fit(const JointIdentification& r, bool use_output_error) {
     if (r.validation_oe) return {r.validation_oe->drive_fit_percent, "the validation log (output error)"};
     return {r.estimation_oe.drive_fit_percent, "the estimation log (output error; no validation log: an optimistic figure)"};
   }
-  if (r.validation_idim) return {r.validation_idim->drive_fit_percent, "the validation log (IDIM-LS)"};
-  return {r.estimation_idim.drive_fit_percent, "the estimation log (IDIM-LS; no validation log: an optimistic figure)"};
+  const std::string m = r.iv ? "IDIM-IV" : "IDIM-LS";
+  if (r.validation_idim) return {r.validation_idim->drive_fit_percent, "the validation log (" + m + ")"};
+  return {r.estimation_idim.drive_fit_percent, "the estimation log (" + m + "; no validation log: an optimistic figure)"};
 }
 
 }  // namespace
@@ -49,9 +50,19 @@ gate::GateResult identification_gate(const std::vector<JointIdentification>& res
   gate::GateInput in;
   in.fit = "fivebar identify";
   in.solver = {true, use_output_error ? "CONVERGENCE" : "closed form (IDIM-LS)", 0};
+  bool closed = false;
+  int iterations = 0;
+  for (const JointIdentification& r : results) {
+    closed = closed || r.method == "IDIM-IV";
+    iterations = std::max(iterations, r.iv_iterations);
+  }
+  if (closed && !use_output_error) in.solver = {true, "CONVERGENCE (IDIM-IV, instrumental variables iterated)", iterations};
   for (const JointIdentification& r : results) {
     if (use_output_error && r.output_error_status != "converged") {
       in.solver = {false, "output error of joint " + r.joint + ": " + r.output_error_status, 0};
+    }
+    if (r.method == "IDIM-IV" && !r.iv_converged) {
+      in.solver = {false, "IDIM-IV of joint " + r.joint + ": " + r.iv_status, r.iv_iterations};
     }
   }
   for (const JointIdentification& r : results) {

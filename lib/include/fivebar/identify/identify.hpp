@@ -6,6 +6,8 @@
 
 #include <Eigen/Dense>
 
+#include <cstddef>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -13,8 +15,36 @@
 #include "fivebar/identify/log.hpp"
 #include "fivebar/identify/model.hpp"
 #include "fivebar/rendered_plot.hpp"
+#include "fivebar/runtime/config.hpp"
 
 namespace fivebar::identify {
+
+/// The feedback a closed-loop log was recorded under (docs/identify.md "Closed loop"): stateful, one
+/// call per log row, as the controller ran. IDIM-IV simulates the loop with it to build its
+/// instruments; it is never given the logged (noisy) reading.
+class LoopController {
+ public:
+  virtual ~LoopController() = default;
+  /// Back to the state the log started in (integrators and derivative memories cleared).
+  virtual void reset() = 0;
+  /// The drive (the log's drive column's units) commanded at `row` from the angle read at it.
+  virtual double drive(std::size_t row, double angle) = 0;
+};
+
+/// The device's PID (fivebar/runtime/controller.hpp `pid_update`, the one implementation the runtime
+/// and `simulate` run) on reference[row] - angle at the log's period, the duty times `scale` (1 for a
+/// `duty` column, motor.supply_voltage_V for a `voltage_V` one).
+std::unique_ptr<LoopController> device_pid(std::vector<double> reference, const runtime::Gains& gains, double period_s,
+                                           double scale);
+
+/// One log of a joint in a fit: several logs of the same joint are fitted together (their rows
+/// stacked; the filters and the edge trimming applied to each). `controller`: the feedback the log
+/// was taken under (closed loop), or null (the drive was applied open loop).
+struct LogSegment {
+  const JointLog* joint = nullptr;
+  const std::vector<double>* time = nullptr;
+  LoopController* controller = nullptr;
+};
 
 struct IdentifyOptions {
   double cutoff_hz = 0.0;        ///< zero-phase low-pass on the position; 0: fs / 10
@@ -32,6 +62,12 @@ struct IdentifyOptions {
   /// below this is not separable (its parameter is held at its prior).
   double rank_tolerance = 1e-4;
   double coulomb_smoothing = 1e-3;  ///< w_s of tanh(w / w_s) in the simulation (fivebar/dynamics.hpp)
+  /// Closed loop (every estimation log has a controller): IDIM-IV stops when no parameter moved by
+  /// more than this fraction of its sigma in an iteration, and is not converged after iv_max_iterations.
+  /// The simulated speed's sign switching a sample earlier or later changes the instruments by a
+  /// step: the iteration can end in a cycle of about 2 % of a sigma (measured), below this bound.
+  double iv_tolerance = 0.05;
+  int iv_max_iterations = 30;
   std::vector<std::string> require;  ///< keys the caller asked to fit: unidentifiable ones are errors
 };
 
@@ -81,7 +117,16 @@ struct JointIdentification {
   double sample_time = 0.0, cutoff_hz = 0.0;
   int decimation = 1;
   int edge_samples = 0;       ///< full-rate samples at each end left out of the fit: the filters' settling
+  int logs = 1;               ///< estimation logs fitted together
   Estimate idim;              ///< mechanical base parameters, IDIM-LS
+  /// Closed loop: IDIM-IV (instruments from the loop simulated with the previous estimate),
+  /// started from IDIM-LS; its status ("converged in N iterations", or why not).
+  std::optional<Estimate> iv;
+  std::string iv_status;
+  int iv_iterations = 0;
+  bool iv_converged = false;
+  /// "IDIM-LS", "IDIM-IV" or "output error": the estimate `parameters` report.
+  std::string method = "IDIM-LS";
   std::optional<Estimate> electrical;  ///< R, L, k_e when a voltage drive logs its current
   std::optional<Estimate> output_error;
   std::string output_error_status;     ///< "converged", "not run: ...", Ceres' message
@@ -97,6 +142,12 @@ struct JointIdentification {
 JointIdentification identify_joint(const JointLog& joint, const std::vector<double>& time, const JointPrior& prior,
                                    const JointLog* validation, const std::vector<double>* validation_time,
                                    const IdentifyOptions& options);
+/// Fits one joint over several logs at once (the same drive and reading columns; sample times within
+/// 5 %). Closed loop when every estimation log has a controller: IDIM-LS, then IDIM-IV; a mix of
+/// open- and closed-loop logs is an InputError. The output-error refinement simulates each open-loop
+/// log and is not run on closed-loop ones. `validation` may be empty.
+JointIdentification identify_joint(const std::vector<LogSegment>& logs, const JointPrior& prior,
+                                   const std::vector<LogSegment>& validation, const IdentifyOptions& options);
 
 /// The least-squares core: Y = W theta + e with the columns of `W` named; a column not separable
 /// from the earlier ones (rank_tolerance) is held at `prior` and named. Used for the mechanical and
@@ -111,6 +162,13 @@ double fit_percent(const std::vector<double>& y, const std::vector<double>& yhat
 std::vector<double> simulate_position(const std::vector<double>& time, const std::vector<double>& drive_torque_u,
                                       double g, const Eigen::VectorXd& mechanical, bool per_direction, double q0,
                                       double w0, double coulomb_smoothing);
+
+/// Closed-loop simulation of the reduced model: at each row the controller reads the simulated angle
+/// and its drive d is held over the sample (drive torque alpha d - g w, RK4 with enough sub-steps for
+/// the smoothed Coulomb term); `drive_out` (optional) the drive it commanded. Non-finite values stop it.
+std::vector<double> simulate_closed_loop(const std::vector<double>& time, LoopController& controller, double alpha, double g,
+                                         const Eigen::VectorXd& mechanical, bool per_direction, double q0, double w0,
+                                         double coulomb_smoothing, std::vector<double>* drive_out = nullptr);
 
 /// Measured against fitted (position above, drive below), SVG and PNG.
 RenderedPlot identify_plot(const JointIdentification& r, bool validation);

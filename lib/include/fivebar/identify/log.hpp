@@ -38,6 +38,11 @@ struct JointLog {
   std::string reading_column;
   std::vector<double> reading_values;
   std::vector<double> current;  ///< measured current_A next to a duty or voltage drive; empty if none
+  /// The reference the joint's controller followed while the log was taken (`theta_ref_rad`, or
+  /// `position_ref_m` for a linear axis), rad (m); empty if the log has none (closed-loop
+  /// identification, docs/identify.md "Closed loop").
+  std::string reference_column;
+  std::vector<double> reference;
 };
 
 struct IdentifyLog {
