@@ -270,31 +270,6 @@ MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig) 
   return source;
 }
 
-/// The device's PID a closed-loop log was taken under: the design's gains for the log's joint (a
-/// bench motor: `controller.pid`), at the log's rate, commanding the log's drive column.
-std::unique_ptr<id::LoopController> closed_loop_controller(const Design& design, const id::JointLog& j, const id::IdentifyLog& l,
-                                                           const std::string& file) {
-  const std::string who = j.prefix.empty() ? "motor" : j.prefix;
-  if (j.reference.empty()) {
-    throw InputError(file + ": --closed-loop: joint '" + who + "' has no reference column (" + (j.prefix.empty() ? "" : j.prefix + "_") +
-                     (j.linear ? "position_ref_m" : "theta_ref_rad") + ")");
-  }
-  if (j.drive != id::DriveKind::duty && j.drive != id::DriveKind::voltage) {
-    throw InputError(file + ": --closed-loop: joint '" + who + "' is driven by '" + j.drive_column +
-                     "'; the device's PID commands a duty (a duty or voltage_V column)");
-  }
-  const auto* controller = design.get<ControllerSettings>();
-  if (controller == nullptr) throw InputError(design.name + ": --closed-loop needs the design's controller: section (the PID the log ran)");
-  const PidGains pid = j.prefix.empty() ? controller->pid : controller->joint(j.station, j.mechanism, j.joint).pid;
-  double scale = 1.0;
-  if (j.drive == id::DriveKind::voltage) {
-    const auto* motor = design.get<MotorSettings>();
-    if (motor == nullptr) throw InputError(design.name + ": --closed-loop with voltage_V needs the motor: section's supply_voltage_V");
-    scale = j.prefix.empty() ? motor->defaults.supply_voltage_V : motor->joint(j.station, j.mechanism, j.joint).supply_voltage_V;
-  }
-  return id::device_pid(j.reference, runtime::Gains{pid.kp, pid.ki, pid.kd, pid.i_clamp}, l.sample_time(), scale);
-}
-
 /// The quality gate's verdict and tests, then the values it or the motor: section refused, a line each.
 void print_patch(const id::Patch& patch) {
   std::size_t passed = 0;
@@ -386,7 +361,7 @@ int run_identify(const IdentifyCliOptions& given) {
       }
       id::LogSegment g{x, &l.time, nullptr};
       if (opt.closed_loop) {
-        loops.push_back(closed_loop_controller(design, *x, l, file));
+        loops.push_back(id::design_pid(design, *x, l.sample_time(), file));
         g.controller = loops.back().get();
       }
       return g;

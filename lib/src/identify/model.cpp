@@ -4,6 +4,11 @@
 
 #include <cmath>
 
+#include "fivebar/error.hpp"
+#include "fivebar/identify/identify.hpp"
+#include "fivebar/sections/controller.hpp"
+#include "fivebar/sections/motor.hpp"
+
 namespace fivebar::identify {
 
 ReducedDrive reduced_drive(DriveKind kind, const MotorParams& m) {
@@ -43,6 +48,28 @@ std::vector<std::string> mechanical_names(bool per_direction, bool linear) {
     return {"inertia_kg_m2", "viscous_pos_Nm_s_per_rad", "viscous_neg_Nm_s_per_rad", "coulomb_Nm", "offset_Nm"};
   }
   return {"inertia_kg_m2", "viscous_Nm_s_per_rad", "coulomb_Nm", "offset_Nm"};
+}
+
+std::unique_ptr<LoopController> design_pid(const Design& design, const JointLog& j, double sample_time, const std::string& file) {
+  const std::string who = j.prefix.empty() ? "motor" : j.prefix;
+  if (j.reference.empty()) {
+    throw InputError(file + ": a closed-loop fit: joint '" + who + "' has no reference column (" + (j.prefix.empty() ? "" : j.prefix + "_") +
+                     (j.linear ? "position_ref_m" : "theta_ref_rad") + ")");
+  }
+  if (j.drive != DriveKind::duty && j.drive != DriveKind::voltage) {
+    throw InputError(file + ": a closed-loop fit: joint '" + who + "' is driven by '" + j.drive_column +
+                     "'; the device's PID commands a duty (a duty or voltage_V column)");
+  }
+  const auto* controller = design.get<ControllerSettings>();
+  if (controller == nullptr) throw InputError(design.name + ": a closed-loop fit needs the design's controller: section (the PID the log ran)");
+  const PidGains pid = j.prefix.empty() ? controller->pid : controller->joint(j.station, j.mechanism, j.joint).pid;
+  double scale = 1.0;
+  if (j.drive == DriveKind::voltage) {
+    const auto* motor = design.get<MotorSettings>();
+    if (motor == nullptr) throw InputError(design.name + ": a closed-loop fit of a voltage_V drive needs the motor: section's supply_voltage_V");
+    scale = j.prefix.empty() ? motor->defaults.supply_voltage_V : motor->joint(j.station, j.mechanism, j.joint).supply_voltage_V;
+  }
+  return device_pid(j.reference, runtime::Gains{pid.kp, pid.ki, pid.kd, pid.i_clamp}, sample_time, scale);
 }
 
 }  // namespace fivebar::identify

@@ -1,5 +1,6 @@
 // The `identify` product: the motor, friction and inertia of the joints of the bench log the
-// design's `bench:` section names (fivebar/identify.hpp, docs/identify.md), by IDIM-LS; writes
+// design's `bench:` section names (fivebar/identify.hpp, docs/identify.md), by IDIM-LS (IDIM-IV for a
+// closed-loop log, one with its reference column); writes
 // identify/identify.json and identify/<design>-identified.yaml (the identified motor keys with
 // their provenance: entries). The output-error refinement and the plots are `fivebar identify`'s.
 
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <string>
 
@@ -52,16 +54,24 @@ Product identify_product() {
     log.path = name;
     identify::IdentifyOptions o;
     o.output_error = false;  // IDIM-LS only: the refinement is `fivebar identify`'s (it simulates)
+    // A log whose every joint carries its reference (theta_ref_rad) was taken under the design's PID:
+    // IDIM-IV, as `fivebar identify --closed-loop` (docs/identify.md "Closed loop").
+    bool closed = true;
+    for (const identify::JointLog& j : log.joints) closed = closed && !j.reference.empty();
     std::vector<identify::JointIdentification> results;
     for (const identify::JointLog& j : log.joints) {
       const bool need_motor = !j.linear && j.drive != identify::DriveKind::torque;
       const identify::JointPrior prior = identify::joint_prior(d, j.station, j.mechanism, j.joint, 0.0, need_motor);
-      results.push_back(identify::identify_joint(j, log.time, prior, nullptr, nullptr, o));
+      std::unique_ptr<identify::LoopController> loop;
+      if (closed) loop = identify::design_pid(d, j, log.sample_time(), name);
+      results.push_back(identify::identify_joint({{&j, &log.time, loop.get()}}, prior, {}, o));
     }
-    Json doc = {{"log", name}, {"method", "IDIM-LS"}, {"joints", Json::array()}};
+    Json doc = {{"log", name}, {"method", closed ? "IDIM-IV" : "IDIM-LS"}, {"joints", Json::array()}};
     for (const auto& r : results) doc["joints"].push_back(identify::to_json(r));
     MeasurementSource source{name, sha256_file(file), today_utc(),
-                             "fivebar identify --rig motor: inverse dynamic model by least squares (IDIM-LS), standard deviation"};
+                             closed ? "fivebar identify --rig motor --closed-loop: inverse dynamic model by instrumental variables under the "
+                                      "design's PID (IDIM-IV), standard deviation"
+                                    : "fivebar identify --rig motor: inverse dynamic model by least squares (IDIM-LS), standard deviation"};
     // The quality gate decides what is written as measured (docs/identify.md "The quality gate").
     identify::Patch patch = identify::patch_design(d, results, source, false);
     doc["gate"] = gate::to_json(patch.gate);
@@ -78,8 +88,9 @@ Product identify_product() {
     ctx.write_file("identify/identify.json", doc.dump(2) + "\n");
 
     Built b;
-    std::string md = "The bench log `" + name + "` fitted by `fivebar identify --rig motor` (IDIM-LS, docs/identify.md; the "
-                     "output-error refinement and the plots are the command's).\n\n";
+    std::string md = "The bench log `" + name + "` fitted by `fivebar identify --rig motor` (" +
+                     (closed ? std::string("closed loop: IDIM-IV under the design's PID") : std::string("IDIM-LS")) +
+                     ", docs/identify.md; the output-error refinement and the plots are the command's).\n\n";
     md::Table t({"joint", "parameter", "value", "σ", ""}, "llrrl");
     for (const auto& r : results) {
       for (const identify::Parameter& q : r.parameters) {

@@ -37,6 +37,12 @@ class LoopController {
 std::unique_ptr<LoopController> device_pid(std::vector<double> reference, const runtime::Gains& gains, double period_s,
                                            double scale);
 
+/// The device's PID a closed-loop log of `joint` was taken under: the design's gains for the joint
+/// (a bench motor: `controller.pid`) at the log's rate, commanding its duty (or duty x the motor's
+/// supply_voltage_V for a voltage_V column). InputError naming `file` when the joint has no reference
+/// column or another drive, or the design no controller: section.
+std::unique_ptr<LoopController> design_pid(const Design& design, const JointLog& joint, double sample_time, const std::string& file);
+
 /// One log of a joint in a fit: several logs of the same joint are fitted together (their rows
 /// stacked; the filters and the edge trimming applied to each). `controller`: the feedback the log
 /// was taken under (closed loop), or null (the drive was applied open loop).
