@@ -173,8 +173,8 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   std::string range_source;
   if (!opt.range_deg.empty()) {
     if (opt.range_deg.size() != 2 || !(opt.range_deg[1] > opt.range_deg[0])) throw InputError("--range-deg: expected LO,HI with LO < HI");
-    po.range_lo = opt.range_deg[0] * std::numbers::pi / 180.0;
-    po.range_hi = opt.range_deg[1] * std::numbers::pi / 180.0;
+    po.range_lo = opt.range_deg[0] * format::kRadPerDeg;
+    po.range_hi = opt.range_deg[1] * format::kRadPerDeg;
     range_source = "--range-deg";
   } else if (!station.empty()) {
     const Station& s = design.require_station(station);
@@ -191,8 +191,8 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
     range_source = "usable range of " + u.joint + " less the controller's joint margin";
   } else {
     // A bench motor: the default potentiometer's 300 deg travel (controller.potentiometer), centred.
-    po.range_lo = -150.0 * std::numbers::pi / 180.0;
-    po.range_hi = 150.0 * std::numbers::pi / 180.0;
+    po.range_lo = -150.0 * format::kRadPerDeg;
+    po.range_hi = 150.0 * format::kRadPerDeg;
     range_source = "the potentiometer's 300 deg travel, centred (give --range-deg for another)";
   }
   const id::ExcitationPlan plan = id::plan_excitation(prior, po);
@@ -201,12 +201,12 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   jp["samples"] = plan.time.size();
   jp["duration_s"] = plan.time.back();
   jp["band_hz"] = {po.f_min_hz, po.f_max_hz};
-  jp["range_deg"] = {po.range_lo * 180.0 / std::numbers::pi, po.range_hi * 180.0 / std::numbers::pi};
+  jp["range_deg"] = {po.range_lo * format::kDegPerRad, po.range_hi * format::kDegPerRad};
   jp["range_source"] = range_source;
   jp["limited_by"] = plan.limited_by;
   jp["crest_factor"] = plan.crest_factor;
   jp["drive_noise_mNm"] = opt.drive_noise_mNm;
-  jp["angle_quantum_deg"] = po.angle_quantum * 180.0 / std::numbers::pi;
+  jp["angle_quantum_deg"] = po.angle_quantum * format::kDegPerRad;
   jp["fade_s"] = plan.fade_s;
   jp["edge_samples"] = plan.edge_samples;
   jp["expected_residual_mNm"] = plan.expected_residual * 1e3;
@@ -225,7 +225,7 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
     std::ostringstream csv;
     csv << "time_s,theta_deg,current_A,duty\n";
     for (std::size_t i = 0; i < plan.time.size(); ++i) {
-      csv << exact(plan.time[i]) << "," << exact(plan.position[i] * 180.0 / std::numbers::pi) << "," << exact(plan.current[i])
+      csv << exact(plan.time[i]) << "," << exact(plan.position[i] * format::kDegPerRad) << "," << exact(plan.current[i])
           << "," << exact(plan.duty[i]) << "\n";
     }
     const std::filesystem::path f = dir / "identify-plan.csv";
@@ -239,12 +239,12 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
   }
   std::cout << "excitation: multisine, Schroeder phases, " << format::shortest(po.f_min_hz) << " ... " << format::shortest(po.f_max_hz)
             << " Hz, " << format::shortest(plan.time.back()) << " s, fading in and out over " << format::shortest(plan.fade_s)
-            << " s; range " << fixed(po.range_lo * 180.0 / std::numbers::pi, 1)
-            << " ... " << fixed(po.range_hi * 180.0 / std::numbers::pi, 1) << " deg (" << range_source << "), limited by the "
+            << " s; range " << fixed(po.range_lo * format::kDegPerRad, 1)
+            << " ... " << fixed(po.range_hi * format::kDegPerRad, 1) << " deg (" << range_source << "), limited by the "
             << plan.limited_by << " (90 % of each limit)\n";
   std::cout << "expected sigmas (IDIM-LS, decimation 10, " << plan.edge_samples << " samples left out at each end; residual "
             << sig(plan.expected_residual * 1e3) << " mNm from the drive noise " << format::shortest(opt.drive_noise_mNm)
-            << " mNm and the reading's quantum " << sig(po.angle_quantum * 180.0 / std::numbers::pi) << " deg, "
+            << " mNm and the reading's quantum " << sig(po.angle_quantum * format::kDegPerRad) << " deg, "
             << fixed(100.0 * plan.quantisation_share, 0) << " % of its variance):\n";
   for (std::size_t i = 0; i < plan.names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);

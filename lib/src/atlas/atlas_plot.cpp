@@ -69,7 +69,7 @@ RenderedPlot plot_atlas(const Atlas& atlas, const std::string& subtitle) {
        11.5, kInk);
   text(cr, kLeft, 64.0,
        "Target: aspect " + fixed(o.shape.aspect, 3) + ", major axis at " +
-           fixed(o.shape.angle * 180.0 / std::numbers::pi, 1) +
+           fixed(o.shape.angle * format::kDegPerRad, 1) +
            " deg to the base line, centred on the symmetry axis at its best height; working mode " +
            to_string(o.working_mode) + ", assembly " + to_string(o.assembly_mode) + ", no joint limits.",
        11.5, kInk);

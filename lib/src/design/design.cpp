@@ -14,6 +14,7 @@
 #include <numbers>
 
 #include "design/design_keys.hpp"
+#include "fivebar/design/angles.hpp"
 #include "fivebar/numerics.hpp"
 #include "fivebar/ranges.hpp"
 #include "sections/rules.hpp"
@@ -30,7 +31,7 @@ using rules::kMaxLengthMm;
 
 namespace {
 
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using angles::kTwoPi;
 
 /// Two joint-limit angles are the same (mod 2 pi) when their ccw difference is within this many
 /// ulps of the largest magnitude involved: degree -> radian conversion rounds each one by ~1 ulp,
@@ -42,14 +43,6 @@ constexpr std::size_t kMaxNameLength = 64;
 constexpr const char* kSafeNameRule =
     "must be a safe file name: 1 to 64 characters from A-Z a-z 0-9 _ . -, "
     "not starting with '.' or '-'";
-
-/// Angle reduced to [0, 2 pi).
-double wrap_two_pi(double angle) {
-  double r = std::fmod(angle, kTwoPi);
-  if (r < 0.0) r += kTwoPi;
-  if (r >= kTwoPi) r = 0.0;  // r was a tiny negative number
-  return r;
-}
 
 bool is_plain_word(std::string_view name) {
   return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
@@ -196,12 +189,12 @@ std::string to_string(AssemblyMode mode) {
 // JointRange
 
 double JointRange::span() const {
-  const double d = wrap_two_pi(hi - lo);
+  const double d = angles::wrap_two_pi(hi - lo);
   return d > 0.0 ? d : kTwoPi;
 }
 
 bool JointRange::contains(double angle, double tol) const {
-  const double offset = wrap_two_pi(angle - lo);  // ccw from lo, in [0, 2 pi)
+  const double offset = angles::wrap_two_pi(angle - lo);  // ccw from lo, in [0, 2 pi)
   return offset <= span() + tol || offset >= kTwoPi - tol;
 }
 
@@ -242,7 +235,7 @@ void Mechanism::validate() const {
           throw ValidationError(detail::key_index(key_of(), j), "= " + format_number(angle) + " deg: must be finite");
         }
       }
-      const double d = wrap_two_pi(range.hi - range.lo);
+      const double d = angles::wrap_two_pi(range.hi - range.lo);
       const double tol = kAngleEqualUlps * tol::kEps * std::max({kTwoPi, std::abs(range.lo), std::abs(range.hi)});
       if (d <= tol || d >= kTwoPi - tol) {
         throw ValidationError(key_of(), "= [" + format_degrees(range.lo) + ", " + format_degrees(range.hi) +

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "fivebar/design/angles.hpp"
 #include "fivebar/device/joint_limits.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/kinematics.hpp"
@@ -24,28 +25,13 @@ namespace fivebar {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using angles::kPi;
+using angles::kTwoPi;
 /// Lengths leave in metres (REP 103). Divided, not multiplied by 1e-3: the quotient is the double
 /// nearest the true value, so 9 mm is written 0.009 rather than 0.009000000000000001.
 constexpr double kMmPerMetre = 1000.0;
 /// Version of the exported layout; a controller may refuse a layout it does not know.
 constexpr int kFormatVersion = 1;
-
-/// Angle in (-pi, pi].
-double normalized(double a) {
-  double r = std::remainder(a, kTwoPi);
-  if (r <= -kPi) r += kTwoPi;
-  return r;
-}
-
-/// Angle in [0, 2 pi).
-double wrap_two_pi(double a) {
-  double r = std::fmod(a, kTwoPi);
-  if (r < 0.0) r += kTwoPi;
-  if (r >= kTwoPi) r = 0.0;  // a tiny negative remainder rounds up to 2 pi
-  return r;
-}
 
 double metres(double mm) { return mm / kMmPerMetre; }
 std::array<double, 2> metres(const Vec2& p) { return {metres(p.x()), metres(p.y())}; }
@@ -177,11 +163,11 @@ std::string design_hash(const Design& d, const std::vector<std::string>& station
   return "sha256:" + sha256_hex(to_yaml(export_view(d, stations)));
 }
 
-double JointBranch::lo() const { return reference - wrap_two_pi(reference - limits->lo); }
+double JointBranch::lo() const { return reference - angles::wrap_two_pi(reference - limits->lo); }
 double JointBranch::hi() const { return lo() + limits->span(); }
 double JointBranch::represent(double theta) const {
   if (!limits) return reference + std::remainder(theta - reference, kTwoPi);
-  const double offset = wrap_two_pi(theta - lo());
+  const double offset = angles::wrap_two_pi(theta - lo());
   const double span = limits->span();
   if (offset <= span) return lo() + offset;
   return (offset - span) < (kTwoPi - offset) ? lo() + offset : lo() + offset - kTwoPi;
@@ -193,8 +179,8 @@ std::array<JointBranch, 2> joint_branches(const Mechanism& m, const Ellipse& e) 
   for (std::size_t j = 0; j < 2; ++j) {
     if (m.joint_limits) b[j].limits = (*m.joint_limits)[j];
     // An unreachable centre fails the gate anyway; the limits then start at lo in (-pi, pi].
-    b[j].reference = centre.status == Status::unreachable ? (m.joint_limits ? normalized((*m.joint_limits)[j].lo) : 0.0)
-                                                          : normalized(j == 0 ? centre.theta1 : centre.theta2);
+    b[j].reference = centre.status == Status::unreachable ? (m.joint_limits ? angles::wrap_pi((*m.joint_limits)[j].lo) : 0.0)
+                                                          : angles::wrap_pi(j == 0 ? centre.theta1 : centre.theta2);
   }
   return b;
 }

@@ -10,6 +10,7 @@
 #include <numbers>
 
 #include "fivebar/collision.hpp"
+#include "fivebar/design/angles.hpp"
 #include "fivebar/device/config.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/kinematics.hpp"
@@ -20,24 +21,11 @@ namespace fivebar {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using angles::kPi;
+using angles::kTwoPi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 using format::fixed;
 using format::kDegPerRad;
-
-double wrap_two_pi(double a) {
-  double r = std::fmod(a, kTwoPi);
-  if (r < 0.0) r += kTwoPi;
-  if (r >= kTwoPi) r = 0.0;
-  return r;
-}
-
-double normalized(double a) {
-  double r = std::remainder(a, kTwoPi);
-  if (r <= -kPi) r += kTwoPi;
-  return r;
-}
 
 std::string deg(double rad, int digits = 2) { return fixed(rad * kDegPerRad, digits); }
 
@@ -105,13 +93,13 @@ std::array<UsableRange, 2> usable_ranges(const Design& design, const Station& st
       r.problem = "the target centre is unreachable: no reference angle";
       continue;
     }
-    r.reference = normalized(j == 1 ? centre.theta1 : centre.theta2);
+    r.reference = angles::wrap_pi(j == 1 ? centre.theta1 : centre.theta2);
     // Distances from the reference to the nearest end, clockwise (down) and counter-clockwise (up).
     double down = kInf, up = kInf;
     const auto allowed_arc = [&](const JointRange& arc, const std::string& by) {
       r.limited = true;
       const double span = arc.span();
-      const double offset = wrap_two_pi(r.reference - arc.lo);
+      const double offset = angles::wrap_two_pi(r.reference - arc.lo);
       if (offset > span) {
         r.usable = false;
         r.problem = "the target centre's angle " + deg(r.reference) + " deg is outside the " + by;
@@ -129,7 +117,7 @@ std::array<UsableRange, 2> usable_ranges(const Design& design, const Station& st
         return;
       }
       const double start = direction - half;  // blocked (start, start + 2 half)
-      const double offset = wrap_two_pi(r.reference - start);
+      const double offset = angles::wrap_two_pi(r.reference - start);
       if (offset < 2.0 * half) {
         r.usable = false;
         r.problem = "the target centre's angle " + deg(r.reference) + " deg is inside the " + by + " (" +
@@ -137,7 +125,7 @@ std::array<UsableRange, 2> usable_ranges(const Design& design, const Station& st
         return;
       }
       // Going up from the reference we meet `start`; going down, start + 2 half.
-      const double to_start = wrap_two_pi(start - r.reference);
+      const double to_start = angles::wrap_two_pi(start - r.reference);
       const double to_end = offset - 2.0 * half;
       if (to_start < up) up = to_start, r.hi_by = by;
       if (to_end < down) down = to_end, r.lo_by = by;
@@ -182,7 +170,7 @@ Station with_usable_limits(const Design& design, const Station& station) {
 double range_margin(const UsableRange& range, double theta) {
   if (!range.limited) return kInf;
   const double span = range.span();
-  const double offset = wrap_two_pi(theta - range.lo);
+  const double offset = angles::wrap_two_pi(theta - range.lo);
   if (offset <= span) return std::min(offset, span - offset);
   return -std::min(offset - span, kTwoPi - offset);
 }
@@ -234,7 +222,7 @@ void visit(const Mechanism& m, const std::array<UsableRange, 2>& ranges, const G
     if (margin < w.margin) {
       w.margin = margin, w.joint = ranges[j].joint, w.point = p;
       // On the range's branch, for the message.
-      w.theta = ranges[j].lo + wrap_two_pi(theta[j] - ranges[j].lo);
+      w.theta = ranges[j].lo + angles::wrap_two_pi(theta[j] - ranges[j].lo);
       if (w.theta > ranges[j].hi + kPi) w.theta -= kTwoPi;
     }
   }

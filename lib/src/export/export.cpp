@@ -4,6 +4,7 @@
 
 #include "fivebar/format.hpp"
 #include "fivebar/export/export.hpp"
+#include "fivebar/design/angles.hpp"
 #include "fivebar/provenance.hpp"
 #include "fivebar/export/mjcf.hpp"
 #include "fivebar/export/ros2_package.hpp"
@@ -39,8 +40,8 @@ namespace fivebar {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-constexpr double kTwoPi = 2.0 * std::numbers::pi;
+using angles::kPi;
+using angles::kTwoPi;
 using format::kDegPerRad;
 /// Lengths leave in metres (REP 103). Divided, not multiplied by 1e-3: the quotient is the double
 /// nearest the true value, so 9 mm is written 0.009 rather than 0.009000000000000001.
@@ -51,13 +52,6 @@ constexpr int kFormatVersion = 1;
 using format::fixed;
 
 std::string point_text(const Vec2& p) { return "(" + fixed(p.x(), 3) + ", " + fixed(p.y(), 3) + ") mm"; }
-
-/// Angle in (-pi, pi].
-double normalized(double a) {
-  double r = std::remainder(a, kTwoPi);
-  if (r <= -kPi) r += kTwoPi;
-  return r;
-}
 
 
 /// Words a name cannot take in the header: C++ keywords and alternative tokens, and the macros GNU
@@ -114,7 +108,7 @@ JointSamples sample_joints(const Mechanism& m, const Ellipse& e, const ExportOpt
       return;
     }
     if (!reference_set) {
-      branch[0].reference = normalized(pose.theta1), branch[1].reference = normalized(pose.theta2);
+      branch[0].reference = angles::wrap_pi(pose.theta1), branch[1].reference = angles::wrap_pi(pose.theta2);
       reference_set = true;
     }
     const std::array<double, 2> theta{branch[0].represent(pose.theta1), branch[1].represent(pose.theta2)};

@@ -29,7 +29,7 @@ using detail::mj_q;
 using detail::mj_vec;
 using detail::MjWriter;
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using format::kDegPerRad;
 
 /// Height of the tactors' tops above the base plate (mm): where the finger rests.
 double tactor_top_mm(const detail::StationBodies& bodies, const Geometry& g) {

@@ -646,7 +646,7 @@ static void tolerance_study(const Mechanism& m, const Ellipse& target, const Acc
   // 0.1 mm of play on each leg.
   ParameterSigmas sigma{};
   for (std::size_t j = 0; j < 8; ++j) sigma[j] = 0.05;
-  sigma[8] = sigma[9] = 0.5 * std::numbers::pi / 180.0;
+  sigma[8] = sigma[9] = 0.5 * format::kRadPerDeg;
   const std::array<double, 2> play{0.1, 0.1};
   const Vec2 P = target.center;
   if (ik(m, P).status != Status::ok) return;

@@ -9,6 +9,7 @@
 
 #include "fivebar/dynamics.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/report.hpp"
 
 namespace fivebar {
@@ -158,7 +159,7 @@ DynamicsAccuracy dynamics_accuracy(const Design& design, const AccuracyOptions& 
     // from t = 0: a quiet start (zero duty, nothing excites the winding) lets an explicit method
     // stride beyond its stability bound, and a run cut by the step bound would count only that.
     SimulationInput in = with_inductance_scale(base, scale);
-    for (SimulatedMechanism& m : in.mechanisms) m.theta0[0] += std::numbers::pi / 180.0;
+    for (SimulatedMechanism& m : in.mechanisms) m.theta0[0] += format::kRadPerDeg;
     StiffnessPoint sp;
     sp.stiffness_ratio = stiffness_ratio(in);
     sp.l_over_r_s = in.mechanisms.front().model.motors.front().inductance() /

@@ -39,9 +39,9 @@ Product tolerance_product() {
   p.title = "Manufacturing tolerance and sensing error";
   p.unavailable = [](const Design& d) -> std::optional<std::string> {
     if (!d.get<ToleranceSettings>()) return "the design has no `tolerance:` section (the printer's and sensors' errors)";
-    // The one resource rule (fivebar/resources/budget.hpp): beyond the bounds only `fivebar tolerance --yes` runs it.
+    // The one resource rule (fivebar/resources/budget.hpp): beyond the bounds only the study run by itself, confirmed, runs it.
     if (const ResourceEstimate e = tolerance_estimate(d, {}); !within_bounds(e)) {
-      return e.what + " is large: " + e.text() + "; run it alone with `fivebar tolerance --yes`, or lower tolerance.samples";
+      return e.what + " is large: " + e.text() + "; lower tolerance.samples, or run the tolerance study by itself and confirm it (docs/reliability.md)";
     }
     return without_mechanisms(d);
   };

@@ -1,5 +1,6 @@
 // Manufacturing tolerance of a five-bar: closed-form first-order sensitivity and a Monte Carlo
 // reference (derivation in fivebar/tolerance.hpp).
+#include "fivebar/format.hpp"
 #include "fivebar/tolerance.hpp"
 
 #include <Eigen/Dense>
@@ -181,7 +182,7 @@ Sensitivity tolerance_sensitivity(const Mechanism& m, const Vec2& P) {
 
 ParameterSigmas parameter_sigmas(const ToleranceSettings& t) {
   const double link = std::sqrt(t.link_sigma_mm * t.link_sigma_mm + 2.0 * t.pin_sigma_mm * t.pin_sigma_mm);
-  const double angle = t.angle_sigma_deg * std::numbers::pi / 180.0;
+  const double angle = t.angle_sigma_deg * format::kRadPerDeg;
   const double base = t.base_sigma_mm;
   return {link, link, link, link, base, base, base, base, angle, angle};
 }

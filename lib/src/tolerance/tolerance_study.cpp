@@ -23,7 +23,7 @@
 namespace fivebar {
 namespace {
 
-constexpr double kDeg = std::numbers::pi / 180.0;
+constexpr double kDeg = format::kRadPerDeg;
 /// Grid points per axis of the target ellipse's bounding box (those inside are the target's).
 constexpr int kTargetGrid = 21;
 /// Cap of the map's grid per axis.
