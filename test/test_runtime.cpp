@@ -1044,6 +1044,29 @@ TEST(RuntimeConfig, SimulateRunsTheExportedConfiguration) {
   }
 }
 
+TEST(RuntimeConfig, TheStepInputRunsTheExportedConfigurationWithoutTheSlewLimit) {
+  // docs/runtime.md "One cycle" 5: a step measures the loop, not the limiter; everything else is
+  // the export's.
+  SimulationRequest request;
+  request.station = "index";
+  request.step = true;
+  const std::vector<SimulationInput> inputs =
+      simulation_inputs(paper(), request, station_inertia(paper(), paper().require_station("index"), nullptr, {}));
+  ASSERT_EQ(inputs.size(), 1u);
+  ASSERT_TRUE(inputs[0].runtime);
+  rt::Config c = rt::parse_config_json(export_text({"index"}), "index.json");
+  std::size_t joints = 0;
+  for (auto& s : c.stations)
+    for (auto& m : s.mechanisms)
+      for (auto& j : m.joints) {
+        EXPECT_TRUE(j.has_velocity_limits) << j.name;
+        j.has_velocity_limits = false;
+        ++joints;
+      }
+  EXPECT_EQ(joints, 4u);
+  EXPECT_EQ(render_json(configuration_document(*inputs[0].runtime)), render_json(configuration_document(c)));
+}
+
 TEST(Runtime, TheExportedHeaderConfiguresTheSameController) {
   const rt::Config json = paper_config();
   const rt::Config header = fivebar_test::runtime_config_from_header();
