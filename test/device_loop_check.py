@@ -2,17 +2,23 @@
 """examples/device_loop.cpp against the simulator: the software-in-the-loop log of a pattern
 (`fivebar replay --sil`) fed to the example through its CSV stand-in for the DAQ gives, row by row,
 the duties the simulator's runtime computed (printed with 17 digits: read back bit for bit), and
-every status is ok; the watchdog zeroes the duties when references stop coming; whatever ends the loop (the end of the input, an input error, SIGTERM), its last
-output is zero duty to every motor.
+every status is ok; the watchdog zeroes the duties when references stop coming; the E-stop (input
+column or SIGUSR1) latches zero duties until an explicit reset (input column or SIGUSR2); --realtime
+paces the loop by absolute deadlines and counts overruns; whatever ends the loop (the end of the
+input, an input error, SIGTERM), its last output is zero duty to every motor; a channel map routes
+ADC and PWM channels to the joints with directions and offsets.
 
     device_loop_check.py FIVEBAR DEVICE_LOOP SOURCE_DIR WORK_DIR
 """
 import csv
+import os
 import pathlib
+import re
 import shutil
 import signal
 import subprocess
 import sys
+import time
 
 FIVEBAR, LOOP, SOURCE, WORK = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3]), pathlib.Path(sys.argv[4])
 DESIGN = str(SOURCE / "designs" / "iros2022.yaml")
@@ -129,6 +135,164 @@ p.send_signal(signal.SIGTERM)
 rest, _ = p.communicate(timeout=60)
 if p.returncode != 128 + signal.SIGTERM or not stopped("".join(seen) + rest, "SIGTERM"):
     failures.append(f"SIGTERM: exit {p.returncode}, output ends {rest.splitlines()[-2:]!r}")
+# E-stop from the input: rows 11..13 have estop 1 (row 12 also asks for a reset: refused while the
+# input is active), rows 14..20 estop 0 without a reset (still latched), row 21 estop_reset 1: rows
+# 11..20 give zero duty with every status `estop`, rows 1..10 are the plain run's, from row 21 the
+# loop runs again (a reset controller: the slew starts from the measured joints).
+def with_estop(estop, reset):
+    lines = [text[0].rstrip("\n") + ",estop,estop_reset\n"]
+    for k, line in enumerate(text[1:], start=1):
+        lines.append(line.rstrip("\n") + f",{int(k in estop)},{int(k in reset)}\n")
+    return "".join(lines)
+
+
+estop_csv = WORK / "estop.csv"
+estop_csv.write_text(with_estop(range(11, 14), {12, 21}))
+r = subprocess.run([LOOP, str(config), str(estop_csv)], capture_output=True, text=True)
+got = rows(r.stdout)[:-1] if r.returncode == 0 else []
+plain = rows(out)[:-1]
+if len(got) != len(text) - 1:
+    failures.append(f"estop: exit {r.returncode}, {len(got)} rows, {r.stderr.strip()!r}")
+else:
+    for k, row in enumerate(got, start=1):
+        is_estop = all(row[c] == "estop" for c in status_cols)
+        zero = all(float(row[c]) == 0.0 for c in duty_cols)
+        if (11 <= k <= 20) != is_estop or (is_estop and not zero):
+            failures.append(f"estop row {k}: statuses {[row[c] for c in status_cols]}, zero duties {zero}")
+        if k <= 10 and row != plain[k - 1]:
+            failures.append(f"estop row {k}: not the plain run's before the E-stop")
+    if not any(float(row[c]) != 0.0 for row in got[20:] for c in duty_cols):
+        failures.append("estop: the loop does not drive the motors again after the reset")
+    notes = [line for line in r.stdout.splitlines() if line.startswith("# estop")]
+    if notes != ["# estop: latched (input)", "# estop: released (input)"]:
+        failures.append(f"estop notes: {notes}")
+bad_estop = WORK / "bad_estop.csv"
+bad_estop.write_text(with_estop(range(0), set()).replace(",0,0\n", ",2,0\n", 1))
+r = subprocess.run([LOOP, str(config), str(bad_estop)], capture_output=True, text=True)
+if r.returncode != 2 or "input:2: estop: expected 0 or 1" not in r.stderr or not stopped(r.stdout, "error"):
+    failures.append(f"estop cell 2: exit {r.returncode}, {r.stderr.strip()!r}")
+# E-stop by SIGUSR1 while the loop waits on a pipe, released by SIGUSR2 (a log without E-stop columns).
+p = subprocess.Popen([LOOP, str(config), "-"], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+p.stdin.write("".join(text[:4]))
+p.stdin.flush()
+seen = [p.stdout.readline() for _ in range(4)]
+
+
+def send(sig, row_lines, expect):
+    p.send_signal(sig)
+    time.sleep(0.3)
+    p.stdin.write("".join(row_lines))
+    p.stdin.flush()
+    return [p.stdout.readline().rstrip("\n") for _ in range(expect)]
+
+
+latched = send(signal.SIGUSR1, text[4:7], 4)
+released = send(signal.SIGUSR2, text[7:10], 4)
+p.stdin.close()
+rest = p.stdout.read()
+p.wait(timeout=60)
+head = seen[0].rstrip("\n")
+parsed = list(csv.DictReader([head] + latched[1:] + released[1:]))
+if (latched[0] != "# estop: latched (SIGUSR1)" or released[0] != "# estop: released (SIGUSR2)" or len(parsed) != 6 or
+        p.returncode != 0 or not stopped(rest, "end of input")):
+    failures.append(f"SIGUSR1/SIGUSR2: exit {p.returncode}, {latched + released!r}")
+else:
+    for k, row in enumerate(parsed):
+        is_estop = all(row[c] == "estop" for c in status_cols)
+        zero = all(float(row[c]) == 0.0 for c in duty_cols)
+        if is_estop != (k < 3) or (is_estop and not zero):
+            failures.append(f"SIGUSR1 row {k + 4}: statuses {[row[c] for c in status_cols]}")
+# --realtime: absolute deadlines at loop_rate_hz (100 Hz: 50 cycles take at least 0.5 s), SCHED_FIFO
+# and mlockall where permitted (stderr says which), an `overrun` column whose sum is the count printed
+# at the end, and the same duties as without pacing.
+fifty = WORK / "fifty.csv"
+fifty.write_text("".join(text[:51]))
+start = time.monotonic()
+r = subprocess.run([LOOP, str(config), str(fifty), "--realtime"], capture_output=True, text=True)
+elapsed = time.monotonic() - start
+got = rows(r.stdout)[:-1] if r.returncode == 0 else []
+m = re.search(r"(\d+) overruns in 50 cycles", r.stderr)
+if (len(got) != 50 or not m or "SCHED_FIFO" not in r.stderr or "mlockall" not in r.stderr and "memory locked" not in r.stderr):
+    failures.append(f"--realtime: exit {r.returncode}, {len(got)} rows, {r.stderr.strip()!r}")
+else:
+    if elapsed < 0.5:
+        failures.append(f"--realtime: 50 cycles at 100 Hz took {elapsed:.3f} s")
+    if sum(int(row["overrun"]) for row in got) != int(m.group(1)):
+        failures.append(f"--realtime: overrun column sums to {sum(int(row['overrun']) for row in got)}, stderr {m.group(0)}")
+    for k, row in enumerate(got):
+        if any(row[c] != plain[k][c] for c in duty_cols + status_cols):
+            failures.append(f"--realtime row {k + 1}: other duties than without pacing")
+    print(f"--realtime: 50 cycles in {elapsed:.3f} s; {r.stderr.strip()}")
+# Unprivileged (as CI on a developer's machine runs it): where this runs as root and setpriv exists,
+# the same 50 cycles as `nobody` without capabilities: SCHED_FIFO is refused, said on stderr, and the
+# loop goes on at normal priority with the same duties.
+if os.geteuid() == 0 and shutil.which("setpriv"):
+    shared = WORK / "nobody.json"
+    shutil.copyfile(config, shared)
+    shared.chmod(0o644)
+    r = subprocess.run(["setpriv", "--reuid", "65534", "--regid", "65534", "--clear-groups", "--inh-caps=-all",
+                        "--bounding-set=-all", LOOP, str(shared), "-", "--realtime"],
+                       input="".join(text[:51]), capture_output=True, text=True)
+    got = rows(r.stdout)[:-1] if r.returncode == 0 else []
+    if "setpriv:" in r.stderr:
+        print(f"unprivileged run skipped: {r.stderr.strip()}")
+    elif (len(got) != 50 or "SCHED_FIFO not permitted" not in r.stderr or
+          any(row[c] != plain[k][c] for k, row in enumerate(got) for c in duty_cols)):
+        failures.append(f"--realtime unprivileged: exit {r.returncode}, {len(got)} rows, {r.stderr.strip()!r}")
+    else:
+        print(f"--realtime unprivileged: {r.stderr.strip()}")
+# Overruns: rows that come 50 ms apart through a pipe (the period is 10 ms) each miss their deadline.
+p = subprocess.Popen([LOOP, str(config), "-", "--realtime"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                     stderr=subprocess.PIPE, text=True)
+p.stdin.write(text[0])
+for line in text[1:7]:
+    p.stdin.write(line)
+    p.stdin.flush()
+    time.sleep(0.05)
+got_out, got_err = p.communicate(timeout=60)
+got = rows(got_out)[:-1]
+m = re.search(r"(\d+) overruns in 6 cycles", got_err)
+if len(got) != 6 or not m or any(row["overrun"] != "1" for row in got[1:]) or int(m.group(1)) < 5:
+    failures.append(f"--realtime overruns: {[row.get('overrun') for row in got]}, {got_err.strip()!r}")
+if subprocess.run([LOOP, str(config), str(log), "--rt-priority", "0"], capture_output=True).returncode != 2:
+    failures.append("--rt-priority 0 is not refused")
+# The channel map: the joints wired to ADC channels 7..4 and PWM channels 0..3 in another order,
+# the second motor reversed and offsets in codes; a raw-channel log whose adc<k>_counts are the
+# joints' codes minus the offsets gives, per PWM channel, its joint's plain duty times its direction.
+joints = [c[:-len("_counts")] for c in header if c.endswith("_counts")]
+if len(joints) == 4:
+    wiring = {j: (7 - i, (i + 2) % 4, -1 if i == 1 else 1, [0, 12, -5, 3][i]) for i, j in enumerate(joints)}
+    (WORK / "map.csv").write_text("joint,adc_channel,pwm_channel,direction,offset_counts\n" +
+                                  "".join(f"{j},{a},{p_},{d},{o}\n" for j, (a, p_, d, o) in wiring.items()))
+    raw_lines = []
+    for line in text:
+        cells = line.rstrip("\n").split(",")
+        for i, c in enumerate(header):
+            if c.endswith("_counts"):
+                j = c[:-len("_counts")]
+                cells[i] = f"adc{wiring[j][0]}_counts" if line is text[0] else str(int(cells[i]) - wiring[j][3])
+        raw_lines.append(",".join(cells) + "\n")
+    (WORK / "raw.csv").write_text("".join(raw_lines))
+    r = subprocess.run([LOOP, str(config), str(WORK / "raw.csv"), "--channels", str(WORK / "map.csv")],
+                       capture_output=True, text=True)
+    got = rows(r.stdout)[:-1] if r.returncode == 0 else []
+    if len(got) != len(plain):
+        failures.append(f"channel map: exit {r.returncode}, {len(got)} rows, {r.stderr.strip()!r}")
+    else:
+        for k, (a, b) in enumerate(zip(plain, got), start=1):
+            for j, (_, pwm, d, _) in wiring.items():
+                if float(b[f"pwm{pwm}_duty"]) != d * float(a[f"{j}_duty"]):
+                    failures.append(f"channel map row {k}: pwm{pwm}_duty {b[f'pwm{pwm}_duty']}, {j} {a[f'{j}_duty']} x {d}")
+    for bad, why in [("a,0,0,1,0\n", "badmap.csv: joint "), ("{0},7,0,1,0\n{1},7,1,1,0\n", "badmap.csv:3: adc_channel: channel 7"),
+                     ("{0},7,0,2,0\n", "badmap.csv:2: direction: expected 1 or -1")]:
+        (WORK / "badmap.csv").write_text("joint,adc_channel,pwm_channel,direction,offset_counts\n" +
+                                         bad.format(*joints))
+        r = subprocess.run([LOOP, str(config), str(WORK / "raw.csv"), "--channels", str(WORK / "badmap.csv")],
+                           capture_output=True, text=True)
+        if r.returncode != 2 or why not in r.stderr:
+            failures.append(f"bad channel map {bad!r}: exit {r.returncode}, {r.stderr.strip()!r}")
+else:
+    failures.append(f"the SIL log's joints: {joints}")
 if nonzero < len(logged):
     failures.append(f"only {nonzero} non-zero duties: the pattern does not drive the motors")
 for f in failures[:20]:

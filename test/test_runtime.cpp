@@ -475,7 +475,9 @@ TEST(Runtime, ThePidFollowsTheHandComputedSequenceThroughTheWholeCycle) {
   rt::Config c = paper_config();
   c.stations.resize(1);
   c.stations[0].mechanisms.resize(1);
-  for (auto& j : c.stations[0].mechanisms[0].joints) j.gains = {0.1, 10.0, 0.02, 0.05};
+  // No slew limit here: the readings jump by e each cycle, and the PID is what is checked (the
+  // slew limit has its own test below).
+  for (auto& j : c.stations[0].mechanisms[0].joints) j.gains = {0.1, 10.0, 0.02, 0.05}, j.has_velocity_limits = false;
   rt::Controller ctl(c);
   const Vec2 p = paper().require_station("index").target.center;
   const double target[2] = {p.x() / 1000, p.y() / 1000};
@@ -561,6 +563,89 @@ TEST(Runtime, BadMeasurementsGiveASensorFaultAndZeroDutyNeverACrash) {
   EXPECT_EQ(ctl.mechanism(0).status, rt::Status::unreachable);
   EXPECT_TRUE(ctl.mechanism(0).command);
   EXPECT_NEAR(ctl.mechanism(0).point_command[0], targets[0], 1e-12);
+}
+
+TEST(Runtime, TheSlewLimitReachesAStepTargetAfterCeilStepOverVTCyclesNeverFaster) {
+  // One mechanism, a proportional gain of 1 (duty = followed target - measured angle) and two
+  // different speed limits; the joints are held at the IK of A (radians readings), the reference
+  // steps from A to B. Closed form: joint j's target moves v_j T per cycle and reaches the command
+  // at cycle n_j = ceil(|theta_B - theta_A| / (v_j T)), never before.
+  rt::Config c = paper_config();
+  c.stations.resize(1);
+  c.stations[0].mechanisms.resize(1);
+  const double v[2] = {2.0, 3.7};  // rad/s
+  for (std::size_t j = 0; j < 2; ++j) {
+    rt::JointConfig& jc = c.stations[0].mechanisms[0].joints[j];
+    jc.gains = {1.0, 0.0, 0.0, 0.0};
+    jc.max_velocity = v[j];
+    ASSERT_TRUE(jc.has_velocity_limits);
+  }
+  const double T = 1.0 / c.loop_rate_hz;
+  const Vec2 a = paper().require_station("index").target.center - Vec2(0.0, 3.0);
+  const Vec2 b = a + Vec2(3.0, 2.0);
+  const Scene at_a = at_points(c, {a}), at_b = at_points(c, {b});
+  rt::Controller ctl(c);
+  ctl.cycle(at_a.readings.data(), rt::Reading::radians, at_a.targets.data());
+  ASSERT_EQ(ctl.mechanism(0).status, rt::Status::ok);
+  const std::array<double, 2> theta_a = ctl.mechanism(0).theta_command;
+  EXPECT_FALSE(ctl.mechanism(0).slew_limited);
+  int n[2] = {0, 0};
+  std::array<double, 2> theta_b{};
+  for (int k = 1; k <= 200; ++k) {
+    ctl.cycle(at_a.readings.data(), rt::Reading::radians, at_b.targets.data());
+    const rt::MechanismState& st = ctl.mechanism(0);
+    ASSERT_EQ(st.status, rt::Status::ok);
+    if (k == 1) {
+      theta_b = st.theta_command;
+      for (std::size_t j = 0; j < 2; ++j) {
+        const double ratio = std::fabs(theta_b[j] - theta_a[j]) / (v[j] * T);
+        ASSERT_GT(ratio, 3.0) << "the step spans several cycles";
+        ASSERT_GT(ratio - std::floor(ratio), 0.01) << "not at a cycle boundary: rounding cannot decide";
+        n[j] = static_cast<int>(std::ceil(ratio));
+      }
+    }
+    for (std::size_t j = 0; j < 2; ++j) {
+      const double delta = theta_b[j] - theta_a[j];
+      const double expected = k < n[j] ? theta_a[j] + std::copysign(k * v[j] * T, delta) : theta_b[j];
+      EXPECT_NEAR(st.theta_follow[j], expected, 1e-12) << "joint " << j << " cycle " << k;
+      if (k < n[j]) EXPECT_NE(st.theta_follow[j], theta_b[j]) << "reached before cycle " << n[j];
+      if (k >= n[j]) EXPECT_EQ(st.theta_follow[j], theta_b[j]) << "cycle " << k;
+      // The duty is p (target - measured): the closed form through the PID, not the state field.
+      EXPECT_NEAR(ctl.duties()[j], std::clamp(expected - at_a.readings[j], -1.0, 1.0), 1e-9);
+    }
+    EXPECT_EQ(st.slew_limited, k < std::max(n[0], n[1]));
+    if (k > std::max(n[0], n[1]) + 2) break;
+  }
+  // reset() starts the slew again from the measured angles (the joints at A): v T after one cycle.
+  ctl.reset();
+  ctl.cycle(at_a.readings.data(), rt::Reading::radians, at_b.targets.data());
+  for (std::size_t j = 0; j < 2; ++j) {
+    EXPECT_NEAR(ctl.mechanism(0).theta_follow[j], theta_a[j] + std::copysign(v[j] * T, theta_b[j] - theta_a[j]), 1e-9);
+  }
+  // So does a sensor fault (zero duty): the cycle after it starts from the measured angles.
+  for (int k = 0; k < 50; ++k) ctl.cycle(at_a.readings.data(), rt::Reading::radians, at_b.targets.data());
+  ASSERT_FALSE(ctl.mechanism(0).slew_limited);
+  const double nan_readings[2] = {std::nan(""), at_a.readings[1]};
+  ctl.cycle(nan_readings, rt::Reading::radians, at_b.targets.data());
+  ASSERT_EQ(ctl.mechanism(0).status, rt::Status::sensor_fault);
+  ctl.cycle(at_a.readings.data(), rt::Reading::radians, at_b.targets.data());
+  EXPECT_TRUE(ctl.mechanism(0).slew_limited);
+  EXPECT_NEAR(ctl.mechanism(0).theta_follow[0], theta_a[0] + std::copysign(v[0] * T, theta_b[0] - theta_a[0]), 1e-9);
+  // Without velocity limits the target is the command at once.
+  for (auto& jc : c.stations[0].mechanisms[0].joints) jc.has_velocity_limits = false;
+  rt::Controller free_ctl(c);
+  free_ctl.cycle(at_a.readings.data(), rt::Reading::radians, at_b.targets.data());
+  EXPECT_EQ(free_ctl.mechanism(0).theta_follow, free_ctl.mechanism(0).theta_command);
+  EXPECT_FALSE(free_ctl.mechanism(0).slew_limited);
+  // A speed limit of 0 (or not finite) is refused at load, naming the key.
+  c.stations[0].mechanisms[0].joints[1].has_velocity_limits = true;
+  c.stations[0].mechanisms[0].joints[1].max_velocity = 0.0;
+  try {
+    rt::Controller bad(c);
+    ADD_FAILURE() << "max_velocity 0 accepted";
+  } catch (const rt::ConfigError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("joint_limits.index_lower_theta2.max_velocity"));
+  }
 }
 
 TEST(Runtime, ATargetBeyondTheJointLimitsLessTheMarginIsHeld) {
@@ -957,6 +1042,29 @@ TEST(RuntimeConfig, SimulateRunsTheExportedConfiguration) {
       EXPECT_EQ(render_json(configuration_document(*in.runtime)), exported) << station << " " << in.reference_name;
     }
   }
+}
+
+TEST(RuntimeConfig, TheStepInputRunsTheExportedConfigurationWithoutTheSlewLimit) {
+  // docs/runtime.md "One cycle" 5: a step measures the loop, not the limiter; everything else is
+  // the export's.
+  SimulationRequest request;
+  request.station = "index";
+  request.step = true;
+  const std::vector<SimulationInput> inputs =
+      simulation_inputs(paper(), request, station_inertia(paper(), paper().require_station("index"), nullptr, {}));
+  ASSERT_EQ(inputs.size(), 1u);
+  ASSERT_TRUE(inputs[0].runtime);
+  rt::Config c = rt::parse_config_json(export_text({"index"}), "index.json");
+  std::size_t joints = 0;
+  for (auto& s : c.stations)
+    for (auto& m : s.mechanisms)
+      for (auto& j : m.joints) {
+        EXPECT_TRUE(j.has_velocity_limits) << j.name;
+        j.has_velocity_limits = false;
+        ++joints;
+      }
+  EXPECT_EQ(joints, 4u);
+  EXPECT_EQ(render_json(configuration_document(*inputs[0].runtime)), render_json(configuration_document(c)));
 }
 
 TEST(Runtime, TheExportedHeaderConfiguresTheSameController) {

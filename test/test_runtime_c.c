@@ -1,6 +1,6 @@
 /* The runtime's C API (fivebar/runtime/c_api.h) from a C99 program: the exported JSON of the paper's
  * device (argv[1]), the joint names, sensor faults at the rails, the PID's sign and symmetry about
- * the commanded angles, the collision figures, the version, a refused configuration naming its key,
+ * the commanded angles, the collision figures, the slew limit's targets, the version, a refused configuration naming its key,
  * and NULL handles. With a second argument, a fixed pattern's duties written exactly (for the
  * comparison of builds). */
 #include <math.h>
@@ -102,6 +102,28 @@ int main(int argc, char** argv) {
     CHECK(moved[0] > 0.0 && fabs(moved[0] - sqrt(dx * dx + dy * dy)) < 1e-12);
     CHECK(fivebar_runtime_moved(rt, NULL) == -1);
     targets[1] = 12.5e-3;
+  }
+  /* The slew limit: joints 0.5 rad short of their commands (more than the showcase's exported
+   * 5.996 rad/s x 10 ms per cycle) follow targets that start at the readings and move exactly
+   * max_velocity / loop_rate_hz toward the commands per cycle; a 0.01 rad gap is closed at once. */
+  {
+    double follow[8];
+    const double step = 5.9959862654712 / 100.0; /* joint_limits.*.max_velocity of the export / loop_rate_hz */
+    for (i = 0; i < n; ++i) readings[i] = commands[i] - 0.5;
+    fivebar_runtime_reset(rt);
+    fivebar_runtime_cycle(rt, readings, FIVEBAR_READING_RADIANS, targets, duties, statuses);
+    CHECK(fivebar_runtime_joint_targets(rt, follow) == (int)n);
+    for (i = 0; i < n; ++i) CHECK(fabs(follow[i] - (readings[i] + step)) < 1e-12);
+    fivebar_runtime_cycle(rt, readings, FIVEBAR_READING_RADIANS, targets, duties, statuses);
+    fivebar_runtime_joint_targets(rt, follow);
+    for (i = 0; i < n; ++i) CHECK(fabs(follow[i] - (readings[i] + 2.0 * step)) < 1e-12);
+    for (i = 0; i < n; ++i) readings[i] = commands[i] - 0.01;
+    fivebar_runtime_reset(rt);
+    fivebar_runtime_cycle(rt, readings, FIVEBAR_READING_RADIANS, targets, duties, statuses);
+    CHECK(fivebar_runtime_joint_targets(rt, follow) == 0);
+    for (i = 0; i < n; ++i) CHECK(follow[i] == commands[i]);
+    CHECK(fivebar_runtime_joint_targets(rt, NULL) == -1);
+    CHECK(fivebar_runtime_joint_targets(NULL, follow) == -1);
   }
   /* The version: the header's. */
   {

@@ -110,6 +110,19 @@ int fivebar_runtime_joint_commands(const fivebar_runtime* r, double* theta) {
   return 0;
 }
 
+int fivebar_runtime_joint_targets(const fivebar_runtime* r, double* theta) {
+  if (r == nullptr || theta == nullptr) return -1;
+  int limited = 0;
+  for (std::size_t k = 0; k < r->controller.mechanism_count(); ++k) {
+    const fivebar::runtime::MechanismState& st = r->controller.mechanism(k);
+    for (std::size_t j = 0; j < 2; ++j) {
+      theta[2 * k + j] = st.theta_follow[j];
+      limited += st.command && st.theta_follow[j] != st.theta_command[j];
+    }
+  }
+  return limited;
+}
+
 int fivebar_runtime_moved(const fivebar_runtime* r, double* moved) {
   if (r == nullptr || moved == nullptr) return -1;
   for (std::size_t k = 0; k < r->controller.mechanism_count(); ++k) moved[k] = r->controller.mechanism(k).moved;

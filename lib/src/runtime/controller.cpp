@@ -101,6 +101,10 @@ struct MechPlan {
   Pose measured;
   std::size_t measured_outline = 0;
   bool fresh = false;  ///< this cycle's reference gave the command
+  /// The joint targets the PIDs follow (the slew limit): the held command approached at most
+  /// max_velocity * period per cycle; from the measured angles after construction, reset() or zero duty.
+  std::array<double, 2> follow{};
+  bool follow_valid = false;
 };
 
 struct StationPlan {
@@ -404,8 +408,20 @@ bool closest_free(Plan& plan, const MechPlan& low, const Part* upper, V2 origin,
 
 void zero(MechPlan& mp, MechanismState& st, double* duty) {
   mp.pid = {PidState{}, PidState{}};
+  mp.follow_valid = false;  // the motors were unpowered: the slew starts again where the joints are
   duty[0] = duty[1] = 0.0;
   st.duty = {0.0, 0.0};
+}
+
+/// The slew limit (docs/runtime.md "One cycle" 5): joint j's target `follow` moves toward the
+/// held command by at most max_velocity * T per cycle where the joint has velocity limits (else it
+/// is the command), the difference taken within half a turn; it reaches the command exactly.
+double slew(const JointConfig& jc, double command, double& follow, double T) {
+  double step = command - follow;
+  if (std::fabs(step) > kPi) step -= kTwoPi * std::round(step / kTwoPi);
+  const double max_step = jc.max_velocity * T;
+  follow = !jc.has_velocity_limits || std::fabs(step) <= max_step ? command : follow + std::copysign(max_step, step);
+  return follow;
 }
 
 }  // namespace
@@ -496,6 +512,7 @@ void Controller::reset() noexcept {
     mp.pid = {PidState{}, PidState{}};
     mp.held.valid = false;
     mp.candidate.valid = false;
+    mp.follow_valid = false;
   }
   for (MechanismState& s : plan_->state) s = MechanismState{};
   for (double& d : plan_->duties) d = 0.0;
@@ -611,8 +628,15 @@ void Controller::cycle(const double* readings, Reading kind, const double* targe
       zero(mp, st, duty);
       continue;
     }
+    if (!mp.follow_valid) {  // after construction, reset() or zero duty: from where the joints are
+      mp.follow = st.theta_measured;
+      mp.follow_valid = true;
+    }
     for (std::size_t j = 0; j < 2; ++j) {
-      double e = mp.held.theta[j] - st.theta_measured[j];
+      const double target = slew(mp.config->joints[j], mp.held.theta[j], mp.follow[j], p.period);
+      st.theta_follow[j] = target;
+      st.slew_limited = st.slew_limited || target != mp.held.theta[j];
+      double e = target - st.theta_measured[j];
       if (std::fabs(e) > kPi) e -= kTwoPi * std::round(e / kTwoPi);
       duty[j] = pid_update(mp.config->joints[j].gains, p.period, mp.pid[j], e);
       st.duty[j] = duty[j];

@@ -22,6 +22,7 @@ constexpr const char* kGainRule = "must be in [0, 1000000] (no motor loop uses m
 constexpr double kMaxLoopRateHz = 1e5;
 constexpr double kMaxVolts = 1000.0;
 constexpr double kMinRadPerVolt = 1e-6, kMaxRadPerVolt = 1e6;
+constexpr double kMaxVelocity = 1e6;  // rad/s: above any motor's; keeps max_velocity / loop_rate_hz finite
 
 bool gain_ok(double g) { return g >= 0.0 && g <= kMaxGain; }
 }  // namespace
@@ -85,6 +86,10 @@ void Config::validate() const {
         require(std::fabs(jc.volts_at_zero) <= kMaxVolts, pp + ".volts_at_zero", "must be within [-1000, 1000] V");
         require(std::fabs(jc.rad_per_volt) >= kMinRadPerVolt && std::fabs(jc.rad_per_volt) <= kMaxRadPerVolt,
                 pp + ".rad_per_volt", "|rad_per_volt| must be in [1e-6, 1e6] rad/V (never 0)");
+        if (jc.has_velocity_limits) {  // the slew limit's step per cycle (controller.cpp slew())
+          require(jc.max_velocity > 0.0 && jc.max_velocity <= kMaxVelocity, "joint_limits." + jc.name + ".max_velocity",
+                  "must be in (0, 1e6] rad/s (the slew limit: a joint target moves at most this fast)");
+        }
         if (jc.has_position_limits) {
           const std::string lp = "joint_limits." + jc.name;
           require(finite_all({jc.min_position, jc.max_position}) && jc.max_position > jc.min_position &&

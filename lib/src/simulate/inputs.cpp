@@ -179,6 +179,15 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
     for (const PatternSpec& s : specs)
       if (s.kind == PatternKind::stretch) separation = s.separation_mm;
     SimulationInput in = make("step");
+    // The loop's step response: the runtime's slew limit is off here (docs/runtime.md "One cycle"
+    // 5), since through it a 1 mm step becomes a ramp at the joint speed, which measures the
+    // limiter rather than the loop (the tuner holds the overshoot against a loop's damping; the
+    // report compares integrators on this input).
+    auto unlimited = std::make_shared<runtime::Config>(*runtime);
+    for (runtime::StationConfig& st : unlimited->stations)
+      for (runtime::MechanismConfig& m : st.mechanisms)
+        for (runtime::JointConfig& j : m.joints) j.has_velocity_limits = false;
+    in.runtime = std::move(unlimited);
     const Vec2 c = station.target.center;
     const std::array<Vec2, 2> start{c - Vec2(0.0, 0.5 * separation), c + Vec2(0.0, 0.5 * separation)};
     const auto n = static_cast<std::size_t>(std::floor(request.step_hold_s * rate + tol::kSamplePeriodsRel)) + 1;

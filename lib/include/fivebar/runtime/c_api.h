@@ -53,6 +53,11 @@ int fivebar_runtime_cycle(fivebar_runtime* runtime, const double* readings, int 
 int fivebar_runtime_points(const fivebar_runtime* runtime, double* measured_m, double* commanded_m);
 /* Commanded joint angles of the last cycle, joint_count values (rad, on each joint's branch). */
 int fivebar_runtime_joint_commands(const fivebar_runtime* runtime, double* theta_rad);
+/* The joint targets the PIDs followed in the last cycle (the slew limit: the commands approached at
+ * most max_velocity / loop_rate_hz per cycle; 0 for a mechanism with zero duty), joint_count values
+ * (rad). Returns the number of joints still short of their command (slew-limited), or -1 for a
+ * NULL handle or pointer. */
+int fivebar_runtime_joint_targets(const fivebar_runtime* runtime, double* theta_rad);
 /* The priority rule's distance moved per mechanism of the last cycle (m; 0 unless its status is
  * moved_by_priority), mechanism_count values. Returns 0, or -1 for a NULL handle or pointer. */
 int fivebar_runtime_moved(const fivebar_runtime* runtime, double* moved_m);

@@ -14,11 +14,14 @@
 ///      than min_clearance to the upper's, the lower target moves to the closest collision-free
 ///      point: closed-form exits of rays from the forbidden capsules of its tactor point, checked
 ///      by at most kPriorityMaxProbes pose evaluations (a march and a bisection where links block);
-///   5. per joint the PID with the integral clamp and a backward-difference derivative:
+///   5. the slew limit: per joint the target theta_f the PID follows moves toward the command by at
+///      most max_velocity T per cycle (joints with has_velocity_limits; from the measured angle after
+///      init, a reset or zero duty), then the PID with the integral clamp and a backward-difference
+///      derivative:
 ///        s_k = clamp(s_{k-1} + e_k T, -i_clamp / i, i_clamp / i)   (no clamp when i <= 0),
 ///        d_k = (e_k - e_{k-1}) / T (0 at the first sample after init, a reset or a fault),
 ///        duty_k = clamp(p e_k + i s_k + d d_k, -1, 1),  T = 1 / loop_rate_hz,
-///      e_k = theta_command - theta_measured taken within half a turn.
+///      e_k = theta_f - theta_measured taken within half a turn.
 /// Every number it returns is finite. No allocation and no exception after construction; the work
 /// of a cycle is bounded (docs/runtime.md "Real-time"); the same inputs give the same outputs.
 
@@ -72,6 +75,11 @@ struct MechanismState {
   bool command = false;                    ///< a commanded pose exists (else zero duty)
   std::array<double, 2> point_command{};   ///< m
   std::array<double, 2> theta_command{};   ///< rad, on the joint's branch
+  /// rad: the joint targets the PIDs followed this cycle (the slew limit: theta_command approached
+  /// at most max_velocity / loop_rate_hz per cycle from the measured angles after construction,
+  /// reset() or zero duty; within a turn of theta_command); 0 with zero duty.
+  std::array<double, 2> theta_follow{};
+  bool slew_limited = false;               ///< theta_follow is not yet theta_command
   double moved = 0.0;                      ///< |point_command - target| after the priority rule, m
   std::array<double, 2> duty{};            ///< in [-1, 1]
 };
