@@ -297,6 +297,8 @@ int run_identify(const IdentifyCliOptions& opt) {
   const id::IdentifyLog est = id::read_identify_log(std::filesystem::path(opt.log));
   std::optional<id::IdentifyLog> val;
   if (!opt.validation.empty()) val = id::read_identify_log(std::filesystem::path(opt.validation));
+  id::require_log_joints_in(design, est);
+  if (val) id::require_log_joints_in(design, *val);
   // The study's memory and time from the logs' size, before the work (docs/reliability.md).
   check_budget(identify_estimate(est.time.size() + (val ? val->time.size() : 0), est.joints.size()), opt.yes,
                "confirm with fivebar identify --yes");
