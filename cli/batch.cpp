@@ -5,9 +5,11 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <numbers>
 
 #include "common.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/ranges.hpp"
@@ -32,100 +34,30 @@ CsvReader::CsvReader(const std::string& path, std::vector<std::string> columns) 
     }
     in_ = file_.get();
   }
-  std::string header;
-  if (!next_line(header)) throw InputError(name_ + ": empty, expected a header line with " + format::join(columns_));
-  const auto names = split(header, ',');
-  width_ = names.size();
-  for (const auto& want : columns_) {
-    std::size_t found = names.size();
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      if (names[i] == want) found = i;
-    }
-    if (found == names.size()) {
-      throw InputError(where() + ": header has no column '" + want + "' (expected " + format::join(columns_) + ", got '" +
-                       std::string(trim(header)) + "')");
-    }
-    index_.push_back(found);
-  }
+  // The one bounded reader (fivebar/csv_reader.hpp) with the bench's bounds: 4096 bytes a line,
+  // 1 GiB and 20,000,000 rows in all (docs/reliability.md "Resource bounds"), a duplicated column
+  // refused, strict decimal numbers.
+  reader_ = std::make_unique<csv::Reader>(*in_, name_);
+  for (const auto& want : columns_) index_.push_back(reader_->require(want));
 }
 
 CsvReader::~CsvReader() = default;
 
-namespace {
-
-/// Longest CSV line read: far beyond any row of numbers, short enough that an endless stream
-/// without line breaks (/dev/zero, a binary file) is refused instead of exhausting memory.
-constexpr std::size_t kMaxCsvLineBytes = std::size_t{1} << 20;
-
-/// std::getline with a length limit: false at the end of the stream, `too_long` set when the
-/// line has more than kMaxCsvLineBytes bytes (the rest of the line is not read).
-bool getline_bounded(std::istream& in, std::string& line, bool& too_long) {
-  line.clear();
-  too_long = false;
-  std::streambuf* buf = in.rdbuf();
-  if (buf == nullptr || !in.good()) return false;
-  bool any = false;
-  while (true) {
-    const auto c = buf->sbumpc();
-    if (std::char_traits<char>::eq_int_type(c, std::char_traits<char>::eof())) {
-      in.setstate(std::ios::eofbit);
-      return any;
-    }
-    any = true;
-    if (std::char_traits<char>::to_char_type(c) == '\n') return true;
-    if (line.size() >= kMaxCsvLineBytes) {
-      too_long = true;
-      return true;
-    }
-    line.push_back(std::char_traits<char>::to_char_type(c));
-  }
-}
-
-}  // namespace
-
-bool CsvReader::next_line(std::string& line) {
-  bool too_long = false;
-  while (getline_bounded(*in_, line, too_long)) {
-    ++line_no_;
-    if (too_long) {
-      throw InputError(where() + ": line longer than " + std::to_string(kMaxCsvLineBytes) +
-                       " bytes: not a CSV file of numbers");
-    }
-    const auto t = trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    return true;
-  }
-  if (in_->bad()) throw InputError(name_ + ": read error after line " + std::to_string(line_no_));
-  return false;
-}
-
 bool CsvReader::next(std::vector<double>& values) {
-  std::string line;
-  if (!next_line(line)) return false;
-  const auto fields = split(line, ',');
-  if (fields.size() < width_) {
-    throw InputError(where() + ": " + std::to_string(fields.size()) + " fields, the header has " +
-                     std::to_string(width_));
-  }
+  if (!reader_->next()) return false;
   values.resize(columns_.size());
   for (std::size_t k = 0; k < columns_.size(); ++k) {
-    const auto v = parse_number(fields[index_[k]]);
-    if (!v) {
-      throw InputError(where() + ": " + columns_[k] + " = '" + std::string(fields[index_[k]]) +
-                       "' is not a finite number");
-    }
+    const double v = reader_->number(index_[k], std::numeric_limits<double>::max());
     // Lengths and coordinates (mm) obey the design files' range; angles only need to be finite.
     if (columns_[k].ends_with("_mm")) {
-      if (const auto rule = ranges::coordinate_rule(*v)) {
-        throw InputError(where() + ": " + columns_[k] + " = " + exact(*v) + " " + *rule);
-      }
+      if (const auto rule = ranges::coordinate_rule(v)) throw InputError(reader_->at(index_[k]) + *rule + " mm");
     }
-    values[k] = *v;
+    values[k] = v;
   }
   return true;
 }
 
-std::string CsvReader::where() const { return name_ + ":" + std::to_string(line_no_); }
+std::string CsvReader::where() const { return name_ + ":" + std::to_string(reader_->line()); }
 
 BatchSink::BatchSink(const std::string& output_path) {
   if (!output_path.empty()) file_.emplace(output_path);

@@ -17,13 +17,18 @@
 #include "fivebar/io.hpp"
 #include "fivebar/kinematics.hpp"
 
+namespace fivebar::csv {
+class Reader;
+}  // namespace fivebar::csv
+
 namespace fivebar::cli {
 
 // --- Batch CSV --------------------------------------------------------------------------------
 
 /// Reads a CSV with a header line, streaming: only the current row is held. Columns are found by
-/// name (extra columns are ignored, so a previous command's output can be fed back). Blank lines
-/// and lines starting with '#' are skipped; '-' reads stdin. Errors are InputError "FILE:LINE: ...".
+/// name (extra columns are ignored, so a previous command's output can be fed back). Read by the
+/// one bounded reader, fivebar/csv_reader.hpp (its syntax, bounds and messages); '-' reads stdin.
+/// Errors are InputError "FILE:LINE: column 'NAME' = 'CELL': ...".
 class CsvReader {
  public:
   CsvReader(const std::string& path, std::vector<std::string> columns);
@@ -34,14 +39,12 @@ class CsvReader {
   std::string where() const;
 
  private:
-  bool next_line(std::string& line);
   std::string name_;
   std::unique_ptr<std::istream> file_;
   std::istream* in_ = nullptr;
-  std::size_t line_no_ = 0;
+  std::unique_ptr<csv::Reader> reader_;
   std::vector<std::string> columns_;
   std::vector<std::size_t> index_;
-  std::size_t width_ = 0;
 };
 
 /// Where batch rows go: stdout, or an atomically written file (--output).

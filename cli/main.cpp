@@ -19,6 +19,7 @@
 #include "help.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
+#include "fivebar/sections/bench.hpp"
 #include "fivebar/version.hpp"
 
 namespace {
@@ -94,6 +95,21 @@ void guard_numeric_flags(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) guard_numeric_flags(*sub);
 }
 
+/// docs/bench-files.md "Where bench files may be": the files a design's `bench:` section names
+/// stay in the design file's folder unless the command says otherwise. One flag, the same on every
+/// command (each loads designs, and `run` reads their bench files).
+void add_outside_paths_flag(CLI::App& app) {
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    if (sub->get_subcommands([](CLI::App*) { return true; }).empty()) {
+      sub->add_flag_callback("--allow-outside-paths", [] { fivebar::allow_bench_paths_outside(true); },
+                             "Read the files a design's bench: section names even outside the design file's folder "
+                             "(absolute, '..', or a link leading out; refused without this flag)");
+    } else {
+      add_outside_paths_flag(*sub);
+    }
+  }
+}
+
 }  // namespace
 
 namespace fivebar::cli {
@@ -141,6 +157,8 @@ int run(int argc, char** argv) {
 #undef FIVEBAR_COMMAND
   // After every subcommand: their numeric flags refuse NaN, infinities and overflow.
   guard_numeric_flags(app);
+  add_outside_paths_flag(app);
+  fivebar::allow_bench_paths_outside(false);  // per run: the fuzzer calls this in-process
 
   try {
     std::vector<std::string> args = join_dash_values(argc, argv);

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "common.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/scene.hpp"
@@ -237,8 +238,13 @@ void serve_output(Server& s, const httplib::Request& req, httplib::Response& res
     res.status = 404;
     return;
   }
-  std::ifstream in(want, std::ios::binary);
-  std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string body;
+  try {
+    body = csv::read_bounded(want, std::uintmax_t{256} << 20, "output file");  // bounded as every read
+  } catch (const InputError&) {
+    res.status = 404;
+    return;
+  }
   const std::string ext = want.extension().string();
   const char* type = ext == ".html" ? "text/html" : ext == ".svg" ? "image/svg+xml" : ext == ".png" ? "image/png"
                      : ext == ".json" ? "application/json" : "text/plain";

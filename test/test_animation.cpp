@@ -239,14 +239,14 @@ TEST(AnimationInput, BadTimeSeriesNameFileAndLine) {
     (void)read_simulated_tracks(no_column, "a.csv");
     ADD_FAILURE() << "no throw";
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("a.csv:1: no column y_mm"));
+    EXPECT_THAT(e.what(), HasSubstr("a.csv:1: column 'y_mm' is missing"));
   }
   std::istringstream bad_number("t_s,mechanism,x_mm,y_mm\n0,lower,1,2\n0.01,lower,abc,2\n");
   try {
     (void)read_simulated_tracks(bad_number, "b.csv");
     ADD_FAILURE() << "no throw";
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("b.csv:3: x_mm = 'abc' is not a finite number"));
+    EXPECT_THAT(e.what(), HasSubstr("b.csv:3: column 'x_mm' = 'abc': not a finite decimal number"));
   }
   std::istringstream backwards("t_s,mechanism,x_mm,y_mm\n0.5,lower,1,2\n0.1,lower,1,2\n");
   EXPECT_THROW((void)read_simulated_tracks(backwards, "c.csv"), InputError);

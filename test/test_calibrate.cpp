@@ -10,6 +10,9 @@
 #include <random>
 #include <set>
 #include <string>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 
 #include "fivebar/calibrate.hpp"
 #include "fivebar/design.hpp"
@@ -798,6 +801,28 @@ TEST(Sha256, KnownAnswers) {
   EXPECT_EQ(sha256_hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
             "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
   EXPECT_EQ(sha256_hex(std::string(1000000, 'a')), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+// The file is hashed streaming, 64 KiB at a time (docs/reliability.md "Resource bounds"): the FIPS
+// 180-2 answer for a million 'a', and at every length around a chunk and a block boundary the
+// digest of the whole text in one piece (whose known answers are above); past the bound, refused.
+TEST(Sha256, AFileIsHashedStreamingAndBounded) {
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / ("fivebar_sha256_" + std::to_string(::getpid()));
+  const auto write = [&](const std::string& text) { std::ofstream(file, std::ios::binary) << text; };
+  write(std::string(1000000, 'a'));
+  EXPECT_EQ(sha256_file(file), "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+  std::mt19937 rng(7);
+  for (const std::size_t n : {0u, 1u, 55u, 56u, 63u, 64u, 65u, 119u, 120u, 65535u, 65536u, 65537u, 131071u, 131072u, 131135u}) {
+    std::string text(n, '\0');
+    for (char& c : text) c = static_cast<char>(rng() & 0xff);
+    write(text);
+    EXPECT_EQ(sha256_file(file), sha256_hex(text)) << n << " bytes";
+  }
+  write(std::string(101, 'x'));
+  EXPECT_EQ(sha256_file(file, 101), sha256_hex(std::string(101, 'x')));
+  EXPECT_THROW((void)sha256_file(file, 100), InputError);
+  EXPECT_THROW((void)sha256_file("/dev/zero", std::uintmax_t{1} << 20), InputError);
+  std::filesystem::remove(file);
 }
 
 }  // namespace

@@ -98,7 +98,7 @@ TEST_F(CliAnimate, BadInputExitsTwoAndWritesNothing) {
       {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o", "--simulated", "none.csv"},
        "--simulated none.csv"},
       {{"animate", kDesign, "-s", "index", "--pattern", "stretch", "--out", "o", "--simulated", bad_csv.string()},
-       "bad.csv:1: no column y_mm"},
+       "bad.csv:1: column 'y_mm' is missing"},
   };
   const std::vector<std::string> before = tree(dir_);
   for (const Case& c : cases) {

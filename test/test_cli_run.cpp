@@ -28,6 +28,7 @@ using ft::slurp;
 using nlohmann::json;
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::IsEmpty;
 using ::testing::MatchesRegex;
 
@@ -119,3 +120,40 @@ TEST_F(Cli, RunIntoAnUnusableOutputRootFailsWithoutPartialFiles) {
 }
 
 }  // namespace
+
+// docs/bench-files.md "Where bench files may be": a bench file outside the design file's folder
+// (a '..' path, an absolute path, a link leading out) is refused at the design's line and key
+// with nothing created and nothing of the file echoed; `--allow-outside-paths` reads it.
+TEST_F(Cli, RunReadsBenchFilesOutsideTheDesignFolderOnlyWithTheFlag) {
+  fs::create_directories(dir_ / "d");
+  fs::create_directories(dir_ / "elsewhere");
+  fs::copy_file(kSource / "designs" / "bench" / "calibration.csv", dir_ / "elsewhere" / "cal.csv");
+  fs::create_symlink("../elsewhere/cal.csv", dir_ / "d" / "link.csv");
+  const std::string from = "calibration: bench/calibration.csv";
+  const std::string text = ft::slurp(kDesign);
+  const std::string line = std::to_string(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(text.find(from)), '\n') + 1);
+  const std::string absolute = (dir_ / "elsewhere" / "cal.csv").string();
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"../elsewhere/cal.csv", "must not leave the design file's folder"},
+      {absolute, "must be a path relative to the design file's folder"},
+      {"link.csv", "a symbolic link that leads out of the design file's folder"}};
+  for (const auto& [name, rule] : cases) {
+    SCOPED_TRACE(name);
+    design_with("d/b.yaml", from, "calibration: " + name);
+    const Outcome refused = run({"run", "d/b.yaml", "--out", "out", "--products", "calibrate"});
+    EXPECT_EQ(refused.code, 2) << refused.err;
+    EXPECT_THAT(refused.err, HasSubstr("d/b.yaml:" + line + ": bench.calibration = " + name + ": " + rule));
+    EXPECT_THAT(refused.err, Not(HasSubstr("station,mechanism")));  // nothing of the file is echoed
+    EXPECT_FALSE(fs::exists(dir_ / "out"));
+    // Any command that loads the design refuses it the same way, and takes the same flag.
+    EXPECT_EQ(run({"fk", "d/b.yaml", "-s", "index", "-m", "lower", "--theta", "60,120"}).code, 2);
+    const Outcome read = run({"run", "d/b.yaml", "--out", "out", "--products", "calibrate", "--allow-outside-paths"});
+    ASSERT_EQ(read.code, 0) << read.err;
+    const json s = json::parse(ft::slurp(dir_ / "out" / "iros2022" / "summary.json"));
+    ASSERT_EQ(s["built"].size(), 1u);
+    EXPECT_EQ(s["built"][0]["name"], "calibrate");
+    EXPECT_TRUE(fs::exists(dir_ / "out" / "iros2022" / "calibrate")) << "the calibration was read and fitted";
+    EXPECT_EQ(run({"fk", "d/b.yaml", "-s", "index", "-m", "lower", "--theta", "60,120", "--allow-outside-paths"}).code, 0);
+    fs::remove_all(dir_ / "out");
+  }
+}

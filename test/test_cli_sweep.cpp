@@ -25,6 +25,7 @@ using ft::Outcome;
 using ft::slurp;
 using nlohmann::json;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 /// The paper's design and a scratch directory per test (test/cli_test.hpp); spawn() and wait_for()
 /// for the runs that are interrupted or go through mpirun.
@@ -213,6 +214,36 @@ TEST_F(CliSweep, MpiRunEqualsTheSerialRun) {
   EXPECT_EQ(slurp(dir_ / "mpi" / "sweep.csv"), slurp(dir_ / "serial" / "sweep.csv"));
   EXPECT_EQ(slurp(dir_ / "mpi" / "pareto.csv"), slurp(dir_ / "serial" / "pareto.csv"));
   EXPECT_FALSE(fs::exists(dir_ / "mpi" / "sweep.shard-0-of-2.csv"));
+}
+
+}  // namespace
+
+namespace {
+
+// docs/reliability.md "Resume": the CSV a resume reads goes through the one bounded reader. A
+// sweep.csv whose second line is 2 GiB of zeros (a hole, no disk) was read into one string and,
+// under a 1 GB address space, taken for the end of the file: the sweep started afresh, exit 0.
+// Now it is refused at the line, exit 2, having held one bounded line.
+class CliSweepResume : public ft::CliTest {
+ protected:
+  CliSweepResume() : CliTest("fivebar_test_cli_sweep_resume") {}
+};
+
+TEST_F(CliSweepResume, AnEndlessLineIsRefusedAtItsLine) {
+  const std::vector<std::string> args{"sweep", kDesign, "--station", "index", "--mechanism", "lower", "--vary", "L3=11:19:30",
+                                      "--vary", "L4=11:19:30", "--out", "s", "--no-plots"};
+  ASSERT_EQ(run(args).code, 0);
+  const std::string csv = ft::slurp(dir_ / "s" / "sweep.csv");
+  std::ofstream(dir_ / "s" / "sweep.csv", std::ios::binary) << csv.substr(0, csv.find('\n') + 1);
+  fs::resize_file(dir_ / "s" / "sweep.csv", std::uintmax_t{2} << 30);
+  std::vector<std::string> limited{"-c", "ulimit -v 1000000 && exec \"$0\" \"$@\"", FIVEBAR_BINARY};
+  limited.insert(limited.end(), args.begin(), args.end());
+  limited.push_back("--resume");
+  const ft::Outcome r = ft::run("/bin/sh", limited, dir_, dir_, ft::child_timeout_s(120.0));
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("s/sweep.csv:2: line longer than 65536 bytes"));
+  EXPECT_THAT(r.err, Not(HasSubstr("internal error")));
+  EXPECT_EQ(fs::file_size(dir_ / "s" / "sweep.csv"), std::uintmax_t{2} << 30) << "the CSV is left as it was";
 }
 
 }  // namespace

@@ -98,6 +98,7 @@ struct Case {
   int exit_code = 2;
   bool rows_may_stream = false;          ///< a batch without --output may print rows before the bad one
   std::vector<std::string> not_messages;  ///< none of these may appear on stderr
+  unsigned long memory_kb = 0;            ///< run under `ulimit -v` of this many KiB (0: no limit)
 };
 
 std::ostream& operator<<(std::ostream& os, const Case& c) { return os << c.name; }
@@ -304,20 +305,20 @@ std::vector<Case> cases() {
     return Case{std::move(name), ik({"--point-file", "in.csv", "--output", "angles.csv"}),
                 {good, text("in.csv", std::move(csv))}, std::move(messages)};
   };
-  c.push_back(batch("CsvRowNotANumber", "x_mm,y_mm\n6.25,15.5\n6.25,abc\n", {"in.csv:3: y_mm = 'abc'", "finite"}));
-  c.push_back(batch("CsvRowNaN", "x_mm,y_mm\n6.25,15.5\nnan,15.5\n", {"in.csv:3: x_mm = 'nan'", "finite"}));
-  c.push_back(batch("CsvRowOverflow", "x_mm,y_mm\n1e999,15.5\n", {"in.csv:2: x_mm = '1e999'", "finite"}));
-  c.push_back(batch("CsvRowTooFewFields", "x_mm,y_mm\n6.25,15.5\n6.25\n", {"in.csv:3:", "1 fields", "header has 2"}));
-  c.push_back(batch("CsvMissingColumn", "x,y\n6.25,15.5\n", {"in.csv:1:", "no column 'x_mm'"}));
-  c.push_back(batch("CsvEmpty", "", {"in.csv: empty", "header"}));
-  c.push_back(batch("CsvBinaryRow", "x_mm,y_mm\n6.25,15.5\n\xff\xfe,\x01\n", {"in.csv:3: x_mm = '"}));
+  c.push_back(batch("CsvRowNotANumber", "x_mm,y_mm\n6.25,15.5\n6.25,abc\n", {"in.csv:3: column 'y_mm' = 'abc'", "finite"}));
+  c.push_back(batch("CsvRowNaN", "x_mm,y_mm\n6.25,15.5\nnan,15.5\n", {"in.csv:3: column 'x_mm' = 'nan'", "finite"}));
+  c.push_back(batch("CsvRowOverflow", "x_mm,y_mm\n1e999,15.5\n", {"in.csv:2: column 'x_mm' = '1e999'", "finite"}));
+  c.push_back(batch("CsvRowTooFewFields", "x_mm,y_mm\n6.25,15.5\n6.25\n", {"in.csv:3:", "1 cells", "the header (line 1) has 2"}));
+  c.push_back(batch("CsvMissingColumn", "x,y\n6.25,15.5\n", {"in.csv:1:", "column 'x_mm' is missing"}));
+  c.push_back(batch("CsvEmpty", "", {"in.csv:1: empty file", "header"}));
+  c.push_back(batch("CsvBinaryRow", "x_mm,y_mm\n6.25,15.5\n\xff\xfe,\x01\n", {"in.csv:3: column 'x_mm' = '"}));
   c.push_back(batch("CsvLineOf2MB", "x_mm,y_mm\n" + repeat("1", 2u << 20) + ",2\n", {"in.csv:2:", "line longer than"}));
   c.push_back({"CsvMissingFile", ik({"--point-file", "nosuch.csv"}), {good}, {"cannot open 'nosuch.csv'"}});
   c.push_back({"CsvIsADirectory", ik({"--point-file", "adir"}), {good, directory("adir")}, {"adir: is a directory"}});
   c.push_back({"CsvFromDevZero", fk({"--theta-file", "/dev/zero"}), {good}, {"/dev/zero:1:", "line longer than"}});
   c.push_back({"ThetaCsvBadRowStreamed", fk({"--theta-file", "in.csv"}),
                {good, text("in.csv", "theta1_deg,theta2_deg\n100,80\n100,eighty\n")},
-               {"in.csv:3: theta2_deg = 'eighty'"}, 2, /*rows_may_stream=*/true});
+               {"in.csv:3: column 'theta2_deg' = 'eighty'"}, 2, /*rows_may_stream=*/true});
   c.push_back({"PointAndPointFileTogether", ik({"--point", "1,2", "--point-file", "points.csv"}), {good, points},
                {"--point"}});
   c.push_back({"UnknownNestedSubcommand", {"report", "frobnicate", "good.yaml"}, {good},
@@ -492,6 +493,34 @@ std::vector<Case> cases() {
                {text("b.yaml", show_with("calibration: bench/calibration.csv", "calibration: cal.csv")),
                 text("cal.csv", meas_header + "index,lower,2.1,2.8,6.5,junk\n")},
                {"cal.csv:2: column 'y_mm' = 'junk'"}});
+  // --- Issue 45: the last readers through the one bounded reader (docs/reliability.md) ----------------
+  const std::vector<std::string> animate_sim{"animate", "show.yaml", "-s", "index", "--pattern", "stretch", "--out", "out",
+                                             "--simulated", "sim.csv"};
+  c.push_back({"AnimateSimulatedHexadecimalCell", animate_sim,
+               {showcase, text("sim.csv", "t_s,mechanism,x_mm,y_mm\n0,lower,6.25,15.5\n0.01,lower,0x10,15.5\n")},
+               {"sim.csv:3: column 'x_mm' = '0x10': not a finite decimal number"}});
+  c.push_back({"AnimateSimulatedDuplicatedColumn", animate_sim,
+               {showcase, text("sim.csv", "t_s,mechanism,x_mm,y_mm,x_mm\n0,lower,6.25,15.5,1e300\n")},
+               {"sim.csv:1: column 5 'x_mm': duplicate of column 3"}});
+  c.push_back({"AnimateSimulatedUnknownMechanism", animate_sim,
+               {showcase, text("sim.csv", "t_s,mechanism,x_mm,y_mm\n0,lower,6.25,15.5\n0,middle,6.25,15.5\n")},
+               {"sim.csv:3: column 'mechanism' = 'middle': not lower or upper"}});
+  c.push_back({"BatchDuplicatedColumn", ik({"--point-file", "in.csv", "--output", "angles.csv"}),
+               {good, text("in.csv", "x_mm,y_mm,x_mm\n6.25,15.5,13.75\n")}, {"in.csv:1: column 3 'x_mm': duplicate of column 1"}});
+  c.push_back({"BatchLineOf5000Bytes", ik({"--point-file", "in.csv", "--output", "angles.csv"}),
+               {good, text("in.csv", "x_mm,y_mm\n6.25," + std::string(5000, ' ') + "15.5\n")},
+               {"in.csv:2: line longer than 4096 bytes"}});
+  // 2 GiB of zeros (a hole) read whole under a 1 GB address space: bad_alloc before.
+  c.push_back({"ExportCheckTwoGigabytes", {"export", "--check", "big.json", "show.yaml"}, {showcase, sparse("big.json", 2ull << 30)},
+               {"big.json", "larger than 67108864 bytes"}, 2, false, {}, 1000000});
+  {
+    // A typo in a column's station is named where it is (before: "no columns for joint index_lower_theta1").
+    std::string log = ft::slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/bench/replay.csv");
+    for (std::size_t at; (at = log.find("index_lower_theta1_")) != std::string::npos;) log.replace(at, 18, "indx_lower_theta1");
+    c.push_back({"IdentifyColumnOfAnUnknownStation",
+                 {"identify", "show.yaml", "log.csv", "--rig", "mechanism", "index/lower", "--no-files", "--no-output-error"},
+                 {showcase, text("log.csv", log)}, {"log.csv:2: column 2 'indx_lower_theta1_...': the design has no station 'indx'"}});
+  }
   c.push_back({"IdentifyCutoffZero", {"identify", "show.yaml", "id.csv", "--cutoff", "0", "--out", "out"},
                {showcase, text("id.csv", ft::slurp(fs::path(FIVEBAR_SOURCE_DIR) / "designs/bench/identification.csv"))},
                {"--cutoff = 0"}});
@@ -511,7 +540,14 @@ TEST_P(Hostile, RefusedCleanlyAndNothingWritten) {
   const auto before = ft::tree(scratch.path());
 
   const double bound = ft::child_timeout_s(10.0);
-  const ft::Outcome r = ft::run(FIVEBAR_BINARY, k.args, scratch.path(), io.path(), bound);
+  // A memory limit: through the shell's ulimit, which the binary inherits (exec).
+  std::vector<std::string> args = k.args;
+  std::string program = FIVEBAR_BINARY;
+  if (k.memory_kb > 0) {
+    args.insert(args.begin(), {"-c", "ulimit -v " + std::to_string(k.memory_kb) + " && exec \"$0\" \"$@\"", FIVEBAR_BINARY});
+    program = "/bin/sh";
+  }
+  const ft::Outcome r = ft::run(program, args, scratch.path(), io.path(), bound);
   ASSERT_TRUE(r.spawned);
   std::string command = "fivebar";
   for (const auto& a : k.args) command += " " + (a.size() > 60 ? a.substr(0, 60) + "..." : a);

@@ -259,6 +259,14 @@ TEST(ReplayDesign, BadLogNamesAreTheDesignFilesLineAndKey) {
   EXPECT_THAT(other("calibration: bench/calibration.csv", "calibration: ../m.csv"), HasSubstr("bench.calibration = ../m.csv: must not leave"));
   EXPECT_THAT(other("identification: bench/identification.csv", "identification: /dev/zero"),
               HasSubstr("bench.identification = /dev/zero: must be a path relative"));
+  // Unless the caller allows it (the command line's --allow-outside-paths): then each is loaded
+  // as written, and the next load without the permission refuses them again.
+  allow_bench_paths_outside(true);
+  EXPECT_EQ(message("replay_logs: [/etc/passwd]"), "loaded");
+  EXPECT_EQ(message("replay_logs: [logs/../../x.csv]"), "loaded");
+  EXPECT_EQ(other("calibration: bench/calibration.csv", "calibration: ../m.csv"), "loaded");
+  allow_bench_paths_outside(false);
+  EXPECT_THAT(message("replay_logs: [/etc/passwd]"), HasSubstr(at + "[0] = /etc/passwd: must be a path relative"));
   // One name without a list, written back as a list.
   const Design one = load_design_from_string(with("replay_logs: x/log.csv"), "d.yaml");
   ASSERT_NE(one.get<BenchSettings>(), nullptr);

@@ -1,3 +1,4 @@
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/scene.hpp"
 
@@ -28,6 +29,16 @@ using json = Json;
 namespace {
 
 using format::join;
+
+/// The summary.json an earlier run left in `out_dir`, or "" (none, unreadable, or past 16 MiB: a
+/// summary is kilobytes, so a link to /dev/zero is ignored unread, as a missing one is).
+std::string earlier_summary(const std::filesystem::path& out_dir) {
+  try {
+    return csv::read_bounded(out_dir / "summary.json", std::uintmax_t{16} << 20, "summary");
+  } catch (const InputError&) {
+    return {};
+  }
+}
 
 }  // namespace
 
@@ -247,11 +258,9 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
   // come earlier in the list, so one pass from the end gives every chain.
   std::map<std::string, double> measured;
   {
-    std::ifstream in(report.out_dir / "summary.json", std::ios::binary);
-    if (in) {
-      std::ostringstream text;
-      text << in.rdbuf();
-      const json earlier = json::parse(text.str(), nullptr, false);
+    const std::string text = earlier_summary(report.out_dir);
+    if (!text.empty()) {
+      const json earlier = json::parse(text, nullptr, false);
       if (!earlier.is_discarded() && earlier.is_object() && earlier.contains("built") && earlier["built"].is_array()) {
         for (const json& b : earlier["built"]) {
           if (b.is_object() && b.contains("name") && b["name"].is_string() && b.contains("wall_s") &&
@@ -356,11 +365,13 @@ SceneReport products::run_scene_with(const Design& design, const SceneOptions& o
     return std::filesystem::is_regular_file(dir / rel, ec);
   };
   files.read = [dir](const std::string& rel) -> std::optional<std::string> {
-    std::ifstream in(dir / rel, std::ios::binary);
-    if (!in) return std::nullopt;
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
+    // The products' own files, bounded as every read (docs/reliability.md): one past 256 MiB is
+    // linked, not inlined.
+    try {
+      return csv::read_bounded(dir / rel, std::uintmax_t{256} << 20, "product file");
+    } catch (const InputError&) {
+      return std::nullopt;
+    }
   };
   report.index_html = report.out_dir / "index.html";
   write_file_atomic(report.index_html, md::to_html_page(markdown, "fivebar: " + design.name, files));

@@ -24,6 +24,8 @@
 /// The static picture (no script run, e.g. through an <img>) shows the first frame.
 
 #include <array>
+#include <cstddef>
+#include <cstdint>
 #include <istream>
 #include <string>
 #include <string_view>
@@ -41,9 +43,15 @@ struct SimulatedTrack {
   std::vector<Vec2> point_mm;  ///< simulated tactor point P at time_s
 };
 
-/// Reads the time series CSV of write_time_series_csv() (fivebar/dynamics.hpp): one track per
-/// mechanism, in order of first appearance. `name` names the file in messages; InputError for a
-/// header without the columns t_s, mechanism, x_mm, y_mm or a row whose numbers do not parse.
+/// Bounds of a time series read back (docs/reliability.md "Resource bounds").
+inline constexpr std::size_t kMaxSimulatedLine = 4096;                       ///< bytes a line
+inline constexpr std::uintmax_t kMaxSimulatedBytes = std::uintmax_t{1} << 30;  ///< bytes in all
+inline constexpr std::size_t kMaxSimulatedRows = 10'000'000;                 ///< data rows
+/// Reads the time series CSV of write_time_series_csv() (fivebar/dynamics.hpp) through the bounded
+/// reader of fivebar/csv_reader.hpp: one track per mechanism (`lower`, `upper`), in order of first
+/// appearance. `name` names the file in messages; InputError "NAME:LINE: column ..." for a header
+/// without the columns t_s, mechanism, x_mm, y_mm or with a duplicated one, a cell that is not a
+/// finite decimal number, a coordinate beyond 1e12 mm, a time going back, or a bound passed.
 std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_view name);
 
 struct AnimationOptions {

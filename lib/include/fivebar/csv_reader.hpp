@@ -49,6 +49,8 @@ class Reader {
   std::size_t rows() const { return rows_; }  ///< data rows read so far
   const std::vector<std::string>& cells() const { return cells_; }
   const std::string& cell(std::size_t c) const { return cells_[c]; }
+  /// The current row's line as read (line break and a CR before it removed).
+  const std::string& text() const { return buffer_; }
 
   /// The cell as a finite number: decimal or scientific notation only (no hexadecimal `0x10`, no
   /// trailing text `41496junk`, no inf or nan), |v| <= max_abs. InputError "ORIGIN:LINE: column

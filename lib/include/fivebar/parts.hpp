@@ -56,8 +56,11 @@ struct TriangleMesh {
   Eigen::Vector3d bbox_max() const;
 };
 
+/// Largest STL read_stl() reads (a part's render is megabytes).
+inline constexpr std::uintmax_t kMaxStlBytes = std::uintmax_t{256} << 20;
 /// Reads a binary STL (80-byte header, count, 50-byte records). Throws IoError when the file cannot
-/// be read, InputError when it is not a well-formed binary STL (ASCII STL, truncated, bad count).
+/// be read, InputError when it is not a well-formed binary STL (ASCII STL, truncated, bad count) or
+/// is larger than kMaxStlBytes (checked while reading).
 TriangleMesh read_stl(const std::filesystem::path& path);
 
 /// Topological and geometric checks of a printed part (CGAL Polygon_mesh_processing).

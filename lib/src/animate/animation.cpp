@@ -11,6 +11,7 @@
 #include <optional>
 #include <sstream>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/json.hpp"
@@ -215,82 +216,35 @@ std::string region_path_d(const Region& region, const View& view) {
 }  // namespace
 
 std::vector<SimulatedTrack> read_simulated_tracks(std::istream& in, std::string_view name) {
-  const auto fail = [&](std::size_t line, const std::string& what) {
-    throw InputError(std::string(name) + ":" + std::to_string(line) + ": " + what);
-  };
-  const auto split = [](const std::string& line) {
-    std::vector<std::string> out;
-    std::string cell;
-    std::istringstream s(line);
-    while (std::getline(s, cell, ',')) out.push_back(cell);
-    if (!line.empty() && line.back() == ',') out.emplace_back();
-    return out;
-  };
-  // A reader of a user-named file is bounded (docs/reliability.md): lines of at most
-  // kMaxSimulatedLineBytes (a `fivebar simulate` row is about 250) and at most
-  // kMaxSimulatedBytes in all, so /dev/zero or a wrong file is refused after one bounded read.
-  constexpr std::size_t kMaxSimulatedLineBytes = 4096;
-  constexpr std::size_t kMaxSimulatedBytes = std::size_t{1} << 30;
-  std::size_t total = 0;
-  const auto getline_bounded = [&](std::string& out, std::size_t line_no) {
-    out.clear();
-    std::streambuf* buf = in.rdbuf();
-    if (buf == nullptr || !in.good()) return false;
-    bool any = false;
-    while (true) {
-      const auto c = buf->sbumpc();
-      if (std::char_traits<char>::eq_int_type(c, std::char_traits<char>::eof())) {
-        in.setstate(std::ios::eofbit);
-        return any;
-      }
-      any = true;
-      if (++total > kMaxSimulatedBytes) fail(line_no, "more than " + std::to_string(kMaxSimulatedBytes) + " bytes: not a time series of fivebar simulate");
-      const char ch = std::char_traits<char>::to_char_type(c);
-      if (ch == '\n') return true;
-      if (out.size() >= kMaxSimulatedLineBytes) {
-        fail(line_no, "line longer than " + std::to_string(kMaxSimulatedLineBytes) + " bytes: not a time series of fivebar simulate");
-      }
-      out.push_back(ch);
-    }
-  };
-  std::string line;
-  if (!getline_bounded(line, 1)) fail(1, "empty file: expected the time series header");
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  const std::vector<std::string> header = split(line);
-  const auto column = [&](const char* key) {
-    const auto it = std::find(header.begin(), header.end(), key);
-    if (it == header.end()) fail(1, std::string("no column ") + key + " in the header");
-    return static_cast<std::size_t>(it - header.begin());
-  };
-  const std::size_t ct = column("t_s"), cm = column("mechanism"), cx = column("x_mm"), cy = column("y_mm");
-  const std::size_t need = std::max({ct, cm, cx, cy}) + 1;
+  // The one bounded reader of fivebar/csv_reader.hpp (docs/reliability.md "Resource bounds"):
+  // lines of kMaxSimulatedLine bytes (a `fivebar simulate` row is about 250), kMaxSimulatedBytes
+  // in all and kMaxSimulatedRows rows (24 bytes of tracks a row: 240 MB at most), each checked
+  // while reading; strict decimal cells, no duplicated column.
+  csv::Limits limits;
+  limits.max_line = kMaxSimulatedLine;
+  limits.max_bytes = kMaxSimulatedBytes;
+  limits.max_rows = kMaxSimulatedRows;
+  csv::Reader reader(in, std::string(name), limits);
+  const std::size_t ct = reader.require("t_s"), cm = reader.require("mechanism"), cx = reader.require("x_mm"),
+                    cy = reader.require("y_mm");
   std::vector<SimulatedTrack> tracks;
   std::map<std::string, std::size_t> index;
-  std::size_t line_no = 1;
-  const auto number = [&](const std::string& text, const char* key) {
-    char* end = nullptr;
-    const double v = std::strtod(text.c_str(), &end);
-    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-      fail(line_no, std::string(key) + " = '" + text.substr(0, 40) + "' is not a finite number");
-    }
-    return v;
-  };
-  while (getline_bounded(line, line_no + 1)) {
-    ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty()) continue;
-    const std::vector<std::string> cells = split(line);
-    if (cells.size() < need) fail(line_no, "expected " + std::to_string(header.size()) + " fields");
-    const double t = number(cells[ct], "t_s");
-    const Vec2 p(number(cells[cx], "x_mm"), number(cells[cy], "y_mm"));
+  while (reader.next()) {
+    const double t = reader.number(ct, std::numeric_limits<double>::max(), "s");
+    const Vec2 p(reader.number(cx, std::numeric_limits<double>::max(), "mm"),
+                 reader.number(cy, std::numeric_limits<double>::max(), "mm"));
     // A tactor point is a coordinate (docs/reliability.md "Numeric ranges"): |x| <= 1e12 mm.
     for (const auto& [v, key] : {std::pair{p.x(), "x_mm"}, std::pair{p.y(), "y_mm"}}) {
-      if (const auto why = ranges::coordinate_rule(v)) fail(line_no, std::string(key) + " = " + format::shortest(v) + " mm: " + *why);
+      if (const auto why = ranges::coordinate_rule(v)) {
+        throw InputError(reader.where() + std::string(key) + " = " + format::shortest(v) + " mm: " + *why);
+      }
     }
-    auto [it, added] = index.emplace(cells[cm], tracks.size());
-    if (added) tracks.push_back(SimulatedTrack{cells[cm], {}, {}});
+    // Two tracks at most: a file of a million mechanism names would hold a million tracks.
+    if (reader.cell(cm) != "lower" && reader.cell(cm) != "upper") throw InputError(reader.at(cm) + "not lower or upper");
+    auto [it, added] = index.emplace(reader.cell(cm), tracks.size());
+    if (added) tracks.push_back(SimulatedTrack{reader.cell(cm), {}, {}});
     SimulatedTrack& track = tracks[it->second];
-    if (!track.time_s.empty() && t < track.time_s.back()) fail(line_no, "t_s goes back in time");
+    if (!track.time_s.empty() && t < track.time_s.back()) throw InputError(reader.at(ct) + "t_s goes back in time");
     track.time_s.push_back(t);
     track.point_mm.push_back(p);
   }

@@ -26,6 +26,7 @@
 #include <sstream>
 
 #include "fivebar/coverage/coverage.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/device/config.hpp"
@@ -627,11 +628,9 @@ ExportCheck check_export(const std::string& text, ExportFormat format, const Des
 ExportCheck check_export_file(const std::filesystem::path& file, const Design& d) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file.string() + ": no such exported file");
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(file.string() + ": cannot read the file");
-  const std::string content = text.str();
+  // An exported file is a few kilobytes (a URDF with meshes inline some megabytes): one past
+  // kMaxExportedFileBytes is refused while reading, not read whole (docs/reliability.md).
+  const std::string content = csv::read_bounded(file, kMaxExportedFileBytes, "exported file");
   std::string ext = file.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
   const auto first = content.find_first_not_of(" \t\r\n");

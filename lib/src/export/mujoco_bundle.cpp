@@ -7,6 +7,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/device/joint_limits.hpp"
@@ -204,11 +205,8 @@ std::string license_note(const Design& design, const Station& station) {
 }
 
 std::string read_bytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot read the mesh for the MuJoCo bundle");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  // A mesh that fivebar parts wrote: megabytes; bounded as every read (docs/reliability.md).
+  return csv::read_bounded(file, std::uintmax_t{256} << 20, "mesh for the MuJoCo bundle");
 }
 
 }  // namespace

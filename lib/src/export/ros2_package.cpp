@@ -1,5 +1,6 @@
 // The ROS 2 description package (fivebar/export/ros2_package.hpp).
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/export/ros2_package.hpp"
 
 #include <algorithm>
@@ -20,11 +21,8 @@ namespace fivebar {
 namespace {
 
 std::string read_bytes(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot read the mesh for the ROS 2 package");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  // A mesh that fivebar parts wrote: megabytes; bounded as every read (docs/reliability.md).
+  return csv::read_bounded(file, std::uintmax_t{256} << 20, "mesh for the ROS 2 package");
 }
 
 /// A ROS package version is MAJOR.MINOR.PATCH; fivebar's own when it is one, else 0.0.0.

@@ -86,6 +86,7 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
   csv::Reader reader(in, path, csv::Limits{kMaxLogLine, kMaxLogBytes, kMaxLogRows});
   const std::vector<std::string>& header = reader.header();
   const std::size_t header_line = reader.header_line();
+  log.header_line = header_line;
   int time_col = -1;
   std::map<std::string, std::size_t> joint_index;  // prefix -> joints[]
   struct Binding {
@@ -123,6 +124,7 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
     auto [it, added] = joint_index.emplace(prefix, log.joints.size());
     if (added) {
       probe.prefix = prefix.empty() ? "" : prefix.substr(0, prefix.size() - 1);
+      probe.column = c + 1;
       log.joints.push_back(probe);
     }
     bind[c] = Binding{it->second, kind};

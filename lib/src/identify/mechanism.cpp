@@ -12,8 +12,22 @@
 
 namespace fivebar::identify {
 
+void require_log_joints_in(const Design& design, const IdentifyLog& log) {
+  for (const JointLog& j : log.joints) {
+    if (j.station.empty()) continue;  // a bench motor
+    const std::string at = log.path + ":" + std::to_string(log.header_line) + ": column " + std::to_string(j.column) + " '" +
+                           j.prefix + "_...': ";
+    const Station* s = design.station(j.station);
+    if (s == nullptr) throw InputError(at + "the design has no station '" + j.station + "'");
+    if (s->mechanism(j.mechanism) == nullptr) {
+      throw InputError(at + "station '" + j.station + "' has no " + j.mechanism + " mechanism");
+    }
+  }
+}
+
 std::vector<JointIdentification> identify_mechanism(const Design& design, const IdentifyLog& log, const std::string& station,
                                                     const std::string& mechanism, const IdentifyOptions& options) {
+  require_log_joints_in(design, log);
   const Station& st = design.require_station(station);
   const Mechanism* mech = st.mechanism(mechanism);
   if (mech == nullptr) throw InputError("--rig mechanism " + station + "/" + mechanism + ": the station has no such mechanism");

@@ -52,6 +52,7 @@ Product identify_product() {
     const std::filesystem::path file = BenchSettings::resolve(d, name);
     identify::IdentifyLog log = identify::read_identify_log(file);
     log.path = name;
+    identify::require_log_joints_in(d, log);
     identify::IdentifyOptions o;
     o.output_error = false;  // IDIM-LS only: the refinement is `fivebar identify`'s (it simulates)
     // A log whose every joint carries its reference (theta_ref_rad) was taken under the design's PID:

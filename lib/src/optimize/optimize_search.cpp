@@ -30,6 +30,8 @@
 #include <unordered_map>
 
 #include "fivebar/atlas.hpp"
+#include "fivebar/csv_reader.hpp"
+#include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/optimize.hpp"
@@ -45,6 +47,22 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr const char* kCheckpointFormat = "fivebar-optimize-checkpoint";
 constexpr const char* kShardFormat = "fivebar-optimize-shard";
+/// Largest checkpoint or shard file read back (docs/reliability.md "Resource bounds"): they hold
+/// the islands' populations and a front, megabytes at most; a larger file (or /dev/zero behind
+/// a link) is refused while reading.
+constexpr std::uintmax_t kMaxOptimizeFileBytes = std::uintmax_t{256} << 20;
+
+/// A checkpoint or shard file (`what`), parsed: InputError naming it past kMaxOptimizeFileBytes
+/// (checked while reading) or when it is not JSON.
+Json read_optimize_file(const std::filesystem::path& path, const std::string& what) {
+  try {
+    return Json::parse(csv::read_bounded(path, kMaxOptimizeFileBytes, what));
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(path.string() + ": not a " + what + " of fivebar optimize (" + e.what() + ")");
+  }
+}
 /// Least time between two checkpoints of a run (docs/reliability.md "Resource bounds").
 constexpr double kCheckpointSeconds = 1.0;
 
@@ -958,14 +976,9 @@ OptimizeResult run_optimize(const Design& design, const OptimizeOptions& options
   };
 
   if (options.resume) {
-    std::ifstream in(checkpoint);
-    if (!in) throw InputError(checkpoint.string() + ": no checkpoint to resume from");
-    Json j;
-    try {
-      in >> j;
-    } catch (const std::exception& e) {
-      throw InputError(checkpoint.string() + ": not a checkpoint of fivebar optimize (" + e.what() + ")");
-    }
+    std::error_code ec;
+    if (!std::filesystem::exists(checkpoint, ec)) throw InputError(checkpoint.string() + ": no checkpoint to resume from");
+    const Json j = read_optimize_file(checkpoint, "checkpoint");
     if (j.value("format", "") != kCheckpointFormat) throw InputError(checkpoint.string() + ": not a checkpoint of fivebar optimize");
     if (j.value("design_hash", "") != design_hash(p)) {
       throw InputError(checkpoint.string() + ": the checkpoint is of another design or other optimize: settings");
@@ -1159,14 +1172,11 @@ OptimizeResult merge_optimize_shards(const Design& design, const OptimizeOptions
   r.algorithm = p.settings().resolved_algorithm();
   for (std::uint64_t k = 0; k < shards; ++k) {
     const auto path = options.out_dir / ("front" + shard_suffix(k, shards) + ".json");
-    std::ifstream in(path);
-    if (!in) throw InputError(path.string() + ": shard " + std::to_string(k) + " of " + std::to_string(shards) + " is missing");
-    Json j;
-    try {
-      in >> j;
-    } catch (const std::exception& e) {
-      throw InputError(path.string() + ": not a shard file of fivebar optimize (" + e.what() + ")");
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) {
+      throw InputError(path.string() + ": shard " + std::to_string(k) + " of " + std::to_string(shards) + " is missing");
     }
+    const Json j = read_optimize_file(path, "shard file");
     if (j.value("format", "") != kShardFormat || j.value("design_hash", "") != design_hash(p)) {
       throw InputError(path.string() + ": a shard of another design or other optimize: settings");
     }

@@ -3,6 +3,7 @@
 // source), the design-intent checks and the bill of materials. Reading STL and fitting hole
 // walls: parts_mesh.cpp; CGAL's mesh checks: cgal/mesh_checks.cpp.
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/parts.hpp"
 
@@ -56,12 +57,14 @@ std::string num(double value) { return format::shortest(value); }
 using format::fixed;
 using format::join;
 
+/// A file of the parts folder (a source, a render's hash), or "" when it cannot be read or is
+/// past 64 MiB (not one fivebar wrote): bounded as every read (docs/reliability.md).
 std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  try {
+    return csv::read_bounded(path, std::uintmax_t{64} << 20, "parts file");
+  } catch (const InputError&) {
+    return {};
+  }
 }
 
 std::string hex64(std::uint64_t v) {

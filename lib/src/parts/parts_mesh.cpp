@@ -14,6 +14,7 @@
 #include <set>
 #include <unordered_map>
 
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/parts.hpp"
@@ -40,9 +41,12 @@ Eigen::Vector3d TriangleMesh::bbox_max() const {
 }
 
 TriangleMesh read_stl(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError("cannot read '" + path.string() + "': " + std::strerror(errno));
-  const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw IoError("cannot read '" + path.string() + "': " + std::strerror(errno));
+  }
+  // A part's STL is megabytes; bounded as every read (docs/reliability.md).
+  const std::string data = csv::read_bounded(path, kMaxStlBytes, "STL mesh");
   if (data.size() < 84) throw InputError(path.string() + ": not a binary STL (" + std::to_string(data.size()) + " bytes)");
   std::uint32_t count = 0;
   std::memcpy(&count, data.data() + 80, 4);

@@ -4,7 +4,6 @@
 #include <array>
 #include <cstdint>
 #include <fstream>
-#include <sstream>
 
 #include "fivebar/error.hpp"
 
@@ -52,18 +51,18 @@ void block(std::array<std::uint32_t, 8>& h, const unsigned char* p) {
 
 }  // namespace
 
-std::string sha256_hex(std::string_view data) {
-  std::array<std::uint32_t, 8> h{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a, 0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
-  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
-  std::size_t n = data.size();
-  std::size_t i = 0;
-  for (; i + 64 <= n; i += 64) block(h, bytes + i);
+namespace {
+
+constexpr std::array<std::uint32_t, 8> kH0{0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
+                                           0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+
+/// The padding and length block after the last whole block, then the digest in hex.
+std::string finish(std::array<std::uint32_t, 8>& h, const unsigned char* rest_bytes, std::size_t rest, std::uint64_t n) {
   std::array<unsigned char, 128> tail{};
-  const std::size_t rest = n - i;
-  for (std::size_t k = 0; k < rest; ++k) tail[k] = bytes[i + k];
+  for (std::size_t k = 0; k < rest; ++k) tail[k] = rest_bytes[k];
   tail[rest] = 0x80;
   const std::size_t len = rest < 56 ? 64 : 128;
-  const std::uint64_t bits = static_cast<std::uint64_t>(n) * 8;
+  const std::uint64_t bits = n * 8;
   for (int k = 0; k < 8; ++k) tail[len - 1 - static_cast<std::size_t>(k)] = static_cast<unsigned char>(bits >> (8 * k));
   block(h, tail.data());
   if (len == 128) block(h, tail.data() + 64);
@@ -75,12 +74,42 @@ std::string sha256_hex(std::string_view data) {
   return out;
 }
 
-std::string sha256_file(const std::filesystem::path& path) {
+}  // namespace
+
+std::string sha256_hex(std::string_view data) {
+  std::array<std::uint32_t, 8> h = kH0;
+  const auto* bytes = reinterpret_cast<const unsigned char*>(data.data());
+  const std::size_t n = data.size();
+  std::size_t i = 0;
+  for (; i + 64 <= n; i += 64) block(h, bytes + i);
+  return finish(h, bytes + i, n - i, n);
+}
+
+std::string sha256_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.generic_string() + ": cannot read the file to hash");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return sha256_hex(text.str());
+  // Streamed in chunks: the memory is one chunk whatever the file, and a file past max_bytes (or
+  // /dev/zero) is refused once it passes the bound.
+  std::array<std::uint32_t, 8> h = kH0;
+  std::array<char, 65536> chunk{};
+  std::uint64_t n = 0;
+  std::size_t held = 0;  // bytes of an unfinished block at the start of chunk
+  while (in.read(chunk.data() + held, static_cast<std::streamsize>(chunk.size() - held)) || in.gcount() > 0) {
+    const auto got = static_cast<std::size_t>(in.gcount());
+    n += got;
+    if (n > max_bytes) {
+      throw InputError(path.generic_string() + ": larger than " + std::to_string(max_bytes) +
+                       " bytes: not hashed (docs/reliability.md \"Resource bounds\")");
+    }
+    const std::size_t have = held + got;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(chunk.data());
+    std::size_t i = 0;
+    for (; i + 64 <= have; i += 64) block(h, bytes + i);
+    held = have - i;
+    for (std::size_t k = 0; k < held; ++k) chunk[k] = chunk[i + k];
+  }
+  if (in.bad()) throw InputError(path.generic_string() + ": read error while hashing the file");
+  return finish(h, reinterpret_cast<const unsigned char*>(chunk.data()), held, n);
 }
 
 }  // namespace fivebar

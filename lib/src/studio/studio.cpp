@@ -1,6 +1,7 @@
 // The studio's state and figures (fivebar/studio.hpp, docs/studio.md): the same library calls as
 // `fivebar coverage`, `fivebar collision` and `fivebar workspace`, on a design loaded from the
 // edited text of its file.
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/studio.hpp"
 
 #include <algorithm>
@@ -211,12 +212,9 @@ RegionFigure region_figure(Region r) {
   return {std::move(r), std::move(j)};
 }
 
+/// The design file's text, bounded as the loader bounds it (kMaxDesignFileBytes, fivebar/design.hpp).
 std::string read_text(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string() + ": cannot be read");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  return csv::read_bounded(file, kMaxDesignFileBytes, "design file");
 }
 
 std::vector<std::string> split_lines(std::string_view text) {

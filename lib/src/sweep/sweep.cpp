@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "fivebar/collision.hpp"
+#include "fivebar/csv_reader.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/json.hpp"
 #include "fivebar/kinematics.hpp"
@@ -411,6 +412,9 @@ std::vector<std::string> split_csv(const std::string& line) {
   return out;
 }
 
+/// Longest line of a sweep CSV read back: a row is a few hundred bytes (its status message included).
+constexpr std::size_t kMaxSweepCsvLine = std::size_t{64} << 10;
+
 bool parse_double(const std::string& text, double& v) {
   if (text.empty()) {
     v = kNaN;
@@ -424,29 +428,29 @@ bool parse_double(const std::string& text, double& v) {
 
 void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& settings,
                     const std::function<void(const SweepRow&, const std::string& line)>& row) {
-  std::ifstream in(csv);
+  std::ifstream in(csv, std::ios::binary);
   if (!in) throw InputError(csv.string() + ": cannot read the sweep CSV");
-  std::string line;
-  if (!std::getline(in, line) || line != sweep_csv_header(settings)) {
-    throw InputError(csv.string() + ":1: header differs from this sweep's (" + sweep_csv_header(settings) +
-                     "): not the same sweep");
+  // The one bounded reader (fivebar/csv_reader.hpp): a row of this sweep is far below 64 KiB and
+  // the file holds at most the sweep's designs, so a file that is not this sweep's CSV (a link to
+  // /dev/zero, a line with no end) is refused after one bounded line (docs/reliability.md "Resume").
+  csv::Limits limits;
+  limits.max_line = kMaxSweepCsvLine;
+  limits.max_bytes = std::numeric_limits<std::uintmax_t>::max();
+  limits.max_rows = static_cast<std::size_t>(std::min<std::uint64_t>(sweep_size(settings), std::numeric_limits<std::size_t>::max()));
+  csv::Reader reader(in, csv.string(), limits);
+  if (reader.header() != split_csv(sweep_csv_header(settings))) {
+    throw InputError(reader.where() + "header differs from this sweep's (" + sweep_csv_header(settings) + "): not the same sweep");
   }
   const std::size_t nv = settings.vary.size();
-  std::uint64_t line_no = 1;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty()) continue;
-    const auto f = split_csv(line);
-    auto bad = [&](const std::string& why) {
-      throw InputError(csv.string() + ":" + std::to_string(line_no) + ": " + why);
-    };
-    if (f.size() != nv + 13) bad("expected " + std::to_string(nv + 13) + " fields, found " + std::to_string(f.size()));
+  while (reader.next()) {
+    const auto& f = reader.cells();
+    auto bad = [&](const std::string& why) { throw InputError(reader.where() + why); };
     SweepRow r;
     const auto res = std::from_chars(f[0].data(), f[0].data() + f[0].size(), r.index);
-    if (res.ec != std::errc{} || f[0].empty()) bad("index '" + f[0] + "' is not a whole number");
+    if (res.ec != std::errc{} || f[0].empty() || res.ptr != f[0].data() + f[0].size()) bad("index '" + csv::shown(f[0]) + "' is not a whole number");
     r.values.resize(nv);
     for (std::size_t d = 0; d < nv; ++d) {
-      if (!parse_double(f[1 + d], r.values[d]) || std::isnan(r.values[d])) bad("bad value '" + f[1 + d] + "'");
+      if (!parse_double(f[1 + d], r.values[d]) || !std::isfinite(r.values[d])) bad("bad value '" + csv::shown(f[1 + d]) + "'");
     }
     r.status = f[1 + nv];
     if (f[2 + nv] != "0" && f[2 + nv] != "1") bad("covered must be 0 or 1");
@@ -455,9 +459,9 @@ void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& setti
                          &r.min_force_capability, &r.footprint_w_mm, &r.footprint_h_mm, &r.footprint_mm2,
                          &r.collision_fraction, &r.robust_margin_mm};
     for (std::size_t k = 0; k < 10; ++k) {
-      if (!parse_double(f[3 + nv + k], *metrics[k])) bad("bad number '" + f[3 + nv + k] + "'");
+      if (!parse_double(f[3 + nv + k], *metrics[k])) bad("bad number '" + csv::shown(f[3 + nv + k]) + "'");
     }
-    row(r, line);
+    row(r, reader.text());
   }
 }
 
@@ -465,6 +469,16 @@ void read_sweep_csv(const std::filesystem::path& csv, const SweepSettings& setti
 // --- run -----------------------------------------------------------------------------------------
 
 namespace {
+
+/// sweep.identity.json, parsed (null when it is not JSON): a few hundred bytes when fivebar wrote
+/// it, so one past 1 MiB is refused unread (InputError).
+Json read_identity(const std::filesystem::path& path) {
+  try {
+    return Json::parse(csv::read_bounded(path, std::uintmax_t{1} << 20, "sweep identity"));
+  } catch (const Json::exception&) {
+    return Json();
+  }
+}
 
 bool better_lexicographic(const SweepRow& a, const SweepRow& b, const std::vector<std::string>& objectives) {
   for (const std::string& o : objectives) {
@@ -577,13 +591,9 @@ SweepResult run_sweep(const Design& design, const SweepOptions& options) {
                    {"total", result.total}};
   const bool resuming = options.resume && std::filesystem::exists(result.csv);
   if (resuming) {
-    std::ifstream in(identity_path);
-    Json found;
-    try {
-      if (in) found = Json::parse(in);
-    } catch (const Json::exception&) {
-      found = Json();
-    }
+    std::error_code ec;
+    const bool in = std::filesystem::exists(identity_path, ec);
+    const Json found = in ? read_identity(identity_path) : Json();
     if (!in || found != identity) {
       throw InputError(result.csv.string() + ": cannot resume: " +
                        (in ? "not the same sweep: " + identity_path.filename().string() + " names another (design hash " +

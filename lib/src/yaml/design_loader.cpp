@@ -469,6 +469,9 @@ class Loader {
   std::set<std::string>* catalogue = nullptr;
   /// The caller's rule from a layer above the design (DesignRule), or none.
   const DesignRule* scene_rule = nullptr;
+  /// The design file's path (load_design), set on the design before it is validated, so that the
+  /// rules that look at files beside it (the bench files' links, docs/bench-files.md) run at load.
+  std::filesystem::path source;
 };
 
 Loader::Entries Loader::entries(const YAML::Node& map, const std::string& path, int line,
@@ -812,6 +815,7 @@ Design Loader::load(const std::string& raw) {
   }
 
   try {
+    design.source = source;
     design.validate();
     if (scene_rule != nullptr && *scene_rule) (*scene_rule)(design);
   } catch (const ValidationError& e) {
@@ -959,9 +963,10 @@ Design load_design(const std::filesystem::path& path, const DesignRule& rule) {
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxDesignFileBytes) throw too_large(kMaxDesignFileBytes, "more than ");
 
-  Design design = load_design_from_string(text, origin, rule);
-  design.source = path;
-  return design;
+  Loader loader(origin);
+  loader.scene_rule = &rule;
+  loader.source = path;
+  return loader.load(text);
 }
 
 }  // namespace fivebar

@@ -3,6 +3,9 @@
 
 #include "yaml/key_lines.hpp"
 
+#include "fivebar/csv_reader.hpp"
+#include "fivebar/design.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <map>
@@ -35,7 +38,8 @@ void collect(const YAML::Node& node, const std::string& path, std::map<std::stri
 std::optional<int> yaml_key_line(const std::filesystem::path& file, const std::string& key) {
   std::map<std::string, int> lines;
   try {
-    collect(YAML::LoadFile(file.string()), "", lines);
+    // Bounded as the loader bounds a design file (a file swapped since it was loaded included).
+    collect(YAML::Load(csv::read_bounded(file, kMaxDesignFileBytes, "design file")), "", lines);
   } catch (const std::exception&) {
     return std::nullopt;
   }

@@ -247,8 +247,11 @@ ExportCheck check_export(const std::string& text, ExportFormat format, const Des
 /// STL renders: its inertials, visuals and mesh assets are then not compared (not_compared says
 /// so). InputError "ORIGIN:LINE: ..." for text that is not such a document.
 ExportCheck check_robot_export(const std::string& text, const Design& design, const std::string& origin);
+/// Largest file `export --check` reads (docs/reliability.md "Resource bounds").
+inline constexpr std::uintmax_t kMaxExportedFileBytes = std::uintmax_t{64} << 20;
 /// Same, reading `file`: a URDF or MJCF by extension (.urdf, .xml) or by a leading '<', else the
-/// controller formats of detect_export_format().
+/// controller formats of detect_export_format(). InputError naming the file past
+/// kMaxExportedFileBytes (checked while reading).
 ExportCheck check_export_file(const std::filesystem::path& file, const Design& design);
 
 /// The gate and the written files as JSON (units at the edges).

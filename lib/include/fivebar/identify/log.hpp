@@ -27,6 +27,7 @@ inline constexpr double kMaxLogValue = 1e9;                       ///< |cell|, S
 /// One joint's columns, SI (or the linear axis' newtons and metres).
 struct JointLog {
   std::string prefix;      ///< "" (a bench motor) or "index_lower_theta1"
+  std::size_t column = 0;  ///< 1-based column of the header that first names this joint (messages)
   std::string station;     ///< from the prefix, else empty
   std::string mechanism;   ///< from the prefix, else empty
   int joint = 0;           ///< 1 or 2 from the prefix, else 0
@@ -47,6 +48,7 @@ struct JointLog {
 
 struct IdentifyLog {
   std::string path;          ///< for messages
+  std::size_t header_line = 0;  ///< 1-based line of the header (messages)
   std::vector<double> time;  ///< s, strictly increasing
   std::vector<JointLog> joints;
   double sample_time() const;  ///< median step, s

@@ -21,6 +21,11 @@ namespace fivebar::identify {
 /// the design lacks `geometry:` (the links' inertia), or the logged motion leaves the mechanism's
 /// workspace or meets a type II singularity (naming the time). The output-error refinement is not
 /// run (a joint of a closed chain is not simulated alone).
+/// InputError "PATH:LINE: column N 'NAME': the design has no station 'S'" (or no mechanism) for a
+/// joint of `log` whose column prefix names a station or mechanism the design lacks: a typo in a
+/// column is named where it is, not reported as the joint it was meant for being missing.
+void require_log_joints_in(const Design& design, const IdentifyLog& log);
+
 std::vector<JointIdentification> identify_mechanism(const Design& design, const IdentifyLog& log, const std::string& station,
                                                     const std::string& mechanism, const IdentifyOptions& options);
 

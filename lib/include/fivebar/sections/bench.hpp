@@ -20,6 +20,12 @@
 
 namespace fivebar {
 
+/// Whether the files a design names (`bench:`) may lie outside the design file's folder
+/// (docs/bench-files.md "Where bench files may be"). False unless the caller allows it: the
+/// command line's `--allow-outside-paths`. Process-wide; set before designs are loaded.
+void allow_bench_paths_outside(bool allow);
+bool bench_paths_outside_allowed();
+
 struct BenchSettings {
   static constexpr std::string_view kKey = "bench";
   std::string calibration;     ///< as written (relative to the design file); empty: none
@@ -30,7 +36,8 @@ struct BenchSettings {
   static std::filesystem::path resolve(const Design& design, const std::string& file);
   void validate() const;
   /// ValidationError on `bench.<key>` when `file`, resolved and its links followed, lies outside
-  /// the design file's folder (docs/bench-files.md); nothing when it is missing. Called when the
+  /// the design file's folder (docs/bench-files.md); nothing when it is missing or when
+  /// bench_paths_outside_allowed(). Called when the
   /// design is loaded and again by each product before it reads the file.
   static void check_inside(const Design& design, const std::string& key, const std::string& file);
   /// check_inside() for a product about to read the file: InputError "DESIGN: bench.<key> = ...".
