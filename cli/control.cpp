@@ -73,10 +73,14 @@ void print_tuning(const TuneResult& r) {
       std::cout << "                 theta2 " << gains_text(t.before[1]) << std::string(8, ' ') << "theta2 "
                 << gains_text(t.after[1]) << "\n";
     }
-    std::cout << "    " << (t.improved ? "tuned: objective " + figure(t.objective_before_mm, 4) + " -> " +
-                                           figure(t.objective_after_mm, 4) + " mm"
-                                     : "kept the design's gains: no candidate beat them (objective " +
-                                           figure(t.objective_before_mm, 4) + " mm)")
+    std::cout << "    "
+              << (t.improved ? std::string(t.objective_after_mm < t.objective_before_mm
+                                               ? "tuned: objective "
+                                               : "tuned: the design's gains miss a constraint, these meet them; objective ") +
+                                   figure(t.objective_before_mm, 4) + " -> " + figure(t.objective_after_mm, 4) + " mm"
+                  : std::isnan(t.objective_before_mm) ? std::string("kept the design's gains: the budget ended before they were measured")
+                                                      : "kept the design's gains: no candidate beat them (objective " +
+                                                            figure(t.objective_before_mm, 4) + " mm)")
               << "\n";
     const auto onset = [](double hz) {
       return std::isnan(hz) ? std::string("--") : std::isfinite(hz) ? fixed(hz, 1) + " Hz" : std::string("never");

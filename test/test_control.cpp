@@ -33,13 +33,6 @@
 namespace fivebar {
 namespace {
 
-// The tunings of ABadStartImproves... (evaluations per mechanism) and the tolerance of "unchanged".
-#ifdef FIVEBAR_SANITIZE
-constexpr int kBadStartEvaluations = 6, kOptimumEvaluations = 4;
-#else
-constexpr int kBadStartEvaluations = 6, kOptimumEvaluations = 12;
-#endif
-constexpr double kSearchTolerance = 1e-3;
 
 const Design& paper() {
   static const Design d = load_design(std::string(FIVEBAR_SOURCE_DIR) + "/designs/iros2022.yaml");
@@ -617,10 +610,10 @@ std::string showcase_text() {
   text << in.rdbuf();
   return text.str();
 }
-Design showcase_with_index_gains(const PidGains& g) {
+Design showcase_with_index_gains(const PidGains& lower, const PidGains& upper) {
   std::vector<FileEdit> edits;
-  for (const char* m : {"lower", "upper"}) {
-    const std::string key = std::string("controller.stations.index.") + m + ".pid.";
+  for (const auto& [m, g] : {std::pair<std::string, PidGains>{"lower", lower}, {"upper", upper}}) {
+    const std::string key = "controller.stations.index." + m + ".pid.";
     edits.push_back({key + "kp", g.kp});
     edits.push_back({key + "ki", g.ki});
     edits.push_back({key + "kd", g.kd});
@@ -652,16 +645,18 @@ double simulated_objective(const Design& d, const std::string& mechanism, const 
 }
 
 // docs/control.md: the search starts from the design's gains; from spoilt ones (the showcase's
-// kp and kd, ki a third of its) it improves, and the simulation, run here, confirms the result's
-// objective is below the start's. Tuned again from the result, the gains come back as they are.
+// ki and kd, kp 5.5 instead of 6.4: every floor met, the tracking worse) it improves until COBYLA
+// converges, and the simulation, run here, confirms the result's objective is below the start's.
+// Tuned again from the result (the tuner's optimum), no candidate beats it: it comes back to the
+// last bit.
 TEST(ControlTune, ABadStartImprovesAndGainsAtTheOptimumComeBackUnchanged) {
-  const PidGains spoilt{6.376, 20.0, 0.1132, 0.2};
-  const Design d = showcase_with_index_gains(spoilt);
+  const PidGains spoilt{5.5, 62.45, 0.1132, 0.2};
+  const Design d = showcase_with_index_gains(spoilt, spoilt);
   const Station& index = d.require_station("index");
   TuneOptions o = tune_options(*d.get<ControllerSettings>());
   ASSERT_EQ(o.start, TuneStart::design);
-  o.max_evaluations = kBadStartEvaluations;
-  o.max_seconds = 3600.0;  // the evaluation count stops it: deterministic
+  o.max_evaluations = 200;  // COBYLA converges first (about 40 evaluations here)
+  o.max_seconds = 3600.0;
   std::map<std::string, std::map<std::string, MechanismInertia>> inertia{{"index", paper_inertia("index")}};
   const TuneResult r = tune_controller(d, {&index}, inertia, o);
   ASSERT_EQ(r.mechanisms.size(), 2u);
@@ -669,34 +664,38 @@ TEST(ControlTune, ABadStartImprovesAndGainsAtTheOptimumComeBackUnchanged) {
     SCOPED_TRACE(t.mechanism);
     for (std::size_t j = 0; j < 2; ++j) {
       EXPECT_EQ(t.start[j].kp, spoilt.kp);  // the design's gains, per joint
-      EXPECT_EQ(t.start[j].ki, spoilt.ki);
+      EXPECT_EQ(t.before[j].ki, spoilt.ki);
       EXPECT_EQ(t.before[j].kd, spoilt.kd);
     }
+    EXPECT_EQ(t.stop, "converged");
     ASSERT_TRUE(t.improved);
     EXPECT_TRUE(t.feasible);
     const double before = simulated_objective(d, t.mechanism, t.before, o.rtol);
     const double after = simulated_objective(d, t.mechanism, t.after, o.rtol);
     std::cout << t.mechanism << ": objective " << before << " -> " << after << " mm, kp " << t.after[0].kp << " ki "
-              << t.after[0].ki << " kd " << t.after[0].kd << "\n";
+              << t.after[0].ki << " kd " << t.after[0].kd << ", " << t.evaluations << " evaluations\n";
     EXPECT_LT(after, before);
+    // Both admissible (every floor met, the step within its bound): the objective is the tracking.
     EXPECT_NEAR(before, t.objective_before_mm, 1e-9);
     EXPECT_NEAR(after, t.objective_after_mm, 1e-9);
   }
-  // The result as the design's gains (one set for both mechanisms: the lower one's): tuned again
-  // with the same options, no candidate beats them, and they come back to the last bit.
-  const PidGains tuned = r.mechanisms[0].after[0];
-  const Design at_optimum = showcase_with_index_gains(tuned);
-  o.max_evaluations = kOptimumEvaluations;
+  // The result as the design's gains: tuned again with the same options, it is kept exactly.
+  const Design at_optimum = showcase_with_index_gains(r.mechanisms[0].after[0], r.mechanisms[1].after[0]);
   const TuneResult again = tune_controller(at_optimum, {&at_optimum.require_station("index")}, inertia, o);
-  const TunedMechanism& lower = again.mechanisms[0];
-  EXPECT_GT(lower.evaluations, 1);
-  for (std::size_t j = 0; j < 2; ++j) {
-    // Within the search tolerance (xtol_rel 1e-3 on the logarithms): unchanged.
-    EXPECT_NEAR(std::log(lower.after[j].kp / tuned.kp), 0.0, kSearchTolerance);
-    EXPECT_NEAR(std::log(lower.after[j].ki / tuned.ki), 0.0, kSearchTolerance);
-    EXPECT_NEAR(std::log(lower.after[j].kd / tuned.kd), 0.0, kSearchTolerance);
+  ASSERT_EQ(again.mechanisms.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const TunedMechanism& t = again.mechanisms[k];
+    SCOPED_TRACE(t.mechanism);
+    EXPECT_GT(t.evaluations, 1);
+    EXPECT_FALSE(t.improved);
+    for (std::size_t j = 0; j < 2; ++j) {
+      EXPECT_EQ(t.after[j].kp, r.mechanisms[k].after[0].kp);
+      EXPECT_EQ(t.after[j].ki, r.mechanisms[k].after[0].ki);
+      EXPECT_EQ(t.after[j].kd, r.mechanisms[k].after[0].kd);
+    }
+    EXPECT_EQ(t.objective_after_mm, t.objective_before_mm);
+    EXPECT_NEAR(t.objective_before_mm, r.mechanisms[k].objective_after_mm, 1e-12);  // the same figure, re-simulated
   }
-  EXPECT_LE(lower.objective_after_mm, lower.objective_before_mm);
 }
 
 // The merge's edits (gain_merge) give the tuned mechanisms their gains and leave every other joint's;
