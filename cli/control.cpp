@@ -79,8 +79,10 @@ void print_tuning(const TuneResult& r) {
                                                : "tuned: the design's gains miss a constraint, these meet them; objective ") +
                                    figure(t.objective_before_mm, 4) + " -> " + figure(t.objective_after_mm, 4) + " mm"
                   : std::isnan(t.objective_before_mm) ? std::string("kept the design's gains: the budget ended before they were measured")
-                                                      : "kept the design's gains: no candidate beat them (objective " +
-                                                            figure(t.objective_before_mm, 4) + " mm)")
+                  : t.evaluations < 2 ? "kept the design's gains: the budget ended before another candidate was tried (objective " +
+                                            figure(t.objective_before_mm, 4) + " mm)"
+                                      : "kept the design's gains: no candidate beat them (objective " +
+                                            figure(t.objective_before_mm, 4) + " mm)")
               << "\n";
     const auto onset = [](double hz) {
       return std::isnan(hz) ? std::string("--") : std::isfinite(hz) ? fixed(hz, 1) + " Hz" : std::string("never");

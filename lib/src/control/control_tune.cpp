@@ -467,8 +467,7 @@ std::optional<std::array<PidGains, 2>> pole_placement_at(const LoopModel& loop, 
 
 TuneOptions tune_options(const ControllerSettings& c) {
   TuneOptions o;
-  TuneSettings t = c.tune.value_or(TuneSettings{});
-  if (!c.tune) t.start = "design";  // as the loader's default (docs/control.md)
+  const TuneSettings t = c.tune.value_or(TuneSettings{});
   o.rho_limit = t.rho_limit;
   o.max_evaluations = t.evaluations;
   o.max_seconds = t.max_seconds;

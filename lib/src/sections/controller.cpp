@@ -271,9 +271,6 @@ void load(const Value& v, Design& design) {
   if (defaults.travel) c.potentiometer.travel = *defaults.travel;
   if (const Value* t = find(all, "tune")) {
     TuneSettings& tune = c.tune.emplace();
-    // The start a file gets without `start:`: the design's own gains (docs/control.md). Set here,
-    // where a file is read; TuneSettings' in-code default is the older pole placement.
-    tune.start = "design";
     if (!t->is_null()) {  // `tune:` alone: every default
       const auto keys = t->entries({"rho_limit", "evaluations", "max_seconds", "per_joint", "start", "min_damping",
                                     "min_gain_margin"},
