@@ -353,7 +353,7 @@ int run_identify(const IdentifyCliOptions& given) {
   const id::IdentifyLog& est = logs.front();
   std::optional<id::IdentifyLog> val;
   if (!opt.validation.empty()) val = id::read_identify_log(std::filesystem::path(opt.validation));
-  id::require_log_joints_in(design, est);
+  for (const id::IdentifyLog& l : logs) id::require_log_joints_in(design, l);
   if (val) id::require_log_joints_in(design, *val);
   // The study's memory and time from the logs' size, before the work (docs/reliability.md).
   std::size_t rows = val ? val->time.size() : 0;

@@ -28,7 +28,6 @@ KNOWN: dict[str, int] = {
     "lib/src/simulate/simulate.cpp:simulate": 309,
     "lib/src/animate/animation.cpp:animate_pattern_svg": 297,
     "lib/src/parts/parts.cpp:build_parts": 250,
-    "lib/src/control/control_tune.cpp:tune_controller": 248,
     "lib/src/optimize/optimize_search.cpp:run_optimize": 242,
     "lib/src/atlas/atlas_plot.cpp:plot_atlas": 236,
     "lib/src/scene.cpp:products::run_scene_with": 223,

@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -22,6 +23,11 @@ using nlohmann::json;
 using ::testing::HasSubstr;
 
 namespace {
+
+/// Index gains the tuning improves on within kEvaluations evaluations per mechanism (the showcase's
+/// tuned ki and kd, kp 5.5 instead of 6.4: every floor met, the tracking worse).
+const std::string kSpoilt = "{kp: 5.5, ki: 62.45, kd: 0.1132}";
+const std::string kEvaluations = "10";
 
 class CliControl : public ft::CliTest {
  protected:
@@ -142,9 +148,19 @@ TEST_F(CliControl, TuneWritesThePatchAndPrintsBeforeAndAfter) {
   for (const json& m : j["tuning"]["mechanisms"]) {
     EXPECT_EQ(m["station"], "index");
     EXPECT_EQ(m["evaluations"], 3);
-    EXPECT_EQ(m["before"]["gains"]["kp"], 5.0);  // the hand-set controller.pid
-    EXPECT_NE(m["design"]["gains"]["kp"], 5.0);  // the showcase runs an earlier tuning's gains
-    EXPECT_GT(m["start"]["omega_rad_s"].get<double>(), 0.0);  // started from the pole placement
+    // Started from the design's own gains (the showcase runs an earlier tuning's, not controller.pid).
+    EXPECT_NE(m["design"]["gains"]["kp"], 5.0);
+    EXPECT_EQ(m["before"]["gains"], m["design"]["gains"]);
+    EXPECT_EQ(m["start"]["gains"], m["design"]["gains"]);
+    EXPECT_EQ(m["start"]["omega_rad_s"].get<double>(), 0.0);
+    // Never worse: either the design's gains exactly, or a lower objective.
+    if (m["improved"].get<bool>()) {
+      EXPECT_LT(m["after"]["objective_mm"].get<double>(), m["before"]["objective_mm"].get<double>());
+    } else {
+      EXPECT_EQ(m["after"]["gains"], m["design"]["gains"]);
+    }
+    EXPECT_EQ(m["before"]["simulated_s"], m["patterns_s"]);  // the whole patterns, within the 30 s budget
+    EXPECT_TRUE(m["before"]["not_computed"].empty());
     feasible = feasible && m["feasible"].get<bool>();
   }
   EXPECT_EQ(r.code, feasible ? 0 : 1);
@@ -154,7 +170,109 @@ TEST_F(CliControl, TuneWritesThePatchAndPrintsBeforeAndAfter) {
                             "--tune-evaluations", "3", "--out", out});
   EXPECT_THAT(text.out, HasSubstr("gains before"));
   EXPECT_THAT(text.out, HasSubstr("gains after"));
-  EXPECT_THAT(text.out, HasSubstr("index/lower    kp 5.000, ki 1.000, kd 0.0500"));
+  EXPECT_THAT(text.out, HasSubstr("index/lower    kp 6.376, ki 62.450, kd 0.1132"));  // the design's gains
+}
+
+/// The showcase with both index mechanisms' gains replaced (`lower_pid`, `upper_pid`: the flow maps
+/// written after `pid: `).
+std::string with_index_gains(const std::string& text, const std::string& lower_pid, const std::string& upper_pid) {
+  std::string out = text;
+  for (const auto& [mech, pid] : {std::pair<std::string, std::string>{"lower", lower_pid}, {"upper", upper_pid}}) {
+    const std::size_t at = out.find("      " + mech + ": {pid: {kp: 6.");
+    EXPECT_NE(at, std::string::npos);
+    const std::size_t from = out.find("{pid: ", at) + 6;
+    out.replace(from, out.find('}', from) + 1 - from, pid);
+  }
+  return out;
+}
+
+/// Every number of `text` replaced by '#': what must survive a merge byte for byte.
+std::string without_numbers(const std::string& text) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    const char c = text[i];
+    const bool starts = std::isdigit(static_cast<unsigned char>(c)) ||
+                        (c == '.' && i + 1 < text.size() && std::isdigit(static_cast<unsigned char>(text[i + 1])));
+    if (!starts) {
+      out += c;
+      ++i;
+      continue;
+    }
+    while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.' || text[i] == 'e' ||
+                               ((text[i] == '-' || text[i] == '+') && (text[i - 1] == 'e'))))
+      ++i;
+    out += '#';
+  }
+  return out;
+}
+
+// --merge (docs/control.md): from spoilt index gains the tuning improves; the file then differs
+// only in the numbers of the two tuned mechanisms' gains, every comment and other byte kept; the
+// merged design holds exactly the tuned gains, and `control --tune` on it reports as its "before"
+// the figures the first run reported "after".
+TEST_F(CliControl, MergeChangesOnlyTheTunedNumbersAndTheMergedDesignReportsTheTunedFigures) {
+  const std::string original = with_index_gains(read_text(kDesign), kSpoilt, kSpoilt);
+  const std::filesystem::path design = dir_ / "merge.yaml";
+  std::ofstream(design) << original;
+  const std::string out = (dir_ / "merge-out").string();
+  const Outcome r = run({"control", design.string(), "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                         "--tune-evaluations", kEvaluations, "--merge", "--out", out, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = parse(r);
+  ASSERT_TRUE(j["merge"]["written"].get<bool>()) << j["merge"].dump();
+  EXPECT_TRUE(j["merge"]["refusals"].empty());
+  const std::string merged = read_text(design);
+  EXPECT_NE(merged, original);
+  EXPECT_EQ(without_numbers(merged), without_numbers(original));  // comments, keys, spacing: byte for byte
+  // The changed lines are the two index mechanisms' gains, as the printed diff says.
+  ASSERT_EQ(j["merge"]["changes"].size(), 2u);
+  for (const json& c : j["merge"]["changes"]) {
+    EXPECT_THAT(c["before"].get<std::string>(), HasSubstr("{pid: {kp: "));
+    EXPECT_THAT(merged, HasSubstr(c["after"].get<std::string>()));
+  }
+  // The merged design, tuned again with a single evaluation (its own gains: kept), reports as
+  // "before" the gains and figures the first run reported "after".
+  const Outcome again = run({"control", design.string(), "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                             "--tune-evaluations", "1", "--out", out, "--json"});
+  ASSERT_EQ(again.code, 0) << again.err;
+  const json k = parse(again);
+  for (std::size_t m = 0; m < 2; ++m) {
+    const json& first = j["tuning"]["mechanisms"][m];
+    const json& second = k["tuning"]["mechanisms"][m];
+    SCOPED_TRACE(first["mechanism"].get<std::string>());
+    EXPECT_TRUE(first["improved"].get<bool>());
+    EXPECT_EQ(second["before"]["gains"], first["after"]["gains"]);
+    EXPECT_EQ(second["before"]["gains_theta2"], first["after"]["gains_theta2"]);
+    for (const char* figure : {"max_rho", "max_tracking_error_mm", "saturation_fraction", "min_damping", "kp_margin",
+                               "kd_margin", "step_overshoot_mm", "objective_mm"}) {
+      EXPECT_EQ(second["before"][figure], first["after"][figure]) << figure;
+    }
+    EXPECT_FALSE(second["improved"].get<bool>());
+  }
+}
+
+// A merge the export gate's loop checks refuse: exit 1, the reason named, the file unchanged to the byte.
+TEST_F(CliControl, ARefusedMergeLeavesTheFileUnchanged) {
+  std::string text = with_index_gains(read_text(kDesign), kSpoilt, kSpoilt);
+  const std::string key = "max_tracking_error_mm: 0.5";
+  const std::size_t at = text.find(key);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, key.size(), "max_tracking_error_mm: 0.01");  // no gains track the patterns that well
+  const std::filesystem::path design = dir_ / "refused.yaml";
+  std::ofstream(design) << text;
+  const Outcome r = run({"control", design.string(), "-s", "index", "--grid", "9", "--field", "5", "--tune",
+                         "--tune-evaluations", "2", "--merge", "--out", (dir_ / "refused-out").string()});
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("refused"));
+  EXPECT_THAT(r.err, HasSubstr("controller.max_tracking_error_mm 0.01"));
+  EXPECT_THAT(r.out, HasSubstr("merge into "));
+  EXPECT_EQ(read_text(design), text);
+  // --merge without --tune is bad input, before anything is computed or written.
+  const Outcome bad = run({"control", design.string(), "--merge", "--out", (dir_ / "none").string()});
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.err, HasSubstr("--merge"));
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "none"));
+  EXPECT_EQ(read_text(design), text);
 }
 
 TEST_F(CliControl, ADesignWithoutMotorsIsBadInputAndWritesNothing) {

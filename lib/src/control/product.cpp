@@ -40,19 +40,24 @@ constexpr const char* kPerformance =
     "(none when the quantisation forbids it at any rate).\n\n";
 
 constexpr const char* kTuning =
-    "`controller.tune` asks for the gains to be tuned, per mechanism (lib/include/fivebar/control.hpp "
-    "\"Tuning\"): a pole placement on the loop linearised at the target's centre (the three roots of each "
-    "joint's PID loop at −ω, ω chosen for the least spectral radius over the target) is refined by NLopt's "
-    "COBYLA to the least worst simulated tracking error over the station's patterns, with the constraints an "
+    "`controller.tune` asks for the gains to be tuned, per mechanism (lib/include/fivebar/control/tune.hpp "
+    "\"Tuning\"): from the gains the design runs (or, with `controller.tune.start`, a pole placement on the loop "
+    "linearised at the target's centre, or the hand-set gains), NLopt's "
+    "COBYLA searches the least worst simulated tracking error over the station's patterns, with the constraints an "
     "engineer sets over the target (the export gate's grid): spectral radius at most the limit, every oscillatory "
     "pole damped at least `controller.tune.min_damping` (ζ), kp and kd each multipliable by "
     "`controller.tune.min_gain_margin` without losing stability, the simulated 1 mm step (duty saturation and "
     "integral clamp included) overshooting no more than a second-order loop at that ζ, and no sustained "
     "saturation; masses from the closed form, as the export gate. The chirp (0.2 mm, 0.5 Hz to a quarter of the "
     "loop rate) gives the −3 dB bandwidth and the frequency at which a motor's duty first saturates; the "
-    "bandwidth reported is the smaller. \"Before\" is the hand-set PID (the file's gains without the "
-    "per-station-mechanism scopes a tuning patch writes); `control/tuned-controller.yaml` is the patch of "
-    "`controller:` that applies the tuned gains, `control/tuning.csv` the table.\n\n";
+    "bandwidth reported is the smaller. \"Before\" is the design's own PID, evaluated on the same objective and "
+    "constraints: the tuned gains replace it only when they beat it, otherwise the design's gains are kept. "
+    "`controller.tune.max_seconds` bounds the whole tuning, these figures included (a figure it cut is shown as "
+    "--). `control/tuned-controller.yaml` is the patch of `controller:` that applies the tuned gains "
+    "(`fivebar control --tune --merge` writes them into the design), `control/tuning.csv` the table.\n\n";
+
+/// A figure, or "--" when the time bound left it uncomputed.
+std::string figure(double v, int digits) { return std::isnan(v) ? std::string("--") : md::fixed(v, digits); }
 
 std::string gains_cell(const PidGains& g) {
   return "kp " + md::fixed(g.kp, 3) + ", ki " + md::fixed(g.ki, 3) + ", kd " + md::fixed(g.kd, 4);
@@ -63,6 +68,77 @@ std::string gains_cell(const std::array<PidGains, 2>& g) {
   if (g[0].kp == g[1].kp && g[0].ki == g[1].ki && g[0].kd == g[1].kd) return gains_cell(g[0]);
   return "θ1 " + gains_cell(g[0]) + "; θ2 " + gains_cell(g[1]);
 }
+
+/// The tuning's tables, result and check line (the `control` product under `controller.tune`).
+void add_tuning(Built& b, const TuneResult& tuned) {
+  md::Table t({"station", "mechanism", "gains before (the design's)", "start", "gains after (tuned)", "max ρ before → after",
+               "worst tracking error before → after (mm)", "saturated before → after", "evaluations", "stop",
+               "the design runs"},
+              "lllllrrrrll");
+  bool feasible = true, applied = true;
+  double worst_before = 0.0, worst_after = 0.0;
+  for (const TunedMechanism& m : tuned.mechanisms) {
+    feasible = feasible && m.feasible;
+    applied = applied && m.applied();
+    worst_before = std::max(worst_before, m.error_before_mm);
+    worst_after = std::max(worst_after, m.error_after_mm);
+    bool design_start = m.start_omega_rad_s == 0.0;
+    for (std::size_t j = 0; j < 2; ++j) {
+      design_start = design_start && m.start[j].kp == m.design[j].kp && m.start[j].ki == m.design[j].ki &&
+                     m.start[j].kd == m.design[j].kd;
+    }
+    t.row({m.station, m.mechanism, gains_cell(m.before),
+           (m.start_omega_rad_s > 0.0 ? "pole placement, ω " + md::fixed(m.start_omega_rad_s, 1) + " rad/s"
+            : design_start           ? std::string("the design's gains")
+                                     : std::string("the hand-set gains")) +
+               ", max ρ " + md::fixed(m.rho_start, 4),
+           m.improved ? gains_cell(m.after) : "kept (no candidate beat them)",
+           md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
+           figure(m.error_before_mm, 3) + " → " + figure(m.error_after_mm, 3),
+           figure(100 * m.saturation_before, 1) + " % → " + figure(100 * m.saturation_after, 1) + " %",
+           std::to_string(m.evaluations),
+           m.stop + (m.stop == "time limit" ? " (controller.tune.max_seconds)" : "") +
+               (m.feasible ? "" : ", **not feasible**"),
+           m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design) + ")"});
+  }
+  md::Table f({"station", "mechanism", "least ζ (Hz) before → after", "kp margin before → after",
+               "kd margin before → after", "1 mm step overshoot (mm) before → after",
+               "chirp −3 dB / saturates at (Hz) before → after", "bandwidth (Hz) before → after",
+               "tracking error (mm) before → after"},
+              "llrrrrrrr");
+  const auto onset = [](double hz) {
+    return std::isnan(hz) ? std::string("--") : std::isfinite(hz) ? md::fixed(hz, 1) : std::string("never");
+  };
+  const auto chirp = [&](double bw, double sat) { return figure(bw, 1) + " / " + onset(sat); };
+  for (const TunedMechanism& m : tuned.mechanisms) {
+    f.row({m.station, m.mechanism,
+           md::fixed(m.damping_before, 3) + " (" + md::fixed(m.damping_hz_before, 1) + ") → " +
+               md::fixed(m.damping_after, 3) + " (" + md::fixed(m.damping_hz_after, 1) + ")",
+           "×" + figure(m.kp_margin_before, 2) + " → ×" + figure(m.kp_margin_after, 2),
+           "×" + figure(m.kd_margin_before, 2) + " → ×" + figure(m.kd_margin_after, 2),
+           figure(m.overshoot_before_mm, 3) + " → " + figure(m.overshoot_after_mm, 3),
+           chirp(m.chirp_bandwidth_before_hz, m.chirp_saturation_before_hz) + " → " +
+               chirp(m.chirp_bandwidth_after_hz, m.chirp_saturation_after_hz),
+           figure(m.bandwidth_before_hz, 1) + " → " + figure(m.bandwidth_after_hz, 1),
+           figure(m.error_before_mm, 3) + " → " + figure(m.error_after_mm, 3)});
+  }
+  b.result["tuning"] = to_json(tuned);
+  b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nThe engineer's figures, the design's → tuned " +
+                "(floors: ζ ≥ " + md::fixed(tuned.min_damping, 2) + ", margins ≥ ×" +
+                md::fixed(tuned.min_gain_margin, 2) + ", step overshoot ≤ " +
+                md::fixed(tuned.max_overshoot_fraction, 3) + " mm):\n\n" + f.str() + "\nTuned in " +
+                md::fixed(tuned.wall_s, 1) + " s (budget " + md::fixed(tuned.budget_s, 1) + " s, these figures included), max ρ ≤ " +
+                md::fixed(tuned.rho_limit, 2) + " over the target." +
+                (applied ? " The design runs the tuned gains.\n"
+                         : " The design does not run the tuned gains everywhere: merge "
+                           "`control/tuned-controller.yaml` into its `controller:` section.\n");
+  b.passed = b.passed && feasible;
+  b.check += "; tuned: worst tracking error " + md::fixed(worst_before, 3) + " → " + md::fixed(worst_after, 3) +
+             " mm with max ρ ≤ " + md::fixed(tuned.rho_limit, 2) +
+             (feasible ? "" : " (NOT feasible for every mechanism)") +
+             (applied ? ", the design runs them" : ", not applied (control/tuned-controller.yaml)");
+}
+
 
 }  // namespace
 
@@ -157,63 +233,7 @@ Product control_product() {
       }
       ctx.write_file("control/tuned-controller.yaml", tuned_patch_yaml(tuned));
       ctx.write_file("control/tuning.csv", tuning_csv(tuned));
-      md::Table t({"station", "mechanism", "gains before (hand-set)", "start", "gains after (tuned)", "max ρ before → after",
-                   "worst tracking error before → after (mm)", "saturated before → after", "evaluations", "stop",
-                   "the design runs"},
-                  "lllllrrrrll");
-      bool feasible = true, applied = true;
-      double worst_before = 0.0, worst_after = 0.0;
-      for (const TunedMechanism& m : tuned.mechanisms) {
-        feasible = feasible && m.feasible;
-        applied = applied && m.applied();
-        worst_before = std::max(worst_before, m.error_before_mm);
-        worst_after = std::max(worst_after, m.error_after_mm);
-        t.row({m.station, m.mechanism, gains_cell(m.before),
-               (m.start_omega_rad_s > 0.0 ? "pole placement, ω " + md::fixed(m.start_omega_rad_s, 1) + " rad/s"
-                                          : std::string("the hand-set gains")) +
-                   ", max ρ " + md::fixed(m.rho_start, 4),
-               gains_cell(m.after),
-               md::fixed(m.rho_before, 4) + " → " + md::fixed(m.rho_after, 4),
-               md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3),
-               md::fixed(100 * m.saturation_before, 1) + " % → " + md::fixed(100 * m.saturation_after, 1) + " %",
-               std::to_string(m.evaluations),
-               m.stop + (m.stop == "time limit" ? " (controller.tune.max_seconds)" : "") +
-                   (m.feasible ? "" : ", **not feasible**"),
-               m.applied() ? "the tuned gains" : "other gains (" + gains_cell(m.design) + ")"});
-      }
-      md::Table f({"station", "mechanism", "least ζ (Hz) before → after", "kp margin before → after",
-                   "kd margin before → after", "1 mm step overshoot (mm) before → after",
-                   "chirp −3 dB / saturates at (Hz) before → after", "bandwidth (Hz) before → after",
-                   "tracking error (mm) before → after"},
-                  "llrrrrrrr");
-      const auto onset = [](double hz) { return std::isfinite(hz) ? md::fixed(hz, 1) : std::string("never"); };
-      const auto chirp = [&](double bw, double sat) { return md::fixed(bw, 1) + " / " + onset(sat); };
-      for (const TunedMechanism& m : tuned.mechanisms) {
-        f.row({m.station, m.mechanism,
-               md::fixed(m.damping_before, 3) + " (" + md::fixed(m.damping_hz_before, 1) + ") → " +
-                   md::fixed(m.damping_after, 3) + " (" + md::fixed(m.damping_hz_after, 1) + ")",
-               "×" + md::fixed(m.kp_margin_before, 2) + " → ×" + md::fixed(m.kp_margin_after, 2),
-               "×" + md::fixed(m.kd_margin_before, 2) + " → ×" + md::fixed(m.kd_margin_after, 2),
-               md::fixed(m.overshoot_before_mm, 3) + " → " + md::fixed(m.overshoot_after_mm, 3),
-               chirp(m.chirp_bandwidth_before_hz, m.chirp_saturation_before_hz) + " → " +
-                   chirp(m.chirp_bandwidth_after_hz, m.chirp_saturation_after_hz),
-               md::fixed(m.bandwidth_before_hz, 1) + " → " + md::fixed(m.bandwidth_after_hz, 1),
-               md::fixed(m.error_before_mm, 3) + " → " + md::fixed(m.error_after_mm, 3)});
-      }
-      b.result["tuning"] = to_json(tuned);
-      b.markdown += "### Tuning\n\n" + std::string(kTuning) + t.str() + "\nThe engineer's figures, hand-set → tuned " +
-                    "(floors: ζ ≥ " + md::fixed(tuned.min_damping, 2) + ", margins ≥ ×" +
-                    md::fixed(tuned.min_gain_margin, 2) + ", step overshoot ≤ " +
-                    md::fixed(tuned.max_overshoot_fraction, 3) + " mm):\n\n" + f.str() + "\nTuned in " +
-                    md::fixed(tuned.wall_s, 1) + " s, max ρ ≤ " + md::fixed(tuned.rho_limit, 2) + " over the target." +
-                    (applied ? " The design runs the tuned gains.\n"
-                             : " The design does not run the tuned gains everywhere: merge "
-                               "`control/tuned-controller.yaml` into its `controller:` section.\n");
-      b.passed = b.passed && feasible;
-      b.check += "; tuned: worst tracking error " + md::fixed(worst_before, 3) + " → " + md::fixed(worst_after, 3) +
-                 " mm with max ρ ≤ " + md::fixed(tuned.rho_limit, 2) +
-                 (feasible ? "" : " (NOT feasible for every mechanism)") +
-                 (applied ? ", the design runs them" : ", not applied (control/tuned-controller.yaml)");
+      add_tuning(b, tuned);
     }
     return b;
   };

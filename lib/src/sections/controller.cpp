@@ -109,8 +109,8 @@ void TuneSettings::validate() const {
   if (!(min_gain_margin >= 1.0) || !(min_gain_margin <= 100.0)) {
     throw ValidationError("min_gain_margin", "= " + plain_number(min_gain_margin) + ": must be in [1, 100] (a factor on the gains)");
   }
-  if (start != "pole_placement" && start != "hand_set") {
-    throw ValidationError("start", "= " + detail::quoted(start) + ": must be pole_placement or hand_set");
+  if (start != "design" && start != "pole_placement" && start != "hand_set") {
+    throw ValidationError("start", "= " + detail::quoted(start) + ": must be design, pole_placement or hand_set");
   }
 }
 
@@ -285,7 +285,7 @@ void load(const Value& v, Design& design) {
         if (word != "true" && word != "false") pj->fail_value("must be true or false");
         tune.per_joint = word == "true";
       }
-      if (const Value* st = find(keys, "start")) tune.start = st->text("must be pole_placement or hand_set");
+      if (const Value* st = find(keys, "start")) tune.start = st->text("must be design, pole_placement or hand_set");
     }
   }
 

@@ -54,6 +54,18 @@ std::shared_ptr<const runtime::Config> exported_config(const Design& design, con
   return std::make_shared<const runtime::Config>(std::move(config));
 }
 
+/// The loop's step response runs without the runtime's slew limit (docs/runtime.md "One cycle"
+/// 5): through it a 1 mm step becomes a ramp at the joint speed, which measures the limiter rather
+/// than the loop (the tuner holds the overshoot against a loop's damping; the report compares
+/// integrators on this input).
+std::shared_ptr<const runtime::Config> without_slew_limit(const runtime::Config& exported) {
+  auto unlimited = std::make_shared<runtime::Config>(exported);
+  for (runtime::StationConfig& st : unlimited->stations)
+    for (runtime::MechanismConfig& m : st.mechanisms)
+      for (runtime::JointConfig& j : m.joints) j.has_velocity_limits = false;
+  return unlimited;
+}
+
 }  // namespace
 
 runtime::Config runtime_config(const SimulationInput& input) {
@@ -179,15 +191,7 @@ std::vector<SimulationInput> simulation_inputs(const Design& design, const Simul
     for (const PatternSpec& s : specs)
       if (s.kind == PatternKind::stretch) separation = s.separation_mm;
     SimulationInput in = make("step");
-    // The loop's step response: the runtime's slew limit is off here (docs/runtime.md "One cycle"
-    // 5), since through it a 1 mm step becomes a ramp at the joint speed, which measures the
-    // limiter rather than the loop (the tuner holds the overshoot against a loop's damping; the
-    // report compares integrators on this input).
-    auto unlimited = std::make_shared<runtime::Config>(*runtime);
-    for (runtime::StationConfig& st : unlimited->stations)
-      for (runtime::MechanismConfig& m : st.mechanisms)
-        for (runtime::JointConfig& j : m.joints) j.has_velocity_limits = false;
-    in.runtime = std::move(unlimited);
+    in.runtime = without_slew_limit(*runtime);
     const Vec2 c = station.target.center;
     const std::array<Vec2, 2> start{c - Vec2(0.0, 0.5 * separation), c + Vec2(0.0, 0.5 * separation)};
     const auto n = static_cast<std::size_t>(std::floor(request.step_hold_s * rate + tol::kSamplePeriodsRel)) + 1;

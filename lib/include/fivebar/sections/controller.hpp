@@ -69,9 +69,11 @@ struct TuneSettings {
   int evaluations = 60;       ///< objective evaluations per mechanism (each simulates every pattern)
   double max_seconds = 30.0;  ///< wall-time bound of the whole tuning, s
   bool per_joint = false;     ///< kp, ki, kd per joint instead of one set per mechanism
-  /// Where the optimiser starts: "pole_placement" (on the linearised model at the target's
-  /// centre) or "hand_set" (the file's gains).
-  std::string start = "pole_placement";
+  /// Where the optimiser starts: "design" (the gains the design runs, per joint), "pole_placement"
+  /// (on the linearised model at the target's centre) or "hand_set" (the file's gains without the
+  /// `stations.<s>.<m>` scopes a tuning patch writes). Whatever the start, the result is never
+  /// worse than the design's gains (docs/control.md).
+  std::string start = "design";
   /// Least damping ratio of any oscillatory closed-loop pole allowed anywhere on the target grid.
   /// 0.3 is a stated engineering floor, not a datasheet value: a second-order loop at zeta = 0.3
   /// overshoots a step by exp(-pi zeta / sqrt(1 - zeta^2)) = 37 %; the tuned large step (with the
