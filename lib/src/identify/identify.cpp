@@ -34,6 +34,18 @@ double relative_error_percent(const std::vector<double>& y, const std::vector<do
   return ny > 0.0 ? 100.0 * norm(d) / ny : 0.0;
 }
 
+/// One RK4 step of x' = w, w' = f(w) (the reduced model's speed equation), the open-loop and the
+/// closed-loop simulations' one integrator.
+template <class F>
+void rk4_step(double& x, double& w, double h, const F& f) {
+  const double a1 = f(w);
+  const double a2 = f(w + 0.5 * h * a1);
+  const double a3 = f(w + 0.5 * h * a2);
+  const double a4 = f(w + h * a3);
+  x += h / 6.0 * (w + 2.0 * (w + 0.5 * h * a1) + 2.0 * (w + 0.5 * h * a2) + (w + h * a3));
+  w += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+}
+
 /// The filtered motion and drive of one log.
 struct Prepared {
   std::vector<double> q, qf, v, a;      // full rate
@@ -445,12 +457,7 @@ std::vector<double> simulate_position(const std::vector<double>& time, const std
   for (std::size_t k = 0; k + 1 < time.size(); ++k) {
     const double h = time[k + 1] - time[k];
     auto f = [&](double ww) { return acceleration(th, per_direction, g, u[k], ww, ws); };
-    const double a1 = f(w);
-    const double a2 = f(w + 0.5 * h * a1);
-    const double a3 = f(w + 0.5 * h * a2);
-    const double a4 = f(w + h * a3);
-    x += h / 6.0 * (w + 2.0 * (w + 0.5 * h * a1) + 2.0 * (w + 0.5 * h * a2) + (w + h * a3));
-    w += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+    rk4_step(x, w, h, f);
     out[k + 1] = x;
   }
   return out;
@@ -823,12 +830,7 @@ std::vector<double> simulate_closed_loop(const std::vector<double>& time, LoopCo
     const double u = alpha * d;
     auto f = [&](double ww) { return acceleration(th, per_direction, g, u, ww, ws); };
     for (int i = 0; i < sub; ++i) {
-      const double a1 = f(w);
-      const double a2 = f(w + 0.5 * h * a1);
-      const double a3 = f(w + 0.5 * h * a2);
-      const double a4 = f(w + h * a3);
-      x += h / 6.0 * (w + 2.0 * (w + 0.5 * h * a1) + 2.0 * (w + 0.5 * h * a2) + (w + h * a3));
-      w += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+      rk4_step(x, w, h, f);
     }
   }
   return out;
