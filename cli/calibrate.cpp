@@ -17,7 +17,7 @@
 #include "common.hpp"
 #include "fivebar/calibrate.hpp"
 #include "fivebar/csv_reader.hpp"
-#include "fivebar/provenance.hpp"  // today_utc()
+#include "fivebar/provenance.hpp"  // today_utc(), recorded_source()
 #include "fivebar/provenance/gate.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
@@ -148,7 +148,8 @@ int run_calibrate(const CalibrateCliOptions& opt) {
   if (!opt.hard_stops.empty()) {
     const std::string text = read_text(opt.hard_stops, "hard-stop readings");
     const calibrate::CalibrationResult r = calibrate::hard_stop_calibration(design, text, opt.hard_stops);
-    source.file = opt.hard_stops;
+    // Recorded relative to the folder the patched design is written in (checked from there).
+    source.file = opt.out.empty() ? opt.hard_stops : recorded_source(opt.hard_stops, opt.out);
     source.sha256 = sha256_hex(text);
     doc["hard_stops"] = calibrate::to_json(r);
     if (!opt.json) print_result(r);
@@ -174,7 +175,7 @@ int run_calibrate(const CalibrateCliOptions& opt) {
     co.sigma_mm = opt.sigma_mm;
     co.holdout = opt.holdout;
     const calibrate::CalibrationResult r = calibrate::calibrate(design, rows, co, opt.measurements);
-    source.file = opt.measurements;
+    source.file = opt.out.empty() ? opt.measurements : recorded_source(opt.measurements, opt.out);
     source.sha256 = sha256_hex(text);
     doc["calibration"] = calibrate::to_json(r);
     if (!opt.json) print_result(r);

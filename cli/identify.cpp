@@ -255,9 +255,10 @@ int run_plan(const IdentifyCliOptions& opt, const Design& design) {
 }
 
 /// Where the identified values come from: the log, its hash, today, the method.
-MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig) {
+/// `folder`: where the patched design is written; the log is recorded relative to it.
+MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig, const std::filesystem::path& folder) {
   MeasurementSource source;
-  source.file = opt.log;
+  source.file = recorded_source(opt.log, folder);
   source.sha256 = sha256_file(opt.log);
   source.date = today_utc();
   source.method = std::string(mechanism_rig ? "fivebar identify --rig mechanism: " : "fivebar identify --rig motor: ") +
@@ -266,7 +267,7 @@ MeasurementSource log_source(const IdentifyCliOptions& opt, bool mechanism_rig) 
                                         : "inverse dynamic model by least squares (IDIM-LS)") +
                   ", standard deviation";
   // Several logs: the entry's source is the first (its hash is checked); the others are named with theirs.
-  for (std::size_t i = 1; i < opt.logs.size(); ++i) source.method += "; with " + opt.logs[i] + " (sha256 " + sha256_file(opt.logs[i]) + ")";
+  for (std::size_t i = 1; i < opt.logs.size(); ++i) source.method += "; with " + recorded_source(opt.logs[i], folder) + " (sha256 " + sha256_file(opt.logs[i]) + ")";
   return source;
 }
 
@@ -409,7 +410,8 @@ int run_identify(const IdentifyCliOptions& given) {
   // with the values that passed the quality gate ("The quality gate").
   std::optional<id::Patch> patch;
   if (refused.empty()) {
-    patch = id::patch_design(design, results, log_source(opt, !rig_station.empty()), opt.method == "oe");
+    patch = id::patch_design(design, results, log_source(opt, !rig_station.empty(), command_output_dir(opt.out, design.name, "identify")),
+                             opt.method == "oe");
     if (patch->design) patch->design->reset<BenchSettings>();  // written elsewhere: its bench: files would not resolve
     doc["gate"] = gate::to_json(patch->gate);
     doc["patched"] = patch->patched;

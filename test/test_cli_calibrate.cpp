@@ -193,6 +193,33 @@ TEST_F(CliCalibrate, AFitThatFailsTheQualityGateIsRefusedWithReasonsAndNothingWr
   EXPECT_TRUE(doc["files"].empty());
 }
 
+// The entry names its measurement file relative to the patched design's folder, the way
+// require_measured resolves it: given relative to the working directory (bench/m.csv, the patch
+// written into cal/), its hash is still checked when the patch is loaded from anywhere else, and an
+// edit of the file after the fit makes every value it measured untrusted. (Recorded as given, the
+// entry named cal/bench/m.csv: not found, so never checked.)
+TEST_F(CliCalibrate, TheRecordedSourceIsFoundFromThePatchedDesignWhereverItRuns) {
+  fs::create_directories(dir_ / "bench");
+  write("bench/m.csv", csv(40));
+  const ft::Outcome r = run({"calibrate", kDesign, "bench/m.csv", "--out", "cal"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const fs::path patched = dir_ / "cal" / "iros2022-calibrated.yaml";
+  EXPECT_THAT(ft::slurp(patched), HasSubstr("source: \"../bench/m.csv\""));
+  const auto untrusted = [&] {
+    return fivebar::untrusted_values(fivebar::load_design(patched), "kinematics", {"index"}, "lower");
+  };
+  EXPECT_TRUE(untrusted().empty());
+  // The kinematic values the fit measured: the first eight calibration keys that have an entry.
+  const fivebar::Design d = fivebar::load_design(patched);
+  const auto keys = fivebar::calibration_keys(d, "index", "lower");
+  const auto measured = std::count_if(keys.begin(), keys.begin() + 8, [&](const std::string& k) { return fivebar::is_measured(d, k); });
+  ASSERT_GT(measured, 0);
+  std::ofstream(dir_ / "bench" / "m.csv", std::ios::app) << "index,lower,0.1,0.2,1,2\n";
+  const auto after = untrusted();
+  EXPECT_EQ(static_cast<long>(after.size()), static_cast<long>(measured));
+  for (const fivebar::UntrustedValue& v : after) EXPECT_THAT(v.reason, HasSubstr("has changed since the fit")) << v.key;
+}
+
 // controller.require_measured follows --station: the index station measured through gated fits is
 // exported although the thumb is still assumed; a hand-written entry (no gate) is not trusted.
 TEST_F(CliCalibrate, RequireMeasuredFollowsTheExportedStationsAndTrustsOnlyGatedEntries) {

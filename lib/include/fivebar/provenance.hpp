@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -99,11 +100,16 @@ std::array<std::string, 12> calibration_keys(const Design& design, std::string_v
 
 /// Where measured values came from: the fields of a provenance entry but the sigma.
 struct MeasurementSource {
-  std::string file;    ///< as given on the command line
+  std::string file;    ///< relative to the folder of the design the entry is written in (recorded_source())
   std::string sha256;  ///< of its bytes (fivebar/sha256.hpp)
   std::string date;    ///< YYYY-MM-DD, UTC
   std::string method;  ///< "fivebar calibrate: ...", "fivebar identify: IDIM-LS ...", ...
 };
+/// The path a provenance entry records for `data` (a file read now, a path as the user gave it,
+/// relative to the working directory) when the design carrying the entry is written into
+/// `design_folder`: relative to that folder, the way untrusted_values() resolves it, so that the
+/// file's hash is checked wherever fivebar later runs; absolute when no relative path leads there.
+std::string recorded_source(const std::filesystem::path& data, const std::filesystem::path& design_folder);
 /// Today's date, YYYY-MM-DD (UTC): the `date` of the entries written now.
 std::string today_utc();
 /// One measured value: the key path it sets and its standard deviation (the key's file unit).

@@ -69,7 +69,8 @@ Product identify_product() {
     }
     Json doc = {{"log", name}, {"method", closed ? "IDIM-IV" : "IDIM-LS"}, {"joints", Json::array()}};
     for (const auto& r : results) doc["joints"].push_back(identify::to_json(r));
-    MeasurementSource source{name, sha256_file(file), today_utc(),
+    // The patched design is written into <output>/identify/: the log recorded relative to it.
+    MeasurementSource source{recorded_source(file, ctx.dir / "identify"), sha256_file(file), today_utc(),
                              closed ? "fivebar identify --rig motor --closed-loop: inverse dynamic model by instrumental variables under the "
                                       "design's PID (IDIM-IV), standard deviation"
                                     : "fivebar identify --rig motor: inverse dynamic model by least squares (IDIM-LS), standard deviation"};

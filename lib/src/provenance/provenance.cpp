@@ -322,6 +322,18 @@ std::string today_utc() {
   return buffer;
 }
 
+std::string recorded_source(const std::filesystem::path& data, const std::filesystem::path& design_folder) {
+  namespace fs = std::filesystem;
+  std::error_code e1;
+  std::error_code e2;
+  // Both made absolute and free of links and dots, so the relative path leads where the OS would.
+  const fs::path to = fs::weakly_canonical(fs::absolute(data, e1), e1);
+  const fs::path from = fs::weakly_canonical(fs::absolute(design_folder.empty() ? fs::path(".") : design_folder, e2), e2);
+  if (e1 || e2) return data.generic_string();
+  const fs::path relative = to.lexically_relative(from);
+  return relative.empty() ? to.generic_string() : relative.generic_string();
+}
+
 Design with_measured_values(const Design& design, const std::vector<MeasuredValue>& values, const MeasurementSource& source,
                             const Eigen::MatrixXd& covariance, const std::vector<GateRecord>& gates) {
   if (!gates.empty() && gates.size() != values.size()) throw std::invalid_argument("with_measured_values: one gate record per value");
