@@ -55,6 +55,7 @@ struct IdentifyCliOptions {
   std::optional<int> decimation;  ///< given: >= 1
   bool per_direction = false;
   bool instant_drive = false;
+  bool keep_reversals = false;
   bool no_output_error = false;
   std::string method = "idim";
   bool json = false;
@@ -100,7 +101,11 @@ std::string fit_text(const id::Fit& f, bool chain = false) {
 void print_joint(const id::JointIdentification& r) {
   std::cout << "joint " << r.joint << ": drive " << r.drive_column << ", reading " << r.reading_column << ", "
             << format::shortest(1.0 / r.sample_time) << " Hz, low-pass " << format::shortest(r.cutoff_hz)
-            << " Hz (Butterworth, zero phase), decimation " << r.decimation << ", " << r.idim.rows << " rows\n";
+            << " Hz (Butterworth, zero phase), decimation " << r.decimation << ", " << r.idim.rows << " rows";
+  if (r.reversal_samples > 0) {
+    std::cout << " (" << r.reversal_rows << " within " << r.reversal_samples << " samples of a reversal left out)";
+  }
+  std::cout << "\n";
   print_estimate_table(r);
   if (!r.unidentifiable.empty()) {
     std::cout << "  not identifiable from this log (held at the prior): " << format::join(r.unidentifiable) << "\n";
@@ -373,6 +378,7 @@ int run_identify(const IdentifyCliOptions& given) {
   o.decimation = opt.decimation.value_or(0);  // 0: the library's default
   o.per_direction = opt.per_direction;
   o.zero_order_hold = !opt.instant_drive;
+  o.skip_reversals = !opt.keep_reversals;
   o.output_error = !opt.no_output_error;
   o.use_output_error = opt.method == "oe";
   if (o.use_output_error && !o.output_error) throw InputError("--method oe: needs the output-error refinement (drop --no-output-error)");
@@ -501,6 +507,9 @@ void setup_identify(CLI::App& app) {
   sub->add_option("--filter-order", opt->filter_order, "Butterworth order (run forward and backward)")->capture_default_str();
   sub->add_option("--decimation", opt->decimation, "Decimation factor (default 10)")->type_name("R");
   sub->add_flag("--per-direction", opt->per_direction, "Viscous friction per direction of motion");
+  sub->add_flag("--keep-reversals", opt->keep_reversals,
+                "Voltage and duty drives: keep the rows near a reversal of the speed (by default those within the "
+                "filters' main lobes of one are left out: the reading stalls in the backlash while the motor turns)");
   sub->add_flag("--instant-drive", opt->instant_drive,
                 "The drive column is an instantaneous value at each sample (default: a command held over the sample, "
                 "so the regression takes the mean of two consecutive commands)");

@@ -212,6 +212,13 @@ int edge_samples(int order, double cutoff_hz, double fs, int decimation) {
   return settling_samples(butterworth_lowpass(order, cutoff_hz, fs), kEdgeTail) + 2 + decimation_settling_samples(decimation, kEdgeTail);
 }
 
+int reversal_samples(double cutoff_hz, double fs, int decimation) {
+  // Half the main lobe of each low-pass, 1 / (2 f_c): the position's and, at 0.8 of fs / (2 R), the
+  // decimation's; the two samples of the one-sided differences.
+  const double lobe = 0.5 * fs / cutoff_hz + (decimation > 1 ? 0.5 * fs / (0.8 * fs / (2.0 * decimation)) : 0.0);
+  return static_cast<int>(std::ceil(lobe)) + 2;
+}
+
 double decimation_noise_gain(int factor) {
   if (factor < 2) return 1.0;
   const auto sos = decimation_filter(factor);

@@ -52,6 +52,8 @@ Json to_json(const JointIdentification& r) {
             {"cutoff_hz", r.cutoff_hz},
             {"decimation", r.decimation},
             {"edge_samples", r.edge_samples},
+            {"reversal_samples", r.reversal_samples},
+            {"reversal_rows", r.reversal_rows},
             {"method", r.method},
             {"logs", r.logs}};
   j["parameters"] = Json::array();

@@ -52,6 +52,11 @@ inline constexpr double kEdgeTail = 1e-3;
 /// than on the data: the position low-pass's settling (Butterworth `order` at `cutoff_hz`), the two
 /// samples of the one-sided differences, and the decimation filter's settling (kEdgeTail).
 int edge_samples(int order, double cutoff_hz, double sample_rate_hz, int decimation);
+/// Full-rate samples on each side of a reversal of the filtered speed within which a disturbance at
+/// the reversal (the reading stalled in the backlash) weighs on the IDIM-LS rows: half the main lobe
+/// of the position's low-pass (`cutoff_hz`) and of the decimation filter, and the two samples of the
+/// one-sided differences (20 at 1 kHz, fs / 10, decimation 10).
+int reversal_samples(double cutoff_hz, double sample_rate_hz, int decimation);
 /// The sections of decimate()'s anti-aliasing filter at `factor` (>= 2), normalised frequency (fs 1).
 std::vector<Biquad> decimation_filter(int factor);
 

@@ -57,6 +57,12 @@ struct IdentifyOptions {
   int filter_order = 4;          ///< Butterworth order (run twice: filtfilt)
   int decimation = 0;            ///< 0: 10, less when the log would keep fewer than 50 rows per unknown
   bool per_direction = false;    ///< viscous friction per direction of motion
+  /// Voltage and duty drives: leave out the rows within reversal_samples() of a reversal of the
+  /// filtered speed. There the reading (after the gearbox) stalls in the backlash while the motor, whose
+  /// speed the back-EMF sees, already turns; the back-EMF's damping, about 100 times the friction's
+  /// with the design's motor, turns that mismatch into a viscous friction biased up and a Coulomb
+  /// friction biased down (docs/identify.md "A voltage drive and its sampled current").
+  bool skip_reversals = true;
   /// The logged drive is a command held over each sample (zero-order hold): the regression pairs the
   /// acceleration at t_k (two central differences) with (d_k-2 + 3 d_k-1 + 3 d_k + d_k+1) / 8, and a
   /// voltage's current is taken over each sample through the winding's lag. false: the drive is an
@@ -123,6 +129,10 @@ struct JointIdentification {
   double sample_time = 0.0, cutoff_hz = 0.0;
   int decimation = 1;
   int edge_samples = 0;       ///< full-rate samples at each end left out of the fit: the filters' settling
+  /// Voltage and duty drives (IdentifyOptions::skip_reversals): full-rate samples on each side of a
+  /// reversal of the speed left out (0: none), and the decimated rows that left out.
+  int reversal_samples = 0;
+  int reversal_rows = 0;
   int logs = 1;               ///< estimation logs fitted together
   Estimate idim;              ///< mechanical base parameters, IDIM-LS
   /// Closed loop: IDIM-IV (instruments from the loop simulated with the previous estimate),
