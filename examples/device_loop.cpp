@@ -213,6 +213,7 @@ class CsvIo : public DeviceIo {
     estop_reset_ = optional("estop_reset");
     out_ << "time_s";
     lio::LinuxIoConfig wiring;
+    std::string ref_header;
     if (linux_base) wiring = *linux_base;
     for (const auto& s : c.stations)
       for (const auto& m : s.mechanisms) {
@@ -242,9 +243,10 @@ class CsvIo : public DeviceIo {
         }
         target_.push_back(column(s.name + "_" + m.name + "_x_ref_mm"));
         target_.push_back(column(s.name + "_" + m.name + "_y_ref_mm"));
-        if (linux_base) out_ << "," << s.name << "_" << m.name << "_x_ref_mm," << s.name << "_" << m.name << "_y_ref_mm";
+        if (linux_base) ref_header += "," + s.name + "_" + m.name + "_x_ref_mm," + s.name + "_" + m.name + "_y_ref_mm";
       }
     if (linux_base) {
+      out_ << ref_header;  // after every joint's columns, as log_row() writes them
       pins_ = std::make_unique<lio::LinuxIo>(wiring);  // sets every channel up, or IoError naming the file
       last_readings_.assign(joint_names_.size(), 0.0);
       last_targets_mm_.assign(target_.size(), 0.0);
@@ -316,9 +318,9 @@ class CsvIo : public DeviceIo {
   void write_zero(double t, const char* status, bool overrun) override {
     if (pins_) {
       if (!pins_->write_zero()) throw std::runtime_error(std::string("write failed: ") + pins_->error());
-      log_row(t, nullptr);
-      for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << "," << status;
-      end_row(overrun);
+      // Not a cycle of the runtime: a note, so the log stays what `fivebar replay` runs.
+      out_ << "# " << status << ": t = " << t << " s, zero duty" << (overrun ? ", overrun" : "") << "\n";
+      out_.flush();
       return;
     }
     out_ << t;
@@ -336,10 +338,9 @@ class CsvIo : public DeviceIo {
       std::cerr << "device_loop: zero duty not written: " << pins_->error() << "\n";
       return false;
     }
-    if (pins_) {
-      log_row(t, nullptr);
-      for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << ",stopped";
-      end_row(false);
+    if (pins_) {  // a note only: the log stays the runtime's cycles
+      out_ << "# zero duty written to every channel\n";
+      out_.flush();
       return true;
     }
     write_zero(t, "stopped", false);
@@ -347,14 +348,14 @@ class CsvIo : public DeviceIo {
   }
 
  private:
-  /// --io linux: time, per joint the reading (empty where it failed) and the duty (0 without
-  /// `duties`), the references (mm): the replay log's columns before the statuses.
+  /// --io linux: time, per joint the reading (empty where it failed) and the duty, the references
+  /// (mm): the replay log's columns before the statuses.
   void log_row(double t, const double* duties) {
     out_ << t;
     for (std::size_t i = 0; i < last_readings_.size(); ++i) {
       out_ << ",";
       if (!std::isnan(last_readings_[i])) out_ << last_readings_[i];
-      out_ << "," << (duties ? duties[i] : 0.0);
+      out_ << "," << duties[i];
     }
     for (double v : last_targets_mm_) out_ << "," << v;
   }
