@@ -317,6 +317,38 @@ TEST_F(Replay, FailedReadingsReplayCleanAndANonZeroDutyOnOneIsFlaggedAtItsRow) {
       EXPECT_THAT(e.what(), HasSubstr("log.csv:12: column 'index_lower_theta1_counts'")) << cell;
     }
   }
+  // With the device loop's status columns (the statuses it logged: sensor_fault on the lower
+  // mechanism exactly at the failed rows, ok elsewhere, as the clean SIL run is ok throughout): the
+  // log replays; a failed row logged `ok` is a status mismatch at that row; a cell that is not a
+  // status is refused at its line and column.
+  const auto with_statuses = [&](std::size_t bad_row, const std::string& bad_status) {
+    std::string t = rows[0] + ",index_lower_status,index_upper_status\n";
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+      const std::size_t row = i - 1;
+      bool fault = false;
+      for (const auto& [fr, j] : failed) fault = fault || fr == row;
+      t += rows[i] + "," + (row == bad_row ? bad_status : fault ? "sensor_fault" : "ok") + ",ok\n";
+    }
+    return t;
+  };
+  const ReplayResult with = replay_log(full, read(with_statuses(9999, ""), full), 0.0);
+  EXPECT_TRUE(with.passed());
+  EXPECT_EQ(with.status_mismatches, 0u);
+  const ReplayResult wrong = replay_log(full, read(with_statuses(120, "ok"), full), 0.0);
+  EXPECT_FALSE(wrong.passed());
+  EXPECT_EQ(wrong.status_mismatches, 1u);
+  ASSERT_TRUE(wrong.first_status_mismatch);
+  EXPECT_EQ(wrong.first_status_row, 120u);
+  EXPECT_EQ(wrong.first_status_mechanism, "index/lower");
+  EXPECT_EQ(wrong.first_status_logged, rt::Status::ok);
+  EXPECT_EQ(wrong.first_status_runtime, rt::Status::sensor_fault);
+  EXPECT_EQ(wrong.mismatches, 0u);
+  try {
+    read(with_statuses(5, "faulty"), full);
+    ADD_FAILURE() << "a status 'faulty' was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("log.csv:7: column 'index_lower_status' = 'faulty'"));
+  }
 }
 
 TEST(ReplayDesign, BadLogNamesAreTheDesignFilesLineAndKey) {

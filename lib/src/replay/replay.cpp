@@ -82,6 +82,18 @@ ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const
     target_col.push_back(column(m + "_x_ref_mm"));
     target_col.push_back(column(m + "_y_ref_mm"));
   }
+  // The optional status columns: all of them or none.
+  std::vector<std::size_t> status_col;
+  for (const std::string& m : cols.mechanisms)
+    if (at.count(m + "_status")) status_col.push_back(at[m + "_status"]);
+  if (!status_col.empty() && status_col.size() != cols.mechanisms.size()) {
+    for (const std::string& m : cols.mechanisms) column(m + "_status");  // names the first one missing
+  }
+  const auto status = [&](std::size_t c) {
+    for (std::size_t s = 0; s < 6; ++s)
+      if (reader.cell(c) == runtime::to_string(static_cast<runtime::Status>(s))) return static_cast<runtime::Status>(s);
+    throw InputError(reader.at(c) + "not a status (ok, moved_by_priority, unreachable, singular, limit, sensor_fault)");
+  };
   while (reader.next()) {
     const auto number = [&](std::size_t c) { return reader.number(c, csv::kMaxBenchValue); };
     log.time_s.push_back(number(t_col));
@@ -97,6 +109,11 @@ ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const
     log.readings.push_back(std::move(r));
     log.duties.push_back(std::move(d));
     log.targets_m.push_back(std::move(t));
+    if (!status_col.empty()) {
+      std::vector<runtime::Status> st;
+      for (std::size_t c : status_col) st.push_back(status(c));
+      log.statuses.push_back(std::move(st));
+    }
   }
   if (log.time_s.empty()) throw InputError(origin + ": the log has no data row");
   return log;
@@ -151,7 +168,19 @@ ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, doubl
   }
   for (std::size_t row = 0; row < r.rows; ++row) {
     ctl.cycle(log.readings[row].data(), log.kind, log.targets_m[row].data());
-    for (std::size_t k = 0; k < r.mechanisms.size(); ++k) ++r.status_counts[k][static_cast<std::size_t>(ctl.mechanism(k).status)];
+    for (std::size_t k = 0; k < r.mechanisms.size(); ++k) {
+      const runtime::Status st = ctl.mechanism(k).status;
+      ++r.status_counts[k][static_cast<std::size_t>(st)];
+      if (log.statuses.empty() || log.statuses[row][k] == st) continue;
+      ++r.status_mismatches;
+      if (!r.first_status_mismatch) {
+        r.first_status_mismatch = true;
+        r.first_status_row = row;
+        r.first_status_mechanism = r.mechanisms[k];
+        r.first_status_logged = log.statuses[row][k];
+        r.first_status_runtime = st;
+      }
+    }
     if (trace) {
       trace->duties[row].assign(ctl.duties(), ctl.duties() + cols.joints.size());
       for (std::size_t k = 0; k < r.mechanisms.size(); ++k) trace->statuses[row].push_back(ctl.mechanism(k).status);
@@ -213,6 +242,12 @@ Json to_json(const ReplayResult& r) {
   j["mismatches"] = r.mismatches;
   j["failed_readings"] = r.failed_readings;
   j["failed_readings_not_faulted"] = r.failed_not_faulted;
+  j["status_mismatches"] = r.status_mismatches;
+  j["first_status_mismatch"] = r.first_status_mismatch ? Json{{"row", r.first_status_row + 1},
+                                                              {"mechanism", r.first_status_mechanism},
+                                                              {"logged_status", runtime::to_string(r.first_status_logged)},
+                                                              {"runtime_status", runtime::to_string(r.first_status_runtime)}}
+                                                       : Json(nullptr);
   j["passed"] = r.passed();
   j["first_mismatch"] = r.first_mismatch ? Json{{"row", r.first_row + 1},  // data rows from 1, as the text
                                                 {"time_s", r.first_time_s},
