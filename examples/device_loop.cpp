@@ -620,6 +620,9 @@ int main(int argc, char** argv) {
     ChannelMap channels;
     if (!o.channels.empty()) channels = read_channel_map(o.channels);
     lio::LinuxIoConfig linux_base;
+    if (o.io != "linux" && (o.sysfs_root != "/" || o.iio_device != 0 || o.pwm_chip != 0)) {
+      throw std::runtime_error("--sysfs-root, --iio-device and --pwm-chip are for --io linux");
+    }
     if (o.io == "linux") {
       if (o.channels.empty() || !channels.has_gpio) {
         throw std::runtime_error("--io linux: needs --channels MAP.csv with the column direction_gpio");

@@ -437,6 +437,10 @@ if len(joints) == 4:
                         "--sysfs-root", str(sysroot)], capture_output=True, text=True)
     if r.returncode != 2 or "direction_gpio" not in r.stderr:
         failures.append(f"--io linux without direction_gpio: exit {r.returncode}, {r.stderr.strip()!r}")
+    for bad in [["--io", "spi"], ["--pwm-chip", "x"], ["--sysfs-root", str(sysroot)]]:
+        r = subprocess.run([LOOP, str(config), str(WORK / "const.csv")] + bad, capture_output=True, text=True)
+        if r.returncode != 2 or bad[0] not in r.stderr:
+            failures.append(f"{bad}: exit {r.returncode}, {r.stderr.strip()!r}")
     shutil.rmtree(sysroot, ignore_errors=True)
     print(f"--io linux: {len(reference)} cycles, period {period} ns")
 if nonzero < len(logged):
