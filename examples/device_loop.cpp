@@ -3,7 +3,7 @@
 // joints and the reference points from an I/O backend, runs one cycle, and writes the duties.
 //
 //   device_loop CONFIG.json [IN.csv|-] [--realtime] [--rt-priority N] [--watchdog N] [--channels MAP.csv]
-//               [--io csv|linux] [--sysfs-root DIR] [--iio-device N] [--pwm-chip N]
+//               [--io csv|linux] [--sysfs-root DIR] [--iio-device N] [--pwm-chip N] [--estop-gpio N]
 //
 // The backend here is a CSV stream standing in for the DAQ and the motor drivers: each input row
 // holds time_s, per joint <joint>_counts (or _volts, _theta_rad), per mechanism
@@ -290,6 +290,7 @@ class CsvIo : public DeviceIo {
     }
     for (std::size_t i = 0; i < reading_.size(); ++i) readings[i] = cell(reading_[i]) + offset_[i];
     in.estop = flag(estop_);
+    if (pins_ && pins_->estop()) in.estop = true;  // the E-stop line (--estop-gpio), or the input's column
     in.estop_reset = flag(estop_reset_);
     // Every reference cell empty: no new reference this cycle (else each must be a number).
     in.fresh = false;
@@ -413,6 +414,7 @@ struct Options {
   std::string io = "csv";        ///< --io csv|linux
   std::string sysfs_root = "/";  ///< --sysfs-root: where sys/ is (a scratch folder in tests)
   long iio_device = 0, pwm_chip = 0;
+  long estop_gpio = -1;  ///< --estop-gpio N (--io linux): the E-stop input line
 };
 
 /// A whole number in [lo, hi] after `flag`, or exit 2 naming both.
@@ -428,7 +430,7 @@ bool whole(const std::string& flag, const std::string& value, long lo, long hi, 
 bool parse(int argc, char** argv, Options& o) {
   if (argc < 2) {
     std::cerr << "usage: device_loop CONFIG.json [IN.csv|-] [--realtime] [--rt-priority N] [--watchdog N] [--channels MAP.csv]\n"
-                 "                   [--io csv|linux] [--sysfs-root DIR] [--iio-device N] [--pwm-chip N]\n";
+                 "                   [--io csv|linux] [--sysfs-root DIR] [--iio-device N] [--pwm-chip N] [--estop-gpio N]\n";
     return false;
   }
   o.config = argv[1];
@@ -453,9 +455,9 @@ bool parse(int argc, char** argv, Options& o) {
         return false;
       }
       (arg == "--io" ? o.io : o.sysfs_root) = value;
-    } else if (arg == "--iio-device" || arg == "--pwm-chip") {
+    } else if (arg == "--iio-device" || arg == "--pwm-chip" || arg == "--estop-gpio") {
       const std::string value = i + 1 < argc ? argv[++i] : "";
-      if (!whole(arg, value, 0, 1000000, arg == "--iio-device" ? o.iio_device : o.pwm_chip)) return false;
+      if (!whole(arg, value, 0, 1000000, arg == "--iio-device" ? o.iio_device : arg == "--pwm-chip" ? o.pwm_chip : o.estop_gpio)) return false;
     } else if (arg == "--watchdog" || arg == "--rt-priority") {
       const std::string value = i + 1 < argc ? argv[++i] : "";
       if (!(arg == "--watchdog" ? whole(arg, value, 0, 1000000000L, o.watchdog) : whole(arg, value, 1, 99, o.priority))) return false;
@@ -620,8 +622,8 @@ int main(int argc, char** argv) {
     ChannelMap channels;
     if (!o.channels.empty()) channels = read_channel_map(o.channels);
     lio::LinuxIoConfig linux_base;
-    if (o.io != "linux" && (o.sysfs_root != "/" || o.iio_device != 0 || o.pwm_chip != 0)) {
-      throw std::runtime_error("--sysfs-root, --iio-device and --pwm-chip are for --io linux");
+    if (o.io != "linux" && (o.sysfs_root != "/" || o.iio_device != 0 || o.pwm_chip != 0 || o.estop_gpio >= 0)) {
+      throw std::runtime_error("--sysfs-root, --iio-device, --pwm-chip and --estop-gpio are for --io linux");
     }
     if (o.io == "linux") {
       if (o.channels.empty() || !channels.has_gpio) {
@@ -632,6 +634,7 @@ int main(int argc, char** argv) {
       linux_base.pwm_chip = static_cast<int>(o.pwm_chip);
       linux_base.pwm_hz = config.pwm_hz;
       linux_base.adc_bits = config.adc_bits;
+      linux_base.estop_gpio = static_cast<int>(o.estop_gpio);
     }
     io_owner = std::make_unique<CsvIo>(o.input == "-" ? std::cin : file, std::cout, config, o.realtime,
                                        o.channels.empty() ? nullptr : &channels, o.io == "linux" ? &linux_base : nullptr);

@@ -334,7 +334,7 @@ def kernel_tree():
         for f in ["period", "duty_cycle", "polarity", "enable"]:
             (chip / f"pwm{m}" / f).write_text("")
     (chip / "export").write_text("")
-    for g in range(20, 24):
+    for g in list(range(20, 24)) + [30]:
         (sysroot / f"sys/class/gpio/gpio{g}").mkdir(parents=True)
         for f in ["direction", "value"]:
             (sysroot / f"sys/class/gpio/gpio{g}" / f).write_text("")
@@ -432,6 +432,22 @@ if len(joints) == 4:
     others = [(chip / f"pwm{m}" / "duty_cycle").read_text().strip() for m in range(4) if m != broken]
     if p.returncode != 2 or f"pwm{broken}/duty_cycle: Is a directory" not in stderr or others != ["0", "0", "0"]:
         failures.append(f"--io linux failed write: exit {p.returncode}, {stderr.strip()!r}, others {others}")
+    # The E-stop line (--estop-gpio 30): reading 1, every cycle is a zero-duty note, no row, the
+    # files at zero; reading 0, the run is the one without the line.
+    iio, chip = kernel_tree()
+    for j, (a, _, _, o) in wiring.items():
+        (iio / f"in_voltage{a}_raw").write_text(f"{int(first[j + '_counts']) - o}\n")
+    (sysroot / "sys/class/gpio/gpio30/value").write_text("1\n")
+    r = subprocess.run(linux_cmd() + ["--estop-gpio", "30"], input="".join(const_lines), capture_output=True, text=True)
+    notes = [line for line in r.stdout.splitlines() if line.startswith("# estop: t = ")]
+    duties = [(chip / f"pwm{m}" / "duty_cycle").read_text().strip() for m in range(4)]
+    if (r.returncode != 0 or rows(r.stdout) or len(notes) != len(reference) or "# estop: latched (input)" not in r.stdout or
+            duties != ["0"] * 4 or (sysroot / "sys/class/gpio/gpio30/direction").read_text().strip() != "in"):
+        failures.append(f"--estop-gpio pressed: exit {r.returncode}, {len(rows(r.stdout))} rows, {len(notes)} notes, {duties}")
+    (sysroot / "sys/class/gpio/gpio30/value").write_text("0\n")
+    r = subprocess.run(linux_cmd() + ["--estop-gpio", "30"], input="".join(const_lines), capture_output=True, text=True)
+    if r.returncode != 0 or r.stdout != linux_out:
+        failures.append(f"--estop-gpio released: exit {r.returncode}, the output differs from the run without the line")
     # --io linux needs the direction lines in the map.
     r = subprocess.run([LOOP, str(config), str(WORK / "const.csv"), "--io", "linux", "--channels", str(WORK / "map.csv"),
                         "--sysfs-root", str(sysroot)], capture_output=True, text=True)

@@ -1278,5 +1278,41 @@ TEST(LinuxIo, WritesTheCsvBackendsDutiesToThePwmAndGpioFilesBitForBit) {
   EXPECT_THROW(lio::pwm_period_ns(0.0), lio::IoError);
 }
 
+
+// The E-stop input line (--estop-gpio): set up as an input; pressed when its value reads 1, and
+// fail-safe when it reads anything but 0 or cannot be read; no line: never pressed.
+TEST(LinuxIo, TheEStopLineIsPressedUnlessItReadsZero) {
+  const fs::path root = (fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path()) /
+                        ("fivebar_test_linux_estop_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  kernel_tree(root, {0}, {20, 30});
+  lio::LinuxIoConfig cfg;
+  cfg.root = root.string();
+  cfg.iio_device = 1;
+  cfg.pwm_chip = 2;
+  cfg.pwm_hz = 1000.0;
+  cfg.adc_bits = 16;
+  cfg.joints.push_back({0, 0, 20, 1.0, 0.0});
+  {
+    lio::LinuxIo none(cfg);
+    EXPECT_FALSE(none.estop());
+  }
+  cfg.estop_gpio = 30;
+  lio::LinuxIo io(cfg);
+  const fs::path line = root / "sys/class/gpio/gpio30";
+  EXPECT_EQ(file_text(line / "direction"), "in");
+  put_text(line / "value", "0");
+  EXPECT_FALSE(io.estop());
+  put_text(line / "value", "1");
+  EXPECT_TRUE(io.estop());
+  put_text(line / "value", "junk");
+  EXPECT_TRUE(io.estop());
+  put_text(line / "value", "00");
+  EXPECT_TRUE(io.estop());
+  fs::remove(line / "value");
+  EXPECT_TRUE(io.estop());
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace fivebar

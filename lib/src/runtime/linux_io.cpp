@@ -99,6 +99,25 @@ LinuxIo::LinuxIo(LinuxIoConfig config) : config_(std::move(config)) {
     p.direction_value = line + "/value";
     paths_.push_back(std::move(p));
   }
+  if (config_.estop_gpio >= 0) {
+    const std::string line = gpio + "/gpio" + std::to_string(config_.estop_gpio);
+    exported(line, gpio + "/export", config_.estop_gpio);
+    must(line + "/direction", "in");
+    estop_value_ = line + "/value";
+  }
+}
+
+bool LinuxIo::estop() noexcept {
+  if (estop_value_.empty()) return false;
+  char text[16];
+  ssize_t n = -1;
+  const int fd = ::open(estop_value_.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd >= 0) {
+    n = ::read(fd, text, sizeof text);
+    ::close(fd);
+  }
+  // Only a clean "0" releases: a failed read or any other text is a pressed E-stop.
+  return !(n >= 1 && text[0] == '0' && (n == 1 || text[1] == '\n'));
 }
 
 std::size_t LinuxIo::read(double* readings) noexcept {

@@ -8,7 +8,7 @@
 /// folder laid out like the kernel's files:
 ///   <root>/sys/bus/iio/devices/iio:device<D>/in_voltage<K>_raw             read: the joint's ADC code
 ///   <root>/sys/class/pwm/pwmchip<C>/export, pwm<M>/{period,duty_cycle,polarity,enable}   written
-///   <root>/sys/class/gpio/export, gpio<G>/{direction,value}                 written
+///   <root>/sys/class/gpio/export, gpio<G>/{direction,value}                 written (the E-stop line's value read)
 /// Per cycle: read() and write() open, read or write and close each file (as `cat` and `echo >`
 /// do), with no allocation and no exception.
 #include <cstddef>
@@ -41,6 +41,7 @@ struct LinuxIoConfig {
   double pwm_hz = 0.0;     ///< the exported pwm_hz: period = round(1e9 / pwm_hz) ns
   int adc_bits = 0;        ///< the exported adc.bits: a code outside [0, 2^bits) is a failed reading
   std::vector<JointWiring> joints;  ///< in the runtime's joint order
+  int estop_gpio = -1;     ///< an E-stop input line (sysfs number; value 1 = pressed), -1: none
 };
 
 /// The PWM period in ns for `pwm_hz` (round(1e9 / pwm_hz)); IoError unless it is in [1, 1e9].
@@ -67,6 +68,9 @@ class LinuxIo {
   bool write(const double* duties) noexcept;
   /// Zero duty on every channel (every one attempted); false if a write failed.
   bool write_zero() noexcept;
+  /// The E-stop input line (estop_gpio): true when its value reads 1, and when it cannot be read
+  /// or reads anything but 0 or 1 (fail-safe); false without a line.
+  bool estop() noexcept;
 
   long long period_ns() const { return period_ns_; }
   /// The last failure: "FILE: reason".
@@ -82,6 +86,7 @@ class LinuxIo {
   long long period_ns_ = 0;
   long long max_code_ = 0;
   std::vector<Paths> paths_;
+  std::string estop_value_;  ///< gpio<estop_gpio>/value, empty without
   char error_[512] = {};
 };
 
