@@ -54,7 +54,8 @@ FIVEBAR_TEST_PACKAGES=(
   prusa-slicer unzip
   # The runtime for a Raspberry Pi (ctest runtime_aarch64, test/runtime_package/aarch64.sh): Debian's
   # aarch64 cross compiler builds the runtime package alone, qemu-user runs its C test and compares
-  # its duties with the x86-64 build's bit for bit.
+  # its duties with the x86-64 build's bit for bit, and cpack makes its arm64 .deb packages (checked
+  # with dpkg-deb and file).
   g++-aarch64-linux-gnu
   qemu-user
   # The studio's browser test (test/studio_browser.py) drives Chromium over the DevTools protocol.

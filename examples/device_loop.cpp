@@ -3,6 +3,7 @@
 // joints and the reference points from an I/O backend, runs one cycle, and writes the duties.
 //
 //   device_loop CONFIG.json [IN.csv|-] [--realtime] [--rt-priority N] [--watchdog N] [--channels MAP.csv]
+//               [--io csv|linux] [--sysfs-root DIR] [--iio-device N] [--pwm-chip N] [--estop-gpio N]
 //
 // The backend here is a CSV stream standing in for the DAQ and the motor drivers: each input row
 // holds time_s, per joint <joint>_counts (or _volts, _theta_rad), per mechanism
@@ -39,6 +40,13 @@
 // cycle whose output comes after its deadline (the next period's start) is an overrun: the row's
 // `overrun` column is 1, the next cycle starts at once and the deadlines start again from it (no
 // burst of cycles to catch up); the count is printed on stderr at the end.
+//
+// --io linux (LinuxIo; docs/runtime.md "Linux I/O"): the joints are read from the kernel's IIO files
+// and the duties go to its PWM and GPIO files (fivebar/runtime/linux_io.hpp), wired by the channel
+// map (which then needs the column direction_gpio); the input stream brings only time_s, the
+// reference points and the E-stop columns, and the output is the log in the replay format
+// (`fivebar replay` reads it: readings, a failed one as an empty cell, duties, references,
+// statuses). A write that fails is an error: zero duty is attempted on every channel, exit 2.
 
 #include <signal.h>
 #include <sched.h>
@@ -63,8 +71,10 @@
 #include <vector>
 
 #include "fivebar/runtime.hpp"
+#include "fivebar/runtime/linux_io.hpp"
 
 namespace rt = fivebar::runtime;
+namespace lio = fivebar::runtime::linux_io;
 
 /// One sample of the device's inputs besides the joints and the references.
 struct Inputs {
@@ -89,8 +99,9 @@ class DeviceIo {
   /// An event for the log (`estop: latched (SIGUSR1)`).
   virtual void note(const char* what) = 0;
   virtual rt::Reading kind() const = 0;
-  /// Zero duty to every motor: the loop's last output, whatever ends it (`why`: what did).
-  virtual void stop(double t_s, const char* why) = 0;
+  /// Zero duty to every motor: the loop's last output, whatever ends it (`why`: what did); false
+  /// if that could not be written.
+  virtual bool stop(double t_s, const char* why) = 0;
 };
 
 /// Where each joint is wired (--channels FILE): its ADC channel, its PWM channel, the motor's
@@ -99,34 +110,37 @@ class DeviceIo {
 /// `joint,adc_channel,pwm_channel,direction,offset_counts`, one row per joint of the configuration's
 /// stations (the ones the input has); channels whole numbers >= 0, each used once per kind.
 struct Channel {
-  long adc = -1, pwm = -1;
+  long adc = -1, pwm = -1, gpio = -1;  ///< gpio: the direction line (optional column direction_gpio)
   double direction = 1.0, offset_counts = 0.0;
 };
 struct ChannelMap {
   std::string path;                       ///< the file, for messages
   std::map<std::string, Channel> joints;  ///< by joint name
+  bool has_gpio = false;                  ///< the file has the column direction_gpio (needed by --io linux)
 };
 
 ChannelMap read_channel_map(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot be read");
   std::string line;
-  const char* header = "joint,adc_channel,pwm_channel,direction,offset_counts";
+  const std::string header = "joint,adc_channel,pwm_channel,direction,offset_counts";
   ChannelMap map;
   map.path = path;
-  std::map<long, std::string> adc_used, pwm_used;
+  std::map<long, std::string> adc_used, pwm_used, gpio_used;
   for (int n = 1; std::getline(in, line); ++n) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::string at = path + ":" + std::to_string(n) + ": ";
     if (n == 1) {
-      if (line != header) throw std::runtime_error(at + "expected the header " + header);
+      map.has_gpio = line == header + ",direction_gpio";
+      if (line != header && !map.has_gpio) throw std::runtime_error(at + "expected the header " + header + " (and optionally ,direction_gpio)");
       continue;
     }
     if (line.empty() || line[0] == '#') continue;
     std::vector<std::string> cells;
     std::stringstream ss(line);
     for (std::string cell; std::getline(ss, cell, ',');) cells.push_back(cell);
-    if (cells.size() != 5) throw std::runtime_error(at + "expected 5 cells");
+    const std::size_t expected = map.has_gpio ? 6 : 5;
+    if (cells.size() != expected) throw std::runtime_error(at + "expected " + std::to_string(expected) + " cells");
     const auto number = [&](std::size_t i, const char* key) {
       double x = 0.0;
       const std::string& t = cells[i];
@@ -150,6 +164,7 @@ ChannelMap read_channel_map(const std::string& path) {
     if (ch.direction != 1.0 && ch.direction != -1.0) throw std::runtime_error(at + "direction: expected 1 or -1");
     ch.offset_counts = number(4, "offset_counts");
     if (!(std::fabs(ch.offset_counts) <= 1e9)) throw std::runtime_error(at + "offset_counts: expected a finite number of codes");
+    if (map.has_gpio) ch.gpio = channel(5, "direction_gpio", gpio_used);
     map.joints[cells[0]] = ch;
   }
   return map;
@@ -162,7 +177,11 @@ class CsvIo : public DeviceIo {
   /// station runs against the export of several, as `fivebar replay` reads it).
   /// With a channel map the readings are ADC codes in columns `adc<k>_counts` and the duties go to
   /// columns `pwm<k>_duty` (joint order), each through its joint's channels, direction and offset.
-  CsvIo(std::istream& in, std::ostream& out, rt::Config& c, bool log_overruns, const ChannelMap* channels)
+  /// With `linux_base` (--io linux; needs `channels`): the readings come from the kernel's IIO files
+  /// and the duties go to its PWM and GPIO files (LinuxIo, wired by the channel map), the input
+  /// brings only time_s, the references and the E-stop columns, and the output is the replay log.
+  CsvIo(std::istream& in, std::ostream& out, rt::Config& c, bool log_overruns, const ChannelMap* channels,
+        const lio::LinuxIoConfig* linux_base = nullptr)
       : in_(in), out_(out), log_overruns_(log_overruns) {
     std::string line;
     if (!next_line(line)) throw std::runtime_error("input: no header row");
@@ -184,7 +203,7 @@ class CsvIo : public DeviceIo {
                      c.stations.end());
     if (c.stations.empty()) throw std::runtime_error("input: no station of the configuration has columns");
     const std::string first = c.stations.front().mechanisms.front().joints[0].name;
-    kind_ = channels || at.count(first + "_counts") ? rt::Reading::counts
+    kind_ = channels || linux_base || at.count(first + "_counts") ? rt::Reading::counts
             : at.count(first + "_volts")          ? rt::Reading::volts
                                                   : rt::Reading::radians;
     const char* suffix = kind_ == rt::Reading::counts ? "_counts" : kind_ == rt::Reading::volts ? "_volts" : "_theta_rad";
@@ -193,10 +212,22 @@ class CsvIo : public DeviceIo {
     estop_ = optional("estop");
     estop_reset_ = optional("estop_reset");
     out_ << "time_s";
+    lio::LinuxIoConfig wiring;
+    std::string ref_header;
+    if (linux_base) wiring = *linux_base;
     for (const auto& s : c.stations)
       for (const auto& m : s.mechanisms) {
         for (const auto& j : m.joints) {
-          if (channels) {
+          if (linux_base) {
+            const auto ch = channels->joints.find(j.name);
+            if (ch == channels->joints.end()) throw std::runtime_error(channels->path + ": joint " + j.name + " has no row");
+            wiring.joints.push_back({static_cast<int>(ch->second.adc), static_cast<int>(ch->second.pwm),
+                                     static_cast<int>(ch->second.gpio), ch->second.direction, ch->second.offset_counts});
+            joint_names_.push_back(j.name);
+            out_ << "," << j.name << "_counts," << j.name << "_duty";  // the replay log (fivebar/replay.hpp)
+            direction_.push_back(1.0);  // the direction is applied by LinuxIo, the log holds the joint's duty
+            offset_.push_back(0.0);
+          } else if (channels) {
             const auto ch = channels->joints.find(j.name);
             if (ch == channels->joints.end()) throw std::runtime_error(channels->path + ": joint " + j.name + " has no row");
             reading_.push_back(column("adc" + std::to_string(ch->second.adc) + "_counts"));
@@ -212,7 +243,14 @@ class CsvIo : public DeviceIo {
         }
         target_.push_back(column(s.name + "_" + m.name + "_x_ref_mm"));
         target_.push_back(column(s.name + "_" + m.name + "_y_ref_mm"));
+        if (linux_base) ref_header += "," + s.name + "_" + m.name + "_x_ref_mm," + s.name + "_" + m.name + "_y_ref_mm";
       }
+    if (linux_base) {
+      out_ << ref_header;  // after every joint's columns, as log_row() writes them
+      pins_ = std::make_unique<lio::LinuxIo>(wiring);  // sets every channel up, or IoError naming the file
+      last_readings_.assign(joint_names_.size(), 0.0);
+      last_targets_mm_.assign(target_.size(), 0.0);
+    }
     for (const auto& s : c.stations)
       for (const auto& m : s.mechanisms) out_ << "," << s.name << "_" << m.name << "_status";
     if (log_overruns_) out_ << ",overrun";
@@ -246,23 +284,46 @@ class CsvIo : public DeviceIo {
       return x == 1.0;
     };
     in.t_s = cell(time_);
+    if (pins_) {
+      pins_->read(readings);  // a failed reading is NaN: the runtime's sensor fault, an empty cell in the log
+      std::copy(readings, readings + last_readings_.size(), last_readings_.begin());
+    }
     for (std::size_t i = 0; i < reading_.size(); ++i) readings[i] = cell(reading_[i]) + offset_[i];
     in.estop = flag(estop_);
+    if (pins_ && pins_->estop()) in.estop = true;  // the E-stop line (--estop-gpio), or the input's column
     in.estop_reset = flag(estop_reset_);
     // Every reference cell empty: no new reference this cycle (else each must be a number).
     in.fresh = false;
     for (std::size_t i : target_) in.fresh = in.fresh || (i < cells.size() && !cells[i].empty());
     if (in.fresh)
-      for (std::size_t i = 0; i < target_.size(); ++i) targets[i] = cell(target_[i]) / 1000.0;
+      for (std::size_t i = 0; i < target_.size(); ++i) {
+        const double mm = cell(target_[i]);
+        targets[i] = mm / 1000.0;
+        if (pins_) last_targets_mm_[i] = mm;  // logged as read: the replay divides it as this loop did
+      }
     return true;
   }
   void write(double t, const double* duties, const rt::Status* statuses, bool overrun) override {
+    if (pins_) {
+      if (!pins_->write(duties)) throw std::runtime_error(std::string("write failed: ") + pins_->error());
+      log_row(t, duties);
+      for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << "," << rt::to_string(statuses[k]);
+      end_row(overrun);
+      return;
+    }
     out_ << t;
     for (std::size_t i = 0; i < reading_.size(); ++i) out_ << "," << direction_[i] * duties[i];
     for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << "," << rt::to_string(statuses[k]);
     end_row(overrun);
   }
   void write_zero(double t, const char* status, bool overrun) override {
+    if (pins_) {
+      if (!pins_->write_zero()) throw std::runtime_error(std::string("write failed: ") + pins_->error());
+      // Not a cycle of the runtime: a note, so the log stays what `fivebar replay` runs.
+      out_ << "# " << status << ": t = " << t << " s, zero duty" << (overrun ? ", overrun" : "") << "\n";
+      out_.flush();
+      return;
+    }
     out_ << t;
     for (std::size_t i = 0; i < reading_.size(); ++i) out_ << ",0";
     for (std::size_t k = 0; k < target_.size() / 2; ++k) out_ << "," << status;
@@ -270,12 +331,35 @@ class CsvIo : public DeviceIo {
   }
   void note(const char* what) override { out_ << "# " << what << "\n"; }
   rt::Reading kind() const override { return kind_; }
-  void stop(double t, const char* why) override {
+  bool stop(double t, const char* why) override {
     out_ << "# stopped: " << why << "\n";
+    if (pins_ && !pins_->write_zero()) {  // every channel attempted
+      out_ << "# zero duty not written: " << pins_->error() << "\n";
+      out_.flush();
+      std::cerr << "device_loop: zero duty not written: " << pins_->error() << "\n";
+      return false;
+    }
+    if (pins_) {  // a note only: the log stays the runtime's cycles
+      out_ << "# zero duty written to every channel\n";
+      out_.flush();
+      return true;
+    }
     write_zero(t, "stopped", false);
+    return true;
   }
 
  private:
+  /// --io linux: time, per joint the reading (empty where it failed) and the duty, the references
+  /// (mm): the replay log's columns before the statuses.
+  void log_row(double t, const double* duties) {
+    out_ << t;
+    for (std::size_t i = 0; i < last_readings_.size(); ++i) {
+      out_ << ",";
+      if (!std::isnan(last_readings_[i])) out_ << last_readings_[i];
+      out_ << "," << duties[i];
+    }
+    for (double v : last_targets_mm_) out_ << "," << v;
+  }
   void end_row(bool overrun) {
     if (log_overruns_) out_ << (overrun ? ",1" : ",0");
     out_ << "\n";
@@ -307,6 +391,9 @@ class CsvIo : public DeviceIo {
   std::vector<std::string> header_;
   std::vector<std::size_t> reading_, target_;
   std::vector<double> direction_, offset_;  ///< per joint: the channel map's (1 and 0 without one)
+  std::unique_ptr<lio::LinuxIo> pins_;      ///< --io linux
+  std::vector<std::string> joint_names_;
+  std::vector<double> last_readings_, last_targets_mm_;  ///< --io linux: this cycle's, for the log
 };
 
 namespace {
@@ -324,6 +411,10 @@ struct Options {
   bool realtime = false;
   long watchdog = 10;
   long priority = 80;
+  std::string io = "csv";        ///< --io csv|linux
+  std::string sysfs_root = "/";  ///< --sysfs-root: where sys/ is (a scratch folder in tests)
+  long iio_device = 0, pwm_chip = 0;
+  long estop_gpio = -1;  ///< --estop-gpio N (--io linux): the E-stop input line
 };
 
 /// A whole number in [lo, hi] after `flag`, or exit 2 naming both.
@@ -338,7 +429,8 @@ bool whole(const std::string& flag, const std::string& value, long lo, long hi, 
 
 bool parse(int argc, char** argv, Options& o) {
   if (argc < 2) {
-    std::cerr << "usage: device_loop CONFIG.json [IN.csv|-] [--realtime] [--rt-priority N] [--watchdog N] [--channels MAP.csv]\n";
+    std::cerr << "usage: device_loop CONFIG.json [IN.csv|-] [--realtime] [--rt-priority N] [--watchdog N] [--channels MAP.csv]\n"
+                 "                   [--io csv|linux] [--sysfs-root DIR] [--iio-device N] [--pwm-chip N] [--estop-gpio N]\n";
     return false;
   }
   o.config = argv[1];
@@ -352,6 +444,20 @@ bool parse(int argc, char** argv, Options& o) {
         std::cerr << "device_loop: --channels: expected a file name\n";
         return false;
       }
+    } else if (arg == "--io" || arg == "--sysfs-root") {
+      const std::string value = i + 1 < argc ? argv[++i] : "";
+      if (arg == "--io" && value != "csv" && value != "linux") {
+        std::cerr << "device_loop: --io " << value << ": expected csv or linux\n";
+        return false;
+      }
+      if (value.empty()) {
+        std::cerr << "device_loop: " << arg << ": expected a value\n";
+        return false;
+      }
+      (arg == "--io" ? o.io : o.sysfs_root) = value;
+    } else if (arg == "--iio-device" || arg == "--pwm-chip" || arg == "--estop-gpio") {
+      const std::string value = i + 1 < argc ? argv[++i] : "";
+      if (!whole(arg, value, 0, 1000000, arg == "--iio-device" ? o.iio_device : arg == "--pwm-chip" ? o.pwm_chip : o.estop_gpio)) return false;
     } else if (arg == "--watchdog" || arg == "--rt-priority") {
       const std::string value = i + 1 < argc ? argv[++i] : "";
       if (!(arg == "--watchdog" ? whole(arg, value, 0, 1000000000L, o.watchdog) : whole(arg, value, 1, 99, o.priority))) return false;
@@ -515,8 +621,23 @@ int main(int argc, char** argv) {
     // Leaves out the stations the log lacks.
     ChannelMap channels;
     if (!o.channels.empty()) channels = read_channel_map(o.channels);
+    lio::LinuxIoConfig linux_base;
+    if (o.io != "linux" && (o.sysfs_root != "/" || o.iio_device != 0 || o.pwm_chip != 0 || o.estop_gpio >= 0)) {
+      throw std::runtime_error("--sysfs-root, --iio-device, --pwm-chip and --estop-gpio are for --io linux");
+    }
+    if (o.io == "linux") {
+      if (o.channels.empty() || !channels.has_gpio) {
+        throw std::runtime_error("--io linux: needs --channels MAP.csv with the column direction_gpio");
+      }
+      linux_base.root = o.sysfs_root;
+      linux_base.iio_device = static_cast<int>(o.iio_device);
+      linux_base.pwm_chip = static_cast<int>(o.pwm_chip);
+      linux_base.pwm_hz = config.pwm_hz;
+      linux_base.adc_bits = config.adc_bits;
+      linux_base.estop_gpio = static_cast<int>(o.estop_gpio);
+    }
     io_owner = std::make_unique<CsvIo>(o.input == "-" ? std::cin : file, std::cout, config, o.realtime,
-                                       o.channels.empty() ? nullptr : &channels);
+                                       o.channels.empty() ? nullptr : &channels, o.io == "linux" ? &linux_base : nullptr);
     rt::Controller controller(std::move(config));
     run(o, *io_owner, controller, t);
   } catch (const std::exception& e) {
@@ -525,6 +646,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int signal_number = g_signal;
-  io_owner->stop(t, signal_number == SIGINT ? "SIGINT" : signal_number == SIGTERM ? "SIGTERM" : "end of input");
+  const bool stopped = io_owner->stop(t, signal_number == SIGINT ? "SIGINT" : signal_number == SIGTERM ? "SIGTERM" : "end of input");
+  if (!stopped) return 2;  // the motors may still be driven: said on stderr
   return signal_number != 0 ? 128 + signal_number : 0;
 }

@@ -293,6 +293,172 @@ if len(joints) == 4:
             failures.append(f"bad channel map {bad!r}: exit {r.returncode}, {r.stderr.strip()!r}")
 else:
     failures.append(f"the SIL log's joints: {joints}")
+# --io linux (docs/runtime.md "Linux I/O") against a scratch folder laid out like the kernel's
+# sysfs files (on tmpfs where there is one): the joints wired as above plus direction GPIO lines
+# 20..23, the IIO files holding the SIL log's first codes (less the offsets), the input the SIL log
+# with those codes in every row (the CSV backend's run of it is the reference). After 40 cycles,
+# the loop waiting on the pipe, each duty_cycle file holds round(|duty x direction| period) ns and
+# each value file 1 where that is negative, from the CSV run's duty of row 40; every logged duty is
+# the CSV run's; at the end every duty_cycle is 0; `fivebar replay` accepts the log. A failed
+# reading (an IIO file holding `junk`) is an empty cell, the mechanism's duties 0 and sensor_fault,
+# and the log still replays; a write that fails (a duty_cycle turned into a folder) stops the loop,
+# exit 2, every other channel at zero duty.
+def find_key(node, key):
+    if isinstance(node, dict):
+        for k, v in node.items():
+            if k == key:
+                return v
+            found = find_key(v, key)
+            if found is not None:
+                return found
+    return None
+
+
+import json
+import math
+pwm_hz = find_key(json.loads(config.read_text()), "pwm_hz")
+period = int(math.floor(1e9 / pwm_hz + 0.5))
+shm = pathlib.Path("/dev/shm") if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else WORK
+sysroot = shm / f"fivebar_device_loop_{os.getpid()}"
+
+
+def kernel_tree():
+    shutil.rmtree(sysroot, ignore_errors=True)
+    iio = sysroot / "sys/bus/iio/devices/iio:device0"
+    iio.mkdir(parents=True)
+    for k in range(8):
+        (iio / f"in_voltage{k}_raw").write_text("0\n")
+    chip = sysroot / "sys/class/pwm/pwmchip0"
+    for m in range(4):
+        (chip / f"pwm{m}").mkdir(parents=True)
+        for f in ["period", "duty_cycle", "polarity", "enable"]:
+            (chip / f"pwm{m}" / f).write_text("")
+    (chip / "export").write_text("")
+    for g in list(range(20, 24)) + [30]:
+        (sysroot / f"sys/class/gpio/gpio{g}").mkdir(parents=True)
+        for f in ["direction", "value"]:
+            (sysroot / f"sys/class/gpio/gpio{g}" / f).write_text("")
+    (sysroot / "sys/class/gpio/export").write_text("")
+    return iio, chip
+
+
+def ns_of(duty):
+    y = abs(duty) * period
+    n = math.floor(y)
+    return int(n + (1 if y - n >= 0.5 else 0))
+
+
+def linux_cmd():
+    return [LOOP, str(config), "-", "--io", "linux", "--channels", str(WORK / "gpiomap.csv"), "--sysfs-root", str(sysroot)]
+
+
+if len(joints) == 4:
+    (WORK / "gpiomap.csv").write_text("joint,adc_channel,pwm_channel,direction,offset_counts,direction_gpio\n" +
+                                      "".join(f"{j},{a},{p_},{d},{o},{20 + i}\n" for i, (j, (a, p_, d, o)) in enumerate(wiring.items())))
+    first = dict(zip(header, text[1].rstrip("\n").split(",")))
+    const_lines = [text[0]]
+    for line in text[1:]:
+        cells = line.rstrip("\n").split(",")
+        for i, c in enumerate(header):
+            if c.endswith("_counts"):
+                cells[i] = first[c]
+        const_lines.append(",".join(cells) + "\n")
+    (WORK / "const.csv").write_text("".join(const_lines))
+    reference = rows(subprocess.run([LOOP, str(config), str(WORK / "const.csv")], check=True, capture_output=True,
+                                    text=True).stdout)[:-1]
+    iio, chip = kernel_tree()
+    for j, (a, _, _, o) in wiring.items():
+        (iio / f"in_voltage{a}_raw").write_text(f"{int(first[j + '_counts']) - o}\n")
+    err = open(WORK / "linux.err", "w")
+    p = subprocess.Popen(linux_cmd(), stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True)
+    p.stdin.write("".join(const_lines[:41]))
+    p.stdin.flush()
+    head = p.stdout.readline()
+    got = [p.stdout.readline() for _ in range(40)]
+    row40 = dict(zip(head.rstrip("\n").split(","), got[-1].rstrip("\n").split(",")))
+    for j, (_, pwm, d, _) in wiring.items():
+        duty = float(reference[39][f"{j}_duty"])
+        ns = (chip / f"pwm{pwm}" / "duty_cycle").read_text().strip()
+        line = (sysroot / f"sys/class/gpio/gpio{20 + list(wiring).index(j)}" / "value").read_text().strip()
+        if row40.get(f"{j}_duty") != reference[39][f"{j}_duty"] or ns != str(ns_of(d * duty)) or line != ("1" if d * duty < 0 else "0"):
+            failures.append(f"--io linux row 40 {j}: log {row40.get(j + '_duty')}, csv {duty}, duty_cycle {ns}, direction {line}")
+    p.stdin.write("".join(const_lines[41:]))
+    p.stdin.close()
+    rest = p.stdout.read()
+    p.wait(timeout=60)
+    err.close()
+    linux_out = head + "".join(got) + rest
+    (WORK / "linux.csv").write_text(linux_out)
+    got = rows(linux_out)  # the stop is a note: every row is a cycle of the runtime
+    if p.returncode != 0 or len(got) != len(reference) or not linux_out.endswith("# stopped: end of input\n# zero duty written to every channel\n"):
+        failures.append(f"--io linux: exit {p.returncode}, {len(got)} rows, {(WORK / 'linux.err').read_text().strip()!r}")
+    elif any(a[f"{j}_duty"] != b[f"{j}_duty"] for a, b in zip(reference, got) for j in wiring):
+        failures.append("--io linux: the logged duties are not the CSV backend's")
+    for m in range(4):
+        d = chip / f"pwm{m}"
+        state = [(d / f).read_text().strip() for f in ["duty_cycle", "period", "polarity", "enable"]]
+        if state != ["0", str(period), "normal", "1"]:
+            failures.append(f"--io linux pwm{m} at the end: {state}")
+    r = subprocess.run([FIVEBAR, "replay", str(WORK / "linux.csv"), "--config", str(config)], capture_output=True, text=True)
+    if r.returncode != 0:
+        failures.append(f"fivebar replay of the --io linux log: exit {r.returncode}, {r.stderr.strip()!r}")
+    # A failed reading: the first joint's ADC file holds junk.
+    first_joint = next(iter(wiring))
+    (iio / f"in_voltage{wiring[first_joint][0]}_raw").write_text("junk\n")
+    r = subprocess.run(linux_cmd(), input="".join(const_lines), capture_output=True, text=True)
+    (WORK / "failed.csv").write_text(r.stdout)
+    got = rows(r.stdout)
+    mech = first_joint.rsplit("_", 1)[0]
+    if (r.returncode != 0 or len(got) != len(reference) or any(row[f"{first_joint}_counts"] != "" for row in got) or
+            any(row[f"{mech}_status"] != "sensor_fault" or float(row[f"{mech}_theta1_duty"]) != 0.0 or
+                float(row[f"{mech}_theta2_duty"]) != 0.0 for row in got)):
+        failures.append(f"--io linux failed reading: exit {r.returncode}, {r.stderr.strip()!r}, {got[:1]}")
+    r = subprocess.run([FIVEBAR, "replay", str(WORK / "failed.csv"), "--config", str(config)], capture_output=True, text=True)
+    if r.returncode != 0 or f"failed readings (empty cells): {len(reference)}, 0 without" not in r.stdout:
+        failures.append(f"fivebar replay of failed readings: exit {r.returncode}, {r.stdout.strip()[-300:]!r} {r.stderr.strip()!r}")
+    # A write that fails after 5 cycles.
+    iio, chip = kernel_tree()
+    p = subprocess.Popen(linux_cmd(), stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p.stdin.write("".join(const_lines[:6]))
+    p.stdin.flush()
+    got = [p.stdout.readline() for _ in range(6)]
+    broken = wiring[joints[2]][1]
+    (chip / f"pwm{broken}" / "duty_cycle").unlink()
+    (chip / f"pwm{broken}" / "duty_cycle").mkdir()
+    p.stdin.write(const_lines[6])
+    p.stdin.close()
+    rest, stderr = p.stdout.read(), p.stderr.read()
+    p.wait(timeout=60)
+    others = [(chip / f"pwm{m}" / "duty_cycle").read_text().strip() for m in range(4) if m != broken]
+    if p.returncode != 2 or f"pwm{broken}/duty_cycle: Is a directory" not in stderr or others != ["0", "0", "0"]:
+        failures.append(f"--io linux failed write: exit {p.returncode}, {stderr.strip()!r}, others {others}")
+    # The E-stop line (--estop-gpio 30): reading 1, every cycle is a zero-duty note, no row, the
+    # files at zero; reading 0, the run is the one without the line.
+    iio, chip = kernel_tree()
+    for j, (a, _, _, o) in wiring.items():
+        (iio / f"in_voltage{a}_raw").write_text(f"{int(first[j + '_counts']) - o}\n")
+    (sysroot / "sys/class/gpio/gpio30/value").write_text("1\n")
+    r = subprocess.run(linux_cmd() + ["--estop-gpio", "30"], input="".join(const_lines), capture_output=True, text=True)
+    notes = [line for line in r.stdout.splitlines() if line.startswith("# estop: t = ")]
+    duties = [(chip / f"pwm{m}" / "duty_cycle").read_text().strip() for m in range(4)]
+    if (r.returncode != 0 or rows(r.stdout) or len(notes) != len(reference) or "# estop: latched (input)" not in r.stdout or
+            duties != ["0"] * 4 or (sysroot / "sys/class/gpio/gpio30/direction").read_text().strip() != "in"):
+        failures.append(f"--estop-gpio pressed: exit {r.returncode}, {len(rows(r.stdout))} rows, {len(notes)} notes, {duties}")
+    (sysroot / "sys/class/gpio/gpio30/value").write_text("0\n")
+    r = subprocess.run(linux_cmd() + ["--estop-gpio", "30"], input="".join(const_lines), capture_output=True, text=True)
+    if r.returncode != 0 or r.stdout != linux_out:
+        failures.append(f"--estop-gpio released: exit {r.returncode}, the output differs from the run without the line")
+    # --io linux needs the direction lines in the map.
+    r = subprocess.run([LOOP, str(config), str(WORK / "const.csv"), "--io", "linux", "--channels", str(WORK / "map.csv"),
+                        "--sysfs-root", str(sysroot)], capture_output=True, text=True)
+    if r.returncode != 2 or "direction_gpio" not in r.stderr:
+        failures.append(f"--io linux without direction_gpio: exit {r.returncode}, {r.stderr.strip()!r}")
+    for bad in [["--io", "spi"], ["--pwm-chip", "x"], ["--sysfs-root", str(sysroot)]]:
+        r = subprocess.run([LOOP, str(config), str(WORK / "const.csv")] + bad, capture_output=True, text=True)
+        if r.returncode != 2 or bad[0] not in r.stderr:
+            failures.append(f"{bad}: exit {r.returncode}, {r.stderr.strip()!r}")
+    shutil.rmtree(sysroot, ignore_errors=True)
+    print(f"--io linux: {len(reference)} cycles, period {period} ns")
 if nonzero < len(logged):
     failures.append(f"only {nonzero} non-zero duties: the pattern does not drive the motors")
 for f in failures[:20]:

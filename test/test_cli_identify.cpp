@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -263,6 +264,25 @@ TEST_F(CliIdentify, TheDeviceLogOfReplayIsIdentified) {
   Outcome r = run({"identify", kDesign, log, "--rig", "mechanism", "index/lower", "--no-files", "--no-output-error", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string text = ft::slurp(log);
+  // With the status columns device_loop --io linux logs (text, not numbers): read, not used; the
+  // same figures.
+  {
+    std::istringstream in(text);
+    std::string with, line;
+    bool header = true;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#') {
+        with += line + "\n";
+        continue;
+      }
+      with += line + (header ? ",index_lower_status,index_upper_status\n" : ",ok,sensor_fault\n");
+      header = false;
+    }
+    const Outcome s = run({"identify", kDesign, write("status.csv", with).string(), "--rig", "mechanism", "index/lower", "--no-files",
+                           "--no-output-error", "--json"});
+    ASSERT_EQ(s.code, 0) << s.err;
+    EXPECT_EQ(parse(s)["joints"], parse(r)["joints"]);
+  }
   std::string dup = text;
   dup.replace(dup.find("index_upper_x_ref_mm"), std::string("index_upper_x_ref_mm").size(), "index_lower_x_ref_mm");
   r = run({"identify", kDesign, write("dup.csv", dup).string(), "--rig", "mechanism", "index/lower", "--no-files"});

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <algorithm>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -212,6 +214,141 @@ TEST_F(Replay, ScaledGainsAreFlaggedWithTheDifferenceTheScalePredicts) {
   EXPECT_EQ(h.back(), "index_upper_status");
   EXPECT_DOUBLE_EQ(std::stod(v[2]) - std::stod(v[1]), std::stod(v[3]));
   EXPECT_NEAR(std::stod(v[2]), c * std::stod(v[1]), 1e-12);
+}
+
+// Failed readings (docs/runtime.md "Replay": an empty reading cell). The device here is the
+// runtime fed NaN for the lower mechanism's readings at known rows, its log written with
+// write_replay_row: the written cells are empty, the log replays clean, the lower mechanism's
+// duties on those rows are 0 (the runtime's sensor fault), the upper mechanism's duties are the
+// fault-free log's bit for bit (the priority rule follows the upper mechanism, not the lower). A
+// non-zero logged duty on a failed row is flagged at that row and joint; a cell that is not the
+// marker (`nan`, `-`) stays refused at its line and column.
+TEST_F(Replay, FailedReadingsReplayCleanAndANonZeroDutyOnOneIsFlaggedAtItsRow) {
+  const SilRun run = sil(false);
+  ASSERT_TRUE(run.result.ok());
+  const rt::Config full = exported();
+  const ReplayLog clean = read(slurp(run.log), full);
+  const rt::Config config = config_for_log(full, clean);
+  ASSERT_EQ(clean.readings.front().size(), 4u);  // index lower theta1, theta2, upper theta1, theta2
+  const std::vector<std::pair<std::size_t, std::size_t>> failed{{30, 0}, {31, 1}, {75, 0}, {75, 1}, {120, 1}};
+  rt::Controller device(config);
+  std::ostringstream text;
+  write_replay_header(text, config, clean.kind);
+  std::vector<std::vector<double>> duties;
+  for (std::size_t row = 0; row < clean.time_s.size(); ++row) {
+    std::vector<double> readings = clean.readings[row];
+    for (const auto& [r, j] : failed)
+      if (r == row) readings[j] = std::numeric_limits<double>::quiet_NaN();
+    device.cycle(readings.data(), clean.kind, clean.targets_m[row].data());
+    duties.emplace_back(device.duties(), device.duties() + 4);
+    write_replay_row(text, clean.time_s[row], readings, clean.targets_m[row], device.duties(), 4);
+  }
+  const std::string log_text = text.str();
+  const ReplayLog log = read(log_text, full);
+  EXPECT_EQ(log.failed_readings, failed.size());
+  for (const auto& [r, j] : failed) {
+    EXPECT_TRUE(std::isnan(log.readings[r][j])) << r;
+    EXPECT_EQ(duties[r][0], 0.0) << r;  // the lower mechanism's two duties
+    EXPECT_EQ(duties[r][1], 0.0) << r;
+  }
+  for (std::size_t row = 0; row < duties.size(); ++row) {
+    EXPECT_EQ(duties[row][2], clean.duties[row][2]) << row;
+    EXPECT_EQ(duties[row][3], clean.duties[row][3]) << row;
+  }
+  // The marker on the line: two commas with nothing between them where the reading was.
+  std::istringstream lines(log_text);
+  std::string line;
+  for (std::size_t n = 0; n <= 31 + 1; ++n) std::getline(lines, line);  // header + 31 rows, then row 31 (0-based)
+  EXPECT_THAT(line, ::testing::StartsWith(format::shortest(clean.time_s[31]) + ","));
+  EXPECT_THAT(line, HasSubstr(",,"));
+  const ReplayResult r = replay_log(full, log, 0.0);
+  EXPECT_TRUE(r.passed());
+  EXPECT_EQ(r.mismatches, 0u);
+  EXPECT_EQ(r.failed_readings, failed.size());
+  EXPECT_EQ(r.failed_not_faulted, 0u);
+  EXPECT_EQ(r.joints[0].failed_readings, 2u);
+  EXPECT_EQ(r.joints[1].failed_readings, 3u);
+  EXPECT_EQ(r.status_counts[0][static_cast<std::size_t>(rt::Status::sensor_fault)], 4u);  // rows 30, 31, 75, 120
+  // The same log with a duty of 0.25 logged on failed row 75 (data row 76): flagged there.
+  std::vector<std::string> rows;
+  for (std::istringstream in(log_text); std::getline(in, line);) rows.push_back(line);
+  std::vector<std::string> cells = split(rows[1 + 75]);
+  const std::vector<std::string> header = split(rows[0]);
+  const std::size_t duty_col = static_cast<std::size_t>(std::find(header.begin(), header.end(), "index_lower_theta2_duty") - header.begin());
+  ASSERT_LT(duty_col, header.size());
+  ASSERT_EQ(cells[duty_col], "0");
+  cells[duty_col] = "0.25";
+  std::string changed;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    std::string l = rows[i];
+    if (i == 1 + 75) {
+      l.clear();
+      for (std::size_t k = 0; k < cells.size(); ++k) l += (k ? "," : "") + cells[k];
+    }
+    changed += l + "\n";
+  }
+  const ReplayResult bad = replay_log(full, read(changed, full), 1e-9);
+  EXPECT_FALSE(bad.passed());
+  EXPECT_EQ(bad.mismatches, 1u);
+  ASSERT_TRUE(bad.first_mismatch);
+  EXPECT_EQ(bad.first_row, 75u);
+  EXPECT_EQ(bad.first_joint, "index_lower_theta2");
+  EXPECT_EQ(bad.first_logged, 0.25);
+  EXPECT_EQ(bad.first_runtime, 0.0);
+  EXPECT_EQ(bad.failed_not_faulted, 0u);  // the runtime did its part
+  // Other non-numbers in a reading cell stay refused, naming the line and the column.
+  const std::size_t reading_col = static_cast<std::size_t>(std::find(header.begin(), header.end(), "index_lower_theta1_counts") - header.begin());
+  for (const std::string& cell : {std::string("nan"), std::string("-"), std::string("inf")}) {
+    std::vector<std::string> c = split(rows[1 + 10]);
+    c[reading_col] = cell;
+    std::string t = rows[0] + "\n";
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+      std::string l = rows[i];
+      if (i == 1 + 10) {
+        l.clear();
+        for (std::size_t k = 0; k < c.size(); ++k) l += (k ? "," : "") + c[k];
+      }
+      t += l + "\n";
+    }
+    try {
+      read(t, full);
+      ADD_FAILURE() << cell << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), HasSubstr("log.csv:12: column 'index_lower_theta1_counts'")) << cell;
+    }
+  }
+  // With the device loop's status columns (the statuses it logged: sensor_fault on the lower
+  // mechanism exactly at the failed rows, ok elsewhere, as the clean SIL run is ok throughout): the
+  // log replays; a failed row logged `ok` is a status mismatch at that row; a cell that is not a
+  // status is refused at its line and column.
+  const auto with_statuses = [&](std::size_t bad_row, const std::string& bad_status) {
+    std::string t = rows[0] + ",index_lower_status,index_upper_status\n";
+    for (std::size_t i = 1; i < rows.size(); ++i) {
+      const std::size_t row = i - 1;
+      bool fault = false;
+      for (const auto& [fr, j] : failed) fault = fault || fr == row;
+      t += rows[i] + "," + (row == bad_row ? bad_status : fault ? "sensor_fault" : "ok") + ",ok\n";
+    }
+    return t;
+  };
+  const ReplayResult with = replay_log(full, read(with_statuses(9999, ""), full), 0.0);
+  EXPECT_TRUE(with.passed());
+  EXPECT_EQ(with.status_mismatches, 0u);
+  const ReplayResult wrong = replay_log(full, read(with_statuses(120, "ok"), full), 0.0);
+  EXPECT_FALSE(wrong.passed());
+  EXPECT_EQ(wrong.status_mismatches, 1u);
+  ASSERT_TRUE(wrong.first_status_mismatch);
+  EXPECT_EQ(wrong.first_status_row, 120u);
+  EXPECT_EQ(wrong.first_status_mechanism, "index/lower");
+  EXPECT_EQ(wrong.first_status_logged, rt::Status::ok);
+  EXPECT_EQ(wrong.first_status_runtime, rt::Status::sensor_fault);
+  EXPECT_EQ(wrong.mismatches, 0u);
+  try {
+    read(with_statuses(5, "faulty"), full);
+    ADD_FAILURE() << "a status 'faulty' was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("log.csv:7: column 'index_lower_status' = 'faulty'"));
+  }
 }
 
 TEST(ReplayDesign, BadLogNamesAreTheDesignFilesLineAndKey) {

@@ -15,6 +15,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <new>
 #include <initializer_list>
 #include <random>
@@ -25,7 +27,9 @@
 #include "fivebar/dynamics.hpp"
 #include "fivebar/export/export.hpp"
 #include "fivebar/runtime.hpp"
+#include "fivebar/runtime/linux_io.hpp"
 #include "paper.hpp"
+#include "process.hpp"
 
 // --- Allocation counter: every global operator new of this executable --------------------------
 namespace {
@@ -1109,6 +1113,205 @@ TEST(Runtime, TheExportedHeaderConfiguresTheSameController) {
     y.cycle(r.data(), rt::Reading::radians, s.targets.data());
     ASSERT_EQ(std::memcmp(x.duties(), y.duties(), 8 * sizeof(double)), 0) << k;
   }
+}
+
+
+// --- The Linux I/O backend (fivebar/runtime/linux_io.hpp) against a scratch folder laid out like
+// the kernel's sysfs files ------------------------------------------------------------------------
+
+namespace fs = std::filesystem;
+namespace lio = fivebar::runtime::linux_io;
+
+std::string file_text(const fs::path& p) {
+  std::ifstream in(p);
+  std::string t((std::istreambuf_iterator<char>(in)), {});
+  while (!t.empty() && t.back() == '\n') t.pop_back();
+  return t;
+}
+void put_text(const fs::path& p, const std::string& t) { std::ofstream(p) << t << "\n"; }
+
+/// The tree the mainline drivers give: an IIO ADC with channels 0-7, a PWM chip with `pwm` of its
+/// channels already exported, the GPIO class folder with `gpios` exported.
+void kernel_tree(const fs::path& root, const std::vector<int>& pwm, const std::vector<int>& gpios) {
+  const fs::path iio = root / "sys/bus/iio/devices/iio:device1", chip = root / "sys/class/pwm/pwmchip2", gpio = root / "sys/class/gpio";
+  fs::create_directories(iio);
+  for (int k = 0; k < 8; ++k) put_text(iio / ("in_voltage" + std::to_string(k) + "_raw"), "0");
+  fs::create_directories(chip);
+  put_text(chip / "export", "");
+  for (int m : pwm) {
+    const fs::path d = chip / ("pwm" + std::to_string(m));
+    fs::create_directories(d);
+    for (const char* f : {"period", "duty_cycle", "polarity", "enable"}) put_text(d / f, "");
+  }
+  fs::create_directories(gpio);
+  put_text(gpio / "export", "");
+  for (int g : gpios) {
+    fs::create_directories(gpio / ("gpio" + std::to_string(g)));
+    put_text(gpio / ("gpio" + std::to_string(g)) / "direction", "in");
+    put_text(gpio / ("gpio" + std::to_string(g)) / "value", "0");
+  }
+}
+
+// Eight joints wired to ADC channels 7..0, PWM channels in another order, GPIO lines 20..27, two
+// motors reversed, offsets in codes. Over 300 cycles of moving references and noisy readings the
+// files read give exactly the codes plus offsets; the duty_cycle and direction files hold, bit for
+// bit, the documented conversion (round(|d| P) ns, line 1 where d < 0; P = round(1e9 / pwm_hz),
+// computed here) of the duties a second runtime gives when fed the same numbers directly (what the
+// CSV backend does); nothing allocates in read() and write(). A failed or out-of-range read is NaN
+// (the runtime's sensor fault); a write that fails returns false naming the file, the other
+// channels still written; write_zero() attempts every channel.
+TEST(LinuxIo, WritesTheCsvBackendsDutiesToThePwmAndGpioFilesBitForBit) {
+  // On tmpfs where there is one: on ext4 each close after O_TRUNC flushes the file to the disk
+  // (auto_da_alloc), 20 s for this test; sysfs writes no disk either.
+  struct Tree {
+    fs::path path;
+    ~Tree() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } tree{(fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path()) /
+         ("fivebar_test_linux_io_" + std::to_string(::getpid()))};
+  fs::remove_all(tree.path);
+  fs::create_directories(tree.path);
+  const fs::path root = tree.path;
+  kernel_tree(root, {0, 1, 2, 3, 4, 5, 6}, {20, 21, 22, 23, 24, 25, 26, 27});  // pwm7 not yet exported
+  const rt::Config c = paper_config();
+  ASSERT_EQ(c.mechanism_count(), 4u);
+  const std::vector<int> pwm{3, 1, 0, 2, 7, 5, 6, 4};
+  const std::vector<double> direction{1, -1, 1, 1, 1, 1, -1, 1}, offset{0, 12, -5, 3, 0, 0, 7, 0};
+  lio::LinuxIoConfig cfg;
+  cfg.root = root.string();
+  cfg.iio_device = 1;
+  cfg.pwm_chip = 2;
+  cfg.pwm_hz = c.pwm_hz;
+  cfg.adc_bits = c.adc_bits;
+  for (int j = 0; j < 8; ++j) cfg.joints.push_back({7 - j, pwm[j], 20 + j, direction[j], offset[j]});
+  // A PWM channel not exported whose folder the "kernel" does not create: refused after the export.
+  try {
+    lio::LinuxIo io(cfg);
+    ADD_FAILURE() << "set up without pwm7";
+  } catch (const lio::IoError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("pwmchip2/pwm7: not there after writing 7 to"));
+  }
+  EXPECT_EQ(file_text(root / "sys/class/pwm/pwmchip2/export"), "7");
+  kernel_tree(root, {7}, {});
+  lio::LinuxIo io(cfg);
+  const long long period = std::llround(1e9 / c.pwm_hz);
+  ASSERT_EQ(io.period_ns(), period);
+  const fs::path chip = root / "sys/class/pwm/pwmchip2", iio = root / "sys/bus/iio/devices/iio:device1";
+  for (int j = 0; j < 8; ++j) {
+    const fs::path d = chip / ("pwm" + std::to_string(pwm[j]));
+    EXPECT_EQ(file_text(d / "period"), std::to_string(period));
+    EXPECT_EQ(file_text(d / "polarity"), "normal");
+    EXPECT_EQ(file_text(d / "enable"), "1");
+    EXPECT_EQ(file_text(d / "duty_cycle"), "0");
+    EXPECT_EQ(file_text(root / ("sys/class/gpio/gpio" + std::to_string(20 + j)) / "direction"), "low");
+  }
+  // Readings as ADC codes: the IK of moving points through the calibration, rounded to a code.
+  rt::Controller via_files(c), direct(c);
+  const std::vector<Vec2> base = centres(c);
+  std::vector<double> readings(8), codes(8), numbers(8);
+  long long nonzero = 0, negative = 0, allocations = 0;
+  for (int k = 0; k < 300; ++k) {
+    std::vector<Vec2> p = base;
+    for (Vec2& q : p) q += Vec2(1.5 * std::cos(0.05 * k), 1.5 * std::sin(0.05 * k));
+    const Scene s = at_points(c, p);
+    std::size_t j = 0;
+    for (const auto& st : c.stations)
+      for (const auto& m : st.mechanisms)
+        for (const auto& jc : m.joints) {
+          const double theta = s.readings[j] + 0.01 * std::sin(0.7 * k + double(j));  // away from the command
+          const double volts = theta / jc.rad_per_volt + jc.volts_at_zero;
+          codes[j] = std::round((volts - c.adc_range_v[0]) / c.volts_per_count) - offset[j];
+          put_text(iio / ("in_voltage" + std::to_string(7 - j) + "_raw"), std::to_string(static_cast<long long>(codes[j])));
+          numbers[j] = codes[j] + offset[j];
+          ++j;
+        }
+    const long long before = g_allocations.load();
+    const std::size_t failed = io.read(readings.data());
+    via_files.cycle(readings.data(), rt::Reading::counts, s.targets.data());
+    const bool written = io.write(via_files.duties());
+    allocations += g_allocations.load() - before;
+    ASSERT_EQ(failed, 0u);
+    ASSERT_TRUE(written) << io.error();
+    direct.cycle(numbers.data(), rt::Reading::counts, s.targets.data());
+    for (j = 0; j < 8; ++j) {
+      ASSERT_EQ(readings[j], numbers[j]) << k << " " << j;
+      const double d = direct.duties()[j] * direction[j];
+      const long long ns = std::llround(std::fabs(d) * static_cast<double>(period));
+      ASSERT_EQ(file_text(chip / ("pwm" + std::to_string(pwm[j])) / "duty_cycle"), std::to_string(ns)) << k << " " << j;
+      ASSERT_EQ(file_text(root / ("sys/class/gpio/gpio" + std::to_string(20 + j)) / "value"), d < 0 ? "1" : "0") << k << " " << j;
+      nonzero += ns != 0;
+      negative += d < 0;
+    }
+  }
+  EXPECT_EQ(allocations, 0);
+  EXPECT_GT(nonzero, 8 * 250);  // the motors were driven, both ways
+  EXPECT_GT(negative, 300);
+  // Failed readings: not a number, out of [0, 2^bits), empty, gone.
+  const std::string top = std::to_string(1LL << c.adc_bits);
+  put_text(iio / "in_voltage7_raw", "junk");
+  put_text(iio / "in_voltage6_raw", top);
+  put_text(iio / "in_voltage5_raw", "-1");
+  std::ofstream(iio / "in_voltage4_raw").close();
+  fs::remove(iio / "in_voltage3_raw");
+  put_text(iio / "in_voltage2_raw", std::to_string((1LL << c.adc_bits) - 1));
+  EXPECT_EQ(io.read(readings.data()), 5u);
+  for (int j = 0; j < 5; ++j) EXPECT_TRUE(std::isnan(readings[j])) << j;
+  EXPECT_EQ(readings[5], double((1LL << c.adc_bits) - 1) + offset[5]);
+  via_files.cycle(readings.data(), rt::Reading::counts, base.empty() ? nullptr : at_points(c, base).targets.data());
+  EXPECT_EQ(via_files.mechanism(0).status, rt::Status::sensor_fault);
+  // A write that fails: pwm1's duty_cycle is a folder. The others are still written.
+  fs::remove(chip / "pwm1/duty_cycle");
+  fs::create_directories(chip / "pwm1/duty_cycle");
+  const std::vector<double> half(8, 0.5);
+  EXPECT_FALSE(io.write(half.data()));
+  EXPECT_THAT(io.error(), HasSubstr("pwmchip2/pwm1/duty_cycle: Is a directory"));
+  EXPECT_EQ(file_text(chip / "pwm3/duty_cycle"), std::to_string(std::llround(0.5 * static_cast<double>(period))));
+  EXPECT_FALSE(io.write_zero());
+  for (int m : {0, 2, 3, 4, 5, 6, 7}) EXPECT_EQ(file_text(chip / ("pwm" + std::to_string(m)) / "duty_cycle"), "0") << m;
+  // The conversion's edges.
+  EXPECT_EQ(lio::duty_cycle_ns(-1.0, 1000000), 1000000);
+  EXPECT_EQ(lio::duty_cycle_ns(0.5e-6, 1000000), 1);  // 0.5 ns rounds away from zero
+  EXPECT_EQ(lio::duty_cycle_ns(std::nan(""), 1000000), 0);
+  EXPECT_EQ(lio::direction_value(-0.0), 0);
+  EXPECT_THROW(lio::pwm_period_ns(0.0), lio::IoError);
+}
+
+
+// The E-stop input line (--estop-gpio): set up as an input; pressed when its value reads 1, and
+// fail-safe when it reads anything but 0 or cannot be read; no line: never pressed.
+TEST(LinuxIo, TheEStopLineIsPressedUnlessItReadsZero) {
+  const fs::path root = (fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : fs::temp_directory_path()) /
+                        ("fivebar_test_linux_estop_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  kernel_tree(root, {0}, {20, 30});
+  lio::LinuxIoConfig cfg;
+  cfg.root = root.string();
+  cfg.iio_device = 1;
+  cfg.pwm_chip = 2;
+  cfg.pwm_hz = 1000.0;
+  cfg.adc_bits = 16;
+  cfg.joints.push_back({0, 0, 20, 1.0, 0.0});
+  {
+    lio::LinuxIo none(cfg);
+    EXPECT_FALSE(none.estop());
+  }
+  cfg.estop_gpio = 30;
+  lio::LinuxIo io(cfg);
+  const fs::path line = root / "sys/class/gpio/gpio30";
+  EXPECT_EQ(file_text(line / "direction"), "in");
+  put_text(line / "value", "0");
+  EXPECT_FALSE(io.estop());
+  put_text(line / "value", "1");
+  EXPECT_TRUE(io.estop());
+  put_text(line / "value", "junk");
+  EXPECT_TRUE(io.estop());
+  put_text(line / "value", "00");
+  EXPECT_TRUE(io.estop());
+  fs::remove(line / "value");
+  EXPECT_TRUE(io.estop());
+  fs::remove_all(root);
 }
 
 }  // namespace

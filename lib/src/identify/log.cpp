@@ -45,7 +45,8 @@ std::string where(const std::string& path, std::size_t line) { return path + ":"
 /// Joint part of a column name: "" or "<station>_<mechanism>_theta<1|2>_"; false when malformed.
 /// `x_ref_mm`, `y_ref_mm`, or either after "<station>_<mechanism>_": the targets of the device log.
 bool is_reference_column(const std::string& name) {
-  for (const std::string suffix : {"x_ref_mm", "y_ref_mm"}) {
+  // The device log's targets and (device_loop --io linux) its statuses: read, not used.
+  for (const std::string suffix : {"x_ref_mm", "y_ref_mm", "status"}) {
     if (name == suffix) return true;
     if (name.size() > suffix.size() + 1 && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0 &&
         name[name.size() - suffix.size() - 1] == '_') {
@@ -101,7 +102,7 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
       time_col = static_cast<int>(c);
       continue;
     }
-    if (is_reference_column(name)) continue;  // the device log's targets (docs/bench-files.md): read, not used
+    if (is_reference_column(name)) continue;  // the device log's targets and statuses (docs/bench-files.md): read, not used
     const ColumnKind* kind = nullptr;
     std::string prefix;
     for (const ColumnKind& k : kColumns) {
@@ -197,9 +198,17 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
   // Rows.
   std::vector<std::size_t> row_lines;
   std::vector<double> v(header.size());
+  std::vector<bool> is_status_column(header.size());
+  for (std::size_t c = 0; c < header.size(); ++c) {
+    const std::string& n = header[c];
+    is_status_column[c] = n == "status" || (n.size() > 7 && n.compare(n.size() - 7, 7, "_status") == 0);
+  }
   while (reader.next()) {
     const std::size_t line_no = reader.line();
-    for (std::size_t c = 0; c < header.size(); ++c) v[c] = reader.number(c, kMaxLogValue, "no bench quantity is that large in SI units");
+    for (std::size_t c = 0; c < header.size(); ++c) {
+      if (is_status_column[c]) continue;  // text (ok, sensor_fault, ...), not used
+      v[c] = reader.number(c, kMaxLogValue, "no bench quantity is that large in SI units");
+    }
     const double time = v[static_cast<std::size_t>(time_col)];
     if (!log.time.empty() && !(time > log.time.back())) {
       throw InputError(where(path, line_no) + "column 'time_s': " + format::shortest(time) + " does not increase (previous row " +

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <istream>
+#include <limits>
 #include <map>
 #include <ostream>
 
@@ -81,16 +82,38 @@ ReplayLog read_replay_log(std::istream& in, const runtime::Config& config, const
     target_col.push_back(column(m + "_x_ref_mm"));
     target_col.push_back(column(m + "_y_ref_mm"));
   }
+  // The optional status columns: all of them or none.
+  std::vector<std::size_t> status_col;
+  for (const std::string& m : cols.mechanisms)
+    if (at.count(m + "_status")) status_col.push_back(at[m + "_status"]);
+  if (!status_col.empty() && status_col.size() != cols.mechanisms.size()) {
+    for (const std::string& m : cols.mechanisms) column(m + "_status");  // names the first one missing
+  }
+  const auto status = [&](std::size_t c) {
+    for (std::size_t s = 0; s < 6; ++s)
+      if (reader.cell(c) == runtime::to_string(static_cast<runtime::Status>(s))) return static_cast<runtime::Status>(s);
+    throw InputError(reader.at(c) + "not a status (ok, moved_by_priority, unreachable, singular, limit, sensor_fault)");
+  };
   while (reader.next()) {
     const auto number = [&](std::size_t c) { return reader.number(c, csv::kMaxBenchValue); };
     log.time_s.push_back(number(t_col));
     std::vector<double> r, t, d;
-    for (std::size_t c : reading_col) r.push_back(number(c));
+    // The documented marker of a failed reading: an empty cell (NaN to the runtime, a sensor fault).
+    for (std::size_t c : reading_col) {
+      const bool failed = reader.cell(c).empty();
+      log.failed_readings += failed ? 1 : 0;
+      r.push_back(failed ? std::numeric_limits<double>::quiet_NaN() : number(c));
+    }
     for (std::size_t c : duty_col) d.push_back(number(c));
     for (std::size_t i = 0; i < target_col.size(); ++i) t.push_back(number(target_col[i]) / 1000.0);
     log.readings.push_back(std::move(r));
     log.duties.push_back(std::move(d));
     log.targets_m.push_back(std::move(t));
+    if (!status_col.empty()) {
+      std::vector<runtime::Status> st;
+      for (std::size_t c : status_col) st.push_back(status(c));
+      log.statuses.push_back(std::move(st));
+    }
   }
   if (log.time_s.empty()) throw InputError(origin + ": the log has no data row");
   return log;
@@ -107,7 +130,10 @@ void write_replay_header(std::ostream& out, const runtime::Config& config, runti
 void write_replay_row(std::ostream& out, double t, const std::vector<double>& readings, const std::vector<double>& targets,
                       const double* duties, std::size_t joints) {
   out << format::shortest(t);
-  for (std::size_t j = 0; j < joints; ++j) out << "," << format::shortest(readings[j]) << "," << format::shortest(duties[j]);
+  // A failed reading (NaN) is written as the documented marker, an empty cell.
+  for (std::size_t j = 0; j < joints; ++j) {
+    out << "," << (std::isnan(readings[j]) ? std::string() : format::shortest(readings[j])) << "," << format::shortest(duties[j]);
+  }
   for (double v : targets) out << "," << format::shortest(v * 1000.0);
   out << "\n";
 }
@@ -128,9 +154,13 @@ ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, doubl
   ReplayResult r;
   r.tolerance = tolerance;
   r.rows = log.time_s.size();
-  for (const std::string& j : cols.joints) r.joints.push_back({j, 0.0, 0});
+  for (const std::string& j : cols.joints) r.joints.push_back({j, 0.0, 0, 0});
+  std::vector<std::size_t> mechanism_of;  // per joint: its mechanism (runtime order), for the failed readings' check
   for (const auto& s : config.stations)
-    for (const auto& m : s.mechanisms) r.mechanisms.push_back(s.name + "/" + m.name);
+    for (const auto& m : s.mechanisms) {
+      for (std::size_t i = 0; i < m.joints.size(); ++i) mechanism_of.push_back(r.mechanisms.size());
+      r.mechanisms.push_back(s.name + "/" + m.name);
+    }
   r.status_counts.assign(r.mechanisms.size(), {});
   if (trace) {
     trace->duties.assign(r.rows, {});
@@ -138,12 +168,31 @@ ReplayResult replay_log(const runtime::Config& full, const ReplayLog& log, doubl
   }
   for (std::size_t row = 0; row < r.rows; ++row) {
     ctl.cycle(log.readings[row].data(), log.kind, log.targets_m[row].data());
-    for (std::size_t k = 0; k < r.mechanisms.size(); ++k) ++r.status_counts[k][static_cast<std::size_t>(ctl.mechanism(k).status)];
+    for (std::size_t k = 0; k < r.mechanisms.size(); ++k) {
+      const runtime::Status st = ctl.mechanism(k).status;
+      ++r.status_counts[k][static_cast<std::size_t>(st)];
+      if (log.statuses.empty() || log.statuses[row][k] == st) continue;
+      ++r.status_mismatches;
+      if (!r.first_status_mismatch) {
+        r.first_status_mismatch = true;
+        r.first_status_row = row;
+        r.first_status_mechanism = r.mechanisms[k];
+        r.first_status_logged = log.statuses[row][k];
+        r.first_status_runtime = st;
+      }
+    }
     if (trace) {
       trace->duties[row].assign(ctl.duties(), ctl.duties() + cols.joints.size());
       for (std::size_t k = 0; k < r.mechanisms.size(); ++k) trace->statuses[row].push_back(ctl.mechanism(k).status);
     }
     for (std::size_t j = 0; j < cols.joints.size(); ++j) {
+      // A failed reading: the runtime must give that joint zero duty and its mechanism sensor_fault
+      // (docs/runtime.md "One cycle"); the logged duty is compared below like any other.
+      if (std::isnan(log.readings[row][j])) {
+        ++r.failed_readings;
+        ++r.joints[j].failed_readings;
+        if (ctl.duties()[j] != 0.0 || ctl.mechanism(mechanism_of[j]).status != runtime::Status::sensor_fault) ++r.failed_not_faulted;
+      }
       // A logged duty may be rounded by the device's logger: the difference, not bits, is compared.
       const double diff = std::fabs(ctl.duties()[j] - log.duties[row][j]);
       ReplayJoint& rj = r.joints[j];
@@ -191,6 +240,14 @@ Json to_json(const ReplayResult& r) {
   j["tolerance"] = r.tolerance;
   j["max_duty_difference"] = r.max_difference;
   j["mismatches"] = r.mismatches;
+  j["failed_readings"] = r.failed_readings;
+  j["failed_readings_not_faulted"] = r.failed_not_faulted;
+  j["status_mismatches"] = r.status_mismatches;
+  j["first_status_mismatch"] = r.first_status_mismatch ? Json{{"row", r.first_status_row + 1},
+                                                              {"mechanism", r.first_status_mechanism},
+                                                              {"logged_status", runtime::to_string(r.first_status_logged)},
+                                                              {"runtime_status", runtime::to_string(r.first_status_runtime)}}
+                                                       : Json(nullptr);
   j["passed"] = r.passed();
   j["first_mismatch"] = r.first_mismatch ? Json{{"row", r.first_row + 1},  // data rows from 1, as the text
                                                 {"time_s", r.first_time_s},
@@ -200,7 +257,8 @@ Json to_json(const ReplayResult& r) {
                                          : Json(nullptr);
   Json joints = Json::array();
   for (const ReplayJoint& rj : r.joints) {
-    joints.push_back({{"joint", rj.joint}, {"max_duty_difference", rj.max_difference}, {"mismatches", rj.mismatches}});
+    joints.push_back({{"joint", rj.joint}, {"max_duty_difference", rj.max_difference}, {"mismatches", rj.mismatches},
+                      {"failed_readings", rj.failed_readings}});
   }
   j["joints"] = joints;
   Json mechs = Json::array();

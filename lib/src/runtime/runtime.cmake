@@ -29,9 +29,27 @@ if(_fivebar_runtime_type STREQUAL "STATIC_LIBRARY" AND CMAKE_CXX_COMPILER_ID MAT
   target_link_libraries(fivebar_runtime INTERFACE $<$<LINK_LANGUAGE:C>:stdc++> $<$<LINK_LANGUAGE:C>:m>)
 endif()
 
+# The Linux I/O backend (fivebar/runtime/linux_io.hpp: the kernel's IIO, PWM and GPIO sysfs files),
+# device side: a library of its own beside the core, so the controller stays platform-free.
+if(CMAKE_SYSTEM_NAME STREQUAL "Linux")
+  add_library(fivebar_runtime_linux ${FIVEBAR_RUNTIME_LIB_DIR}/src/runtime/linux_io.cpp)
+  add_library(fivebar::runtime_linux ALIAS fivebar_runtime_linux)
+  target_compile_features(fivebar_runtime_linux PUBLIC cxx_std_17)
+  set_target_properties(fivebar_runtime_linux PROPERTIES CXX_STANDARD 17 CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON
+                                                         EXPORT_NAME runtime_linux VERSION ${FIVEBAR_RUNTIME_VERSION} SOVERSION 0)
+  target_include_directories(fivebar_runtime_linux
+    PUBLIC $<BUILD_INTERFACE:${FIVEBAR_RUNTIME_LIB_DIR}/include> $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  if(TARGET fivebar_warnings)
+    target_link_libraries(fivebar_runtime_linux PRIVATE $<BUILD_INTERFACE:fivebar_warnings>)
+  endif()
+  set(_fivebar_runtime_targets fivebar_runtime fivebar_runtime_linux)
+else()
+  set(_fivebar_runtime_targets fivebar_runtime)
+endif()
+
 # Components: `runtime` (the shared library, when built shared) and `development` (headers, the
 # static library, the CMake package with its version file).
-install(TARGETS fivebar_runtime EXPORT fivebarRuntimeTargets
+install(TARGETS ${_fivebar_runtime_targets} EXPORT fivebarRuntimeTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime NAMELINK_COMPONENT development
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
