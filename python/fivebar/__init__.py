@@ -20,6 +20,7 @@ every element has a status (``fivebar.Status`` values, uint8), never NaN. Bad in
 
 from __future__ import annotations
 
+import os
 import re
 import tempfile
 from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Union
@@ -89,6 +90,7 @@ __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
+    "collision", "pattern", "replay", "runtime", "Collision", "PatternResult", "Replay",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]
@@ -223,6 +225,44 @@ class GateCheck(Record):
 class ExportGate(Record):
     """The export gate's verdict (fivebar export): passed, stations, checks [GateCheck], reasons,
     joints [(name, lo, hi) rad], validation (the loop checks' figures)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["passed"])
+
+
+class Collision(Record):
+    """Two tactor targets of a station under the priority rule (fivebar collision --upper --lower):
+    station, collides (at the requested targets), clearance_mm (exact, negative = overlap; None when
+    a target has no pose), closest_pair, required_clearance_mm, status (clear, moved,
+    upper_unusable, lower_unusable, no_free_point), reason, upper_target / lower_target /
+    lower_point (mm, the commanded lower point), moved_mm, clearance_after_mm, upper_pose /
+    lower_pose (Pose at the commanded points)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return not self._fields["collides"]
+
+
+class PatternResult(Record):
+    """A skin-deformation pattern checked sample by sample (fivebar pattern): station, pattern,
+    passed, centre (mm), max_joint_speed (rad/s), t (s, n), clearance_mm and
+    commanded_clearance_mm (n, NaN where a pose is missing), moved_mm (n), mechanisms {"lower",
+    "upper": {target_mm, point_mm (n x 2), theta (n x 2, rad, continuous), joint_speed (n x 2,
+    rad/s), lci (n), status (n, uint8: index into status_names)}}, status_names, first_failure."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["passed"])
+
+
+class Replay(Record):
+    """A device log through the runtime (fivebar replay LOG --config EXPORTED.json): passed, rows,
+    max_duty_difference, mismatches, joints, mechanisms, t (rows), logged_duty and runtime_duty
+    (rows x joints), status (rows x mechanisms, fivebar.runtime.Status values)."""
 
     __slots__ = ()
 
@@ -437,3 +477,38 @@ def export_gate(design: Design, *, stations: Sequence[str] = (), progress: Progr
     d = _native._export_gate(design, list(stations), progress)
     d["checks"] = [GateCheck(c) for c in d["checks"]]
     return ExportGate(d)
+
+
+# --- Device: collision, patterns, replay ------------------------------------------------------------
+
+
+def collision(design: Design, upper: Sequence[float], lower: Sequence[float], *, station: str = "") -> Collision:
+    """The upper tactor at ``upper`` and the lower at ``lower`` (x, y mm) on a station with both
+    mechanisms (``station=``, default the only one): exact clearance of the link outlines and the
+    paper's priority rule (the upper keeps its target; a colliding lower target moves to the
+    closest collision-free point). Nothing is written."""
+    return Collision(_native._collision(design, station, tuple(upper), tuple(lower)))
+
+
+def pattern(design: Design, kind: str, *, station: str = "", amplitude_mm: Optional[float] = None,
+            amplitude_deg: Optional[float] = None, frequency_hz: Optional[float] = None,
+            duration_s: Optional[float] = None, rate_hz: Optional[float] = None,
+            separation_mm: Optional[float] = None, center: Optional[Sequence[float]] = None,
+            max_joint_speed_deg_s: Optional[float] = None) -> PatternResult:
+    """The pattern ``kind`` (stretch, slip, twist, pivot) on a station with both mechanisms, as
+    ``fivebar pattern`` computes it: parameters not given come from the design's ``patterns:``
+    section, else the defaults (the CLI's options of the same names). Nothing is written."""
+    return PatternResult(_native._pattern(design, station, kind, amplitude_mm, amplitude_deg, frequency_hz,
+                                          duration_s, rate_hz, separation_mm,
+                                          None if center is None else tuple(center), max_joint_speed_deg_s))
+
+
+def replay(log: Union[str, "os.PathLike[str]"], config: Union[str, "os.PathLike[str]"], *,
+           tolerance: float = 1e-9) -> Replay:
+    """Feeds a device log (CSV of measured joints, reference points and logged duties) through a
+    fresh runtime of the exported configuration ``config`` (fivebar export --format json) and
+    compares the duties row by row, as ``fivebar replay LOG --config EXPORTED.json``."""
+    return Replay(_native._replay(str(log), str(config), float(tolerance)))
+
+
+from . import runtime  # noqa: E402  (fivebar.runtime.Controller: the device runtime)
