@@ -91,6 +91,7 @@ __all__ = [
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
     "collision", "pattern", "replay", "runtime", "Collision", "PatternResult", "Replay",
+    "calibrate", "Calibration", "identify", "Identification", "parts", "Part",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]
@@ -268,6 +269,44 @@ class Replay(Record):
 
     def __bool__(self) -> bool:
         return bool(self._fields["passed"])
+
+
+class Calibration(Record):
+    """A kinematic calibration (fivebar calibrate DESIGN MEAS.csv): station, mechanisms, poses;
+    per parameter (arrays in the order of ``keys``, the design key paths; ``names`` such as
+    "lower.L3", ``units``): value, sigma (posterior, 0 when held), design_value, identified;
+    covariance over the identified parameters (``covariance_names``, file units) and
+    key_covariance (``key_covariance_keys``); unidentifiable [(parameter, combination)],
+    requested_unidentifiable, condition_number, observability_index, sigma_mm; the quality gate's
+    gate_passed and gate_reasons (one line per refused value); design: the patched Design the CLI
+    would write with --out (provenance entries included), or None when the gate refused."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["gate_passed"]) and not self._fields["requested_unidentifiable"]
+
+
+class Identification(Record):
+    """A motor identification (fivebar identify DESIGN LOG.csv, the motor rig): joints [one dict per
+    joint: joint, method, keys, value, sigma, identified (arrays in the order of keys),
+    unidentifiable, estimate_names, estimate_value, estimate_sigma, covariance, correlation (of the
+    mechanical base parameters' estimate), residual_sigma, drive_fit_percent], refused (keys
+    asked for with fit= that the log cannot identify), gate_passed, gate_reasons, patched,
+    not_patched, design (the patched Design the CLI would write, or None)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["gate_passed"]) and not self._fields["refused"]
+
+
+class Part(Record):
+    """One printable part (fivebar parts --no-render): station, name (the file stem), kind, uses
+    ("lower/L1", ...), mechanisms (["lower", "upper"]), count, length_mm (links' centre distance, else None), height_mm
+    (or None), scad (the text of its top-level .scad file)."""
+
+    __slots__ = ()
 
 
 # --- Kinematics ------------------------------------------------------------------------------------
@@ -509,6 +548,40 @@ def replay(log: Union[str, "os.PathLike[str]"], config: Union[str, "os.PathLike[
     fresh runtime of the exported configuration ``config`` (fivebar export --format json) and
     compares the duties row by row, as ``fivebar replay LOG --config EXPORTED.json``."""
     return Replay(_native._replay(str(log), str(config), float(tolerance)))
+
+
+def calibrate(design: Design, measurements: Union[str, "os.PathLike[str]"], *, station: str = "",
+              mechanism: str = "", frame: str = "fixed", fit: Sequence[str] = (), loss: str = "none",
+              loss_scale: float = 2.0, sigma_mm: Optional[float] = None, holdout: int = 0) -> Calibration:
+    """Fits link lengths, base joints and potentiometer calibration to a measurement file, as
+    ``fivebar calibrate DESIGN MEAS.csv`` with the options of the same names (--frame, --fit,
+    --loss, --loss-scale, --sigma, --holdout). Nothing is written; ``result.design`` is the
+    patched design when the quality gate passed."""
+    return Calibration(_native._calibrate(design, os.fspath(measurements), station, mechanism, frame, list(fit), loss,
+                                          float(loss_scale), sigma_mm, int(holdout)))
+
+
+def identify(design: Design, logs: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]], *,
+             validation: Optional[Union[str, "os.PathLike[str]"]] = None, joint: str = "", method: str = "idim",
+             closed_loop: bool = False, output_error: bool = True, per_direction: bool = False,
+             instant_drive: bool = False, cutoff_hz: Optional[float] = None, decimation: Optional[int] = None,
+             filter_order: int = 4, load_inertia: float = 0.0, fit: Sequence[str] = ()) -> Identification:
+    """Identifies the motor model of each joint of the logs (one path or several fitted together),
+    as ``fivebar identify DESIGN LOG.csv --no-files`` with the options of the same names
+    (``output_error=False`` is --no-output-error; --rig mechanism and --plan are not bound).
+    Nothing is written; ``result.design`` is the patched design when the quality gate passed."""
+    paths = [os.fspath(logs)] if isinstance(logs, (str, os.PathLike)) else [os.fspath(p) for p in logs]
+    return Identification(_native._identify(design, paths, "" if validation is None else os.fspath(validation), joint,
+                                            method, bool(closed_loop), bool(output_error), bool(per_direction),
+                                            bool(instant_drive), cutoff_hz, decimation, int(filter_order),
+                                            float(load_inertia), list(fit)))
+
+
+def parts(design: Design, *, station: Optional[str] = None, fn: Optional[int] = None) -> List[Part]:
+    """The printable parts of every station (or ``station``) with their OpenSCAD text, as
+    ``fivebar parts --no-render`` writes them (``fn`` overrides print.fn). Nothing is written or
+    rendered: ``part.scad`` is the file's text (it uses the library ``fivebar.scad``)."""
+    return [Part(d) for d in _native._parts(design, station, fn)]
 
 
 from . import runtime  # noqa: E402  (fivebar.runtime.Controller: the device runtime)
