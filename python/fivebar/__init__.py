@@ -521,12 +521,24 @@ def export_gate(design: Design, *, stations: Sequence[str] = (), progress: Progr
 # --- Device: collision, patterns, replay ------------------------------------------------------------
 
 
+def _point(value: Any, name: str) -> Any:
+    """(x, y) in mm from a sequence or array of two numbers, or InputError naming the argument."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected 2 numbers (x, y) in mm, got {value!r}") from None
+    if a.shape != (2,):
+        got = f"{a.size} numbers" if a.ndim == 1 else f"an array of shape {a.shape}"
+        raise InputError(f"{name}: expected 2 numbers (x, y) in mm, got {got}")
+    return (float(a[0]), float(a[1]))
+
+
 def collision(design: Design, upper: Sequence[float], lower: Sequence[float], *, station: str = "") -> Collision:
     """The upper tactor at ``upper`` and the lower at ``lower`` (x, y mm) on a station with both
     mechanisms (``station=``, default the only one): exact clearance of the link outlines and the
     paper's priority rule (the upper keeps its target; a colliding lower target moves to the
     closest collision-free point). Nothing is written."""
-    return Collision(_native._collision(design, station, tuple(upper), tuple(lower)))
+    return Collision(_native._collision(design, station, _point(upper, "upper"), _point(lower, "lower")))
 
 
 def pattern(design: Design, kind: str, *, station: str = "", amplitude_mm: Optional[float] = None,
@@ -539,7 +551,7 @@ def pattern(design: Design, kind: str, *, station: str = "", amplitude_mm: Optio
     section, else the defaults (the CLI's options of the same names). Nothing is written."""
     return PatternResult(_native._pattern(design, station, kind, amplitude_mm, amplitude_deg, frequency_hz,
                                           duration_s, rate_hz, separation_mm,
-                                          None if center is None else tuple(center), max_joint_speed_deg_s))
+                                          None if center is None else _point(center, "center"), max_joint_speed_deg_s))
 
 
 def replay(log: Union[str, "os.PathLike[str]"], config: Union[str, "os.PathLike[str]"], *,

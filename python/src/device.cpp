@@ -329,7 +329,9 @@ class PyController {
  private:
   static runtime::Config load(const std::string& text_or_path) {
     try {
-      const bool text = text_or_path.find('{') != std::string::npos;
+      // JSON text starts with '{' (after blanks); anything else is a path.
+      const std::size_t first = text_or_path.find_first_not_of(" \t\r\n");
+      const bool text = first != std::string::npos && text_or_path[first] == '{';
       if (text) return runtime::parse_config_json(text_or_path, "<config>");
     } catch (const runtime::ConfigError& e) {
       throw InputError(e.what());

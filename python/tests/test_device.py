@@ -74,6 +74,10 @@ def test_collision_errors(showcase):
         fivebar.collision(showcase, (6, 15), (6, 15))
     with pytest.raises(fivebar.InputError, match="lower: expected a finite point"):
         fivebar.collision(showcase, (6, 15), (math.nan, 15), station="index")
+    with pytest.raises(fivebar.InputError, match=r"upper: expected 2 numbers \(x, y\) in mm, got 3 numbers"):
+        fivebar.collision(showcase, (6, 15, 1), (6, 15), station="index")
+    with pytest.raises(fivebar.InputError, match="lower: expected 2 numbers"):
+        fivebar.collision(showcase, (6, 15), "here", station="index")
 
 
 # --- pattern ----------------------------------------------------------------------------------------
