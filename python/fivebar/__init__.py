@@ -90,7 +90,7 @@ __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
-    "collision", "pattern", "replay", "runtime", "Collision", "PatternResult", "Replay",
+    "collision", "collision_map", "CollisionMap", "pattern", "replay", "runtime", "Collision", "PatternResult", "Replay",
     "calibrate", "Calibration", "identify", "Identification", "parts", "Part",
 ]
 
@@ -245,6 +245,21 @@ class Collision(Record):
 
     def __bool__(self) -> bool:
         return not self._fields["collides"]
+
+
+class CollisionMap(Record):
+    """Every pair of tactor positions on a grid in the target ellipse (fivebar collision without
+    points; no picture): station, spacing_mm, points (n x 2 mm), upper_ok / lower_ok (usable by
+    each mechanism), upper_fraction / lower_fraction (per point: the share of usable positions of
+    the other tactor that collide with it), centre_collides (per point: 1 when the lower tactor
+    there collides with the upper at the centre, 0 when not, 2 when unusable), pairs, colliding,
+    colliding_fraction, any_free; to_dict() adds the separation bins and the priority rule at the
+    centre."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["any_free"])
 
 
 class PatternResult(Record):
@@ -539,6 +554,13 @@ def collision(design: Design, upper: Sequence[float], lower: Sequence[float], *,
     paper's priority rule (the upper keeps its target; a colliding lower target moves to the
     closest collision-free point). Nothing is written."""
     return Collision(_native._collision(design, station, _point(upper, "upper"), _point(lower, "lower")))
+
+
+def collision_map(design: Design, *, station: str = "", spacing_mm: float = 0.75) -> CollisionMap:
+    """The collision map of a station with both mechanisms (``fivebar collision DESIGN`` without
+    --upper and --lower): every pair of grid points of spacing ``spacing_mm`` inside the target
+    ellipse, checked exactly. Nothing is written."""
+    return CollisionMap(_native._collision_map(design, station, float(spacing_mm)))
 
 
 def pattern(design: Design, kind: str, *, station: str = "", amplitude_mm: Optional[float] = None,

@@ -271,6 +271,21 @@ class Collision(Record):
     lower_pose: Pose
     def __bool__(self) -> bool: ...
 
+class CollisionMap(Record):
+    station: str
+    spacing_mm: float
+    points: F64
+    upper_ok: npt.NDArray[np.bool_]
+    lower_ok: npt.NDArray[np.bool_]
+    upper_fraction: F64
+    lower_fraction: F64
+    centre_collides: U8
+    pairs: int
+    colliding: int
+    colliding_fraction: float
+    any_free: bool
+    def __bool__(self) -> bool: ...
+
 class PatternResult(Record):
     station: str
     pattern: str
@@ -386,6 +401,7 @@ def tolerance(design: Design, *, station: str = "", spacing_mm: float = 0.25,
 def control(design: Design, *, station: str = "", progress: ProgressLine = None) -> List[ControlStudy]: ...
 def export_gate(design: Design, *, stations: Sequence[str] = (), progress: ProgressLine = None) -> ExportGate: ...
 def collision(design: Design, upper: Sequence[float], lower: Sequence[float], *, station: str = "") -> Collision: ...
+def collision_map(design: Design, *, station: str = "", spacing_mm: float = 0.75) -> CollisionMap: ...
 def pattern(design: Design, kind: Literal["stretch", "slip", "twist", "pivot"], *, station: str = "",
             amplitude_mm: Optional[float] = None, amplitude_deg: Optional[float] = None,
             frequency_hz: Optional[float] = None, duration_s: Optional[float] = None, rate_hz: Optional[float] = None,

@@ -103,6 +103,47 @@ py::dict collision_pair(const Design& design, const std::string& station, const 
   return d;
 }
 
+/// `fivebar collision` without points: every pair of grid points of the target ellipse (no picture).
+py::dict collision_map_dict(const Design& design, const std::string& station, double spacing_mm) {
+  if (!(spacing_mm > 0.0) || !std::isfinite(spacing_mm)) throw InputError("spacing_mm must be a positive number of mm");
+  const Station& s = pair_station(design, station);
+  const Geometry& g = design_geometry(design);
+  CollisionMapOptions options;
+  options.spacing_mm = spacing_mm;
+  CollisionMap map;
+  Interruptible run;
+  run.run([&] { map = collision_map(s, g, options); });
+  const py::ssize_t n = py::ssize_t(map.points.size());
+  py::array_t<bool> upper_ok(n), lower_ok(n);
+  py::array_t<double> upper_fraction(n), lower_fraction(n);
+  py::array_t<std::uint8_t> centre(n);
+  for (py::ssize_t k = 0; k < n; ++k) {
+    const std::size_t i = std::size_t(k);
+    upper_ok.mutable_at(k) = map.upper_ok[i] != 0;
+    lower_ok.mutable_at(k) = map.lower_ok[i] != 0;
+    upper_fraction.mutable_at(k) = map.upper_fraction[i];
+    lower_fraction.mutable_at(k) = map.lower_fraction[i];
+    centre.mutable_at(k) = map.centre_collides[i];
+  }
+  py::dict d;
+  d["station"] = map.station;
+  d["spacing_mm"] = map.spacing_mm;
+  d["points"] = points_array(map.points);
+  d["upper_ok"] = upper_ok;
+  d["lower_ok"] = lower_ok;
+  d["upper_fraction"] = upper_fraction;
+  d["lower_fraction"] = lower_fraction;
+  d["centre_collides"] = centre;
+  d["pairs"] = map.pairs;
+  d["colliding"] = map.colliding;
+  d["colliding_fraction"] = map.colliding_fraction;
+  d["any_free"] = map.any_free;
+  Json doc = {{"command", "collision"}, {"design", design.name}};
+  doc.update(to_json(map));
+  d["summary"] = to_python(doc);
+  return d;
+}
+
 // --- Pattern --------------------------------------------------------------------------------------
 
 struct PatternArgs {
@@ -403,6 +444,7 @@ class PyController {
 
 void register_device(py::module_& m) {
   m.def("_collision", &collision_pair, py::arg("design"), py::arg("station"), py::arg("upper"), py::arg("lower"));
+  m.def("_collision_map", &collision_map_dict, py::arg("design"), py::arg("station"), py::arg("spacing_mm"));
   m.def("_pattern",
         [](const Design& d, const std::string& station, const std::string& kind, std::optional<double> amplitude_mm,
            std::optional<double> amplitude_deg, std::optional<double> frequency_hz, std::optional<double> duration_s,

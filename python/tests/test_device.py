@@ -67,6 +67,29 @@ def test_collision_moved_point_is_free_and_closer_points_on_its_ray_are_not(show
     assert closer.collides
 
 
+def test_collision_map_equals_cli_json_and_pair_checks(showcase, tmp_path):
+    doc = run_cli("collision", SHOWCASE, "--station", "index", "--spacing", "1.5", "--json", "--out", tmp_path)
+    doc.pop("files")
+    m = fivebar.collision_map(showcase, station="index", spacing_mm=1.5)
+    assert m.to_dict() == doc
+    assert len(m.points) == doc["points"] and m.pairs == doc["pairs"] and m.colliding == doc["colliding_pairs"]
+    assert m.colliding_fraction == pytest.approx(m.colliding / m.pairs, rel=1e-15)
+    # Brute force by the pair check (a second path through the library): the lower tactor at every
+    # point against the upper at the centre, and three upper positions' colliding shares.
+    centre = int(np.argmin(np.hypot(*(m.points - np.array(showcase.station("index").target.center)).T)))
+    assert np.hypot(*(m.points[centre] - np.array(showcase.station("index").target.center))) < 1e-12
+    usable = m.lower_ok & m.upper_ok
+    for upper_index in (centre, 0, len(m.points) - 1):
+        if not m.upper_ok[upper_index]:
+            continue
+        hits = [fivebar.collision(showcase, m.points[upper_index], q, station="index").collides
+                for q, ok in zip(m.points, m.lower_ok) if ok]
+        assert m.upper_fraction[upper_index] == pytest.approx(np.mean(hits), abs=1e-15)
+        if upper_index == centre:
+            assert list(m.centre_collides[m.lower_ok]) == [int(h) for h in hits]
+    assert usable.any() and bool(m) == (doc["min_free_pair_mm"] is not None)
+
+
 def test_collision_errors(showcase):
     with pytest.raises(fivebar.InputError, match="unknown station 'pinky'"):
         fivebar.collision(showcase, (6, 15), (6, 15), station="pinky")
