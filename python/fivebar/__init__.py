@@ -91,7 +91,7 @@ __all__ = [
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
     "collision", "collision_map", "CollisionMap", "pattern", "replay", "runtime", "Collision", "PatternResult", "Replay",
-    "calibrate", "Calibration", "identify", "Identification", "parts", "Part",
+    "calibrate", "Calibration", "calibration_plan", "CalibrationPlan", "identify", "Identification", "parts", "Part",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]
@@ -300,6 +300,20 @@ class Calibration(Record):
 
     def __bool__(self) -> bool:
         return bool(self._fields["gate_passed"]) and not self._fields["requested_unidentifiable"]
+
+
+class CalibrationPlan(Record):
+    """The poses to measure (fivebar calibrate --plan N): plans [one dict per mechanism: station,
+    mechanism, theta (N x 2 rad), volts (N x 2, the readings at the design's calibration),
+    point_mm (N x 2, the tactor by FK), candidates, observability_index and the random sets'
+    median, names, expected_sigma and random_sigma (file units), predicted_target_error_mm
+    (linearised) and the random sets' median, problem ("" or why there is no plan)], csv (the text
+    of calibration-plan.csv)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return all(not p["problem"] for p in self._fields["plans"])
 
 
 class Identification(Record):
@@ -593,6 +607,15 @@ def calibrate(design: Design, measurements: Union[str, "os.PathLike[str]"], *, s
     patched design when the quality gate passed."""
     return Calibration(_native._calibrate(design, os.fspath(measurements), station, mechanism, frame, list(fit), loss,
                                           float(loss_scale), sigma_mm, int(holdout)))
+
+
+def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism: str = "", sigma_mm: float = 0.02,
+                     criterion: str = "i", seed: int = 1) -> CalibrationPlan:
+    """Chooses ``poses`` poses per mechanism to measure, as ``fivebar calibrate DESIGN --plan N``
+    (--station, --mechanism, --plan-sigma, --plan-criterion i or d, --seed). Nothing is written:
+    ``result.csv`` is the text of calibration-plan.csv."""
+    return CalibrationPlan(_native._calibration_plan(design, int(poses), station, mechanism, float(sigma_mm), criterion,
+                                                     int(seed)))
 
 
 def identify(design: Design, logs: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]], *,

@@ -339,6 +339,11 @@ class Calibration(Record):
     design: Optional[Design]
     def __bool__(self) -> bool: ...
 
+class CalibrationPlan(Record):
+    plans: List[Dict[str, Any]]
+    csv: str
+    def __bool__(self) -> bool: ...
+
 class Identification(Record):
     joints: List[Dict[str, Any]]
     refused: List[str]
@@ -413,6 +418,8 @@ def calibrate(design: Design, measurements: Union[str, os.PathLike[str]], *, sta
               frame: Literal["fixed", "fit"] = "fixed", fit: Sequence[str] = (),
               loss: Literal["none", "huber", "cauchy"] = "none", loss_scale: float = 2.0,
               sigma_mm: Optional[float] = None, holdout: int = 0) -> Calibration: ...
+def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism: str = "", sigma_mm: float = 0.02,
+                     criterion: Literal["i", "d"] = "i", seed: int = 1) -> CalibrationPlan: ...
 def identify(design: Design, logs: Union[str, os.PathLike[str], Sequence[Union[str, os.PathLike[str]]]], *,
              validation: Optional[Union[str, os.PathLike[str]]] = None, joint: str = "",
              method: Literal["idim", "oe"] = "idim", closed_loop: bool = False, output_error: bool = True,

@@ -136,6 +136,66 @@ py::dict calibrate_fit(const Design& design, const std::string& path, const Cali
   return d;
 }
 
+/// `fivebar calibrate DESIGN --plan N`: the poses to measure per mechanism (nothing written).
+py::dict calibration_plan(const Design& design, int poses, const std::string& station_given, const std::string& mechanism,
+                          double sigma_mm, const std::string& criterion, std::uint64_t seed) {
+  if (!(sigma_mm > 0.0) || !std::isfinite(sigma_mm) || sigma_mm > csv::kMaxBenchValue) {
+    throw InputError("sigma_mm = " + std::to_string(sigma_mm) + ": must be a finite number > 0 and at most 1e9 (mm)");
+  }
+  if (criterion != "i" && criterion != "d") throw InputError("criterion = '" + criterion + "': must be i or d");
+  calibrate::PlanOptions po;
+  po.poses = poses;
+  po.sigma_mm = sigma_mm;
+  po.criterion = criterion == "d" ? calibrate::PlanCriterion::d_optimal : calibrate::PlanCriterion::i_optimal;
+  po.seed = seed;
+  std::string station = station_given;
+  if (station.empty()) {
+    const auto st = design.select_stations("");
+    if (st.size() != 1) throw InputError("plan: choose a station with station= (the design has several)");
+    station = st.front()->name;
+  }
+  std::vector<calibrate::MechanismPlan> plans;
+  Interruptible run;
+  run.run([&] { plans = calibrate::plan_poses(design, station, mechanism, po); });
+  py::list out;
+  for (const calibrate::MechanismPlan& p : plans) {
+    const py::ssize_t n = py::ssize_t(p.poses.size());
+    py::array_t<double> theta({n, py::ssize_t(2)}), volts({n, py::ssize_t(2)}), point({n, py::ssize_t(2)});
+    for (py::ssize_t k = 0; k < n; ++k) {
+      const calibrate::PlannedPose& x = p.poses[std::size_t(k)];
+      theta.mutable_at(k, 0) = x.theta1;
+      theta.mutable_at(k, 1) = x.theta2;
+      volts.mutable_at(k, 0) = x.volts1;
+      volts.mutable_at(k, 1) = x.volts2;
+      point.mutable_at(k, 0) = x.point.x();
+      point.mutable_at(k, 1) = x.point.y();
+    }
+    py::dict d;
+    d["station"] = p.station;
+    d["mechanism"] = p.mechanism;
+    d["theta"] = theta;
+    d["volts"] = volts;
+    d["point_mm"] = point;
+    d["candidates"] = p.candidates;
+    d["observability_index"] = p.observability_index;
+    d["random_observability_index"] = p.random_observability_index;
+    d["names"] = py::cast(p.names);
+    d["expected_sigma"] = py::array_t<double>(py::ssize_t(p.expected_sigma.size()), p.expected_sigma.data());
+    d["random_sigma"] = py::array_t<double>(py::ssize_t(p.random_sigma.size()), p.random_sigma.data());
+    d["predicted_target_error_mm"] = p.predicted_target_error_mm;
+    d["random_target_error_mm"] = p.random_target_error_mm;
+    d["problem"] = p.problem;
+    out.append(d);
+  }
+  py::dict d;
+  d["plans"] = out;
+  d["csv"] = calibrate::plan_csv(plans);
+  Json doc = {{"command", "calibrate"}, {"design", design.name}};
+  doc["plan"] = calibrate::to_json(plans, po);
+  d["summary"] = to_python(doc);
+  return d;
+}
+
 // --- Identify -------------------------------------------------------------------------------------
 
 namespace id = fivebar::identify;
@@ -358,6 +418,8 @@ void register_bench(py::module_& m) {
           CalibrateArgs a{station, mechanism, frame, loss, fit, loss_scale, sigma_mm, holdout};
           return calibrate_fit(d, path, a);
         });
+  m.def("_calibration_plan", &calibration_plan, py::arg("design"), py::arg("poses"), py::arg("station"),
+        py::arg("mechanism"), py::arg("sigma_mm"), py::arg("criterion"), py::arg("seed"));
   m.def("_identify",
         [](const Design& d, const std::vector<std::string>& logs, const std::string& validation, const std::string& joint,
            const std::string& method, bool closed_loop, bool output_error, bool per_direction, bool instant_drive,

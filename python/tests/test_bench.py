@@ -62,6 +62,27 @@ def test_calibrate_gate_refusal_is_reported_and_nothing_patched(showcase):
     assert c.gate_reasons and all(("  " + line) in proc.stderr for line in c.gate_reasons)
 
 
+def test_calibration_plan_equals_cli_json_and_its_csv(showcase, tmp_path):
+    out = tmp_path / "plan"
+    doc = run_cli("calibrate", SHOWCASE, "--plan", "12", "-s", "index", "-m", "lower", "--out", out, "--json")
+    doc.pop("files")
+    plan = fivebar.calibration_plan(showcase, 12, station="index", mechanism="lower")
+    assert plan.to_dict() == doc
+    assert plan.csv == (out / "calibration-plan.csv").read_text()
+    (p,) = plan.plans
+    assert bool(plan) and p["problem"] == "" and p["theta"].shape == (12, 2)
+    # Each planned tactor point is FK of its planned angles (a second evaluation).
+    lower = showcase.station("index").lower
+    x, y, status = fivebar.fk(lower, p["theta"][:, 0].copy(), p["theta"][:, 1].copy())
+    assert np.all(status == 0)
+    assert x == pytest.approx(p["point_mm"][:, 0], abs=1e-9) and y == pytest.approx(p["point_mm"][:, 1], abs=1e-9)
+    assert list(p["expected_sigma"]) == [r["planned"] for r in doc["plan"][0]["expected_sigma"]]
+    with pytest.raises(fivebar.InputError, match="criterion = 'a'"):
+        fivebar.calibration_plan(showcase, 12, station="index", criterion="a")
+    with pytest.raises(fivebar.InputError, match="choose a station"):
+        fivebar.calibration_plan(showcase, 12)
+
+
 def test_calibrate_errors(showcase, tmp_path):
     with pytest.raises(fivebar.InputError, match="frame = 'moving'"):
         fivebar.calibrate(showcase, MEASUREMENTS, frame="moving")
