@@ -9,12 +9,12 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
-#include <numbers>
 
 #include "bindings.hpp"
 #include "fivebar/collision.hpp"
 #include "fivebar/device/joint_limits.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/pattern.hpp"
 #include "fivebar/replay.hpp"
 #include "fivebar/runtime/controller.hpp"
@@ -24,7 +24,7 @@ namespace fivebar::python {
 
 namespace {
 
-constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+using format::kDegPerRad;
 
 /// The station (empty: the only one) with both mechanisms, as `fivebar collision` and `pattern`
 /// choose it (cli/tactors.hpp); InputError naming what is missing.
