@@ -90,7 +90,8 @@ __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
-    "collision", "collision_map", "CollisionMap", "pattern", "replay", "runtime", "Collision", "PatternResult", "Replay",
+    "collision", "collision_map", "CollisionMap", "pattern", "replay", "replay_sil", "SilReplay", "runtime",
+    "Collision", "PatternResult", "Replay",
     "calibrate", "Calibration", "calibration_plan", "CalibrationPlan", "identify", "Identification", "parts", "Part",
 ]
 
@@ -284,6 +285,17 @@ class Replay(Record):
 
     def __bool__(self) -> bool:
         return bool(self._fields["passed"])
+
+
+class SilReplay(Record):
+    """Software in the loop (fivebar replay DESIGN --sil): ok, runs [one dict per pattern: station,
+    reference, simulated, ok, log (the path of its log, the device's format; None when not
+    simulated), figures (simulate's figures and the run's status, as the CLI's --json)]."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["ok"])
 
 
 class Calibration(Record):
@@ -596,6 +608,17 @@ def replay(log: Union[str, "os.PathLike[str]"], config: Union[str, "os.PathLike[
     fresh runtime of the exported configuration ``config`` (fivebar export --format json) and
     compares the duties row by row, as ``fivebar replay LOG --config EXPORTED.json``."""
     return Replay(_native._replay(str(log), str(config), float(tolerance)))
+
+
+def replay_sil(design: Design, out_dir: Union[str, "os.PathLike[str]"], *, station: str = "",
+               pattern: Optional[str] = None, config: Optional[Union[str, "os.PathLike[str]"]] = None) -> SilReplay:
+    """The runtime closed around the simulator for the patterns of each station with both
+    mechanisms (or ``station``, ``pattern``), as ``fivebar replay DESIGN --sil``: with ``config``
+    the exported file's gains and calibration, else the design's export in memory. Writes each
+    run's log (``<station>-<pattern>-sil.csv``, replayable by ``fivebar.replay``) into ``out_dir``
+    and nothing elsewhere."""
+    return SilReplay(_native._replay_sil(design, os.fspath(out_dir), station, pattern,
+                                         None if config is None else os.fspath(config)))
 
 
 def calibrate(design: Design, measurements: Union[str, "os.PathLike[str]"], *, station: str = "",

@@ -314,6 +314,11 @@ class Replay(Record):
     status: U8
     def __bool__(self) -> bool: ...
 
+class SilReplay(Record):
+    ok: bool
+    runs: List[Dict[str, Any]]
+    def __bool__(self) -> bool: ...
+
 class Calibration(Record):
     station: str
     mechanisms: List[str]
@@ -414,6 +419,8 @@ def pattern(design: Design, kind: Literal["stretch", "slip", "twist", "pivot"], 
             max_joint_speed_deg_s: Optional[float] = None) -> PatternResult: ...
 def replay(log: Union[str, os.PathLike[str]], config: Union[str, os.PathLike[str]], *,
            tolerance: float = 1e-9) -> Replay: ...
+def replay_sil(design: Design, out_dir: Union[str, os.PathLike[str]], *, station: str = "",
+               pattern: Optional[str] = None, config: Optional[Union[str, os.PathLike[str]]] = None) -> SilReplay: ...
 def calibrate(design: Design, measurements: Union[str, os.PathLike[str]], *, station: str = "", mechanism: str = "",
               frame: Literal["fixed", "fit"] = "fixed", fit: Sequence[str] = (),
               loss: Literal["none", "huber", "cauchy"] = "none", loss_scale: float = 2.0,

@@ -17,6 +17,7 @@
 #include "fivebar/format.hpp"
 #include "fivebar/pattern.hpp"
 #include "fivebar/replay.hpp"
+#include "fivebar/replay/sil.hpp"
 #include "fivebar/runtime/controller.hpp"
 #include "fivebar/runtime/json_config.hpp"
 
@@ -338,6 +339,62 @@ py::dict replay(const std::string& log_path, const std::string& config_path, dou
   return d;
 }
 
+/// `fivebar replay DESIGN --sil`: the runtime closed around the simulator for the station's
+/// patterns; each run's log written into `out_dir` (the one folder this writes in).
+py::dict replay_sil(const Design& design, const std::string& out_dir, const std::string& station,
+                    const std::optional<std::string>& pattern, const std::optional<std::string>& config_path) {
+  std::optional<PatternKind> kind;
+  if (pattern) {
+    kind = parse_pattern_kind(*pattern);
+    if (!kind) throw InputError("pattern = '" + *pattern + "': expected stretch, slip, twist or pivot");
+  }
+  SilRequest request;
+  if (!station.empty()) {
+    request.stations.push_back(pair_station(design, station).name);
+  } else {
+    for (const Station& s : design.stations) {
+      if (s.lower && s.upper) request.stations.push_back(s.name);
+    }
+    if (request.stations.empty()) throw InputError("design '" + design.name + "' has no station with both mechanisms");
+  }
+  design_geometry(design);
+  request.pattern = kind;
+  if (config_path) request.config = std::make_shared<const runtime::Config>(read_runtime_config(*config_path, "config"));
+  check_sil_config(design, request, "config " + config_path.value_or(""));  // before the folder exists
+  const std::filesystem::path dir(out_dir);
+  make_directories(dir);
+  const WriteFence fence(dir);
+  request.open_log = [&dir](const std::string& name) { return AtomicFile(dir / name); };
+  std::vector<SilRun> runs;
+  Interruptible run;
+  run.run([&] { runs = run_sil(design, request); });
+  py::list out;
+  Json docs = Json::array();
+  bool all_ok = true;
+  for (const SilRun& r : runs) {
+    all_ok = all_ok && r.ok();
+    Json j = to_json(r);
+    if (r.simulated()) {
+      j["log"] = r.log.generic_string();
+      j["config"] = config_path ? *config_path : std::string("the design's export, in memory");
+    }
+    py::dict d;
+    d["station"] = r.station;
+    d["reference"] = r.reference;
+    d["simulated"] = r.simulated();
+    d["ok"] = r.ok();
+    d["log"] = r.simulated() ? py::object(py::str(r.log.generic_string())) : py::object(py::none());
+    d["figures"] = to_python(j);
+    out.append(d);
+    docs.push_back(j);
+  }
+  py::dict d;
+  d["ok"] = all_ok;
+  d["runs"] = out;
+  d["summary"] = to_python(Json{{"command", "replay"}, {"mode", "sil"}, {"design", design.name}, {"runs", docs}});
+  return d;
+}
+
 // --- Runtime --------------------------------------------------------------------------------------
 
 /// fivebar::runtime::Controller with its configuration, for Python: ConfigError becomes InputError.
@@ -453,6 +510,8 @@ void register_device(py::module_& m) {
           PatternArgs a{amplitude_mm, amplitude_deg, frequency_hz, duration_s, rate_hz, separation_mm, center};
           return pattern(d, station, kind, a, max_speed_deg_s);
         });
+  m.def("_replay_sil", &replay_sil, py::arg("design"), py::arg("out_dir"), py::arg("station"), py::arg("pattern"),
+        py::arg("config"));
   m.def("_replay", &replay, py::arg("log"), py::arg("config"), py::arg("tolerance"));
   py::class_<PyController>(m, "_Controller")
       .def(py::init<const std::string&>(), py::arg("config"))

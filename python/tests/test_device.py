@@ -198,6 +198,31 @@ def test_replay_equals_cli_json(exported):
     assert np.max(np.abs(r.runtime_duty - r.logged_duty)) == doc["max_duty_difference"]
 
 
+def test_replay_sil_equals_cli_json_and_its_log(showcase, exported, tmp_path):
+    config, cli_log = exported
+    doc = run_cli("replay", SHOWCASE, "--sil", "-s", "index", "--pattern", "stretch", "--out", tmp_path / "cli", "--json")
+    sil = fivebar.replay_sil(showcase, tmp_path / "py", station="index", pattern="stretch")
+    (run,) = sil.runs
+    assert bool(sil) and run["ok"] and run["simulated"]
+    doc.pop("files")
+    expected = doc["runs"][0]
+    assert expected.pop("log").endswith("index-stretch-sil.csv") and run["figures"].pop("log") == run["log"]
+    summary = sil.to_dict()
+    summary["runs"][0].pop("log")
+    for d in (summary, doc):  # the simulation's wall time is the only figure that is not the run's
+        assert d["runs"][0].pop("wall_s") > 0.0
+    assert summary == doc
+    # The log is the CLI's byte for byte, and replaying it through the exported runtime gives every
+    # duty again (the runtime in the loop is the exported one).
+    log = tmp_path / "py" / "index-stretch-sil.csv"
+    assert run["log"] == str(log) and log.read_bytes() == (tmp_path / "cli" / "index-stretch-sil.csv").read_bytes()
+    again = fivebar.replay(log, config)
+    assert again.passed and again.max_duty_difference == 0.0
+    with pytest.raises(fivebar.InputError, match="pattern = 'wobble'"):
+        fivebar.replay_sil(showcase, tmp_path / "none", station="index", pattern="wobble")
+    assert not (tmp_path / "none").exists()  # refused before anything is written
+
+
 def test_controller_reproduces_the_logged_duties_row_by_row(exported):
     import csv
     config, log = exported
