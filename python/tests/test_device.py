@@ -286,6 +286,10 @@ def test_controller_reads_counts_through_the_potentiometer_chain(exported):
     out = ctl.step([0.0, 40000.0, 40500.0, 41500.0], [0.00625, 0.0115, 0.00625, 0.0195], kind="counts")
     assert out["status_names"][0] == "sensor_fault" and out["status"][0] == fivebar.runtime.Status.sensor_fault
     assert list(out["duties"][:2]) == [0.0, 0.0]
+    # A reading that is not a number is a fault too, never a NaN duty.
+    out = ctl.step([41000.0, math.nan, 40500.0, 41500.0], [0.00625, 0.0115, 0.00625, 0.0195], kind="counts")
+    assert out["status_names"][0] == "sensor_fault" and list(out["duties"][:2]) == [0.0, 0.0]
+    assert np.all(np.isfinite(out["duties"]))
 
 
 def test_controller_errors(exported):
