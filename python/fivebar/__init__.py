@@ -642,16 +642,18 @@ def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism
 
 
 def identify(design: Design, logs: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]], *,
-             validation: Optional[Union[str, "os.PathLike[str]"]] = None, joint: str = "", method: str = "idim",
+             rig: str = "motor", validation: Optional[Union[str, "os.PathLike[str]"]] = None, joint: str = "",
+             method: str = "idim",
              closed_loop: bool = False, output_error: bool = True, per_direction: bool = False,
              instant_drive: bool = False, cutoff_hz: Optional[float] = None, decimation: Optional[int] = None,
              filter_order: int = 4, load_inertia: float = 0.0, fit: Sequence[str] = ()) -> Identification:
     """Identifies the motor model of each joint of the logs (one path or several fitted together),
     as ``fivebar identify DESIGN LOG.csv --no-files`` with the options of the same names
-    (``output_error=False`` is --no-output-error; --rig mechanism and --plan are not bound).
+    (``output_error=False`` is --no-output-error; ``rig="index/lower"`` is --rig mechanism
+    index/lower, the assembled mechanism from a device log; --plan is not bound).
     Nothing is written; ``result.design`` is the patched design when the quality gate passed."""
     paths = [os.fspath(logs)] if isinstance(logs, (str, os.PathLike)) else [os.fspath(p) for p in logs]
-    return Identification(_native._identify(design, paths, "" if validation is None else os.fspath(validation), joint,
+    return Identification(_native._identify(design, paths, rig, "" if validation is None else os.fspath(validation), joint,
                                             method, bool(closed_loop), bool(output_error), bool(per_direction),
                                             bool(instant_drive), cutoff_hz, decimation, int(filter_order),
                                             float(load_inertia), list(fit)))

@@ -428,7 +428,7 @@ def calibrate(design: Design, measurements: Union[str, os.PathLike[str]], *, sta
 def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism: str = "", sigma_mm: float = 0.02,
                      criterion: Literal["i", "d"] = "i", seed: int = 1) -> CalibrationPlan: ...
 def identify(design: Design, logs: Union[str, os.PathLike[str], Sequence[Union[str, os.PathLike[str]]]], *,
-             validation: Optional[Union[str, os.PathLike[str]]] = None, joint: str = "",
+             rig: str = "motor", validation: Optional[Union[str, os.PathLike[str]]] = None, joint: str = "",
              method: Literal["idim", "oe"] = "idim", closed_loop: bool = False, output_error: bool = True,
              per_direction: bool = False, instant_drive: bool = False, cutoff_hz: Optional[float] = None,
              decimation: Optional[int] = None, filter_order: int = 4, load_inertia: float = 0.0,

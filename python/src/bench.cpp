@@ -202,6 +202,7 @@ namespace id = fivebar::identify;
 
 struct IdentifyArgs {
   std::vector<std::string> logs;
+  std::string rig_station, rig_mechanism;  ///< --rig mechanism STATION/MECHANISM; empty: the motor rig
   std::string validation, joint, method = "idim";
   bool closed_loop = false, output_error = true, per_direction = false, instant_drive = false;
   std::optional<double> cutoff_hz;
@@ -223,6 +224,12 @@ id::IdentifyOptions identify_options(const IdentifyArgs& a) {
   if (a.method != "idim" && a.method != "oe") throw InputError("method = '" + a.method + "': idim or oe");
   if (a.closed_loop && a.method == "oe") {
     throw InputError("method 'oe': not with closed_loop (an open-loop simulation of a log taken under feedback drifts)");
+  }
+  if (!a.rig_station.empty()) {  // the rules of `fivebar identify --rig mechanism` (cli/identify.cpp)
+    if (!a.validation.empty()) throw InputError("validation: not with rig mechanism yet");
+    if (a.method == "oe") throw InputError("method 'oe': not with rig mechanism (a joint of a closed chain is not simulated alone)");
+    if (a.closed_loop) throw InputError("closed_loop: with the motor rig only");
+    if (a.logs.size() > 1) throw InputError("logs: rig mechanism takes one log");
   }
   id::IdentifyOptions o;
   o.cutoff_hz = a.cutoff_hz.value_or(0.0);
@@ -271,7 +278,6 @@ std::vector<id::JointIdentification> identify_motor_joints(const Design& design,
     if (val) vsegs.push_back(segment(*val, a.validation));
     results.push_back(id::identify_joint(segs, prior, vsegs, o));
   }
-  if (results.empty()) throw InputError("joint = '" + a.joint + "': the log has no such joint");
   return results;
 }
 
@@ -316,7 +322,12 @@ py::dict identify_fit(const Design& design, const IdentifyArgs& a) {
   if (val) id::require_log_joints_in(design, *val);
   std::vector<id::JointIdentification> results;
   Interruptible run;
-  run.run([&] { results = identify_motor_joints(design, a, logs, val, o); });
+  const bool mechanism_rig = !a.rig_station.empty();
+  run.run([&] {
+    results = mechanism_rig ? id::identify_mechanism(design, logs.front(), a.rig_station, a.rig_mechanism, o)
+                            : identify_motor_joints(design, a, logs, val, o);
+  });
+  if (results.empty()) throw InputError("joint = '" + a.joint + "': the log has no such joint");
   std::vector<std::string> refused;
   for (const std::string& key : a.fit) {
     bool known = false;
@@ -333,7 +344,7 @@ py::dict identify_fit(const Design& design, const IdentifyArgs& a) {
       throw InputError("fit " + key + ": not a parameter of this rig (parameters: " + keys + ")");
     }
   }
-  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", "motor"}, {"log", a.logs.front()},
+  Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", mechanism_rig ? "mechanism" : "motor"}, {"log", a.logs.front()},
               {"logs", a.logs}, {"closed_loop", a.closed_loop}};
   if (val) doc["validation"] = a.validation;
   doc["method"] = a.method == "oe" ? "output error" : a.closed_loop ? "IDIM-IV" : "IDIM-LS";
@@ -355,7 +366,7 @@ py::dict identify_fit(const Design& design, const IdentifyArgs& a) {
     source.file = a.logs.front();
     source.sha256 = sha256_file(a.logs.front());
     source.date = today_utc();
-    source.method = std::string("fivebar identify --rig motor: ") +
+    source.method = std::string(mechanism_rig ? "fivebar identify --rig mechanism: " : "fivebar identify --rig motor: ") +
                     (a.method == "oe"   ? "output-error refinement (Ceres)"
                      : a.closed_loop    ? "inverse dynamic model by instrumental variables under the design's PID (IDIM-IV)"
                                         : "inverse dynamic model by least squares (IDIM-LS)") +
@@ -421,12 +432,22 @@ void register_bench(py::module_& m) {
   m.def("_calibration_plan", &calibration_plan, py::arg("design"), py::arg("poses"), py::arg("station"),
         py::arg("mechanism"), py::arg("sigma_mm"), py::arg("criterion"), py::arg("seed"));
   m.def("_identify",
-        [](const Design& d, const std::vector<std::string>& logs, const std::string& validation, const std::string& joint,
+        [](const Design& d, const std::vector<std::string>& logs, const std::string& rig, const std::string& validation,
+           const std::string& joint,
            const std::string& method, bool closed_loop, bool output_error, bool per_direction, bool instant_drive,
            std::optional<double> cutoff_hz, std::optional<int> decimation, int filter_order, double load_inertia,
            const std::vector<std::string>& fit) {
-          IdentifyArgs a{logs, validation, joint, method, closed_loop, output_error, per_direction, instant_drive,
-                         cutoff_hz, decimation, filter_order, load_inertia, fit};
+          std::string rig_station, rig_mechanism;
+          if (!rig.empty() && rig != "motor") {
+            const std::size_t slash = rig.find('/');
+            if (slash == std::string::npos || slash == 0 || slash + 1 == rig.size() || rig.find('/', slash + 1) != std::string::npos) {
+              throw InputError("rig = '" + rig + "': \"motor\" or STATION/MECHANISM (e.g. \"index/lower\")");
+            }
+            rig_station = rig.substr(0, slash);
+            rig_mechanism = rig.substr(slash + 1);
+          }
+          IdentifyArgs a{logs, rig_station, rig_mechanism, validation, joint, method, closed_loop, output_error,
+                         per_direction, instant_drive, cutoff_hz, decimation, filter_order, load_inertia, fit};
           return identify_fit(d, a);
         });
   m.def("_parts", &parts, py::arg("design"), py::arg("station"), py::arg("fn"));

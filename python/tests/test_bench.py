@@ -163,6 +163,24 @@ def test_identify_finds_the_synthetic_truth_within_its_sigmas(showcase):
     assert corr == pytest.approx(joint["correlation"][np.ix_(ok, ok)], abs=1e-9)
 
 
+def test_identify_the_assembled_mechanism_equals_cli_json(showcase):
+    log = ROOT / "designs" / "bench" / "replay.csv"
+    doc = run_cli("identify", SHOWCASE, log, "--rig", "mechanism", "index/lower", "--no-files", "--no-output-error",
+                  "--json")
+    doc.pop("files")
+    r = fivebar.identify(showcase, log, rig="index/lower", output_error=False)
+    assert r.to_dict() == doc
+    assert [j["joint"] for j in r.joints] == [j["joint"] for j in doc["joints"]] == ["index_lower_theta1",
+                                                                                     "index_lower_theta2"]
+    for joint in r.joints:
+        cov, s = joint["covariance"], joint["estimate_sigma"]
+        assert np.sqrt(np.diag(cov)) == pytest.approx(s, rel=1e-9)
+    with pytest.raises(fivebar.InputError, match="rig = 'index'"):
+        fivebar.identify(showcase, log, rig="index")
+    with pytest.raises(fivebar.InputError, match="not with rig mechanism"):
+        fivebar.identify(showcase, log, rig="index/lower", method="oe")
+
+
 def test_identify_errors(showcase, tmp_path):
     with pytest.raises(fivebar.InputError, match="method = 'ls'"):
         fivebar.identify(showcase, IDENTIFICATION, method="ls")
