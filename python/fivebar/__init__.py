@@ -92,7 +92,7 @@ __all__ = [
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
     "collision", "collision_map", "CollisionMap", "pattern", "replay", "replay_sil", "SilReplay", "runtime",
     "Collision", "PatternResult", "Replay",
-    "calibrate", "Calibration", "calibration_plan", "CalibrationPlan", "identify", "Identification", "parts", "Part",
+    "calibrate", "Calibration", "calibrate_hard_stops", "calibration_plan", "CalibrationPlan", "identify", "Identification", "parts", "Part",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]
@@ -630,6 +630,14 @@ def calibrate(design: Design, measurements: Union[str, "os.PathLike[str]"], *, s
     patched design when the quality gate passed."""
     return Calibration(_native._calibrate(design, os.fspath(measurements), station, mechanism, frame, list(fit), loss,
                                           float(loss_scale), sigma_mm, int(holdout)))
+
+
+def calibrate_hard_stops(design: Design, log: Union[str, "os.PathLike[str]"]) -> Calibration:
+    """The potentiometers' V0 (and k when both stops of a joint are read) from readings taken with
+    a proximal link on a hard stop (CSV ``station,mechanism,joint,stop,volts``), as ``fivebar
+    calibrate DESIGN --hard-stops LOG``. Nothing is written; ``result.design`` is the patched
+    design when the quality gate passed."""
+    return Calibration(_native._calibrate_hard_stops(design, os.fspath(log)))
 
 
 def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism: str = "", sigma_mm: float = 0.02,

@@ -75,14 +75,10 @@ py::array_t<double> matrix(const Eigen::MatrixXd& m) {
   return a;
 }
 
-py::dict calibrate_fit(const Design& design, const std::string& path, const CalibrateArgs& args) {
-  const calibrate::CalibrateOptions co = calibrate_options(args);
-  const std::string text = csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, "measurement file");
-  const auto rows = calibrate::parse_measurements(text, path, design);
-  calibrate::CalibrationResult r;
-  Interruptible run;
-  run.run([&] { r = calibrate::calibrate(design, rows, co, path); });
-
+/// A calibration's result as the Python dict (`doc_key`: where the CLI's --json puts it, "calibration"
+/// or "hard_stops"); the patched design `fivebar calibrate --out` would write, when the result passed.
+py::dict calibration_dict(const Design& design, const calibrate::CalibrationResult& r, const std::string& path,
+                          const std::string& text, const char* doc_key) {
   const py::ssize_t n = py::ssize_t(r.parameters.size());
   py::array_t<double> value(n), sigma(n), prior(n);
   py::array_t<bool> identified(n);
@@ -131,9 +127,25 @@ py::dict calibrate_fit(const Design& design, const std::string& path, const Cali
     d["design"] = py::none();
   }
   Json doc = {{"command", "calibrate"}, {"design", design.name}};
-  doc["calibration"] = calibrate::to_json(r);
+  doc[doc_key] = calibrate::to_json(r);
   d["summary"] = to_python(doc);
   return d;
+}
+
+py::dict calibrate_fit(const Design& design, const std::string& path, const CalibrateArgs& args) {
+  const calibrate::CalibrateOptions co = calibrate_options(args);
+  const std::string text = csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, "measurement file");
+  const auto rows = calibrate::parse_measurements(text, path, design);
+  calibrate::CalibrationResult r;
+  Interruptible run;
+  run.run([&] { r = calibrate::calibrate(design, rows, co, path); });
+  return calibration_dict(design, r, path, text, "calibration");
+}
+
+/// `fivebar calibrate DESIGN --hard-stops LOG`: the potentiometers from readings at the hard stops.
+py::dict calibrate_hard_stops(const Design& design, const std::string& path) {
+  const std::string text = csv::read_bounded(path, calibrate::kMeasurementLimits.max_bytes, "hard-stop readings");
+  return calibration_dict(design, calibrate::hard_stop_calibration(design, text, path), path, text, "hard_stops");
 }
 
 /// `fivebar calibrate DESIGN --plan N`: the poses to measure per mechanism (nothing written).
@@ -429,6 +441,7 @@ void register_bench(py::module_& m) {
           CalibrateArgs a{station, mechanism, frame, loss, fit, loss_scale, sigma_mm, holdout};
           return calibrate_fit(d, path, a);
         });
+  m.def("_calibrate_hard_stops", &calibrate_hard_stops, py::arg("design"), py::arg("log"));
   m.def("_calibration_plan", &calibration_plan, py::arg("design"), py::arg("poses"), py::arg("station"),
         py::arg("mechanism"), py::arg("sigma_mm"), py::arg("criterion"), py::arg("seed"));
   m.def("_identify",

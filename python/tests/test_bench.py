@@ -62,6 +62,34 @@ def test_calibrate_gate_refusal_is_reported_and_nothing_patched(showcase):
     assert c.gate_reasons and all(("  " + line) in proc.stderr for line in c.gate_reasons)
 
 
+def test_hard_stops_give_the_closed_form_offset_and_equal_the_cli(showcase, tmp_path):
+    # index/lower theta1's low end is a hard stop at the usable range's end (the export's
+    # min_position): readings V = V0 + theta_stop / k give V0 back with the design's k.
+    import json
+    run_cli("export", SHOWCASE, "-s", "index", "--format", "json", "--out", tmp_path / "exp", "--json")
+    p = json.loads((tmp_path / "exp" / "iros2022_controller_index.json").read_text())
+    p = p["fivebar_controller"]["ros__parameters"]
+    theta_stop = p["joint_limits"]["index_lower_theta1"]["min_position"]
+    k = p["potentiometers"]["index_lower_theta1"]["rad_per_volt"]
+    v0 = 0.3
+    log = tmp_path / "stops.csv"
+    log.write_text("station,mechanism,joint,stop,volts\n" + "".join(
+        f"index,lower,1,lo,{v0 + theta_stop / k + dv!r}\n" for dv in (-2e-4, 2e-4)))
+    out = tmp_path / "cal"
+    doc = run_cli("calibrate", SHOWCASE, "--hard-stops", log, "--out", out, "--json")
+    doc.pop("files")
+    c = fivebar.calibrate_hard_stops(showcase, log)
+    assert c.to_dict() == doc and bool(c)
+    key = "controller.stations.index.lower.theta1.potentiometer.volts_at_zero"
+    k_index = c.keys.index(key)
+    assert c.identified[k_index] and c.value[k_index] == pytest.approx(v0, abs=1e-12)
+    assert c.design.to_yaml() == (out / "iros2022-calibrated.yaml").read_text()
+    bad = tmp_path / "bad.csv"
+    bad.write_text("station,mechanism,joint,stop,volts\nindex,lower,1,sideways,1\n")
+    with pytest.raises(fivebar.InputError, match="bad.csv:2: column 'stop'"):
+        fivebar.calibrate_hard_stops(showcase, bad)
+
+
 def test_calibration_plan_equals_cli_json_and_its_csv(showcase, tmp_path):
     out = tmp_path / "plan"
     doc = run_cli("calibrate", SHOWCASE, "--plan", "12", "-s", "index", "-m", "lower", "--out", out, "--json")
