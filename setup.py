@@ -53,7 +53,7 @@ setup(
     version=project_version(),
     packages=["fivebar"],
     package_dir={"": "python"},
-    package_data={"fivebar": ["__init__.pyi", "py.typed"]},
+    package_data={"fivebar": ["__init__.pyi", "runtime.pyi", "py.typed"]},
     ext_modules=[Extension("fivebar._fivebar", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     options={"build": {"build_base": str(ROOT / "build-python" / "setuptools")},

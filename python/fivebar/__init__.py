@@ -20,6 +20,7 @@ every element has a status (``fivebar.Status`` values, uint8), never NaN. Bad in
 
 from __future__ import annotations
 
+import os
 import re
 import tempfile
 from typing import Any, Callable, Dict, Iterable, List, Optional, Sequence, Union
@@ -89,6 +90,9 @@ __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
     "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
+    "collision", "collision_map", "CollisionMap", "pattern", "replay", "replay_sil", "SilReplay", "runtime",
+    "Collision", "PatternResult", "Replay",
+    "calibrate", "Calibration", "calibrate_hard_stops", "calibration_plan", "CalibrationPlan", "identify", "Identification", "parts", "Part",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]
@@ -228,6 +232,122 @@ class ExportGate(Record):
 
     def __bool__(self) -> bool:
         return bool(self._fields["passed"])
+
+
+class Collision(Record):
+    """Two tactor targets of a station under the priority rule (fivebar collision --upper --lower):
+    station, collides (at the requested targets), clearance_mm (exact, negative = overlap; None when
+    a target has no pose), closest_pair, required_clearance_mm, status (clear, moved,
+    upper_unusable, lower_unusable, no_free_point), reason, upper_target / lower_target /
+    lower_point (mm, the commanded lower point), moved_mm, clearance_after_mm, upper_pose /
+    lower_pose (Pose at the commanded points)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return not self._fields["collides"]
+
+
+class CollisionMap(Record):
+    """Every pair of tactor positions on a grid in the target ellipse (fivebar collision without
+    points; no picture): station, spacing_mm, points (n x 2 mm), upper_ok / lower_ok (usable by
+    each mechanism), upper_fraction / lower_fraction (per point: the share of usable positions of
+    the other tactor that collide with it), centre_collides (per point: 1 when the lower tactor
+    there collides with the upper at the centre, 0 when not, 2 when unusable), pairs, colliding,
+    colliding_fraction, any_free; to_dict() adds the separation bins and the priority rule at the
+    centre."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["any_free"])
+
+
+class PatternResult(Record):
+    """A skin-deformation pattern checked sample by sample (fivebar pattern): station, pattern,
+    passed, centre (mm), max_joint_speed (rad/s), t (s, n), clearance_mm and
+    commanded_clearance_mm (n, NaN where a pose is missing), moved_mm (n), mechanisms {"lower",
+    "upper": {target_mm, point_mm (n x 2), theta (n x 2, rad, continuous), joint_speed (n x 2,
+    rad/s), lci (n), status (n, uint8: index into status_names)}}, status_names, first_failure."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["passed"])
+
+
+class Replay(Record):
+    """A device log through the runtime (fivebar replay LOG --config EXPORTED.json): passed, rows,
+    max_duty_difference, mismatches, joints, mechanisms, t (rows), logged_duty and runtime_duty
+    (rows x joints), status (rows x mechanisms, fivebar.runtime.Status values)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["passed"])
+
+
+class SilReplay(Record):
+    """Software in the loop (fivebar replay DESIGN --sil): ok, runs [one dict per pattern: station,
+    reference, simulated, ok, log (the path of its log, the device's format; None when not
+    simulated), figures (simulate's figures and the run's status, as the CLI's --json)]."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["ok"])
+
+
+class Calibration(Record):
+    """A kinematic calibration (fivebar calibrate DESIGN MEAS.csv): station, mechanisms, poses;
+    per parameter (arrays in the order of ``keys``, the design key paths; ``names`` such as
+    "lower.L3", ``units``): value, sigma (posterior, 0 when held), design_value, identified;
+    covariance over the identified parameters (``covariance_names``, file units) and
+    key_covariance (``key_covariance_keys``); unidentifiable [(parameter, combination)],
+    requested_unidentifiable, condition_number, observability_index, sigma_mm; the quality gate's
+    gate_passed and gate_reasons (one line per refused value); design: the patched Design the CLI
+    would write with --out (provenance entries included), or None when the gate refused."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["gate_passed"]) and not self._fields["requested_unidentifiable"]
+
+
+class CalibrationPlan(Record):
+    """The poses to measure (fivebar calibrate --plan N): plans [one dict per mechanism: station,
+    mechanism, theta (N x 2 rad), volts (N x 2, the readings at the design's calibration),
+    point_mm (N x 2, the tactor by FK), candidates, observability_index and the random sets'
+    median, names, expected_sigma and random_sigma (file units), predicted_target_error_mm
+    (linearised) and the random sets' median, problem ("" or why there is no plan)], csv (the text
+    of calibration-plan.csv)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return all(not p["problem"] for p in self._fields["plans"])
+
+
+class Identification(Record):
+    """A motor identification (fivebar identify DESIGN LOG.csv, the motor rig): joints [one dict per
+    joint: joint, method, keys, value, sigma, identified (arrays in the order of keys),
+    unidentifiable, estimate_names, estimate_value, estimate_sigma, covariance, correlation (of the
+    mechanical base parameters' estimate), residual_sigma, drive_fit_percent], refused (keys
+    asked for with fit= that the log cannot identify), gate_passed, gate_reasons, patched,
+    not_patched, design (the patched Design the CLI would write, or None)."""
+
+    __slots__ = ()
+
+    def __bool__(self) -> bool:
+        return bool(self._fields["gate_passed"]) and not self._fields["refused"]
+
+
+class Part(Record):
+    """One printable part (fivebar parts --no-render): station, name (the file stem), kind, uses
+    ("lower/L1", ...), mechanisms (["lower", "upper"]), count, length_mm (links' centre distance, else None), height_mm
+    (or None), scad (the text of its top-level .scad file)."""
+
+    __slots__ = ()
 
 
 # --- Kinematics ------------------------------------------------------------------------------------
@@ -437,3 +557,121 @@ def export_gate(design: Design, *, stations: Sequence[str] = (), progress: Progr
     d = _native._export_gate(design, list(stations), progress)
     d["checks"] = [GateCheck(c) for c in d["checks"]]
     return ExportGate(d)
+
+
+# --- Device: collision, patterns, replay ------------------------------------------------------------
+
+
+def _point(value: Any, name: str) -> Any:
+    """(x, y) in mm from a sequence or array of two numbers, or InputError naming the argument."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected 2 numbers (x, y) in mm, got {value!r}") from None
+    if a.shape != (2,):
+        got = f"{a.size} numbers" if a.ndim == 1 else f"an array of shape {a.shape}"
+        raise InputError(f"{name}: expected 2 numbers (x, y) in mm, got {got}")
+    return (float(a[0]), float(a[1]))
+
+
+def collision(design: Design, upper: Sequence[float], lower: Sequence[float], *, station: str = "") -> Collision:
+    """The upper tactor at ``upper`` and the lower at ``lower`` (x, y mm) on a station with both
+    mechanisms (``station=``, default the only one): exact clearance of the link outlines and the
+    paper's priority rule (the upper keeps its target; a colliding lower target moves to the
+    closest collision-free point). Nothing is written."""
+    return Collision(_native._collision(design, station, _point(upper, "upper"), _point(lower, "lower")))
+
+
+def collision_map(design: Design, *, station: str = "", spacing_mm: float = 0.75) -> CollisionMap:
+    """The collision map of a station with both mechanisms (``fivebar collision DESIGN`` without
+    --upper and --lower): every pair of grid points of spacing ``spacing_mm`` inside the target
+    ellipse, checked exactly. Nothing is written."""
+    return CollisionMap(_native._collision_map(design, station, float(spacing_mm)))
+
+
+def pattern(design: Design, kind: str, *, station: str = "", amplitude_mm: Optional[float] = None,
+            amplitude_deg: Optional[float] = None, frequency_hz: Optional[float] = None,
+            duration_s: Optional[float] = None, rate_hz: Optional[float] = None,
+            separation_mm: Optional[float] = None, center: Optional[Sequence[float]] = None,
+            max_joint_speed_deg_s: Optional[float] = None) -> PatternResult:
+    """The pattern ``kind`` (stretch, slip, twist, pivot) on a station with both mechanisms, as
+    ``fivebar pattern`` computes it: parameters not given come from the design's ``patterns:``
+    section, else the defaults (the CLI's options of the same names). Nothing is written."""
+    return PatternResult(_native._pattern(design, station, kind, amplitude_mm, amplitude_deg, frequency_hz,
+                                          duration_s, rate_hz, separation_mm,
+                                          None if center is None else _point(center, "center"), max_joint_speed_deg_s))
+
+
+def replay(log: Union[str, "os.PathLike[str]"], config: Union[str, "os.PathLike[str]"], *,
+           tolerance: float = 1e-9) -> Replay:
+    """Feeds a device log (CSV of measured joints, reference points and logged duties) through a
+    fresh runtime of the exported configuration ``config`` (fivebar export --format json) and
+    compares the duties row by row, as ``fivebar replay LOG --config EXPORTED.json``."""
+    return Replay(_native._replay(str(log), str(config), float(tolerance)))
+
+
+def replay_sil(design: Design, out_dir: Union[str, "os.PathLike[str]"], *, station: str = "",
+               pattern: Optional[str] = None, config: Optional[Union[str, "os.PathLike[str]"]] = None) -> SilReplay:
+    """The runtime closed around the simulator for the patterns of each station with both
+    mechanisms (or ``station``, ``pattern``), as ``fivebar replay DESIGN --sil``: with ``config``
+    the exported file's gains and calibration, else the design's export in memory. Writes each
+    run's log (``<station>-<pattern>-sil.csv``, replayable by ``fivebar.replay``) into ``out_dir``
+    and nothing elsewhere."""
+    return SilReplay(_native._replay_sil(design, os.fspath(out_dir), station, pattern,
+                                         None if config is None else os.fspath(config)))
+
+
+def calibrate(design: Design, measurements: Union[str, "os.PathLike[str]"], *, station: str = "",
+              mechanism: str = "", frame: str = "fixed", fit: Sequence[str] = (), loss: str = "none",
+              loss_scale: float = 2.0, sigma_mm: Optional[float] = None, holdout: int = 0) -> Calibration:
+    """Fits link lengths, base joints and potentiometer calibration to a measurement file, as
+    ``fivebar calibrate DESIGN MEAS.csv`` with the options of the same names (--frame, --fit,
+    --loss, --loss-scale, --sigma, --holdout). Nothing is written; ``result.design`` is the
+    patched design when the quality gate passed."""
+    return Calibration(_native._calibrate(design, os.fspath(measurements), station, mechanism, frame, list(fit), loss,
+                                          float(loss_scale), sigma_mm, int(holdout)))
+
+
+def calibrate_hard_stops(design: Design, log: Union[str, "os.PathLike[str]"]) -> Calibration:
+    """The potentiometers' V0 (and k when both stops of a joint are read) from readings taken with
+    a proximal link on a hard stop (CSV ``station,mechanism,joint,stop,volts``), as ``fivebar
+    calibrate DESIGN --hard-stops LOG``. Nothing is written; ``result.design`` is the patched
+    design when the quality gate passed."""
+    return Calibration(_native._calibrate_hard_stops(design, os.fspath(log)))
+
+
+def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism: str = "", sigma_mm: float = 0.02,
+                     criterion: str = "i", seed: int = 1) -> CalibrationPlan:
+    """Chooses ``poses`` poses per mechanism to measure, as ``fivebar calibrate DESIGN --plan N``
+    (--station, --mechanism, --plan-sigma, --plan-criterion i or d, --seed). Nothing is written:
+    ``result.csv`` is the text of calibration-plan.csv."""
+    return CalibrationPlan(_native._calibration_plan(design, int(poses), station, mechanism, float(sigma_mm), criterion,
+                                                     int(seed)))
+
+
+def identify(design: Design, logs: Union[str, "os.PathLike[str]", Sequence[Union[str, "os.PathLike[str]"]]], *,
+             rig: str = "motor", validation: Optional[Union[str, "os.PathLike[str]"]] = None, joint: str = "",
+             method: str = "idim",
+             closed_loop: bool = False, output_error: bool = True, per_direction: bool = False,
+             instant_drive: bool = False, cutoff_hz: Optional[float] = None, decimation: Optional[int] = None,
+             filter_order: int = 4, load_inertia: float = 0.0, fit: Sequence[str] = ()) -> Identification:
+    """Identifies the motor model of each joint of the logs (one path or several fitted together),
+    as ``fivebar identify DESIGN LOG.csv --no-files`` with the options of the same names
+    (``output_error=False`` is --no-output-error; ``rig="index/lower"`` is --rig mechanism
+    index/lower, the assembled mechanism from a device log; --plan is not bound).
+    Nothing is written; ``result.design`` is the patched design when the quality gate passed."""
+    paths = [os.fspath(logs)] if isinstance(logs, (str, os.PathLike)) else [os.fspath(p) for p in logs]
+    return Identification(_native._identify(design, paths, rig, "" if validation is None else os.fspath(validation), joint,
+                                            method, bool(closed_loop), bool(output_error), bool(per_direction),
+                                            bool(instant_drive), cutoff_hz, decimation, int(filter_order),
+                                            float(load_inertia), list(fit)))
+
+
+def parts(design: Design, *, station: Optional[str] = None, fn: Optional[int] = None) -> List[Part]:
+    """The printable parts of every station (or ``station``) with their OpenSCAD text, as
+    ``fivebar parts --no-render`` writes them (``fn`` overrides print.fn). Nothing is written or
+    rendered: ``part.scad`` is the file's text (it uses the library ``fivebar.scad``)."""
+    return [Part(d) for d in _native._parts(design, station, fn)]
+
+
+from . import runtime  # noqa: E402  (fivebar.runtime.Controller: the device runtime)

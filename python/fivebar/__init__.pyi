@@ -254,6 +254,122 @@ class ExportGate(Record):
     validation: Dict[str, Any]
     def __bool__(self) -> bool: ...
 
+class Collision(Record):
+    station: str
+    collides: bool
+    clearance_mm: Optional[float]
+    closest_pair: Optional[str]
+    required_clearance_mm: float
+    status: Literal["clear", "moved", "upper_unusable", "lower_unusable", "no_free_point"]
+    reason: str
+    upper_target: F64
+    lower_target: F64
+    lower_point: F64
+    moved_mm: float
+    clearance_after_mm: Optional[float]
+    upper_pose: Pose
+    lower_pose: Pose
+    def __bool__(self) -> bool: ...
+
+class CollisionMap(Record):
+    station: str
+    spacing_mm: float
+    points: F64
+    upper_ok: npt.NDArray[np.bool_]
+    lower_ok: npt.NDArray[np.bool_]
+    upper_fraction: F64
+    lower_fraction: F64
+    centre_collides: U8
+    pairs: int
+    colliding: int
+    colliding_fraction: float
+    any_free: bool
+    def __bool__(self) -> bool: ...
+
+class PatternResult(Record):
+    station: str
+    pattern: str
+    passed: bool
+    centre: F64
+    max_joint_speed: float
+    t: F64
+    clearance_mm: F64
+    commanded_clearance_mm: F64
+    moved_mm: F64
+    mechanisms: Dict[str, Dict[str, np.ndarray]]
+    status_names: List[str]
+    first_failure: Optional[Dict[str, Any]]
+    def __bool__(self) -> bool: ...
+
+class Replay(Record):
+    passed: bool
+    rows: int
+    max_duty_difference: float
+    mismatches: int
+    joints: List[str]
+    mechanisms: List[str]
+    t: F64
+    logged_duty: F64
+    runtime_duty: F64
+    status: U8
+    def __bool__(self) -> bool: ...
+
+class SilReplay(Record):
+    ok: bool
+    runs: List[Dict[str, Any]]
+    def __bool__(self) -> bool: ...
+
+class Calibration(Record):
+    station: str
+    mechanisms: List[str]
+    poses: int
+    keys: List[str]
+    names: List[str]
+    units: List[str]
+    value: F64
+    sigma: F64
+    design_value: F64
+    identified: npt.NDArray[np.bool_]
+    covariance: F64
+    covariance_names: List[str]
+    key_covariance: F64
+    key_covariance_keys: List[str]
+    unidentifiable: List[Tuple[str, str]]
+    requested_unidentifiable: bool
+    condition_number: float
+    observability_index: float
+    sigma_mm: float
+    gate_passed: bool
+    gate_reasons: List[str]
+    design: Optional[Design]
+    def __bool__(self) -> bool: ...
+
+class CalibrationPlan(Record):
+    plans: List[Dict[str, Any]]
+    csv: str
+    def __bool__(self) -> bool: ...
+
+class Identification(Record):
+    joints: List[Dict[str, Any]]
+    refused: List[str]
+    gate_passed: bool
+    gate_reasons: List[str]
+    patched: List[str]
+    not_patched: List[str]
+    design: Optional[Design]
+    def __bool__(self) -> bool: ...
+
+class Part(Record):
+    station: str
+    name: str
+    kind: Literal["proximal_link", "distal_link", "tactor_tip", "station_base"]
+    uses: List[str]
+    mechanisms: List[str]
+    count: int
+    length_mm: Optional[float]
+    height_mm: Optional[float]
+    scad: str
+
 @overload
 def fk(mechanism: Mechanism, theta1: float, theta2: float, *, unit: Optional[Literal["rad", "deg"]] = None,
        branch: Optional[str] = None) -> Pose: ...
@@ -294,3 +410,30 @@ def tolerance(design: Design, *, station: str = "", spacing_mm: float = 0.25,
               progress: ProgressLine = None) -> List[ToleranceMap]: ...
 def control(design: Design, *, station: str = "", progress: ProgressLine = None) -> List[ControlStudy]: ...
 def export_gate(design: Design, *, stations: Sequence[str] = (), progress: ProgressLine = None) -> ExportGate: ...
+def collision(design: Design, upper: Sequence[float], lower: Sequence[float], *, station: str = "") -> Collision: ...
+def collision_map(design: Design, *, station: str = "", spacing_mm: float = 0.75) -> CollisionMap: ...
+def pattern(design: Design, kind: Literal["stretch", "slip", "twist", "pivot"], *, station: str = "",
+            amplitude_mm: Optional[float] = None, amplitude_deg: Optional[float] = None,
+            frequency_hz: Optional[float] = None, duration_s: Optional[float] = None, rate_hz: Optional[float] = None,
+            separation_mm: Optional[float] = None, center: Optional[Sequence[float]] = None,
+            max_joint_speed_deg_s: Optional[float] = None) -> PatternResult: ...
+def replay(log: Union[str, os.PathLike[str]], config: Union[str, os.PathLike[str]], *,
+           tolerance: float = 1e-9) -> Replay: ...
+def replay_sil(design: Design, out_dir: Union[str, os.PathLike[str]], *, station: str = "",
+               pattern: Optional[str] = None, config: Optional[Union[str, os.PathLike[str]]] = None) -> SilReplay: ...
+def calibrate(design: Design, measurements: Union[str, os.PathLike[str]], *, station: str = "", mechanism: str = "",
+              frame: Literal["fixed", "fit"] = "fixed", fit: Sequence[str] = (),
+              loss: Literal["none", "huber", "cauchy"] = "none", loss_scale: float = 2.0,
+              sigma_mm: Optional[float] = None, holdout: int = 0) -> Calibration: ...
+def calibrate_hard_stops(design: Design, log: Union[str, os.PathLike[str]]) -> Calibration: ...
+def calibration_plan(design: Design, poses: int, *, station: str = "", mechanism: str = "", sigma_mm: float = 0.02,
+                     criterion: Literal["i", "d"] = "i", seed: int = 1) -> CalibrationPlan: ...
+def identify(design: Design, logs: Union[str, os.PathLike[str], Sequence[Union[str, os.PathLike[str]]]], *,
+             rig: str = "motor", validation: Optional[Union[str, os.PathLike[str]]] = None, joint: str = "",
+             method: Literal["idim", "oe"] = "idim", closed_loop: bool = False, output_error: bool = True,
+             per_direction: bool = False, instant_drive: bool = False, cutoff_hz: Optional[float] = None,
+             decimation: Optional[int] = None, filter_order: int = 4, load_inertia: float = 0.0,
+             fit: Sequence[str] = ()) -> Identification: ...
+def parts(design: Design, *, station: Optional[str] = None, fn: Optional[int] = None) -> List[Part]: ...
+
+from . import runtime as runtime

@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the three binding sources of the Python module (python/src/): pybind11 stays in these
+// Shared by the binding sources of the Python module (python/src/): pybind11 stays in these
 // translation units only. Units follow the library: mm and radians (docs/python.md).
 
 #include <pybind11/numpy.h>
@@ -24,6 +24,8 @@ namespace py = pybind11;
 void register_design(py::module_& m);
 void register_kinematics(py::module_& m);
 void register_studies(py::module_& m);
+void register_device(py::module_& m);
+void register_bench(py::module_& m);
 
 /// A JSON document of the library (to_json(...), mm and degrees) as Python dicts, lists and numbers.
 py::object to_python(const Json& j);

@@ -120,3 +120,21 @@ def test_a_mistyped_key_path_names_the_nearest_key(showcase):
     with pytest.raises(fivebar.InputError) as e:
         showcase.number("stations.index.zzzzzzzz")
     assert "did you mean" not in str(e.value)
+
+
+def test_every_public_name_has_a_type_stub():
+    import ast
+    import pathlib
+    stub = pathlib.Path(fivebar.__file__).with_name("__init__.pyi")
+    names = set()
+    for node in ast.parse(stub.read_text()).body:
+        if isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            names.add(node.target.id)
+        elif isinstance(node, ast.Assign):
+            names.update(t.id for t in node.targets if isinstance(t, ast.Name))
+        elif isinstance(node, ast.ImportFrom):
+            names.update(a.asname or a.name for a in node.names)
+    missing = [n for n in fivebar.__all__ if n not in names]
+    assert not missing, f"fivebar.__all__ names without a stub in {stub.name}: {missing}"
