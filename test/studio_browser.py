@@ -88,7 +88,8 @@ def status_of(url, headers=None, method="GET", body=None):
         return e.code
 
 
-IDLE = "window.studio && window.studio.figures && !window.studio.inflight && !window.studio.queued"
+IDLE = ("window.studio && window.studio.figures && !window.studio.inflight && !window.studio.queued"
+        " && !window.studio.priorityAbort")
 
 
 def settle(cdp):
@@ -260,6 +261,11 @@ def main():
             med = {k: sorted(s[k] for s in split)[len(split) // 2] for k in split[0]}
             print("  medians: " + ", ".join(f"{k} {v:.1f} ms" for k, v in med.items()) +
                   " (queued: waiting for the answer before; request: the server's answer as the page sees it)")
+        plat = sorted(cdp.js("window.studio.priorityLatencies"))
+        if plat:
+            pp95 = plat[min(len(plat) - 1, int(0.95 * len(plat)))]
+            print(f"  the priority rule's second answer drawn: {len(plat)} times, median {plat[len(plat) // 2]:.1f} ms, p95 {pp95:.1f} ms"
+                  " after the drag event")
         check(len(lat) >= 3, f"the figures redrew during the drags ({len(lat)} redraws)", failures)
         errors = console_errors(cdp)
         check(not errors, f"no console error ({errors})", failures)

@@ -12,8 +12,13 @@
     controls: null, file: '', sha256: '', station: '',
     edits: new Map(), undo: [], redo: [],
     cursor: { lower: null, upper: null },
-    seq: 0, shownSeq: 0, rev: 0, inflight: false, queued: false, oldestEvent: null,
+    seq: 0, shownSeq: 0, rev: 0, inflight: 0, queued: false, oldestEvent: null,
     fullTimer: null, fullAbort: null, fullRev: -1, figures: null, latencies: [], split: [], errors: 0, view: null,
+    priorityAbort: null, priorityLatencies: [],
+    regions: new Map(),  // region id -> loops: the server leaves out the loops of the ones listed here
+    // This page's id: the server answers a priority request that a newer drag request of the same
+    // page has overtaken with "stale", without its search.
+    page: Array.from(crypto.getRandomValues(new Uint8Array(8)), (b) => b.toString(16).padStart(2, '0')).join(''),
   };
   window.studio = st;  // for the browser test (test/studio_browser.py) and the curious
 
@@ -21,7 +26,9 @@
     const init = { method: body === undefined ? 'GET' : 'POST', headers: { 'X-Fivebar-Token': token }, signal };
     if (body !== undefined) { init.body = JSON.stringify(body); init.headers['Content-Type'] = 'application/json'; }
     const res = await fetch(path, init);
+    const timing = /dur=([0-9.]+)/.exec(res.headers.get('Server-Timing') || '');
     const doc = await res.json().catch(() => ({ error: 'HTTP ' + res.status }));
+    if (doc && typeof doc === 'object') doc.server_ms = timing ? Number(timing[1]) : null;  // the server's own time
     if (!res.ok) throw new Error(doc.error || ('HTTP ' + res.status));
     return doc;
   }
@@ -50,44 +57,91 @@
   }
 
   // --- Requests: one in flight, the newest state queued, stale answers dropped ----------------------
+  // A drag's answer comes in two parts (docs/studio.md "Speed"): the regions, coverage, poses and
+  // tolerance bands ("quick"), then the priority rule, whose search is most of the time, in a
+  // second request that the next edit cancels; until it arrives the rule says "not certified yet".
+  // Two drag requests at most in flight: the server answers them on two threads (this machine's two
+  // cores), and an edit that arrives while one is computed need not wait for it.
+  const MAX_INFLIGHT = 2;
   function request(eventTime) {
     if (st.oldestEvent === null) st.oldestEvent = eventTime;
     if (st.fullAbort) { st.fullAbort.abort(); st.fullAbort = null; }  // its answer would be stale
-    if (st.inflight) { st.queued = true; return; }
+    if (st.priorityAbort) { st.priorityAbort.abort(); st.priorityAbort = null; }
+    if (st.inflight >= (st.maxInflight || MAX_INFLIGHT)) { st.queued = true; return; }
     send();
   }
   async function send() {
-    st.inflight = true; st.queued = false;
+    st.inflight++; st.queued = false;
     const seq = ++st.seq, rev = st.rev, since = st.oldestEvent, sent = performance.now();
     st.oldestEvent = null;
     clearTimeout(st.fullTimer);
+    let fig;
     try {
-      const fig = await api('/api/figures', body('live', seq));
-      if (seq > st.shownSeq) {  // a newer answer than the one shown: drawn even mid-drag
-        const answered = performance.now();
-        st.shownSeq = seq;
-        st.figures = fig;
-        draw(fig);
-        const drawn = performance.now();
-        if ($('status').className === 'bad') status('');
-        requestAnimationFrame(() => {
-          if (since === null) return;
-          const now = performance.now();
-          st.latencies.push(now - since);
-          // Where the time went: waiting to be sent, the request, drawing, the frame.
-          st.split.push({ queued: sent - since, request: answered - sent, draw: drawn - answered, frame: now - drawn });
-        });
-        if (rev === st.rev) st.fullTimer = setTimeout(() => full(rev), 120);
-      }
+      fig = await api("/api/figures", body(st.dragFigures || "quick", seq));
     } catch (e) {
       if (!st.queued) { status(e.message, true); markInvalid(); }
-    } finally {
-      st.inflight = false;
+      st.inflight--;
       if (st.queued) send();
+      return;
+    }
+    // The next request (edits that arrived meanwhile) leaves before this answer is drawn.
+    st.inflight--;
+    if (st.queued) send();
+    if (seq <= st.shownSeq) return;  // an older answer than the one shown
+    if (!fillRegions(fig)) { st.regions.clear(); request(performance.now()); return; }
+    const answered = performance.now(), server = fig.server_ms;
+    st.shownSeq = seq;
+    st.figures = fig;
+    draw(fig);
+    const drawn = performance.now();
+    if ($('status').className === 'bad') status('');
+    requestAnimationFrame(() => {
+      if (since === null) return;
+      const now = performance.now();
+      st.latencies.push(now - since);
+      // Where the time went: waiting to be sent, the request, drawing, the frame.
+      st.split.push({ queued: sent - since, request: answered - sent, server, draw: drawn - answered, frame: now - drawn });
+    });
+    if (rev !== st.rev) return;
+    if (typeof fig.priority === 'string') priority(rev, seq, since);
+    st.fullTimer = setTimeout(() => full(rev), 120);
+  }
+  async function priority(rev, seq, since) {
+    const abort = new AbortController();
+    st.priorityAbort = abort;
+    try {
+      const ans = await api('/api/figures', body('priority', seq), abort.signal);
+      if (ans.stale || rev !== st.rev || st.shownSeq !== seq) return;
+      st.figures.priority = ans.priority;
+      tables(st.figures);
+      requestAnimationFrame(() => { if (since !== null) st.priorityLatencies.push(performance.now() - since); });
+    } catch (e) {
+      // Aborted by a newer edit, or refused: the quick answer already reported that.
+    } finally {
+      if (st.priorityAbort === abort) st.priorityAbort = null;
     }
   }
   function body(figures, seq) {
-    return { edits: editsList(), station: st.station, cursor: cursorBody(), figures, seq };
+    return { edits: editsList(), station: st.station, cursor: cursorBody(), figures, seq, page: st.page,
+      have_regions: Array.from(st.regions.keys()) };
+  }
+  // The loops of the regions the answer left out (the page holds them), and the new ones kept.
+  // False when one is missing (dropped here meanwhile): the page then asks again.
+  function fillRegions(fig) {
+    const regions = fig.mechanisms.map((m) => m.region);
+    if (fig.shared_region) regions.push(fig.shared_region);
+    let ok = true;
+    for (const r of regions) {
+      if (r.loops_mm === null) {
+        const loops = st.regions.get(r.id);
+        if (loops === undefined) { ok = false; continue; }
+        r.loops_mm = loops;
+        st.regions.delete(r.id);  // newest last
+      }
+      st.regions.set(r.id, r.loops_mm);
+    }
+    while (st.regions.size > 24) st.regions.delete(st.regions.keys().next().value);
+    return ok;
   }
   function cursorBody() {
     const c = {};
@@ -97,12 +151,12 @@
   }
   async function full(rev) {
     if (rev !== st.rev) return;
-    if (st.inflight) { st.fullTimer = setTimeout(() => full(rev), 60); return; }
+    if (st.inflight || st.priorityAbort) { st.fullTimer = setTimeout(() => full(rev), 60); return; }
     const abort = new AbortController();
     st.fullAbort = abort;
     try {
       const fig = await api('/api/figures', body('full', st.seq), abort.signal);
-      if (rev === st.rev) { st.fullRev = rev; st.figures = fig; draw(fig); }
+      if (rev === st.rev && fillRegions(fig)) { st.fullRev = rev; st.figures = fig; draw(fig); }
     } catch (e) {
       // Aborted by a newer edit, or refused: the live answer already reported that.
     } finally {
@@ -239,8 +293,11 @@
       const p = new DOMPoint(e.clientX, e.clientY).matrixTransform($('world').getScreenCTM().inverse());
       onMove([p.x, p.y], e.timeStamp);
     };
-    const up = () => { window.removeEventListener('pointermove', move); window.removeEventListener('pointerup', up); };
-    window.addEventListener('pointermove', move);
+    // pointerrawupdate (Chromium) is dispatched as the input arrives; pointermove waits for the next
+    // animation frame, up to 16 ms later.
+    const kind = 'onpointerrawupdate' in window ? 'pointerrawupdate' : 'pointermove';
+    const up = () => { window.removeEventListener(kind, move); window.removeEventListener('pointerup', up); };
+    window.addEventListener(kind, move);
     window.addEventListener('pointerup', up);
   }
 
@@ -268,8 +325,10 @@
       tb.appendChild(tr);
     }
     const pr = fig.priority;
-    $('priority').textContent = pr ? `priority rule at the tactor points: ${pr.status}${pr.moved_mm ? `, lower moved ${fmt(pr.moved_mm, 3)} mm` : ''} — ${pr.reason}`
-      : 'priority rule: needs both mechanisms and a geometry: section';
+    $('priority').textContent = typeof pr === 'string' ? 'priority rule at the tactor points: ' + pr
+      : pr ? `priority rule at the tactor points: ${pr.status}${pr.moved_mm ? `, lower moved ${fmt(pr.moved_mm, 3)} mm` : ''} — ${pr.reason}`
+        : 'priority rule: needs both mechanisms and a geometry: section';
+    $('priority').className = typeof pr === 'string' ? 'pending' : '';
     const cm = fig.collision_map;
     $('collision').textContent = typeof cm === 'string' ? 'collision map: ' + cm
       : cm ? `collision map (sampled, ${fmt(cm.spacing_mm, 2)} mm grid): ${fmt(100 * cm.colliding_fraction, 2)} % of ${cm.pairs} pairs collide; every pair farther apart than ${fmt(cm.max_colliding_separation_mm, 3)} mm is free; green dots: lower positions free with the upper at the centre`
