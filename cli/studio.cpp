@@ -340,6 +340,18 @@ void routes(httplib::Server& http, Server& s) {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     res.set_header("Server-Timing", "figures;dur=" + format::fixed(ms, 1));
   });
+  // A pattern played on the edited state: the edited file loaded (every rule of the loader), then
+  // `fivebar pattern`'s check with its samples.
+  http.Post("/api/pattern", [&s](const httplib::Request& req, httplib::Response& res) {
+    json_route(res, req, [&](const Json& in) {
+      const Design d = [&] {
+        const std::lock_guard<std::mutex> lock(s.mutex);
+        return s.studio.design(edits_of(in));
+      }();
+      const std::string station = in.value("station", d.stations.empty() ? std::string() : d.stations.front().name);
+      return studio_pattern(d, station, in.value("pattern", std::string()));
+    });
+  });
   http.Post("/api/preview", [&s](const httplib::Request& req, httplib::Response& res) {
     json_route(res, req, [&](const Json& in) {
       const std::lock_guard<std::mutex> lock(s.mutex);

@@ -143,6 +143,7 @@ def browser_checks(cdp, binary, design, failures):
     check(after != before, f"dragging a base changes the lower region ({before:.3f} -> {after:.3f} mm2)", failures)
     # 2. A link slider, clicked at 65 % of its width.
     key = "stations.index.mechanisms.lower.links[2]"
+    cdp.js(f"document.querySelector('#controls input[type=range][data-key=\"{key}\"]').scrollIntoView({{block: 'center'}})")
     x, y, w = center_of(cdp, f'#controls input[type=range][data-key="{key}"]')
     click(cdp, x + 0.15 * w, y)
     settle(cdp)
@@ -178,7 +179,34 @@ def browser_checks(cdp, binary, design, failures):
     cli["shared"] = f"{st['shared']['margin_mm']:.4f}"
     shown_now = margins(cdp)
     check(shown_now == cli, f"the page's margins {shown_now} equal fivebar coverage --json's {cli}", failures)
+    pattern_checks(cdp, binary, design, failures)
     return slid
+
+
+def pattern_checks(cdp, binary, design, failures):
+    """6. Play the stretch pattern, then show one sample with the scrubber: the tactor points drawn
+    are `fivebar pattern --json --samples`'s commanded points of the saved file (the priority rule's
+    sample, if one moved the lower tactor)."""
+    cdp.js("document.getElementById('patternkind').value = 'stretch'")
+    cdp.js("document.getElementById('play').click()")
+    cdp.wait("window.studio.pattern && window.studio.playing")
+    cdp.wait("!window.studio.playing")
+    played = cdp.js("window.studio.frame")
+    r = subprocess.run([binary, "pattern", design, "--station", "index", "--pattern", "stretch", "--json", "--samples",
+                        "--out", os.path.join(os.path.dirname(design), "pattern-out")], capture_output=True, text=True)
+    samples = json.loads(r.stdout)["samples"]
+    check(played == len(samples) - 1, f"the pattern played to its last sample ({played} of {len(samples) - 1})", failures)
+    moved = [i for i, x in enumerate(samples) if x["moved_mm"] > 0]
+    k = moved[len(moved) // 2] if moved else len(samples) // 3
+    cdp.js(f"(() => {{ const s = document.getElementById('scrub'); s.value = {k}; s.dispatchEvent(new Event('input')); }})()")
+    drawn = cdp.js("Object.fromEntries(Array.from(document.querySelectorAll('[data-pattern-tactor]'))"
+                   ".map(c => [c.dataset.patternTactor, [Number(c.getAttribute('cx')), Number(c.getAttribute('cy'))]]))")
+    want = {m["mechanism"]: m["point_mm"] for m in samples[k]["mechanisms"]}
+    close = set(drawn) == set(want) and all(abs(drawn[n][i] - want[n][i]) <= 1e-9 for n in want for i in (0, 1))
+    check(close, f"sample {k} (moved {samples[k]['moved_mm']:.3f} mm): the tactors drawn {drawn} are fivebar pattern's {want}", failures)
+    text = cdp.js("document.getElementById('patternstatus').textContent")
+    statuses = all(f"{m['mechanism']} {m['status']}" in text for m in samples[k]["mechanisms"])
+    check(f"sample {k} of" in text and statuses, f"the statuses shown: {text!r}", failures)
 
 
 def refusal_checks(address, failures):

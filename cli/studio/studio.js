@@ -15,6 +15,7 @@
     seq: 0, shownSeq: 0, rev: 0, inflight: 0, queued: false, oldestEvent: null,
     fullTimer: null, fullAbort: null, fullRev: -1, figures: null, latencies: [], split: [], errors: 0, view: null,
     priorityAbort: null, priorityLatencies: [],
+    pattern: null, frame: 0, playing: false, patternTimer: null,  // the pattern played (fivebar pattern's samples)
     regions: new Map(),  // region id -> loops: the server leaves out the loops of the ones listed here
     // This page's id: the server answers a priority request that a newer drag request of the same
     // page has overtaken with "stale", without its search.
@@ -45,13 +46,14 @@
   // --- Edits, undo and redo ------------------------------------------------------------------------
   function snapshot() { return JSON.stringify(Array.from(st.edits)); }
   function checkpoint() { st.undo.push(snapshot()); st.redo = []; buttons(); }
-  function restore(snap) { st.edits = new Map(JSON.parse(snap)); st.rev++; syncControls(); request(performance.now()); buttons(); }
+  function restore(snap) { st.edits = new Map(JSON.parse(snap)); st.rev++; patternStale(); syncControls(); request(performance.now()); buttons(); }
   function undo() { if (st.undo.length) { st.redo.push(snapshot()); restore(st.undo.pop()); } }
   function redo() { if (st.redo.length) { st.undo.push(snapshot()); restore(st.redo.pop()); } }
   function buttons() { $('undo').disabled = !st.undo.length; $('redo').disabled = !st.redo.length; }
   function setEdit(key, value, eventTime) {
     st.edits.set(key, value);
     st.rev++;
+    patternStale();
     syncControl(key);
     request(eventTime);
   }
@@ -208,11 +210,13 @@
     el('path', { d: path([fig.target.outline_mm]), fill: 'rgba(0,0,0,0.05)', stroke: '#000', 'stroke-width': 0.12 }, g);
     for (const m of fig.mechanisms) drawMechanism(m, g);
     drawWitnesses(fig, g);
+    el('g', { id: 'patternlayer' }, g);
     drawHandles(fig, g);
     el('line', { x1: v.x0 + 1, y1: v.y0 + 1, x2: v.x0 + 6, y2: v.y0 + 1, stroke: '#000', 'stroke-width': 0.2 }, g);
     const t = el('text', { x: v.x0 + 1, y: -(v.y0 + 1.5), 'font-size': 1.2 }, svg);
     t.textContent = '5 mm';
     tables(fig);
+    drawFrame();
   }
   function drawFields(fig, g) {
     if (Array.isArray(fig.lci_field)) {
@@ -345,6 +349,83 @@
           (m.tolerance.near_singular ? ' [near singular]' : '')).join(', ');
   }
 
+  // --- Pattern ---------------------------------------------------------------------------------------
+  // The design's pattern of the chosen kind, computed by the server for the current edits with the
+  // library call of `fivebar pattern` (the priority rule applied sample by sample), played on the
+  // drawing: the two linkages at the commanded points, the targets as small crosses.
+  async function play() {
+    if (st.playing) { pause(); return; }
+    const kind = $('patternkind').value;
+    const key = JSON.stringify([snapshot(), st.station, kind]);  // the state it is computed for
+    if (!st.pattern || st.pattern.key !== key) {
+      $('patternstatus').textContent = 'pattern: computing ' + kind + '…';
+      $('patternstatus').className = 'pending';
+      try {
+        const p = await api('/api/pattern', { edits: editsList(), station: st.station, pattern: kind });
+        if (key !== JSON.stringify([snapshot(), st.station, $('patternkind').value])) { patternStale(); return; }
+        p.key = key;
+        st.pattern = p;
+        st.frame = 0;
+        const scrub = $('scrub');
+        scrub.max = p.samples.length - 1; scrub.value = 0; scrub.disabled = false;
+      } catch (e) { $('patternstatus').textContent = 'pattern: ' + e.message; $('patternstatus').className = 'bad'; return; }
+    }
+    if (st.frame >= st.pattern.samples.length - 1) st.frame = 0;
+    st.playing = true;
+    $('play').textContent = 'Pause';
+    const dt = 1000 / st.pattern.spec.rate_hz;  // real time: one sample per controller period
+    const t0 = performance.now() - st.frame * dt;
+    const tick = () => {
+      if (!st.playing || !st.pattern) return;
+      st.frame = Math.min(st.pattern.samples.length - 1, Math.floor((performance.now() - t0) / dt));
+      drawFrame();
+      if (st.frame >= st.pattern.samples.length - 1) { pause(); return; }
+      st.patternTimer = requestAnimationFrame(tick);
+    };
+    st.patternTimer = requestAnimationFrame(tick);
+  }
+  function pause() {
+    st.playing = false;
+    if (st.patternTimer) cancelAnimationFrame(st.patternTimer);
+    st.patternTimer = null;
+    $('play').textContent = 'Play';
+  }
+  function patternStale() {
+    if (!st.pattern) return;
+    pause();
+    st.pattern = null;
+    $('scrub').disabled = true;
+    $('patternstatus').textContent = 'pattern: not certified yet for the current state (press Play to compute it)';
+    $('patternstatus').className = 'pending';
+    const layer = $('patternlayer');
+    if (layer) layer.replaceChildren();
+  }
+  function drawFrame() {
+    const layer = $('patternlayer');
+    const p = st.pattern;
+    if (!layer || !p) return;
+    layer.replaceChildren();
+    const k = Math.min(st.frame, p.samples.length - 1);
+    const sample = p.samples[k], frame = p.frames[k];
+    for (const m of sample.mechanisms) {
+      const c = COLOUR[m.mechanism];
+      const joints = frame[m.mechanism];
+      if (joints) {
+        el('polyline', { points: joints.map((q) => q.join(',')).join(' '), fill: 'none', stroke: `rgb(${c})`, 'stroke-width': 0.25,
+          'stroke-dasharray': '0.6 0.3' }, layer);
+      }
+      const [tx, ty] = m.target_mm;
+      el('path', { d: `M${tx - 0.4},${ty - 0.4}l0.8,0.8M${tx - 0.4},${ty + 0.4}l0.8,-0.8`, stroke: `rgb(${c})`, 'stroke-width': 0.12 }, layer);
+      el('circle', { cx: m.point_mm[0], cy: m.point_mm[1], r: 0.5, fill: `rgb(${c})`, 'data-pattern-tactor': m.mechanism }, layer);
+    }
+    $('scrub').value = k;
+    const statuses = sample.mechanisms.map((m) => `${m.mechanism} ${m.status}`).join(', ');
+    const verdict = p.passed ? 'renderable' : `NOT renderable (first failure: sample ${p.first_failure.index}, ${p.first_failure.mechanism} ${p.first_failure.status})`;
+    $('patternstatus').textContent = `${p.pattern}: sample ${k} of ${p.samples.length - 1}, t = ${fmt(sample.time_s, 3)} s: ${statuses}` +
+      (sample.moved_mm > 0 ? `; priority rule moved the lower ${fmt(sample.moved_mm, 3)} mm` : '') + ` — ${verdict}`;
+    $('patternstatus').className = p.passed ? '' : 'bad';
+  }
+
   // --- Controls ------------------------------------------------------------------------------------
   function controls() {
     const box = $('controls');
@@ -427,7 +508,7 @@
     } catch (e) { status(e.message, true); }
   }
   async function reload() {
-    try { await loadState(); st.edits = new Map(); st.undo = []; st.redo = []; buttons(); st.rev++; controls(); request(performance.now()); status('reloaded'); }
+    try { await loadState(); st.edits = new Map(); st.undo = []; st.redo = []; buttons(); st.rev++; patternStale(); controls(); request(performance.now()); status('reloaded'); }
     catch (e) { status(e.message, true); }
   }
   async function run() {
@@ -474,9 +555,12 @@
     $('cancelsave').addEventListener('click', () => $('diffdialog').close());
     $('reload').addEventListener('click', reload);
     $('run').addEventListener('click', run);
+    $('play').addEventListener('click', play);
+    $('patternkind').addEventListener('change', () => { pause(); if (st.pattern) patternStale(); });
+    $('scrub').addEventListener('input', () => { pause(); st.frame = Number($('scrub').value); drawFrame(); });
     $('truescale').addEventListener('change', () => st.figures && draw(st.figures));
     $('station').addEventListener('change', (e) => {
-      st.station = $('station').value; st.cursor = { lower: null, upper: null }; st.rev++; controls(); request(e.timeStamp);
+      st.station = $('station').value; st.cursor = { lower: null, upper: null }; st.rev++; patternStale(); controls(); request(e.timeStamp);
     });
     document.addEventListener('keydown', (e) => {
       if ((e.ctrlKey || e.metaKey) && e.key.toLowerCase() === 'z') { e.preventDefault(); (e.shiftKey ? redo : undo)(); }

@@ -71,6 +71,14 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
 Json studio_priority(const Design& design, std::string_view station, const StudioCursor& cursor = {},
                      StudioCache* cache = nullptr);
 
+/// A pattern (stretch, slip, twist or pivot) played on the station as the design now is
+/// (docs/studio.md "Patterns"): check_pattern() of pattern_spec() with the design's motor speed
+/// limit, what `fivebar pattern --pattern KIND --json --samples` prints (the priority rule applied
+/// sample by sample), plus `frames`: per sample the two linkages at their commanded points
+/// ({lower, upper}: joints O1, A1, P, A2, O2 in mm, null when unreachable). InputError for an
+/// unknown kind or station, a station without both mechanisms or a design without `geometry:`.
+Json studio_pattern(const Design& design, std::string_view station, std::string_view kind);
+
 /// The numbers and modes a page can edit, per station: key path, value, unit and a slider range
 /// (for a length: 0.5 to 1.5 times its value; a coordinate: +- the station's length scale).
 Json studio_controls(const Design& design);

@@ -18,11 +18,13 @@
 #include "fivebar/collision.hpp"
 #include "fivebar/coverage/coverage.hpp"
 #include "fivebar/coverage/report.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/design/edit.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/pattern.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sha256.hpp"
 #include "fivebar/tolerance.hpp"
@@ -357,6 +359,28 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
     j["lci_field"] = kNotCertified;
   }
   j["figures"] = full ? "full" : which == StudioFigures::quick ? "quick" : "live";
+  return j;
+}
+
+Json studio_pattern(const Design& design, std::string_view station, std::string_view kind) {
+  const Station* s = design.station(station);
+  if (s == nullptr) throw InputError("design '" + design.name + "' has no station '" + std::string(station) + "'");
+  const auto k = parse_pattern_kind(kind);
+  if (!k) throw InputError("pattern '" + std::string(kind) + "': expected stretch, slip, twist or pivot");
+  const Geometry* g = design.get<Geometry>();
+  if (!s->lower || !s->upper || g == nullptr) {
+    throw InputError("station '" + s->name + "': a pattern needs both mechanisms and a geometry: section");
+  }
+  const PatternResult r = check_pattern(*s, *g, pattern_spec(design, *s, *k), pattern_joint_speed_limit(design, *s));
+  Json j = to_json(r, true);
+  const auto joints = [](const Mechanism& m, const Pose& p) {
+    return p.status == Status::unreachable ? Json(nullptr) : Json::array({xy(m.O1), xy(p.A1), xy(p.P), xy(p.A2), xy(m.O2)});
+  };
+  Json frames = Json::array();
+  for (const PatternSample& x : r.samples) {
+    frames.push_back({{"lower", joints(*s->lower, x.lower.pose)}, {"upper", joints(*s->upper, x.upper.pose)}});
+  }
+  j["frames"] = std::move(frames);
   return j;
 }
 
