@@ -294,6 +294,43 @@ TEST_F(StudioCli, TheQuickAnswerIsTheLiveOneWithThePriorityRuleInASecondAnswer) 
   EXPECT_EQ(fivebar::studio_priority(d, "index", apart, nullptr)["status"], "clear");
 }
 
+TEST_F(StudioCli, ThePatternPlayedIsTheCommandLinesWithLinkagesOfTheDesignsLengths) {
+  fivebar::Studio studio(write("d.yaml", slurp(kDesign)));
+  // Tactors 3 mm apart at the start of the stretch: they collide, and the priority rule moves the lower.
+  const std::vector<fivebar::FileEdit> e = {{"patterns.stretch.separation_mm", 3.0}};
+  const fivebar::Design d = studio.design(e);
+  const json played = json::parse(fivebar::studio_pattern(d, "index", "stretch").dump());
+  const fs::path edited = write("edited.yaml", studio.edited_text(e));
+  const ft::Outcome r = run({"pattern", edited.string(), "--station", "index", "--pattern", "stretch", "--json", "--samples",
+                             "--out", (dir_ / "out").string()});
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+  const json cli = json::parse(r.out);
+  EXPECT_EQ(played["samples"], cli["samples"]);
+  EXPECT_EQ(played["passed"], cli["passed"]);
+  EXPECT_GT(cli["worst"]["moved_samples"].get<int>(), 0);
+  // Each frame is the linkage at the commanded point: its tactor joint is the point, its links the design's.
+  const fivebar::Station& s = *d.station("index");
+  ASSERT_EQ(played["frames"].size(), played["samples"].size());
+  for (std::size_t k = 0; k < played["frames"].size(); ++k) {
+    for (const json& m : played["samples"][k]["mechanisms"]) {
+      const std::string name = m["mechanism"];
+      const json& joints = played["frames"][k][name];
+      ASSERT_TRUE(joints.is_array());
+      const fivebar::Mechanism& mech = name == "lower" ? *s.lower : *s.upper;
+      const auto at = [&](int i) { return fivebar::Vec2(joints[i][0].get<double>(), joints[i][1].get<double>()); };
+      EXPECT_NEAR((at(2) - fivebar::Vec2(m["point_mm"][0].get<double>(), m["point_mm"][1].get<double>())).norm(), 0.0, 1e-9);
+      // O1 A1 = L1, O2 A2 = L2, A1 P = L3, A2 P = L4 (fivebar/design.hpp), O1 and O2 the bases.
+      EXPECT_NEAR((at(0) - mech.O1).norm(), 0.0, 1e-12);
+      EXPECT_NEAR((at(4) - mech.O2).norm(), 0.0, 1e-12);
+      EXPECT_NEAR((at(1) - at(0)).norm(), mech.L[0], 1e-9);
+      EXPECT_NEAR((at(3) - at(4)).norm(), mech.L[1], 1e-9);
+      EXPECT_NEAR((at(2) - at(1)).norm(), mech.L[2], 1e-9);
+      EXPECT_NEAR((at(2) - at(3)).norm(), mech.L[3], 1e-9);
+    }
+  }
+  EXPECT_THROW(fivebar::studio_pattern(d, "index", "wobble"), fivebar::InputError);
+}
+
 TEST_F(StudioCli, TheToleranceBandAtTheTargetCentreIsTheCommandLines) {
   const fs::path design = write("d.yaml", slurp(kDesign));
   const json fig = fivebar::studio_figures(fivebar::Studio(design).design({}), "index");
