@@ -74,6 +74,7 @@ from ._fivebar import (  # noqa: E402  (the exception types above are handed to 
     Problem,
     Station,
     Status,
+    Studio,
     _set_exception_types,
     load,
     version,
@@ -88,7 +89,7 @@ __version__: str = version()
 __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
-    "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
+    "simulate", "tolerance", "control", "export_gate", "Record", "Studio", "__version__",
 ]
 
 ProgressLine = Optional[Callable[[str], Any]]

@@ -24,6 +24,7 @@ namespace py = pybind11;
 void register_design(py::module_& m);
 void register_kinematics(py::module_& m);
 void register_studies(py::module_& m);
+void register_studio(py::module_& m);
 
 /// A JSON document of the library (to_json(...), mm and degrees) as Python dicts, lists and numbers.
 py::object to_python(const Json& j);

@@ -314,4 +314,5 @@ PYBIND11_MODULE(_fivebar, m) {
   fivebar::python::register_design(m);
   fivebar::python::register_kinematics(m);
   fivebar::python::register_studies(m);
+  fivebar::python::register_studio(m);
 }
