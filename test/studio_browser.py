@@ -299,6 +299,7 @@ def main():
         check(not errors, f"no console error ({errors})", failures)
         if shot:
             import base64
+            cdp.js("document.querySelector('aside').scrollTop = 0")
             png = cdp.call("Page.captureScreenshot", {"format": "png"})["data"]
             with open(shot, "wb") as f:
                 f.write(base64.b64decode(png))
