@@ -3,7 +3,8 @@
 DevTools protocol with python3-websocket. On a copy of designs/iros2022.yaml it drags a base and
 clicks a link slider with the mouse, reads the margins the page shows and compares them with
 `fivebar coverage --json` of the file the page saved, to the digits the page prints; checks undo
-and redo, that the save's diff is what was written and that every comment survives, that no
+and redo, that the save's diff is what was written and that every comment survives, plays a
+pattern and compares one sample's drawn tactors with `fivebar pattern --json --samples`, that no
 console error was logged, and that the token, Host and Origin are refused. It prints the latency
 from a drag event to the redrawn figures (measured in the page) without asserting it: the goal
 (p95 <= 50 ms) is a speed figure, quoted in docs/studio.md, not a pass/fail on a shared machine.
@@ -89,7 +90,7 @@ def status_of(url, headers=None, method="GET", body=None):
 
 
 IDLE = ("window.studio && window.studio.figures && !window.studio.inflight && !window.studio.queued"
-        " && !window.studio.priorityAbort")
+        " && !window.studio.priorityAbort && !window.studio.priorityTimer")
 
 
 def settle(cdp):
