@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <list>
 #include <map>
@@ -49,8 +48,9 @@ Json polyline_json(const std::vector<Vec2>& points) {
 /// third of the bytes of the shortest exact decimal.
 double drawn(double v) { return std::round(v * 1e4) / 1e4; }
 
-/// `id`: a name of the numbers the region is computed from (an FNV-1a hash of `key`), so that a
-/// page holding that region's loops can be sent the region without them (docs/studio.md "Speed").
+/// `id`: a name of the numbers the region is computed from (128 bits of the SHA-256 of `key`: two
+/// states sharing one is out of reach), so that a page holding that region's loops can be sent the
+/// region without them (docs/studio.md "Speed").
 Json region_json(const Region& r, const std::string& key) {
   Json loops = Json::array();
   for (const BoundaryLoop& loop : r.loops()) {
@@ -58,11 +58,7 @@ Json region_json(const Region& r, const std::string& key) {
     for (const Vec2& p : discretise(loop)) points.push_back(Json::array({drawn(p.x()), drawn(p.y())}));
     loops.push_back(std::move(points));
   }
-  std::uint64_t h = 1469598103934665603ULL;
-  for (const char c : key) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
-  char id[17];
-  std::snprintf(id, sizeof id, "%016llx", static_cast<unsigned long long>(h));
-  return {{"id", std::string(id)}, {"area_mm2", r.area_mm2()}, {"components", r.components()}, {"holes", r.holes()}, {"loops_mm", loops}};
+  return {{"id", sha256_hex(key).substr(0, 32)}, {"area_mm2", r.area_mm2()}, {"components", r.components()}, {"holes", r.holes()}, {"loops_mm", loops}};
 }
 
 Json pose_json(const Mechanism& m, const Pose& pose) {
