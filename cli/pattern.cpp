@@ -42,15 +42,7 @@ struct PatternOptions {
 
 /// The design's entry for this station and kind, or the defaults; then the command-line overrides.
 PatternSpec spec_for(const PatternOptions& opt, const Design& design, const Station& s, PatternKind kind) {
-  PatternSpec spec;
-  spec.kind = kind;
-  if (kind == PatternKind::pivot) spec.duration_s = 2.0;
-  if (design.get<PatternSettings>()) {
-    spec.rate_hz = design.get<PatternSettings>()->rate_hz;
-    for (const PatternSpec& p : design.get<PatternSettings>()->for_station(s.name)) {
-      if (p.kind == kind) spec = p;
-    }
-  }
+  PatternSpec spec = pattern_spec(design, s, kind);
   if (opt.amplitude_mm) {
     if (kind == PatternKind::pivot) throw InputError("--amplitude is in mm for stretch, slip and twist; pivot takes --amplitude-deg");
     spec.amplitude_mm = *opt.amplitude_mm;

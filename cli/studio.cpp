@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <random>
 #include <thread>
@@ -114,7 +115,49 @@ struct Server {
   int port = 0;
   RunState run;
   StudioCache cache;  // figures of the numbers a drag leaves alone (the other mechanism, ...)
+  /// The newest drag answer asked for, per page (its random id): a priority request older than it
+  /// is answered "stale" without its search (docs/studio.md "Speed").
+  std::mutex seq_mutex;
+  std::map<std::string, long long> newest_seq;
 };
+
+/// Notes the sequence number of a drag request; true when a priority request of `seq` is already
+/// stale (a newer drag request of the same page has arrived).
+bool note_seq(Server& s, const Json& in, bool priority) {
+  const std::string page_id = in.value("page", std::string());
+  const long long seq = in.value("seq", 0LL);
+  const std::lock_guard<std::mutex> lock(s.seq_mutex);
+  if (!s.newest_seq.count(page_id) && s.newest_seq.size() >= 64) s.newest_seq.clear();  // bounded
+  long long& newest = s.newest_seq[page_id];
+  if (priority) return seq < newest;
+  newest = std::max(newest, seq);
+  return false;
+}
+
+/// Leaves out the loops of the regions the page says it holds (`have_regions`: their ids): an
+/// undragged mechanism's region is the same as in the previous answer (docs/studio.md "Speed").
+void leave_out_known_regions(Json& figures, const Json& in) {
+  if (!in.contains("have_regions") || !in["have_regions"].is_array() || in["have_regions"].size() > 64) return;
+  const auto known = [&](const Json& region) {
+    if (!region.is_object() || !region.contains("id")) return false;
+    for (const Json& id : in["have_regions"]) {
+      if (id == region["id"]) return true;
+    }
+    return false;
+  };
+  for (Json& m : figures["mechanisms"]) {
+    if (known(m["region"])) m["region"]["loops_mm"] = nullptr;
+  }
+  if (known(figures["shared_region"])) figures["shared_region"]["loops_mm"] = nullptr;
+}
+
+/// The figures a request asks for: live, quick, full or priority.
+std::optional<StudioFigures> figures_of(const std::string& name) {
+  if (name == "live") return StudioFigures::live;
+  if (name == "quick") return StudioFigures::quick;
+  if (name == "full") return StudioFigures::full;
+  return std::nullopt;
+}
 
 bool host_allowed(const Server& s, const std::string& host) {
   const std::string port = ":" + std::to_string(s.port);
@@ -272,21 +315,42 @@ void routes(httplib::Server& http, Server& s) {
   http.Post("/api/figures", [&s](const httplib::Request& req, httplib::Response& res) {
     const auto start = std::chrono::steady_clock::now();
     json_route(res, req, [&](const Json& in) {
-      const StudioFigures which = in.value("figures", std::string("live")) == "full" ? StudioFigures::full : StudioFigures::live;
+      const std::string name = in.value("figures", std::string("live"));
+      const bool priority = name == "priority";
+      const auto which = figures_of(name);
+      if (!which && !priority) throw InputError("figures: expected live, quick, full or priority, not '" + name + "'");
+      // A priority request that a newer drag request has overtaken is not searched: its answer
+      // would be dropped by the page.
+      if (note_seq(s, in, priority)) return Json{{"seq", in.value("seq", 0LL)}, {"stale", true}};
       // A drag's answer sets the edits in the design read once; the sampled figures, asked for when
       // the drag stops, load the edited file, so every rule of the loader has its say then too.
       Design d = [&] {
         const std::lock_guard<std::mutex> lock(s.mutex);
-        return which == StudioFigures::live ? s.studio.live_design(edits_of(in)) : s.studio.design(edits_of(in));
+        return which == StudioFigures::full ? s.studio.design(edits_of(in)) : s.studio.live_design(edits_of(in));
       }();
       const std::string station = in.value("station", d.stations.empty() ? std::string() : d.stations.front().name);
-      Json out = studio_figures(d, station, {point_of(in, "lower"), point_of(in, "upper")}, which, &s.cache);
-      out["seq"] = in.value("seq", 0);
+      const StudioCursor cursor{point_of(in, "lower"), point_of(in, "upper")};
+      Json out = priority ? Json{{"priority", studio_priority(d, station, cursor, &s.cache)}}
+                          : studio_figures(d, station, cursor, *which, &s.cache);
+      if (!priority) leave_out_known_regions(out, in);
+      out["seq"] = in.value("seq", 0LL);
       return out;
     });
     // The server's own time for the answer, which the page sets beside its latency.
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     res.set_header("Server-Timing", "figures;dur=" + format::fixed(ms, 1));
+  });
+  // A pattern played on the edited state: the edited file loaded (every rule of the loader), then
+  // `fivebar pattern`'s check with its samples.
+  http.Post("/api/pattern", [&s](const httplib::Request& req, httplib::Response& res) {
+    json_route(res, req, [&](const Json& in) {
+      const Design d = [&] {
+        const std::lock_guard<std::mutex> lock(s.mutex);
+        return s.studio.design(edits_of(in));
+      }();
+      const std::string station = in.value("station", d.stations.empty() ? std::string() : d.stations.front().name);
+      return studio_pattern(d, station, in.value("pattern", std::string()));
+    });
   });
   http.Post("/api/preview", [&s](const httplib::Request& req, httplib::Response& res) {
     json_route(res, req, [&](const Json& in) {
@@ -322,12 +386,15 @@ void routes(httplib::Server& http, Server& s) {
 int run_studio(const StudioOptions& opt) {
   if (opt.port < 0 || opt.port > 65535) throw InputError("--port " + std::to_string(opt.port) + ": expected 0 to 65535");
   namespace fs = std::filesystem;
-  Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}, {}};
+  Server s{Studio(fs::absolute(opt.design), validate_products), {}, random_hex(16), random_hex(16), 0, {}, {}, {}, {}};
   httplib::Server http;
   http.set_payload_max_length(1 << 20);
   // An answer is written in pieces (headers, then the body): without this, Nagle's algorithm holds
   // each piece until the page acknowledges the last, which it delays (measured: 0.3 s per answer).
   http.set_tcp_nodelay(true);
+  // The page's connections stay open (cpp-httplib closes one after 5 requests by default, and a
+  // drag makes some 30 a second): no new connection mid-drag.
+  http.set_keep_alive_max_count(100000);
   routes(http, s);
   s.port = opt.port == 0 ? http.bind_to_any_port("127.0.0.1") : (http.bind_to_port("127.0.0.1", opt.port) ? opt.port : -1);
   if (s.port <= 0) throw InputError("--port " + std::to_string(opt.port) + ": cannot listen on 127.0.0.1 there");

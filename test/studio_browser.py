@@ -3,7 +3,8 @@
 DevTools protocol with python3-websocket. On a copy of designs/iros2022.yaml it drags a base and
 clicks a link slider with the mouse, reads the margins the page shows and compares them with
 `fivebar coverage --json` of the file the page saved, to the digits the page prints; checks undo
-and redo, that the save's diff is what was written and that every comment survives, that no
+and redo, that the save's diff is what was written and that every comment survives, plays a
+pattern and compares one sample's drawn tactors with `fivebar pattern --json --samples`, that no
 console error was logged, and that the token, Host and Origin are refused. It prints the latency
 from a drag event to the redrawn figures (measured in the page) without asserting it: the goal
 (p95 <= 50 ms) is a speed figure, quoted in docs/studio.md, not a pass/fail on a shared machine.
@@ -88,7 +89,8 @@ def status_of(url, headers=None, method="GET", body=None):
         return e.code
 
 
-IDLE = "window.studio && window.studio.figures && !window.studio.inflight && !window.studio.queued"
+IDLE = ("window.studio && window.studio.figures && !window.studio.inflight && !window.studio.queued"
+        " && !window.studio.priorityAbort && !window.studio.priorityTimer")
 
 
 def settle(cdp):
@@ -142,6 +144,7 @@ def browser_checks(cdp, binary, design, failures):
     check(after != before, f"dragging a base changes the lower region ({before:.3f} -> {after:.3f} mm2)", failures)
     # 2. A link slider, clicked at 65 % of its width.
     key = "stations.index.mechanisms.lower.links[2]"
+    cdp.js(f"document.querySelector('#controls input[type=range][data-key=\"{key}\"]').scrollIntoView({{block: 'center'}})")
     x, y, w = center_of(cdp, f'#controls input[type=range][data-key="{key}"]')
     click(cdp, x + 0.15 * w, y)
     settle(cdp)
@@ -177,7 +180,34 @@ def browser_checks(cdp, binary, design, failures):
     cli["shared"] = f"{st['shared']['margin_mm']:.4f}"
     shown_now = margins(cdp)
     check(shown_now == cli, f"the page's margins {shown_now} equal fivebar coverage --json's {cli}", failures)
+    pattern_checks(cdp, binary, design, failures)
     return slid
+
+
+def pattern_checks(cdp, binary, design, failures):
+    """6. Play the stretch pattern, then show one sample with the scrubber: the tactor points drawn
+    are `fivebar pattern --json --samples`'s commanded points of the saved file (the priority rule's
+    sample, if one moved the lower tactor)."""
+    cdp.js("document.getElementById('patternkind').value = 'stretch'")
+    cdp.js("document.getElementById('play').click()")
+    cdp.wait("window.studio.pattern && window.studio.playing")
+    cdp.wait("!window.studio.playing")
+    played = cdp.js("window.studio.frame")
+    r = subprocess.run([binary, "pattern", design, "--station", "index", "--pattern", "stretch", "--json", "--samples",
+                        "--out", os.path.join(os.path.dirname(design), "pattern-out")], capture_output=True, text=True)
+    samples = json.loads(r.stdout)["samples"]
+    check(played == len(samples) - 1, f"the pattern played to its last sample ({played} of {len(samples) - 1})", failures)
+    moved = [i for i, x in enumerate(samples) if x["moved_mm"] > 0]
+    k = moved[len(moved) // 2] if moved else len(samples) // 3
+    cdp.js(f"(() => {{ const s = document.getElementById('scrub'); s.value = {k}; s.dispatchEvent(new Event('input')); }})()")
+    drawn = cdp.js("Object.fromEntries(Array.from(document.querySelectorAll('[data-pattern-tactor]'))"
+                   ".map(c => [c.dataset.patternTactor, [Number(c.getAttribute('cx')), Number(c.getAttribute('cy'))]]))")
+    want = {m["mechanism"]: m["point_mm"] for m in samples[k]["mechanisms"]}
+    close = set(drawn) == set(want) and all(abs(drawn[n][i] - want[n][i]) <= 1e-9 for n in want for i in (0, 1))
+    check(close, f"sample {k} (moved {samples[k]['moved_mm']:.3f} mm): the tactors drawn {drawn} are fivebar pattern's {want}", failures)
+    text = cdp.js("document.getElementById('patternstatus').textContent")
+    statuses = all(f"{m['mechanism']} {m['status']}" in text for m in samples[k]["mechanisms"])
+    check(f"sample {k} of" in text and statuses, f"the statuses shown: {text!r}", failures)
 
 
 def refusal_checks(address, failures):
@@ -260,11 +290,17 @@ def main():
             med = {k: sorted(s[k] for s in split)[len(split) // 2] for k in split[0]}
             print("  medians: " + ", ".join(f"{k} {v:.1f} ms" for k, v in med.items()) +
                   " (queued: waiting for the answer before; request: the server's answer as the page sees it)")
+        plat = sorted(cdp.js("window.studio.priorityLatencies"))
+        if plat:
+            pp95 = plat[min(len(plat) - 1, int(0.95 * len(plat)))]
+            print(f"  the priority rule's second answer drawn: {len(plat)} times, median {plat[len(plat) // 2]:.1f} ms, p95 {pp95:.1f} ms"
+                  " after the drag event")
         check(len(lat) >= 3, f"the figures redrew during the drags ({len(lat)} redraws)", failures)
         errors = console_errors(cdp)
         check(not errors, f"no console error ({errors})", failures)
         if shot:
             import base64
+            cdp.js("document.querySelector('aside').scrollTop = 0")
             png = cdp.call("Page.captureScreenshot", {"format": "png"})["data"]
             with open(shot, "wb") as f:
                 f.write(base64.b64decode(png))

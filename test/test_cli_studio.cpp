@@ -16,7 +16,9 @@
 #include <vector>
 
 #include "cli_test.hpp"
+#include "fivebar/collision.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/sections/geometry.hpp"
 #include "fivebar/coverage/coverage.hpp"
 #include "fivebar/coverage/report.hpp"
 #include "fivebar/studio.hpp"
@@ -260,6 +262,75 @@ TEST_F(StudioCli, TheCacheGivesTheFiguresComputedAfresh) {
   EXPECT_FALSE(fivebar::station_coverage(*last.station("index")).lower->inside);
 }
 
+TEST_F(StudioCli, TheQuickAnswerIsTheLiveOneWithThePriorityRuleInASecondAnswer) {
+  fivebar::Studio studio(write("d.yaml", slurp(kDesign)));
+  fivebar::StudioCache cache;
+  const std::vector<fivebar::FileEdit> e = {{"stations.index.mechanisms.lower.links[2]", 15.25}};
+  const fivebar::Design d = studio.live_design(e);
+  const fivebar::Station& s = *d.station("index");
+  const fivebar::Geometry& g = *d.get<fivebar::Geometry>();
+  // Both tactors at the centre (they collide: the rule moves the lower), then apart (clear).
+  const fivebar::StudioCursor apart{fivebar::Vec2(5.0, 10.0), fivebar::Vec2(7.0, 19.0)};
+  for (const fivebar::StudioCursor& c : {fivebar::StudioCursor{}, apart}) {
+    const json quick = fivebar::studio_figures(d, "index", c, fivebar::StudioFigures::quick, &cache);
+    json live = fivebar::studio_figures(d, "index", c, fivebar::StudioFigures::live);
+    EXPECT_EQ(quick["priority"], "not certified yet");
+    // The rule as `fivebar collision --upper --lower` applies it, computed here directly.
+    const json rule = json::parse(fivebar::to_json(fivebar::apply_priority(*s.upper, *s.lower, g, c.upper.value_or(s.target.center),
+                                                               c.lower.value_or(s.target.center))).dump());
+    EXPECT_EQ(json::parse(fivebar::studio_priority(d, "index", c, &cache).dump()), rule);
+    EXPECT_EQ(live["priority"], rule);
+    // Everything else of the quick answer is the live answer's.
+    json q = quick;
+    q.erase("priority");
+    q.erase("figures");
+    live.erase("priority");
+    live.erase("figures");
+    EXPECT_EQ(q.dump(), live.dump());
+    // Once computed, the quick answer of the same numbers carries it.
+    EXPECT_EQ(json::parse(fivebar::studio_figures(d, "index", c, fivebar::StudioFigures::quick, &cache)["priority"].dump()), rule);
+  }
+  EXPECT_EQ(fivebar::studio_priority(d, "index", {}, nullptr)["status"], "moved");
+  EXPECT_EQ(fivebar::studio_priority(d, "index", apart, nullptr)["status"], "clear");
+}
+
+TEST_F(StudioCli, ThePatternPlayedIsTheCommandLinesWithLinkagesOfTheDesignsLengths) {
+  fivebar::Studio studio(write("d.yaml", slurp(kDesign)));
+  // Tactors 3 mm apart at the start of the stretch: they collide, and the priority rule moves the lower.
+  const std::vector<fivebar::FileEdit> e = {{"patterns.stretch.separation_mm", 3.0}};
+  const fivebar::Design d = studio.design(e);
+  const json played = json::parse(fivebar::studio_pattern(d, "index", "stretch").dump());
+  const fs::path edited = write("edited.yaml", studio.edited_text(e));
+  const ft::Outcome r = run({"pattern", edited.string(), "--station", "index", "--pattern", "stretch", "--json", "--samples",
+                             "--out", (dir_ / "out").string()});
+  ASSERT_TRUE(r.code == 0 || r.code == 1) << r.err;
+  const json cli = json::parse(r.out);
+  EXPECT_EQ(played["samples"], cli["samples"]);
+  EXPECT_EQ(played["passed"], cli["passed"]);
+  EXPECT_GT(cli["worst"]["moved_samples"].get<int>(), 0);
+  // Each frame is the linkage at the commanded point: its tactor joint is the point, its links the design's.
+  const fivebar::Station& s = *d.station("index");
+  ASSERT_EQ(played["frames"].size(), played["samples"].size());
+  for (std::size_t k = 0; k < played["frames"].size(); ++k) {
+    for (const json& m : played["samples"][k]["mechanisms"]) {
+      const std::string name = m["mechanism"];
+      const json& joints = played["frames"][k][name];
+      ASSERT_TRUE(joints.is_array());
+      const fivebar::Mechanism& mech = name == "lower" ? *s.lower : *s.upper;
+      const auto at = [&](int i) { return fivebar::Vec2(joints[i][0].get<double>(), joints[i][1].get<double>()); };
+      EXPECT_NEAR((at(2) - fivebar::Vec2(m["point_mm"][0].get<double>(), m["point_mm"][1].get<double>())).norm(), 0.0, 1e-9);
+      // O1 A1 = L1, O2 A2 = L2, A1 P = L3, A2 P = L4 (fivebar/design.hpp), O1 and O2 the bases.
+      EXPECT_NEAR((at(0) - mech.O1).norm(), 0.0, 1e-12);
+      EXPECT_NEAR((at(4) - mech.O2).norm(), 0.0, 1e-12);
+      EXPECT_NEAR((at(1) - at(0)).norm(), mech.L[0], 1e-9);
+      EXPECT_NEAR((at(3) - at(4)).norm(), mech.L[1], 1e-9);
+      EXPECT_NEAR((at(2) - at(1)).norm(), mech.L[2], 1e-9);
+      EXPECT_NEAR((at(2) - at(3)).norm(), mech.L[3], 1e-9);
+    }
+  }
+  EXPECT_THROW(fivebar::studio_pattern(d, "index", "wobble"), fivebar::InputError);
+}
+
 TEST_F(StudioCli, TheToleranceBandAtTheTargetCentreIsTheCommandLines) {
   const fs::path design = write("d.yaml", slurp(kDesign));
   const json fig = fivebar::studio_figures(fivebar::Studio(design).design({}), "index");
@@ -364,6 +435,44 @@ TEST_F(StudioServer, FiguresAndRefusalsOverHttp) {
   EXPECT_EQ(refused->status, 422);
   EXPECT_THAT(json::parse(refused->body)["error"].get<std::string>(), HasSubstr("links[0]"));
   EXPECT_EQ(c.Post("/api/figures", ok_headers(), "not json", "application/json")->status, 400);
+}
+
+TEST_F(StudioServer, ADragsAnswerLeavesOutTheRegionsThePageHoldsAndAStalePriorityRequest) {
+  httplib::Client c = client();
+  const auto ask = [&](const json& body) {
+    auto r = c.Post("/api/figures", ok_headers(), body.dump(), "application/json");
+    EXPECT_TRUE(r);
+    EXPECT_EQ(r->status, 200) << r->body;
+    return json::parse(r->body);
+  };
+  const json link = {{"key", "stations.index.mechanisms.lower.links[2]"}, {"value", 15.75}};
+  const json first = ask({{"edits", {link}}, {"station", "index"}, {"figures", "quick"}, {"seq", 1}, {"page", "p"}});
+  const fivebar::Design d = fivebar::Studio(design_).design({{"stations.index.mechanisms.lower.links[2]", 15.75}});
+  EXPECT_EQ(first["priority"], "not certified yet");
+  EXPECT_EQ(first["mechanisms"][0]["region"], fivebar::studio_figures(d, "index")["mechanisms"][0]["region"]);
+  // The lower base moved: the page holds the upper region of the first answer, not the new lower one.
+  const json base = {{"key", "stations.index.mechanisms.lower.bases[1][0]"}, {"value", 13.0}};
+  const json held = {first["mechanisms"][0]["region"]["id"], first["mechanisms"][1]["region"]["id"]};
+  const json second = ask({{"edits", {link, base}}, {"station", "index"}, {"figures", "quick"}, {"seq", 2}, {"page", "p"},
+                           {"have_regions", held}});
+  EXPECT_NE(second["mechanisms"][0]["region"]["id"], first["mechanisms"][0]["region"]["id"]);
+  EXPECT_TRUE(second["mechanisms"][0]["region"]["loops_mm"].is_array());
+  EXPECT_EQ(second["mechanisms"][1]["region"]["id"], first["mechanisms"][1]["region"]["id"]);
+  EXPECT_TRUE(second["mechanisms"][1]["region"]["loops_mm"].is_null());
+  EXPECT_TRUE(second["shared_region"]["loops_mm"].is_array());
+  // The priority rule of the first state, asked after the second: stale, not searched.
+  const json stale = ask({{"edits", {link}}, {"station", "index"}, {"figures", "priority"}, {"seq", 1}, {"page", "p"}});
+  EXPECT_EQ(stale["stale"], true);
+  EXPECT_FALSE(stale.contains("priority"));
+  // Of the current state (and of another page, whose requests are its own): the library's rule.
+  const fivebar::Design d2 = fivebar::Studio(design_).design({{"stations.index.mechanisms.lower.links[2]", 15.75},
+                                                              {"stations.index.mechanisms.lower.bases[1][0]", 13.0}});
+  for (const char* page : {"p", "q"}) {
+    const json now = ask({{"edits", {link, base}}, {"station", "index"}, {"figures", "priority"}, {"seq", 2}, {"page", page}});
+    EXPECT_EQ(now["priority"], json::parse(fivebar::studio_priority(d2, "index").dump())) << page;
+  }
+  const json wrong = {{"figures", "everything"}};
+  EXPECT_EQ(c.Post("/api/figures", ok_headers(), wrong.dump(), "application/json")->status, 422);
 }
 
 TEST_F(StudioCli, PrintsItsAddressAndStops) {

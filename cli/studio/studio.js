@@ -12,8 +12,14 @@
     controls: null, file: '', sha256: '', station: '',
     edits: new Map(), undo: [], redo: [],
     cursor: { lower: null, upper: null },
-    seq: 0, shownSeq: 0, rev: 0, inflight: false, queued: false, oldestEvent: null,
+    seq: 0, shownSeq: 0, rev: 0, inflight: 0, queued: false, oldestEvent: null,
     fullTimer: null, fullAbort: null, fullRev: -1, figures: null, latencies: [], split: [], errors: 0, view: null,
+    priorityAbort: null, priorityTimer: null, priorityLatencies: [], lastEdit: 0,
+    pattern: null, frame: 0, playing: false, patternTimer: null,  // the pattern played (fivebar pattern's samples)
+    regions: new Map(),  // region id -> loops: the server leaves out the loops of the ones listed here
+    // This page's id: the server answers a priority request that a newer drag request of the same
+    // page has overtaken with "stale", without its search.
+    page: Array.from(crypto.getRandomValues(new Uint8Array(8)), (b) => b.toString(16).padStart(2, '0')).join(''),
   };
   window.studio = st;  // for the browser test (test/studio_browser.py) and the curious
 
@@ -21,7 +27,9 @@
     const init = { method: body === undefined ? 'GET' : 'POST', headers: { 'X-Fivebar-Token': token }, signal };
     if (body !== undefined) { init.body = JSON.stringify(body); init.headers['Content-Type'] = 'application/json'; }
     const res = await fetch(path, init);
+    const timing = /dur=([0-9.]+)/.exec(res.headers.get('Server-Timing') || '');
     const doc = await res.json().catch(() => ({ error: 'HTTP ' + res.status }));
+    if (doc && typeof doc === 'object') doc.server_ms = timing ? Number(timing[1]) : null;  // the server's own time
     if (!res.ok) throw new Error(doc.error || ('HTTP ' + res.status));
     return doc;
   }
@@ -38,56 +46,112 @@
   // --- Edits, undo and redo ------------------------------------------------------------------------
   function snapshot() { return JSON.stringify(Array.from(st.edits)); }
   function checkpoint() { st.undo.push(snapshot()); st.redo = []; buttons(); }
-  function restore(snap) { st.edits = new Map(JSON.parse(snap)); st.rev++; syncControls(); request(performance.now()); buttons(); }
+  function restore(snap) { st.edits = new Map(JSON.parse(snap)); st.rev++; patternStale(); syncControls(); request(performance.now()); buttons(); }
   function undo() { if (st.undo.length) { st.redo.push(snapshot()); restore(st.undo.pop()); } }
   function redo() { if (st.redo.length) { st.undo.push(snapshot()); restore(st.redo.pop()); } }
   function buttons() { $('undo').disabled = !st.undo.length; $('redo').disabled = !st.redo.length; }
   function setEdit(key, value, eventTime) {
     st.edits.set(key, value);
     st.rev++;
+    patternStale();
     syncControl(key);
     request(eventTime);
   }
 
   // --- Requests: one in flight, the newest state queued, stale answers dropped ----------------------
+  // A drag's answer comes in two parts (docs/studio.md "Speed"): the regions, coverage, poses and
+  // tolerance bands ("quick"), then the priority rule, whose search is most of the time, in a
+  // second request that the next edit cancels; until it arrives the rule says "not certified yet".
+  // Two drag requests at most in flight: the server answers them on two threads (this machine's two
+  // cores), and an edit that arrives while one is computed need not wait for it.
+  const MAX_INFLIGHT = 2;
+  const PRIORITY_PAUSE = 40;  // ms without an edit before the priority rule is asked for
   function request(eventTime) {
     if (st.oldestEvent === null) st.oldestEvent = eventTime;
+    st.lastEdit = performance.now();
+    if (st.priorityTimer) { clearTimeout(st.priorityTimer); st.priorityTimer = null; }
     if (st.fullAbort) { st.fullAbort.abort(); st.fullAbort = null; }  // its answer would be stale
-    if (st.inflight) { st.queued = true; return; }
+    if (st.priorityAbort) { st.priorityAbort.abort(); st.priorityAbort = null; }
+    if (st.inflight >= (st.maxInflight || MAX_INFLIGHT)) { st.queued = true; return; }
     send();
   }
   async function send() {
-    st.inflight = true; st.queued = false;
+    st.inflight++; st.queued = false;
     const seq = ++st.seq, rev = st.rev, since = st.oldestEvent, sent = performance.now();
     st.oldestEvent = null;
     clearTimeout(st.fullTimer);
+    let fig;
     try {
-      const fig = await api('/api/figures', body('live', seq));
-      if (seq > st.shownSeq) {  // a newer answer than the one shown: drawn even mid-drag
-        const answered = performance.now();
-        st.shownSeq = seq;
-        st.figures = fig;
-        draw(fig);
-        const drawn = performance.now();
-        if ($('status').className === 'bad') status('');
-        requestAnimationFrame(() => {
-          if (since === null) return;
-          const now = performance.now();
-          st.latencies.push(now - since);
-          // Where the time went: waiting to be sent, the request, drawing, the frame.
-          st.split.push({ queued: sent - since, request: answered - sent, draw: drawn - answered, frame: now - drawn });
-        });
-        if (rev === st.rev) st.fullTimer = setTimeout(() => full(rev), 120);
-      }
+      fig = await api("/api/figures", body(st.dragFigures || "quick", seq));
     } catch (e) {
       if (!st.queued) { status(e.message, true); markInvalid(); }
-    } finally {
-      st.inflight = false;
+      st.inflight--;
       if (st.queued) send();
+      return;
+    }
+    // The next request (edits that arrived meanwhile) leaves before this answer is drawn.
+    st.inflight--;
+    if (st.queued) send();
+    if (seq <= st.shownSeq) return;  // an older answer than the one shown
+    if (!fillRegions(fig)) { st.regions.clear(); request(performance.now()); return; }
+    const answered = performance.now(), server = fig.server_ms;
+    st.shownSeq = seq;
+    st.figures = fig;
+    draw(fig);
+    const drawn = performance.now();
+    if ($('status').className === 'bad') status('');
+    requestAnimationFrame(() => {
+      if (since === null) return;
+      const now = performance.now();
+      st.latencies.push(now - since);
+      // Where the time went: waiting to be sent, the request, drawing, the frame.
+      st.split.push({ queued: sent - since, request: answered - sent, server, draw: drawn - answered, frame: now - drawn });
+    });
+    if (rev !== st.rev) return;
+    if (typeof fig.priority === 'string') {
+      // Not while the drag goes on: its search would take a core from the next drag answer
+      // (measured: p95 1.5 times longer). Once no edit has come for PRIORITY_PAUSE ms.
+      const wait = Math.max(0, st.lastEdit + (st.priorityPause ?? PRIORITY_PAUSE) - performance.now());
+      st.priorityTimer = setTimeout(() => { st.priorityTimer = null; if (rev === st.rev) priority(rev, seq, since); }, wait);
+    }
+    st.fullTimer = setTimeout(() => full(rev), 120);
+  }
+  async function priority(rev, seq, since) {
+    const abort = new AbortController();
+    st.priorityAbort = abort;
+    try {
+      const ans = await api('/api/figures', body('priority', seq), abort.signal);
+      if (ans.stale || rev !== st.rev || st.shownSeq !== seq) return;
+      st.figures.priority = ans.priority;
+      tables(st.figures);
+      requestAnimationFrame(() => { if (since !== null) st.priorityLatencies.push(performance.now() - since); });
+    } catch (e) {
+      // Aborted by a newer edit, or refused: the quick answer already reported that.
+    } finally {
+      if (st.priorityAbort === abort) st.priorityAbort = null;
     }
   }
   function body(figures, seq) {
-    return { edits: editsList(), station: st.station, cursor: cursorBody(), figures, seq };
+    return { edits: editsList(), station: st.station, cursor: cursorBody(), figures, seq, page: st.page,
+      have_regions: Array.from(st.regions.keys()) };
+  }
+  // The loops of the regions the answer left out (the page holds them), and the new ones kept.
+  // False when one is missing (dropped here meanwhile): the page then asks again.
+  function fillRegions(fig) {
+    const regions = fig.mechanisms.map((m) => m.region);
+    if (fig.shared_region) regions.push(fig.shared_region);
+    let ok = true;
+    for (const r of regions) {
+      if (r.loops_mm === null) {
+        const loops = st.regions.get(r.id);
+        if (loops === undefined) { ok = false; continue; }
+        r.loops_mm = loops;
+        st.regions.delete(r.id);  // newest last
+      }
+      st.regions.set(r.id, r.loops_mm);
+    }
+    while (st.regions.size > 24) st.regions.delete(st.regions.keys().next().value);
+    return ok;
   }
   function cursorBody() {
     const c = {};
@@ -97,12 +161,12 @@
   }
   async function full(rev) {
     if (rev !== st.rev) return;
-    if (st.inflight) { st.fullTimer = setTimeout(() => full(rev), 60); return; }
+    if (st.inflight || st.priorityAbort || st.priorityTimer) { st.fullTimer = setTimeout(() => full(rev), 60); return; }
     const abort = new AbortController();
     st.fullAbort = abort;
     try {
       const fig = await api('/api/figures', body('full', st.seq), abort.signal);
-      if (rev === st.rev) { st.fullRev = rev; st.figures = fig; draw(fig); }
+      if (rev === st.rev && fillRegions(fig)) { st.fullRev = rev; st.figures = fig; draw(fig); }
     } catch (e) {
       // Aborted by a newer edit, or refused: the live answer already reported that.
     } finally {
@@ -154,11 +218,13 @@
     el('path', { d: path([fig.target.outline_mm]), fill: 'rgba(0,0,0,0.05)', stroke: '#000', 'stroke-width': 0.12 }, g);
     for (const m of fig.mechanisms) drawMechanism(m, g);
     drawWitnesses(fig, g);
+    el('g', { id: 'patternlayer' }, g);
     drawHandles(fig, g);
     el('line', { x1: v.x0 + 1, y1: v.y0 + 1, x2: v.x0 + 6, y2: v.y0 + 1, stroke: '#000', 'stroke-width': 0.2 }, g);
     const t = el('text', { x: v.x0 + 1, y: -(v.y0 + 1.5), 'font-size': 1.2 }, svg);
     t.textContent = '5 mm';
     tables(fig);
+    drawFrame();
   }
   function drawFields(fig, g) {
     if (Array.isArray(fig.lci_field)) {
@@ -239,8 +305,11 @@
       const p = new DOMPoint(e.clientX, e.clientY).matrixTransform($('world').getScreenCTM().inverse());
       onMove([p.x, p.y], e.timeStamp);
     };
-    const up = () => { window.removeEventListener('pointermove', move); window.removeEventListener('pointerup', up); };
-    window.addEventListener('pointermove', move);
+    // pointerrawupdate (Chromium) is dispatched as the input arrives; pointermove waits for the next
+    // animation frame, up to 16 ms later.
+    const kind = 'onpointerrawupdate' in window ? 'pointerrawupdate' : 'pointermove';
+    const up = () => { window.removeEventListener(kind, move); window.removeEventListener('pointerup', up); };
+    window.addEventListener(kind, move);
     window.addEventListener('pointerup', up);
   }
 
@@ -268,8 +337,10 @@
       tb.appendChild(tr);
     }
     const pr = fig.priority;
-    $('priority').textContent = pr ? `priority rule at the tactor points: ${pr.status}${pr.moved_mm ? `, lower moved ${fmt(pr.moved_mm, 3)} mm` : ''} — ${pr.reason}`
-      : 'priority rule: needs both mechanisms and a geometry: section';
+    $('priority').textContent = typeof pr === 'string' ? 'priority rule at the tactor points: ' + pr
+      : pr ? `priority rule at the tactor points: ${pr.status}${pr.moved_mm ? `, lower moved ${fmt(pr.moved_mm, 3)} mm` : ''} — ${pr.reason}`
+        : 'priority rule: needs both mechanisms and a geometry: section';
+    $('priority').className = typeof pr === 'string' ? 'pending' : '';
     const cm = fig.collision_map;
     $('collision').textContent = typeof cm === 'string' ? 'collision map: ' + cm
       : cm ? `collision map (sampled, ${fmt(cm.spacing_mm, 2)} mm grid): ${fmt(100 * cm.colliding_fraction, 2)} % of ${cm.pairs} pairs collide; every pair farther apart than ${fmt(cm.max_colliding_separation_mm, 3)} mm is free; green dots: lower positions free with the upper at the centre`
@@ -284,6 +355,83 @@
       fig.mechanisms.map((m) => m.tolerance.status !== 'ok' ? `${m.mechanism} ${m.tolerance.status}`
         : `${m.mechanism} ${fmt(m.tolerance.three_sigma_first_order_mm, 4)} mm (worst case ${fmt(m.tolerance.worst_case_first_order_mm, 4)} mm)` +
           (m.tolerance.near_singular ? ' [near singular]' : '')).join(', ');
+  }
+
+  // --- Pattern ---------------------------------------------------------------------------------------
+  // The design's pattern of the chosen kind, computed by the server for the current edits with the
+  // library call of `fivebar pattern` (the priority rule applied sample by sample), played on the
+  // drawing: the two linkages at the commanded points, the targets as small crosses.
+  async function play() {
+    if (st.playing) { pause(); return; }
+    const kind = $('patternkind').value;
+    const key = JSON.stringify([snapshot(), st.station, kind]);  // the state it is computed for
+    if (!st.pattern || st.pattern.key !== key) {
+      $('patternstatus').textContent = 'pattern: computing ' + kind + '…';
+      $('patternstatus').className = 'pending';
+      try {
+        const p = await api('/api/pattern', { edits: editsList(), station: st.station, pattern: kind });
+        if (key !== JSON.stringify([snapshot(), st.station, $('patternkind').value])) { patternStale(); return; }
+        p.key = key;
+        st.pattern = p;
+        st.frame = 0;
+        const scrub = $('scrub');
+        scrub.max = p.samples.length - 1; scrub.value = 0; scrub.disabled = false;
+      } catch (e) { $('patternstatus').textContent = 'pattern: ' + e.message; $('patternstatus').className = 'bad'; return; }
+    }
+    if (st.frame >= st.pattern.samples.length - 1) st.frame = 0;
+    st.playing = true;
+    $('play').textContent = 'Pause';
+    const dt = 1000 / st.pattern.spec.rate_hz;  // real time: one sample per controller period
+    const t0 = performance.now() - st.frame * dt;
+    const tick = () => {
+      if (!st.playing || !st.pattern) return;
+      st.frame = Math.min(st.pattern.samples.length - 1, Math.floor((performance.now() - t0) / dt));
+      drawFrame();
+      if (st.frame >= st.pattern.samples.length - 1) { pause(); return; }
+      st.patternTimer = requestAnimationFrame(tick);
+    };
+    st.patternTimer = requestAnimationFrame(tick);
+  }
+  function pause() {
+    st.playing = false;
+    if (st.patternTimer) cancelAnimationFrame(st.patternTimer);
+    st.patternTimer = null;
+    $('play').textContent = 'Play';
+  }
+  function patternStale() {
+    if (!st.pattern) return;
+    pause();
+    st.pattern = null;
+    $('scrub').disabled = true;
+    $('patternstatus').textContent = 'pattern: not certified yet for the current state (press Play to compute it)';
+    $('patternstatus').className = 'pending';
+    const layer = $('patternlayer');
+    if (layer) layer.replaceChildren();
+  }
+  function drawFrame() {
+    const layer = $('patternlayer');
+    const p = st.pattern;
+    if (!layer || !p) return;
+    layer.replaceChildren();
+    const k = Math.min(st.frame, p.samples.length - 1);
+    const sample = p.samples[k], frame = p.frames[k];
+    for (const m of sample.mechanisms) {
+      const c = COLOUR[m.mechanism];
+      const joints = frame[m.mechanism];
+      if (joints) {
+        el('polyline', { points: joints.map((q) => q.join(',')).join(' '), fill: 'none', stroke: `rgb(${c})`, 'stroke-width': 0.25,
+          'stroke-dasharray': '0.6 0.3' }, layer);
+      }
+      const [tx, ty] = m.target_mm;
+      el('path', { d: `M${tx - 0.4},${ty - 0.4}l0.8,0.8M${tx - 0.4},${ty + 0.4}l0.8,-0.8`, stroke: `rgb(${c})`, 'stroke-width': 0.12 }, layer);
+      el('circle', { cx: m.point_mm[0], cy: m.point_mm[1], r: 0.5, fill: `rgb(${c})`, 'data-pattern-tactor': m.mechanism }, layer);
+    }
+    $('scrub').value = k;
+    const statuses = sample.mechanisms.map((m) => `${m.mechanism} ${m.status}`).join(', ');
+    const verdict = p.passed ? 'renderable' : `NOT renderable (first failure: sample ${p.first_failure.index}, ${p.first_failure.mechanism} ${p.first_failure.status})`;
+    $('patternstatus').textContent = `${p.pattern}: sample ${k} of ${p.samples.length - 1}, t = ${fmt(sample.time_s, 3)} s: ${statuses}` +
+      (sample.moved_mm > 0 ? `; priority rule moved the lower ${fmt(sample.moved_mm, 3)} mm` : '') + ` — ${verdict}`;
+    $('patternstatus').className = p.passed ? '' : 'bad';
   }
 
   // --- Controls ------------------------------------------------------------------------------------
@@ -368,7 +516,7 @@
     } catch (e) { status(e.message, true); }
   }
   async function reload() {
-    try { await loadState(); st.edits = new Map(); st.undo = []; st.redo = []; buttons(); st.rev++; controls(); request(performance.now()); status('reloaded'); }
+    try { await loadState(); st.edits = new Map(); st.undo = []; st.redo = []; buttons(); st.rev++; patternStale(); controls(); request(performance.now()); status('reloaded'); }
     catch (e) { status(e.message, true); }
   }
   async function run() {
@@ -415,9 +563,12 @@
     $('cancelsave').addEventListener('click', () => $('diffdialog').close());
     $('reload').addEventListener('click', reload);
     $('run').addEventListener('click', run);
+    $('play').addEventListener('click', play);
+    $('patternkind').addEventListener('change', () => { pause(); if (st.pattern) patternStale(); });
+    $('scrub').addEventListener('input', () => { pause(); st.frame = Number($('scrub').value); drawFrame(); });
     $('truescale').addEventListener('change', () => st.figures && draw(st.figures));
     $('station').addEventListener('change', (e) => {
-      st.station = $('station').value; st.cursor = { lower: null, upper: null }; st.rev++; controls(); request(e.timeStamp);
+      st.station = $('station').value; st.cursor = { lower: null, upper: null }; st.rev++; patternStale(); controls(); request(e.timeStamp);
     });
     document.addEventListener('keydown', (e) => {
       if ((e.ctrlKey || e.metaKey) && e.key.toLowerCase() === 'z') { e.preventDefault(); (e.shiftKey ? redo : undo)(); }

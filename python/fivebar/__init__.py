@@ -75,6 +75,7 @@ from ._fivebar import (  # noqa: E402  (the exception types above are handed to 
     Problem,
     Station,
     Status,
+    Studio,
     _set_exception_types,
     load,
     version,
@@ -89,7 +90,7 @@ __version__: str = version()
 __all__ = [
     "InputError", "IoError", "Design", "Station", "Mechanism", "Ellipse", "Pose", "Status", "CoverageResult",
     "Problem", "load", "version", "fk", "ik", "jacobian", "lci", "workspace", "coverage", "sweep", "optimize",
-    "simulate", "tolerance", "control", "export_gate", "Record", "__version__",
+    "simulate", "tolerance", "control", "export_gate", "Record", "Studio", "__version__",
     "collision", "collision_map", "CollisionMap", "pattern", "replay", "replay_sil", "SilReplay", "runtime",
     "Collision", "PatternResult", "Replay",
     "calibrate", "Calibration", "calibrate_hard_stops", "calibration_plan", "CalibrationPlan", "identify", "Identification", "parts", "Part",

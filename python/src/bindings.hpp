@@ -26,6 +26,7 @@ void register_kinematics(py::module_& m);
 void register_studies(py::module_& m);
 void register_device(py::module_& m);
 void register_bench(py::module_& m);
+void register_studio(py::module_& m);
 
 /// A JSON document of the library (to_json(...), mm and degrees) as Python dicts, lists and numbers.
 py::object to_python(const Json& j);

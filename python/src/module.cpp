@@ -316,4 +316,5 @@ PYBIND11_MODULE(_fivebar, m) {
   fivebar::python::register_studies(m);
   fivebar::python::register_device(m);
   fivebar::python::register_bench(m);
+  fivebar::python::register_studio(m);
 }

@@ -113,6 +113,11 @@ struct PatternResult {
   std::array<std::size_t, 9> status_counts{};
 };
 
+/// The pattern of `kind` a design gives `station`: its own entry under `patterns:` (the station's,
+/// else the top-level one), else the defaults of PatternSpec at the section's rate (pivot: 2 s).
+/// What `fivebar pattern` checks before its command-line overrides, and the studio plays.
+PatternSpec pattern_spec(const Design& design, const Station& station, PatternKind kind);
+
 /// Generates and checks `spec` on a station with both mechanisms (InputError otherwise).
 /// `max_joint_speed` in rad/s.
 PatternResult check_pattern(const Station& station, const Geometry& g, const PatternSpec& spec, double max_joint_speed,

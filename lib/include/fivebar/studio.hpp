@@ -20,10 +20,13 @@
 namespace fivebar {
 
 /// Which figures one request computes. `live` is what a drag redraws (regions, coverage, poses,
-/// outlines, the priority rule at the two tactor points); `full` adds the sampled figures (the
+/// outlines, the priority rule at the two tactor points); `quick` is `live` without computing the
+/// priority rule (its search is most of a live answer: docs/studio.md "Speed"): `priority` is the
+/// record when the cache holds it for these numbers, else "not certified yet", and the page asks
+/// for it with studio_priority() in a second request; `full` adds the sampled figures (the
 /// collision map over the target and the LCI field), which the page marks "not certified yet"
 /// until their answer for the current edits has arrived.
-enum class StudioFigures : std::uint8_t { live, full };
+enum class StudioFigures : std::uint8_t { live, full, quick };
 
 /// Where the two tactors are held for the poses, outlines and the priority rule (mm, station
 /// frame); unset: the target centre (the paper's worst case, `centre_rule` of the collision map).
@@ -59,6 +62,22 @@ class StudioCache {
 /// it holds for the same numbers is reused (the same figures, sooner).
 Json studio_figures(const Design& design, std::string_view station, const StudioCursor& cursor = {},
                     StudioFigures which = StudioFigures::live, StudioCache* cache = nullptr);
+
+/// The priority rule at the two tactor points of `station` (the `priority` figure of
+/// studio_figures(): the record of `fivebar collision --upper --lower`, apply_priority()), or null
+/// without both mechanisms and a `geometry:` section. Through `cache` (the entry a later
+/// StudioFigures::quick answer of the same numbers shows). InputError when the station does not
+/// exist.
+Json studio_priority(const Design& design, std::string_view station, const StudioCursor& cursor = {},
+                     StudioCache* cache = nullptr);
+
+/// A pattern (stretch, slip, twist or pivot) played on the station as the design now is
+/// (docs/studio.md "Patterns"): check_pattern() of pattern_spec() with the design's motor speed
+/// limit, what `fivebar pattern --pattern KIND --json --samples` prints (the priority rule applied
+/// sample by sample), plus `frames`: per sample the two linkages at their commanded points
+/// ({lower, upper}: joints O1, A1, P, A2, O2 in mm, null when unreachable). InputError for an
+/// unknown kind or station, a station without both mechanisms or a design without `geometry:`.
+Json studio_pattern(const Design& design, std::string_view station, std::string_view kind);
 
 /// The numbers and modes a page can edit, per station: key path, value, unit and a slider range
 /// (for a length: 0.5 to 1.5 times its value; a coordinate: +- the station's length scale).

@@ -335,6 +335,19 @@ Json tactor_json(const TactorSample& s) {
 
 }  // namespace
 
+PatternSpec pattern_spec(const Design& design, const Station& station, PatternKind kind) {
+  PatternSpec spec;
+  spec.kind = kind;
+  if (kind == PatternKind::pivot) spec.duration_s = 2.0;
+  if (const PatternSettings* settings = design.get<PatternSettings>()) {
+    spec.rate_hz = settings->rate_hz;
+    for (const PatternSpec& p : settings->for_station(station.name)) {
+      if (p.kind == kind) spec = p;
+    }
+  }
+  return spec;
+}
+
 Json to_json(const PatternResult& r, bool samples) {
   Json j;
   j["station"] = r.station;

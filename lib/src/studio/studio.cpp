@@ -17,11 +17,13 @@
 #include "fivebar/collision.hpp"
 #include "fivebar/coverage/coverage.hpp"
 #include "fivebar/coverage/report.hpp"
+#include "fivebar/device/joint_limits.hpp"
 #include "fivebar/design/edit.hpp"
 #include "fivebar/error.hpp"
 #include "fivebar/format.hpp"
 #include "fivebar/io.hpp"
 #include "fivebar/kinematics.hpp"
+#include "fivebar/pattern.hpp"
 #include "fivebar/sections/geometry.hpp"
 #include "fivebar/sha256.hpp"
 #include "fivebar/tolerance.hpp"
@@ -42,10 +44,21 @@ Json polyline_json(const std::vector<Vec2>& points) {
   return out;
 }
 
-Json region_json(const Region& r) {
+/// A drawing coordinate to 0.1 um, far below the polyline's own step (kArcStepRad of an arc): a
+/// third of the bytes of the shortest exact decimal.
+double drawn(double v) { return std::round(v * 1e4) / 1e4; }
+
+/// `id`: a name of the numbers the region is computed from (128 bits of the SHA-256 of `key`: two
+/// states sharing one is out of reach), so that a page holding that region's loops can be sent the
+/// region without them (docs/studio.md "Speed").
+Json region_json(const Region& r, const std::string& key) {
   Json loops = Json::array();
-  for (const BoundaryLoop& loop : r.loops()) loops.push_back(polyline_json(discretise(loop)));
-  return {{"area_mm2", r.area_mm2()}, {"components", r.components()}, {"holes", r.holes()}, {"loops_mm", loops}};
+  for (const BoundaryLoop& loop : r.loops()) {
+    Json points = Json::array();
+    for (const Vec2& p : discretise(loop)) points.push_back(Json::array({drawn(p.x()), drawn(p.y())}));
+    loops.push_back(std::move(points));
+  }
+  return {{"id", sha256_hex(key).substr(0, 32)}, {"area_mm2", r.area_mm2()}, {"components", r.components()}, {"holes", r.holes()}, {"loops_mm", loops}};
 }
 
 Json pose_json(const Mechanism& m, const Pose& pose) {
@@ -174,13 +187,32 @@ class Recent {
       }
     }
     auto value = std::make_shared<const T>(make());  // outside the lock: other requests go on
-    const std::lock_guard<std::mutex> lock(mutex_);
-    items_.emplace_front(key, value);
-    if (items_.size() > kSize) items_.pop_back();
+    put_value(key, value);
     return value;
   }
 
+  /// The entry of `key`, or null: nothing computed.
+  std::shared_ptr<const T> find(const std::string& key) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (const auto& item : items_) {
+      if (item.first == key) return item.second;
+    }
+    return nullptr;
+  }
+
  private:
+  void put_value(const std::string& key, const std::shared_ptr<const T>& value) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    for (auto it = items_.begin(); it != items_.end(); ++it) {
+      if (it->first == key) {  // computed meanwhile by another request: keep one entry
+        items_.erase(it);
+        break;
+      }
+    }
+    items_.emplace_front(key, value);
+    if (items_.size() > kSize) items_.pop_back();
+  }
+
   static constexpr std::size_t kSize = 8;
   std::mutex mutex_;
   std::list<std::pair<std::string, std::shared_ptr<const T>>> items_;
@@ -207,8 +239,8 @@ std::shared_ptr<const T> cached(Recent<T>* recent, const std::string& key, Make&
   return recent->get(key, std::forward<Make>(make));
 }
 
-RegionFigure region_figure(Region r) {
-  Json j = region_json(r);
+RegionFigure region_figure(Region r, const std::string& key) {
+  Json j = region_json(r, key);
   return {std::move(r), std::move(j)};
 }
 
@@ -248,16 +280,33 @@ Json tolerance_json(const Design& design, const Station& s, const Mechanism& m, 
   return j;
 }
 
+/// The paper's priority rule at the two tactor points, as `fivebar collision --upper --lower`
+/// (null without both mechanisms and a geometry). Without `compute`: the cached record of these
+/// numbers, else "not certified yet" (StudioFigures::quick).
+Json priority_figure(const Station& s, const Geometry* g, const Vec2& lower_at, const Vec2& upper_at, StudioCache::Impl* cache,
+                     bool compute) {
+  if (g == nullptr || !s.lower || !s.upper) return nullptr;
+  std::string pk = key_of(*s.upper) + key_of(*s.lower) + key_of(*g);
+  put(pk, upper_at.x(), upper_at.y(), lower_at.x(), lower_at.y());
+  if (!compute) {
+    const auto known = cache ? cache->priorities.find(pk) : nullptr;
+    return known ? *known : Json(kNotCertified);
+  }
+  return *cached(cache ? &cache->priorities : nullptr, pk,
+                 [&] { return to_json(apply_priority(*s.upper, *s.lower, *g, upper_at, lower_at)); });
+}
+
 /// The station's regions, coverage and priority rule (studio_figures()'s live part), each computed
 /// once per request and through the cache when there is one; the tolerance band at each cursor.
+/// Without `priority_now`, the priority rule only when the cache holds it (priority_figure()).
 void live_figures(Json& j, const Design& design, const Station& s, const Geometry* g, const Vec2& lower_at, const Vec2& upper_at,
-                  StudioCache::Impl* cache) {
+                  StudioCache::Impl* cache, bool priority_now) {
   std::vector<std::shared_ptr<const RegionFigure>> regions;
   std::vector<CoverageResult> coverages;
   j["mechanisms"] = Json::array();
   for (const Mechanism* m : s.mechanisms()) {
     const std::string mk = key_of(*m);
-    regions.push_back(cached(cache ? &cache->regions : nullptr, mk, [&] { return region_figure(reachable_region(*m)); }));
+    regions.push_back(cached(cache ? &cache->regions : nullptr, mk, [&] { return region_figure(reachable_region(*m), mk); }));
     coverages.push_back(*cached(cache ? &cache->coverages : nullptr, mk + key_of(s.target),
                                 [&] { return coverage(*m, regions.back()->region, s.target); }));
     const Vec2& at = m->name == "lower" ? lower_at : upper_at;
@@ -272,20 +321,14 @@ void live_figures(Json& j, const Design& design, const Station& s, const Geometr
   if (s.upper) sc.upper = coverages[next++];
   j["shared_region"] = nullptr;
   if (s.lower && s.upper) {
-    const auto shared = cached(cache ? &cache->shared : nullptr, key_of(*s.lower) + key_of(*s.upper),
-                               [&] { return region_figure(regions[0]->region.intersection(regions[1]->region)); });
+    const std::string sk = key_of(*s.lower) + key_of(*s.upper);
+    const auto shared = cached(cache ? &cache->shared : nullptr, sk,
+                               [&] { return region_figure(regions[0]->region.intersection(regions[1]->region), "shared" + sk); });
     j["shared_region"] = shared->json;
     sc.shared = coverage_shared(*sc.lower, *sc.upper, shared->region, s.target);
   }
   j["coverage"] = to_json(sc, s.name);
-  // The paper's priority rule at the two tactor points, as `fivebar collision --upper --lower`.
-  j["priority"] = nullptr;
-  if (g != nullptr && s.lower && s.upper) {
-    std::string pk = key_of(*s.upper) + key_of(*s.lower) + key_of(*g);
-    put(pk, upper_at.x(), upper_at.y(), lower_at.x(), lower_at.y());
-    j["priority"] = *cached(cache ? &cache->priorities : nullptr, pk,
-                            [&] { return to_json(apply_priority(*s.upper, *s.lower, *g, upper_at, lower_at)); });
-  }
+  j["priority"] = priority_figure(s, g, lower_at, upper_at, cache, priority_now);
 }
 
 }  // namespace
@@ -302,7 +345,7 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
   Json j = {{"design", design.name}, {"station", s->name}, {"stations", names}};
   j["target"] = to_json(s->target);
   j["target"]["outline_mm"] = polyline_json(ellipse_polyline(s->target, 120));
-  live_figures(j, design, *s, g, lower_at, upper_at, cache ? &cache->impl() : nullptr);
+  live_figures(j, design, *s, g, lower_at, upper_at, cache ? &cache->impl() : nullptr, which != StudioFigures::quick);
   const bool full = which == StudioFigures::full;
   j["collision_map"] = !full ? Json(kNotCertified) : g != nullptr && s->lower && s->upper ? collision_map_json(*s, *g) : Json(nullptr);
   if (full) {
@@ -311,8 +354,37 @@ Json studio_figures(const Design& design, std::string_view station, const Studio
   } else {
     j["lci_field"] = kNotCertified;
   }
-  j["figures"] = full ? "full" : "live";
+  j["figures"] = full ? "full" : which == StudioFigures::quick ? "quick" : "live";
   return j;
+}
+
+Json studio_pattern(const Design& design, std::string_view station, std::string_view kind) {
+  const Station* s = design.station(station);
+  if (s == nullptr) throw InputError("design '" + design.name + "' has no station '" + std::string(station) + "'");
+  const auto k = parse_pattern_kind(kind);
+  if (!k) throw InputError("pattern '" + std::string(kind) + "': expected stretch, slip, twist or pivot");
+  const Geometry* g = design.get<Geometry>();
+  if (!s->lower || !s->upper || g == nullptr) {
+    throw InputError("station '" + s->name + "': a pattern needs both mechanisms and a geometry: section");
+  }
+  const PatternResult r = check_pattern(*s, *g, pattern_spec(design, *s, *k), pattern_joint_speed_limit(design, *s));
+  Json j = to_json(r, true);
+  const auto joints = [](const Mechanism& m, const Pose& p) {
+    return p.status == Status::unreachable ? Json(nullptr) : Json::array({xy(m.O1), xy(p.A1), xy(p.P), xy(p.A2), xy(m.O2)});
+  };
+  Json frames = Json::array();
+  for (const PatternSample& x : r.samples) {
+    frames.push_back({{"lower", joints(*s->lower, x.lower.pose)}, {"upper", joints(*s->upper, x.upper.pose)}});
+  }
+  j["frames"] = std::move(frames);
+  return j;
+}
+
+Json studio_priority(const Design& design, std::string_view station, const StudioCursor& cursor, StudioCache* cache) {
+  const Station* s = design.station(station);
+  if (s == nullptr) throw InputError("design '" + design.name + "' has no station '" + std::string(station) + "'");
+  return priority_figure(*s, design.get<Geometry>(), cursor.lower.value_or(s->target.center), cursor.upper.value_or(s->target.center),
+                         cache ? &cache->impl() : nullptr, true);
 }
 
 namespace {
