@@ -293,35 +293,7 @@ void print_patch(const id::Patch& patch) {
 std::vector<id::JointIdentification> identify_joints(const IdentifyCliOptions& opt, const Design& design,
                                                      const std::vector<id::IdentifyLog>& logs,
                                                      const std::optional<id::IdentifyLog>& val, const id::IdentifyOptions& o) {
-  std::vector<id::JointIdentification> results;
-  for (const id::JointLog& j : logs.front().joints) {
-    if (!opt.joint.empty() && j.prefix != opt.joint && !(opt.joint == "motor" && j.prefix.empty())) continue;
-    const std::string who = j.prefix.empty() ? "motor" : j.prefix;
-    const bool need_motor = !j.linear && j.drive != id::DriveKind::torque;
-    const id::JointPrior prior = prior_of(design, j.station, j.mechanism, j.joint, opt.load_inertia, need_motor);
-    std::vector<std::unique_ptr<id::LoopController>> loops;
-    auto segment = [&](const id::IdentifyLog& l, const std::string& file) {
-      const id::JointLog* x = nullptr;
-      for (const id::JointLog& c : l.joints) {
-        if (c.prefix == j.prefix) x = &c;
-      }
-      if (x == nullptr) throw InputError(file + ": no columns for joint '" + who + "'");
-      if (x->drive != j.drive || x->linear != j.linear) {
-        throw InputError(file + ": joint '" + who + "' is driven by '" + x->drive_column + "', the first log by '" + j.drive_column + "'");
-      }
-      id::LogSegment g{x, &l.time, nullptr};
-      if (opt.closed_loop) {
-        loops.push_back(id::design_pid(design, *x, l.sample_time(), file));
-        g.controller = loops.back().get();
-      }
-      return g;
-    };
-    std::vector<id::LogSegment> segs, vsegs;
-    for (std::size_t i = 0; i < logs.size(); ++i) segs.push_back(segment(logs[i], opt.logs[i]));
-    if (val) vsegs.push_back(segment(*val, opt.validation));
-    results.push_back(id::identify_joint(segs, prior, vsegs, o));
-  }
-  return results;
+  return id::identify_motor_rig(design, {&logs, opt.logs, val ? &*val : nullptr, opt.validation, opt.joint, opt.load_inertia, opt.closed_loop}, o);
 }
 
 int run_identify(const IdentifyCliOptions& given) {

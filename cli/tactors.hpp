@@ -7,41 +7,20 @@
 
 #include "common.hpp"
 #include "fivebar/error.hpp"
+#include "fivebar/design/pair_station.hpp"
 #include "fivebar/io.hpp"
 
 namespace fivebar::cli {
 
-/// The --station choice (empty: the only station), which must have both mechanisms; InputError
-/// otherwise, naming what is missing.
+/// The --station choice (empty: the only station), which must have both mechanisms
+/// (fivebar/design/pair_station.hpp); InputError otherwise, naming what is missing.
 inline const Station& select_pair_station(const Design& design, const std::string& station) {
-  std::string names;
-  for (const Station& st : design.stations) names += (names.empty() ? "" : ", ") + st.name;
-  const Station* s = nullptr;
-  if (station.empty()) {
-    if (design.stations.size() != 1) {
-      throw InputError("design '" + design.name + "' has stations " + names + ": choose one with --station");
-    }
-    s = &design.stations.front();
-  } else {
-    s = design.station(station);
-    if (s == nullptr) {
-      throw InputError("unknown station '" + station + "' in design '" + design.name + "' (it has: " + names + ")");
-    }
+  if (station.empty() && design.stations.size() > 1) {
+    std::string names;
+    for (const Station& st : design.stations) names += (names.empty() ? "" : ", ") + st.name;
+    throw InputError("design '" + design.name + "' has stations " + names + ": choose one with --station");
   }
-  if (!s->lower || !s->upper) {
-    throw InputError("station '" + s->name + "' has only the " + (s->lower ? "lower" : "upper") +
-                     " mechanism: collision and patterns need both");
-  }
-  return *s;
-}
-
-/// The design's geometry; InputError when the design has none.
-inline const Geometry& require_geometry(const Design& design) {
-  if (!design.get<Geometry>()) {
-    throw InputError("design '" + design.name + "' has no geometry: section: link widths, pins and planes are "
-                     "needed to check collisions (see designs/iros2022.yaml)");
-  }
-  return *design.get<Geometry>();
+  return pair_station(design, station);
 }
 
 /// --out, or outputs/<design name>/<sub> by default; created.

@@ -3,6 +3,7 @@
 // (`fivebar parts --no-render`). Plain dicts and NumPy arrays; nothing is written: the patched
 // design is returned as a Design, the .scad texts as strings.
 
+#include <filesystem>
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -59,6 +60,15 @@ calibrate::CalibrateOptions calibrate_options(const CalibrateArgs& a) {
   co.sigma_mm = a.sigma_mm;
   co.holdout = a.holdout;
   return co;
+}
+
+/// The data file as a provenance entry of a design returned in memory names it: absolute (free of
+/// links and dots), so that untrusted_values() finds it wherever the design is saved. The CLI, which
+/// knows where it writes the design, names it relative to that folder (recorded_source()).
+std::string absolute_source(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::absolute(path, ec), ec);
+  return ec ? path : p.generic_string();
 }
 
 py::array_t<double> matrix(const Eigen::VectorXd& v) {
@@ -119,7 +129,7 @@ py::dict calibration_dict(const Design& design, const calibrate::CalibrationResu
   d["gate_reasons"] = py::cast(r.gate.refusal_lines());
   // The patched design `fivebar calibrate --out` would write, in memory, when the fit passed.
   if (!r.requested_unidentifiable && r.gate.passed) {
-    calibrate::Source source{path, sha256_hex(text), today_utc()};
+    calibrate::Source source{absolute_source(path), sha256_hex(text), today_utc()};
     auto patched = std::make_shared<Design>(calibrate::with_provenance(calibrate::patched_design(design, r), r, source));
     patched->reset<BenchSettings>();  // as the CLI's file: its bench: files would not resolve elsewhere
     d["design"] = patched;
@@ -257,40 +267,12 @@ id::IdentifyOptions identify_options(const IdentifyArgs& a) {
 }
 
 /// Each joint of the logs (or `joint`), its logs fitted together, open or closed loop: the motor
-/// rig of `fivebar identify` (cli/identify.cpp identify_joints()).
+/// rig of `fivebar identify` (identify::identify_motor_rig(), as the CLI).
 std::vector<id::JointIdentification> identify_motor_joints(const Design& design, const IdentifyArgs& a,
                                                            const std::vector<id::IdentifyLog>& logs,
                                                            const std::optional<id::IdentifyLog>& val,
                                                            const id::IdentifyOptions& o) {
-  std::vector<id::JointIdentification> results;
-  for (const id::JointLog& j : logs.front().joints) {
-    if (!a.joint.empty() && j.prefix != a.joint && !(a.joint == "motor" && j.prefix.empty())) continue;
-    const std::string who = j.prefix.empty() ? "motor" : j.prefix;
-    const bool need_motor = !j.linear && j.drive != id::DriveKind::torque;
-    const id::JointPrior prior = id::joint_prior(design, j.station, j.mechanism, j.joint, a.load_inertia, need_motor);
-    std::vector<std::unique_ptr<id::LoopController>> loops;
-    auto segment = [&](const id::IdentifyLog& l, const std::string& file) {
-      const id::JointLog* x = nullptr;
-      for (const id::JointLog& c : l.joints) {
-        if (c.prefix == j.prefix) x = &c;
-      }
-      if (x == nullptr) throw InputError(file + ": no columns for joint '" + who + "'");
-      if (x->drive != j.drive || x->linear != j.linear) {
-        throw InputError(file + ": joint '" + who + "' is driven by '" + x->drive_column + "', the first log by '" + j.drive_column + "'");
-      }
-      id::LogSegment g{x, &l.time, nullptr};
-      if (a.closed_loop) {
-        loops.push_back(id::design_pid(design, *x, l.sample_time(), file));
-        g.controller = loops.back().get();
-      }
-      return g;
-    };
-    std::vector<id::LogSegment> segs, vsegs;
-    for (std::size_t i = 0; i < logs.size(); ++i) segs.push_back(segment(logs[i], a.logs[i]));
-    if (val) vsegs.push_back(segment(*val, a.validation));
-    results.push_back(id::identify_joint(segs, prior, vsegs, o));
-  }
-  return results;
+  return id::identify_motor_rig(design, {&logs, a.logs, val ? &*val : nullptr, a.validation, a.joint, a.load_inertia, a.closed_loop}, o);
 }
 
 py::dict joint_dict(const id::JointIdentification& r) {
@@ -375,7 +357,7 @@ py::dict identify_fit(const Design& design, const IdentifyArgs& a) {
   d["not_patched"] = py::list();
   if (refused.empty()) {
     MeasurementSource source;
-    source.file = a.logs.front();
+    source.file = absolute_source(a.logs.front());
     source.sha256 = sha256_file(a.logs.front());
     source.date = today_utc();
     source.method = std::string(mechanism_rig ? "fivebar identify --rig mechanism: " : "fivebar identify --rig motor: ") +
@@ -383,7 +365,7 @@ py::dict identify_fit(const Design& design, const IdentifyArgs& a) {
                      : a.closed_loop    ? "inverse dynamic model by instrumental variables under the design's PID (IDIM-IV)"
                                         : "inverse dynamic model by least squares (IDIM-LS)") +
                     ", standard deviation";
-    for (std::size_t i = 1; i < a.logs.size(); ++i) source.method += "; with " + a.logs[i] + " (sha256 " + sha256_file(a.logs[i]) + ")";
+    for (std::size_t i = 1; i < a.logs.size(); ++i) source.method += "; with " + absolute_source(a.logs[i]) + " (sha256 " + sha256_file(a.logs[i]) + ")";
     id::Patch patch = id::patch_design(design, results, source, a.method == "oe");
     if (patch.design) patch.design->reset<BenchSettings>();
     doc["gate"] = gate::to_json(patch.gate);

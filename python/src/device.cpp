@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "bindings.hpp"
+#include "fivebar/design/pair_station.hpp"
 #include "fivebar/collision.hpp"
 #include "fivebar/device/joint_limits.hpp"
 #include "fivebar/error.hpp"
@@ -28,36 +29,17 @@ namespace {
 using format::kDegPerRad;
 
 /// The station (empty: the only one) with both mechanisms, as `fivebar collision` and `pattern`
-/// choose it (cli/tactors.hpp); InputError naming what is missing.
-const Station& pair_station(const Design& design, const std::string& station) {
-  std::string names;
-  for (const Station& st : design.stations) names += (names.empty() ? "" : ", ") + st.name;
-  const Station* s = nullptr;
-  if (station.empty()) {
-    if (design.stations.size() != 1) {
-      throw InputError("design '" + design.name + "' has stations " + names + ": choose one with station=");
-    }
-    s = &design.stations.front();
-  } else {
-    s = design.station(station);
-    if (s == nullptr) {
-      throw InputError("unknown station '" + station + "' in design '" + design.name + "' (it has: " + names + ")");
-    }
+/// choose it (fivebar/design/pair_station.hpp); InputError naming what is missing.
+const Station& pair_station_of(const Design& design, const std::string& station) {
+  if (station.empty() && design.stations.size() > 1) {
+    std::string names;
+    for (const Station& st : design.stations) names += (names.empty() ? "" : ", ") + st.name;
+    throw InputError("design '" + design.name + "' has stations " + names + ": choose one with station=");
   }
-  if (!s->lower || !s->upper) {
-    throw InputError("station '" + s->name + "' has only the " + (s->lower ? "lower" : "upper") +
-                     " mechanism: collision and patterns need both");
-  }
-  return *s;
+  return fivebar::pair_station(design, station);
 }
 
-const Geometry& design_geometry(const Design& design) {
-  if (!design.get<Geometry>()) {
-    throw InputError("design '" + design.name + "' has no geometry: section: link widths, pins and planes are "
-                     "needed to check collisions (see designs/iros2022.yaml)");
-  }
-  return *design.get<Geometry>();
-}
+const Geometry& design_geometry(const Design& design) { return require_geometry(design); }
 
 Vec2 finite_point(const std::array<double, 2>& p, const char* what) {
   if (!std::isfinite(p[0]) || !std::isfinite(p[1])) {
@@ -77,7 +59,7 @@ py::array_t<double> xy(const Vec2& p) {
 
 py::dict collision_pair(const Design& design, const std::string& station, const std::array<double, 2>& upper,
                         const std::array<double, 2>& lower) {
-  const Station& s = pair_station(design, station);
+  const Station& s = pair_station_of(design, station);
   const Geometry& g = design_geometry(design);
   const PriorityResult r =
       apply_priority(*s.upper, *s.lower, g, finite_point(upper, "upper"), finite_point(lower, "lower"));
@@ -107,7 +89,7 @@ py::dict collision_pair(const Design& design, const std::string& station, const 
 /// `fivebar collision` without points: every pair of grid points of the target ellipse (no picture).
 py::dict collision_map_dict(const Design& design, const std::string& station, double spacing_mm) {
   if (!(spacing_mm > 0.0) || !std::isfinite(spacing_mm)) throw InputError("spacing_mm must be a positive number of mm");
-  const Station& s = pair_station(design, station);
+  const Station& s = pair_station_of(design, station);
   const Geometry& g = design_geometry(design);
   CollisionMapOptions options;
   options.spacing_mm = spacing_mm;
@@ -155,15 +137,7 @@ struct PatternArgs {
 /// The design's entry for this station and kind, or the defaults; then the arguments (the rules of
 /// `fivebar pattern`'s options, cli/pattern.cpp).
 PatternSpec pattern_spec(const Design& design, const Station& s, PatternKind kind, const PatternArgs& a) {
-  PatternSpec spec;
-  spec.kind = kind;
-  if (kind == PatternKind::pivot) spec.duration_s = 2.0;
-  if (design.get<PatternSettings>()) {
-    spec.rate_hz = design.get<PatternSettings>()->rate_hz;
-    for (const PatternSpec& p : design.get<PatternSettings>()->for_station(s.name)) {
-      if (p.kind == kind) spec = p;
-    }
-  }
+  PatternSpec spec = fivebar::pattern_spec(design, s, kind);  // the design's entry, or the defaults
   if (a.amplitude_mm) {
     if (kind == PatternKind::pivot) throw InputError("amplitude_mm is for stretch, slip and twist; pivot takes amplitude_deg");
     spec.amplitude_mm = *a.amplitude_mm;
@@ -230,7 +204,7 @@ py::dict pattern(const Design& design, const std::string& station, const std::st
   if (max_speed_deg_s && !(*max_speed_deg_s > 0.0 && std::isfinite(*max_speed_deg_s))) {
     throw InputError("max_joint_speed_deg_s must be a positive number of deg/s");
   }
-  const Station& s = pair_station(design, station);
+  const Station& s = pair_station_of(design, station);
   const Geometry& g = design_geometry(design);
   const PatternSpec spec = pattern_spec(design, s, *kind, args);
   double max_speed = pattern_joint_speed_limit(design, s);
@@ -350,7 +324,7 @@ py::dict replay_sil(const Design& design, const std::string& out_dir, const std:
   }
   SilRequest request;
   if (!station.empty()) {
-    request.stations.push_back(pair_station(design, station).name);
+    request.stations.push_back(pair_station_of(design, station).name);
   } else {
     for (const Station& s : design.stations) {
       if (s.lower && s.upper) request.stations.push_back(s.name);

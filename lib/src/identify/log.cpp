@@ -71,6 +71,22 @@ bool parse_prefix(const std::string& prefix, JointLog& j) {
   return true;
 }
 
+/// A status column of the device log (`status`, `<station>_<mechanism>_status`): text, not used.
+bool is_status_column(const std::string& n) { return n == "status" || (n.size() > 7 && n.compare(n.size() - 7, 7, "_status") == 0); }
+
+/// Even sampling (central differences and the filters assume it): each step within 5 % of the mean,
+/// else InputError at the row's line.
+void require_even_sampling(const IdentifyLog& log, const std::vector<std::size_t>& row_lines, const std::string& path) {
+  const double dt = log.sample_time();
+  for (std::size_t i = 0; i + 1 < log.time.size(); ++i) {
+    const double step = log.time[i + 1] - log.time[i];
+    if (std::abs(step - dt) > 0.05 * dt) {
+      throw InputError(where(path, row_lines[i + 1]) + "column 'time_s': step " + format::shortest(step) +
+                       " s differs from the log's sample time " + format::shortest(dt) + " s by more than 5 % (resample the log evenly)");
+    }
+  }
+}
+
 }  // namespace
 
 double IdentifyLog::sample_time() const {
@@ -198,15 +214,10 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
   // Rows.
   std::vector<std::size_t> row_lines;
   std::vector<double> v(header.size());
-  std::vector<bool> is_status_column(header.size());
-  for (std::size_t c = 0; c < header.size(); ++c) {
-    const std::string& n = header[c];
-    is_status_column[c] = n == "status" || (n.size() > 7 && n.compare(n.size() - 7, 7, "_status") == 0);
-  }
   while (reader.next()) {
     const std::size_t line_no = reader.line();
     for (std::size_t c = 0; c < header.size(); ++c) {
-      if (is_status_column[c]) continue;  // text (ok, sensor_fault, ...), not used
+      if (is_status_column(header[c])) continue;  // text (ok, sensor_fault, ...), not used
       v[c] = reader.number(c, kMaxLogValue, "no bench quantity is that large in SI units");
     }
     const double time = v[static_cast<std::size_t>(time_col)];
@@ -226,15 +237,7 @@ IdentifyLog read_identify_log(std::istream& in, const std::string& path) {
   if (log.time.size() < 16) {
     throw InputError(path + ": " + std::to_string(log.time.size()) + " data rows; an identification log needs at least 16");
   }
-  // Even sampling (central differences and the filters assume it).
-  const double dt = log.sample_time();
-  for (std::size_t i = 0; i + 1 < log.time.size(); ++i) {
-    const double step = log.time[i + 1] - log.time[i];
-    if (std::abs(step - dt) > 0.05 * dt) {
-      throw InputError(where(path, row_lines[i + 1]) + "column 'time_s': step " + format::shortest(step) +
-                       " s differs from the log's sample time " + format::shortest(dt) + " s by more than 5 % (resample the log evenly)");
-    }
-  }
+  require_even_sampling(log, row_lines, path);
   return log;
 }
 

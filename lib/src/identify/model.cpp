@@ -72,4 +72,37 @@ std::unique_ptr<LoopController> design_pid(const Design& design, const JointLog&
   return device_pid(j.reference, runtime::Gains{pid.kp, pid.ki, pid.kd, pid.i_clamp}, sample_time, scale);
 }
 
+std::vector<JointIdentification> identify_motor_rig(const Design& design, const MotorRig& rig, const IdentifyOptions& o) {
+  const std::vector<IdentifyLog>& logs = *rig.logs;
+  std::vector<JointIdentification> results;
+  for (const JointLog& j : logs.front().joints) {
+    if (!rig.joint.empty() && j.prefix != rig.joint && !(rig.joint == "motor" && j.prefix.empty())) continue;
+    const std::string who = j.prefix.empty() ? "motor" : j.prefix;
+    const bool need_motor = !j.linear && j.drive != DriveKind::torque;
+    const JointPrior prior = joint_prior(design, j.station, j.mechanism, j.joint, rig.load_inertia, need_motor);
+    std::vector<std::unique_ptr<LoopController>> loops;
+    auto segment = [&](const IdentifyLog& l, const std::string& file) {
+      const JointLog* x = nullptr;
+      for (const JointLog& c : l.joints) {
+        if (c.prefix == j.prefix) x = &c;
+      }
+      if (x == nullptr) throw InputError(file + ": no columns for joint '" + who + "'");
+      if (x->drive != j.drive || x->linear != j.linear) {
+        throw InputError(file + ": joint '" + who + "' is driven by '" + x->drive_column + "', the first log by '" + j.drive_column + "'");
+      }
+      LogSegment g{x, &l.time, nullptr};
+      if (rig.closed_loop) {
+        loops.push_back(design_pid(design, *x, l.sample_time(), file));
+        g.controller = loops.back().get();
+      }
+      return g;
+    };
+    std::vector<LogSegment> segs, vsegs;
+    for (std::size_t i = 0; i < logs.size(); ++i) segs.push_back(segment(logs[i], i < rig.names.size() ? rig.names[i] : "log"));
+    if (rig.validation != nullptr) vsegs.push_back(segment(*rig.validation, rig.validation_name));
+    results.push_back(identify_joint(segs, prior, vsegs, o));
+  }
+  return results;
+}
+
 }  // namespace fivebar::identify

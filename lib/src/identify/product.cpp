@@ -59,14 +59,8 @@ Product identify_product() {
     // IDIM-IV, as `fivebar identify --closed-loop` (docs/identify.md "Closed loop").
     bool closed = true;
     for (const identify::JointLog& j : log.joints) closed = closed && !j.reference.empty();
-    std::vector<identify::JointIdentification> results;
-    for (const identify::JointLog& j : log.joints) {
-      const bool need_motor = !j.linear && j.drive != identify::DriveKind::torque;
-      const identify::JointPrior prior = identify::joint_prior(d, j.station, j.mechanism, j.joint, 0.0, need_motor);
-      std::unique_ptr<identify::LoopController> loop;
-      if (closed) loop = identify::design_pid(d, j, log.sample_time(), name);
-      results.push_back(identify::identify_joint({{&j, &log.time, loop.get()}}, prior, {}, o));
-    }
+    const std::vector<identify::IdentifyLog> logs{std::move(log)};
+    const std::vector<identify::JointIdentification> results = identify::identify_motor_rig(d, {&logs, {name}, nullptr, {}, {}, 0.0, closed}, o);
     Json doc = {{"log", name}, {"method", closed ? "IDIM-IV" : "IDIM-LS"}, {"joints", Json::array()}};
     for (const auto& r : results) doc["joints"].push_back(identify::to_json(r));
     // The patched design is written into <output>/identify/: the log recorded relative to it.

@@ -165,6 +165,21 @@ JointIdentification identify_joint(const JointLog& joint, const std::vector<doub
 JointIdentification identify_joint(const std::vector<LogSegment>& logs, const JointPrior& prior,
                                    const std::vector<LogSegment>& validation, const IdentifyOptions& options);
 
+/// The motor rig of `fivebar identify DESIGN LOG...` (and of the `identify` product and the Python
+/// binding): every joint of the first log, or only `joint`.
+struct MotorRig {
+  const std::vector<IdentifyLog>* logs = nullptr;  ///< the estimation logs (the first names the joints)
+  std::vector<std::string> names;                  ///< their files, for messages
+  const IdentifyLog* validation = nullptr;         ///< or null
+  std::string validation_name;
+  std::string joint;           ///< only this joint (its column prefix, "motor" for none); empty: every joint
+  double load_inertia = 0.0;   ///< kg m^2 at the output, known (joint_prior())
+  bool closed_loop = false;    ///< the logs were taken under the design's PID (design_pid()): IDIM-IV
+};
+/// Each joint's columns in every log fitted together with its prior from the design (joint_prior()).
+/// InputError naming the file when a log lacks a joint's columns or drives it otherwise.
+std::vector<JointIdentification> identify_motor_rig(const Design& design, const MotorRig& rig, const IdentifyOptions& options);
+
 /// The least-squares core: Y = W theta + e with the columns of `W` named; a column not separable
 /// from the earlier ones (rank_tolerance) is held at `prior` and named. Used for the mechanical and
 /// electrical regressions.
