@@ -361,22 +361,7 @@ int run_identify(const IdentifyCliOptions& given) {
       rig_station.empty() ? identify_joints(opt, design, logs, val, o) : id::identify_mechanism(design, est, rig_station, rig_mechanism, o);
   if (results.empty()) throw InputError("--joint '" + opt.joint + "': the log has no such joint");
   // Requested parameters that the logs cannot give.
-  std::vector<std::string> refused;
-  for (const std::string& key : opt.fit) {
-    bool known = false;
-    for (const auto& r : results) {
-      for (const id::Parameter& p : r.parameters) {
-        if (p.key != key) continue;
-        known = true;
-        if (!p.identified) refused.push_back(key + " (" + r.joint + "): " + p.note);
-      }
-    }
-    if (!known) {
-      std::vector<std::string> keys;
-      for (const id::Parameter& p : results.front().parameters) keys.push_back(p.key);
-      throw InputError("--fit " + key + ": not a parameter of this rig (parameters: " + format::join(keys) + ")");
-    }
-  }
+  const std::vector<std::string> refused = id::refused_fits(results, o, "--fit");
   Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", rig}, {"log", opt.log}, {"logs", opt.logs},
               {"closed_loop", opt.closed_loop}};
   if (val) doc["validation"] = opt.validation;

@@ -322,22 +322,7 @@ py::dict identify_fit(const Design& design, const IdentifyArgs& a) {
                             : identify_motor_joints(design, a, logs, val, o);
   });
   if (results.empty()) throw InputError("joint = '" + a.joint + "': the log has no such joint");
-  std::vector<std::string> refused;
-  for (const std::string& key : a.fit) {
-    bool known = false;
-    for (const auto& r : results) {
-      for (const id::Parameter& p : r.parameters) {
-        if (p.key != key) continue;
-        known = true;
-        if (!p.identified) refused.push_back(key + " (" + r.joint + "): " + p.note);
-      }
-    }
-    if (!known) {
-      std::string keys;
-      for (const id::Parameter& p : results.front().parameters) keys += (keys.empty() ? "" : ", ") + p.key;
-      throw InputError("fit " + key + ": not a parameter of this rig (parameters: " + keys + ")");
-    }
-  }
+  const std::vector<std::string> refused = id::refused_fits(results, o, "fit");
   Json doc = {{"command", "identify"}, {"design", design.name}, {"rig", mechanism_rig ? "mechanism" : "motor"}, {"log", a.logs.front()},
               {"logs", a.logs}, {"closed_loop", a.closed_loop}};
   if (val) doc["validation"] = a.validation;

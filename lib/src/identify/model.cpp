@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "fivebar/error.hpp"
+#include "fivebar/format.hpp"
 #include "fivebar/identify/identify.hpp"
 #include "fivebar/sections/controller.hpp"
 #include "fivebar/sections/motor.hpp"
@@ -103,6 +104,26 @@ std::vector<JointIdentification> identify_motor_rig(const Design& design, const 
     results.push_back(identify_joint(segs, prior, vsegs, o));
   }
   return results;
+}
+
+std::vector<std::string> refused_fits(const std::vector<JointIdentification>& results, const IdentifyOptions& o, const std::string& option) {
+  std::vector<std::string> refused;
+  for (const std::string& key : o.require) {
+    bool known = false;
+    for (const JointIdentification& r : results) {
+      for (const Parameter& p : r.parameters) {
+        if (p.key != key) continue;
+        known = true;
+        if (!p.identified) refused.push_back(key + " (" + r.joint + "): " + p.note);
+      }
+    }
+    if (!known) {
+      std::vector<std::string> keys;
+      for (const Parameter& p : results.front().parameters) keys.push_back(p.key);
+      throw InputError(option + " " + key + ": not a parameter of this rig (parameters: " + format::join(keys) + ")");
+    }
+  }
+  return refused;
 }
 
 }  // namespace fivebar::identify

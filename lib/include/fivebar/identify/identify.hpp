@@ -179,6 +179,11 @@ struct MotorRig {
 /// Each joint's columns in every log fitted together with its prior from the design (joint_prior()).
 /// InputError naming the file when a log lacks a joint's columns or drives it otherwise.
 std::vector<JointIdentification> identify_motor_rig(const Design& design, const MotorRig& rig, const IdentifyOptions& options);
+/// The keys of `options.require` that a joint of `results` could not identify ("KEY (JOINT): why"),
+/// for the caller to refuse; InputError (naming the key as `option` KEY, with the rig's parameters)
+/// for a key that is not a parameter of the rig. `results` is not empty (the callers refuse that first).
+std::vector<std::string> refused_fits(const std::vector<JointIdentification>& results, const IdentifyOptions& options,
+                                      const std::string& option);
 
 /// The least-squares core: Y = W theta + e with the columns of `W` named; a column not separable
 /// from the earlier ones (rank_tolerance) is held at `prior` and named. Used for the mechanical and
